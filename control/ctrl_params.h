@@ -1,0 +1,82 @@
+/*
+ * Machine parameters: SI data-sheet values in, fixed-point per-unit out.
+ *
+ * Per-unit bases (chosen so the flux equations need no scaling):
+ *   psi_base = psi_pm                   [Wb]    -> psi_pm = 1 pu
+ *   v_base   = Vdc (nominal DC link)    [V]     -> |V_1..6| = 2/3 pu at nominal Vdc
+ *   w_base   = v_base / psi_base        [rad/s electrical] -> d(psi)/dt = v in pu
+ *   t_base   = 1 / w_base               [s]     (pu time)
+ *   i_base   = psi_base / Ld            [A]     -> Ld = 1 pu
+ *   l_base   = Ld, r_base = v_base / i_base
+ *   T_base   = 1.5 * p * psi_base * i_base [N*m] -> Te = psi x i in pu (3.6)
+ * The SI value of 1 pu of each is kept in ctrl_bases_t (configuration only).
+ *
+ * ctrl_params_init() lives in ctrl_params_config.c: the only place (with the
+ * other *_config.c files) where floating point is allowed in control/.
+ */
+#ifndef CONTROL_CTRL_PARAMS_H
+#define CONTROL_CTRL_PARAMS_H
+
+#include <stdint.h>
+
+#include "fx.h"
+
+/* What a user fills in from a data sheet, SI units. */
+typedef struct {
+    const char *name;
+    int pole_pairs;           /* p */
+    double rs_ohm;            /* stator resistance per phase */
+    double ld_h, lq_h;        /* d and q inductances */
+    double psi_pm_wb;         /* permanent-magnet flux linkage (peak, per phase) */
+    double vdc_v;             /* nominal DC-link voltage */
+    double inertia_kgm2;      /* J, for the speed loop */
+    double torque_rated_nm;   /* rated torque */
+    double speed_rated_rpm;   /* rated mechanical speed */
+    double current_rated_a;   /* rated current (peak of the phase current) */
+    double current_max_a;     /* over-current trip level (peak), > rated */
+    double psi_ref_wb;        /* stator-flux reference; 0 = MTPA (4.15) */
+} ctrl_machine_t;
+
+/* SI value of 1 pu of each quantity (configuration and host tools only). */
+typedef struct {
+    double psi_wb, v_v, w_rad_s, t_s, i_a, torque_nm, r_ohm, l_h;
+} ctrl_bases_t;
+
+/* Fixed-point parameters used per sample; all q24_t fields are Q24 per-unit. */
+typedef struct {
+    uint32_t fs_hz;           /* control (sampling) frequency */
+    int32_t pole_pairs;       /* p (integer) */
+    q24_t ts;                 /* control period Ts, pu time (Ts * w_base) */
+    q24_t rs;                 /* stator resistance, pu */
+    q24_t ts_rs;              /* Ts * Rs, pu (precomputed product) */
+    q24_t ld, lq;             /* pu (ld == FX_ONE by the choice of base) */
+    q24_t inv_ld, inv_lq;     /* 1/Ld, 1/Lq, pu */
+    q24_t psi_pm;             /* pu (== FX_ONE) */
+    q24_t vdc_nom;            /* nominal DC link, pu (== FX_ONE) */
+    q24_t torque_rated;       /* pu */
+    q24_t speed_rated_e;      /* rated electrical speed, pu */
+    q24_t current_rated;      /* pu */
+    q24_t current_max;        /* pu */
+    q24_t psi_ref;            /* fixed flux reference, pu; 0 = MTPA */
+    uint8_t salient;          /* 1 when Ld != Lq (IPMSM) */
+} ctrl_params_t;
+
+/* Error codes shared by configuration functions. */
+#define CTRL_OK 0
+#define CTRL_EINVAL (-1)   /* a parameter is missing, non-finite or out of range */
+#define CTRL_ERANGE (-2)   /* a parameter does not fit the Q format */
+#define CTRL_ENOENT (-3)   /* unknown name */
+
+/*
+ * Validate the machine data and compute bases and fixed-point parameters for a
+ * control frequency. Returns CTRL_OK, or CTRL_EINVAL / CTRL_ERANGE with *p left
+ * zeroed. Either output pointer may not be NULL.
+ */
+int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m,
+                     uint32_t fs_hz);
+
+/* SI -> Q24 per-unit conversion helper for *_config.c files (saturates). */
+q24_t ctrl_q24_from_double(double pu);
+double ctrl_q24_to_double(q24_t x);
+
+#endif /* CONTROL_CTRL_PARAMS_H */

@@ -1,0 +1,71 @@
+/*
+ * Signals exchanged between the estimator, the controllers and the PWM stage.
+ * All q24_t fields are Q24 per-unit (bases in ctrl_params.h); angles are
+ * fx_angle_t (2^32 = 2*pi, electrical).
+ *
+ * Conventions (REFERENCE.md section 1): amplitude-invariant Clarke (3.3), alpha
+ * on phase a; voltage vectors of Table 4.2, V1=100 ... V6=101, V0=000, V7=111;
+ * sector x of (4.5): (2x-3)pi/6 < theta_s <= (2x-1)pi/6, x = 1..6.
+ */
+#ifndef CONTROL_CTRL_TYPES_H
+#define CONTROL_CTRL_TYPES_H
+
+#include <stdint.h>
+
+#include "fx.h"
+
+/* Measurements after conversion from raw counts (done by the firmware). */
+typedef struct {
+    q24_t i_a, i_b;       /* phase currents a, b (i_c = -i_a - i_b), pu */
+    q24_t vdc;            /* DC-link voltage, pu */
+    fx_angle_t theta_e;   /* electrical rotor angle (d axis), from the encoder */
+} ctrl_meas_t;
+
+/* Machine state at one instant (measured at k, or predicted for k+1). */
+typedef struct {
+    q24_t i_alpha, i_beta;     /* stator current, pu */
+    q24_t i_d, i_q;            /* rotor frame, pu */
+    q24_t psi_alpha, psi_beta; /* stator flux linkage, pu */
+    q24_t psi_d, psi_q;        /* rotor frame, pu */
+    q24_t psi_amp;             /* |psi_s|, pu (4.3) */
+    q24_t torque;              /* Te, pu: psi x i (3.6) */
+    fx_angle_t theta_e;        /* rotor electrical angle */
+    q24_t sin_theta, cos_theta;/* of theta_e, Q24 */
+    uint8_t sector;            /* stator-flux sector 1..6 (4.5) */
+} ctrl_mstate_t;
+
+/* What the estimator hands every controller at sample k. */
+typedef struct {
+    ctrl_mstate_t now;         /* at sample k, from the measurements (3.4)/(4.1) */
+    ctrl_mstate_t next;        /* predicted for k+1 with the plan applied in [k, k+1) (5.15) */
+    q24_t omega_e;             /* electrical speed, pu (filtered encoder difference) */
+    q24_t vdc;                 /* DC link, pu */
+} ctrl_estimate_t;
+
+/* References from the outer loop / command interface. */
+typedef struct {
+    q24_t torque;              /* torque reference, pu */
+    q24_t psi;                 /* stator-flux amplitude reference, pu; 0 = controller's own (MTPA) */
+} ctrl_refs_t;
+
+/*
+ * Switching plan for one PWM period: up to four segments, each a voltage
+ * vector index 0..7 (Table 4.2) and its on-time as a Q24 fraction of the
+ * period (sum of durations == FX_ONE). Segment 0 is the "selected" active
+ * vector reported by telemetry. The order of segments carries no timing: the
+ * PWM stage realises the plan's volt-seconds as centre-aligned leg duties.
+ */
+#define CTRL_PLAN_MAX_SEG 4
+typedef struct {
+    uint8_t n_seg;
+    uint8_t vec[CTRL_PLAN_MAX_SEG];
+    q24_t dur[CTRL_PLAN_MAX_SEG];
+} ctrl_plan_t;
+
+/* Leg duties for centre-aligned PWM, Q24 fraction of the period in [0, FX_ONE]:
+ * leg x is high for duty[x] * Ts, centred in the period. */
+typedef struct {
+    q24_t duty[3];
+} ctrl_legs_t;
+
+#endif /* CONTROL_CTRL_TYPES_H */
