@@ -1,0 +1,107 @@
+/*
+ * Switching-table DTC controllers of thesis chapter 4: BST (Table 4.1),
+ * MBST (Table 4.3, sectors (4.18)), AST (Table 4.4), ZST (Table 4.5) and the
+ * flexible table FST (Table 4.6, §4.5.3, voltage replacement (4.19)-(4.21)).
+ *
+ * Delay compensation (REFERENCE §1, thesis §4.6.2): the vector chosen at
+ * sample k acts during [k+1, k+2), so every decision uses the one-step-ahead
+ * prediction est->next (torque, flux amplitude, flux vector -> sector), i.e.
+ * the state at the instant the vector starts to act.
+ *
+ * Flux reference: ref->psi if > 0, else params->psi_ref if > 0, else MTPA of
+ * the torque reference (4.15) (ctrl_mtpa_psi). A negative amplitude reference
+ * is meaningless and is treated like 0.
+ *
+ * Output: one vector for the whole period (n_seg = 1, duration FX_ONE). A
+ * table entry "ZVV" becomes V0 or V7 by ctrl_zero_after(previous vector), so
+ * exactly one leg switches (§4.5.2); the previous vector is the one this
+ * controller chose at k-1 (V0 after reset, the inverter's idle state).
+ */
+#ifndef CONTROL_ST_DTC_H
+#define CONTROL_ST_DTC_H
+
+#include <stdint.h>
+
+#include "controller.h"
+#include "fx.h"
+#include "hysteresis.h"
+#include "st_tables.h"
+#include "vreplace.h"
+
+/* Which table a hysteresis-based controller uses. */
+typedef enum { ST_KIND_BST = 0, ST_KIND_MBST, ST_KIND_AST, ST_KIND_ZST } st_kind_t;
+
+/* SI configuration of BST/MBST/AST/ZST (tunables are the double fields). */
+typedef struct {
+    double h_t;   /* torque band half width h_T, N*m (Table 4.7: 2 % of T_rated) */
+    double h_psi; /* flux band half width h_psi, Wb (Table 4.7: 2 % of psi_pm) */
+    /* Set by cfg_default from the machine (not tunables): SI value of 1 pu
+     * (ctrl_bases_t) and the rated torque, to convert and cross-check at init. */
+    double torque_base_nm, psi_base_wb, torque_rated_nm;
+} st_hyst_cfg_t;
+
+/* SI configuration of FST. */
+typedef struct {
+    double sigma;   /* subsector width of (4.19), rad, [0, pi/12]; 0 = no replacement */
+    double dt_step; /* |Delta T_ref| above which a reference step is detected, N*m;
+                       0 = any change (thesis §4.5.3: Delta T_ref != 0) */
+    double torque_base_nm, psi_base_wb, torque_rated_nm; /* as in st_hyst_cfg_t */
+} st_fst_cfg_t;
+
+/* Runtime state of BST/MBST/AST/ZST. */
+typedef struct {
+    uint8_t kind;         /* st_kind_t */
+    uint8_t prev_vec;     /* vector chosen at k-1, 0..7 */
+    ctrl_hyst2_t flux;    /* two-level flux regulator, band h_psi (Q24 pu) */
+    ctrl_hyst3_t torque3; /* three-level torque regulator (BST, MBST), band h_T */
+    ctrl_hyst2_t torque2; /* two-level torque regulator (AST, ZST), band h_T */
+} st_hyst_state_t;
+
+/* Operating-state logic of FST, §4.5.3 / Fig. 4.6. */
+typedef struct {
+    q24_t dt_step;            /* step threshold, Q24 pu (>= 0) */
+    q24_t tref_prev;          /* T_ref[k-1], Q24 pu */
+    uint8_t flag;             /* 1: reference step seen, active vectors only */
+    uint8_t terr_nonneg_prev; /* (T_err[k-1] >= 0) */
+} st_fst_logic_t;
+
+/* Runtime state of FST. */
+typedef struct {
+    st_fst_logic_t logic;
+    ctrl_vreplace_t vr;
+    uint8_t prev_vec;
+} st_fst_state_t;
+
+/* Clear the FST logic (flag 0, T_ref[k-1] = 0, T_err[k-1] >= 0), keep dt_step. */
+void st_fst_logic_reset(st_fst_logic_t *l);
+
+/*
+ * One sample of the §4.5.3 logic with T_ref[k], T_err[k] = T_ref - T^{k+1} and
+ * the electrical speed omega (all Q24 pu):
+ *   |T_ref[k] - T_ref[k-1]| > dt_step          -> flag = 1 (a step)
+ *   else if flag and sign(T_err) changed since k-1 (the torque crossed the
+ *        reference) and T_ref * omega >= 0       -> flag = 0
+ * The reset is not tested on the step sample itself: there the error sign
+ * changes because the reference moved, not because the torque crossed it.
+ * Returns ST_FST_DYNAMIC while the flag is set, else the steady-state column
+ * by the rotation direction (forward for omega >= 0).
+ */
+st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24_t omega);
+
+/* Flux amplitude reference used by the tables (see above), Q24 pu. */
+q24_t st_psi_reference(const ctrl_params_t *p, const ctrl_refs_t *ref);
+
+extern const ctrl_desc_t ctrl_desc_bst;
+extern const ctrl_desc_t ctrl_desc_mbst;
+extern const ctrl_desc_t ctrl_desc_ast;
+extern const ctrl_desc_t ctrl_desc_zst;
+extern const ctrl_desc_t ctrl_desc_fst;
+
+/* ---- Internal: shared by st_dtc.c (per sample) and st_dtc_config.c
+ * (descriptors, defaults, init). Not for other modules. ---- */
+void st_hyst_reset(void *state);
+void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void st_fst_reset(void *state);
+void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+
+#endif /* CONTROL_ST_DTC_H */
