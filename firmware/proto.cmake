@@ -1,0 +1,13 @@
+# Command interpreter and telemetry of the firmware (owner: proto).
+# Included from firmware/CMakeLists.txt and from tests/proto/CMakeLists.txt;
+# builds for host, cm4 and cm0 (no host libraries).
+if(NOT TARGET pmsm_fw_proto)
+  add_library(pmsm_fw_proto STATIC
+    ${CMAKE_CURRENT_LIST_DIR}/cmd.c
+    ${CMAKE_CURRENT_LIST_DIR}/cmd_num.c
+    ${CMAKE_CURRENT_LIST_DIR}/telemetry.c
+    ${CMAKE_CURRENT_LIST_DIR}/telemetry_frame.c)
+  target_include_directories(pmsm_fw_proto PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+  target_link_libraries(pmsm_fw_proto PUBLIC pmsm_control)
+  pmsm_strict(pmsm_fw_proto)
+endif()
