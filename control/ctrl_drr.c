@@ -1,0 +1,296 @@
+/*
+ * DRR-DTC, thesis §5.3-§5.4, per sample (integer-only). See ctrl_drr.h.
+ */
+#include "ctrl_drr.h"
+
+#include <stddef.h>
+
+#include "mtpa.h"
+#include "plan.h"
+#include "vectors.h"
+
+/* Inputs of the duty formulas are clamped to +-4 pu (rated torque is ~0.3 pu,
+ * flux ~1 pu, rated speed ~0.5 pu for the shipped machines): with that bound
+ * every int64 intermediate below stays under 2^62. */
+#define DRR_LIM (4 * FX_ONE)
+
+/* round(2^24 sqrt(3) / 2) */
+#define DRR_SQ3_2 14529495
+#define DRR_HALF (FX_ONE / 2)
+
+/* Unit vectors of V1..V6 (angle (i-1) pi/3, Table 4.2), Q24. */
+static const q24_t unit_cos[6] = {FX_ONE, DRR_HALF, -DRR_HALF, -FX_ONE, -DRR_HALF, DRR_HALF};
+static const q24_t unit_sin[6] = {0, DRR_SQ3_2, DRR_SQ3_2, 0, -DRR_SQ3_2, -DRR_SQ3_2};
+
+static q24_t drr_lim(q24_t x)
+{
+    return fx_clamp(x, -DRR_LIM, DRR_LIM);
+}
+
+void ctrl_drr_unit(uint8_t idx, q24_t *ux, q24_t *uy)
+{
+    if (idx >= 1u && idx <= 6u) {
+        *ux = unit_cos[idx - 1u];
+        *uy = unit_sin[idx - 1u];
+    } else {
+        *ux = 0;
+        *uy = 0;
+    }
+}
+
+uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err)
+{
+    int n;
+    if (t_err >= 0) {
+        n = psi_err >= 0 ? 1 : 2; /* (5.1) first two rows */
+    } else {
+        n = psi_err < 0 ? 4 : 5; /* (5.1) last two rows */
+    }
+    return ctrl_vec_wrap((int)sector + n);
+}
+
+q24_t ctrl_drr_ema(q24_t gamma, q24_t chi, q24_t lambda)
+{
+    /* (5.4) rewritten gamma[k] = gamma[k-1] + lambda (chi[k] - gamma[k-1]):
+     * |chi - gamma| < 2^32, lambda < 2^25, product < 2^57. */
+    const int64_t d = (int64_t)chi - gamma;
+    return fx_sat32((int64_t)gamma + fx_rshift64_round(d * lambda, FX_QBITS));
+}
+
+int ctrl_drr_vreplace_active(const ctrl_drr_state_t *s, q24_t psi_err)
+{
+    return s != NULL && s->vr.enabled != 0u && fx_abs(psi_err) < s->half_dpsi;
+}
+
+void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q24_t *dc)
+{
+    *c_num = s->c_num;
+    if (s->dc_fixed != 0) {
+        *dc = s->dc_fixed;
+        return;
+    }
+    /* (5.13): C = 2 sqrt(3) A / (2 B |w| / w_rn - sqrt(3) A). The denominator
+     * is < 0 below ~1.07 rated speed (thesis SPMSM) and crosses 0 above; it is
+     * clamped to dc_max < 0, i.e. |C| <= CTRL_DRR_C_MAX. */
+    const q24_t w = fx_abs(drr_lim(omega_e));
+    const q24_t d = fx_sub(fx_lshift_sat(fx_mul(s->kb, w), 1u), s->sqrt3_a);
+    *dc = fx_min(d, s->dc_max);
+}
+
+/* Bits needed for x > 0 (x < 2^62). */
+static unsigned drr_bitlen(uint64_t x)
+{
+    unsigned n = 0;
+    for (unsigned step = 32u; step > 0u; step /= 2u) {
+        if ((x >> step) != 0u) {
+            x >>= step;
+            n += step;
+        }
+    }
+    return n + (x != 0u ? 1u : 0u);
+}
+
+/*
+ * num / den clamped to [0, FX_ONE] (Q24), with |num|, |den| < 2^62 in any
+ * common scale. den == 0 counts as +0: the result is FX_ONE for num > 0, else 0.
+ * Both are scaled by the same power of two so den lies in [2^29, 2^30) before
+ * the single fx_div: about 29 significant bits whatever the input scale.
+ */
+static q24_t drr_ratio01(int64_t num, int64_t den)
+{
+    if (den < 0) {
+        num = -num;
+        den = -den;
+    }
+    if (num <= 0) {
+        return 0;
+    }
+    if (den == 0 || num >= den) {
+        return FX_ONE;
+    }
+    const unsigned bl = drr_bitlen((uint64_t)den);
+    int64_t n;
+    int64_t d;
+    if (bl > 30u) {
+        n = fx_rshift64_round(num, bl - 30u);
+        d = fx_rshift64_round(den, bl - 30u);
+    } else {
+        n = num * ((int64_t)1 << (30u - bl)); /* num < den < 2^bl: no overflow */
+        d = den * ((int64_t)1 << (30u - bl));
+    }
+    return fx_clamp(fx_div((q24_t)n, (q24_t)d), 0, FX_ONE);
+}
+
+q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                    q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e)
+{
+    if (s == NULL || vec < 1u || vec > 6u || psi_amp <= 0) {
+        return 0;
+    }
+    const q24_t e = drr_lim(t_err);
+    const q24_t g = drr_lim(gamma);
+    const q24_t w = drr_lim(omega_e);
+    const q24_t pamp = fx_min(psi_amp, DRR_LIM);
+    q24_t ux;
+    q24_t uy;
+    ctrl_drr_unit(vec, &ux, &uy);
+    /* psi x v_hat = |psi| sin(theta_v - theta_s): positive for V_{x+1}, V_{x+2},
+     * negative for V_{x+4}, V_{x+5} in sector x, so A (psi x v_hat) / |psi| is
+     * the A |sin(.)| term of (5.6) with the sign of (5.7). */
+    const q24_t cross = fx_cross(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
+    q24_t cn;
+    q24_t dc;
+    ctrl_drr_c_parts(s, w, &cn, &dc);
+
+    /*
+     * (5.14) with C = cn / dc and Delta T = A cross / |psi| - kb w, numerator and
+     * denominator both multiplied by dc |psi| (one division, none for C or
+     * |psi|):
+     *   num = |psi| [ e dc - (2 dc + cn) gamma ]
+     *   den = (A cross - kb w |psi|) dc - cn gamma |psi|
+     * Magnitudes (|e|, |g|, |w|, |psi| <= 2^26 by the clamps; |A|, |kb| <= 2^26,
+     * |dc| <= 2^27, |cn| <= 2^30 by init): every intermediate stays under 2^61.
+     */
+    const int64_t n48 = (int64_t)e * dc - ((int64_t)dc * 2 + cn) * g;
+    const int64_t num = fx_rshift64_round(n48, FX_QBITS) * pamp;
+    const q24_t kbw = fx_mul(s->kb, w);
+    const int64_t d48 = (int64_t)s->a * cross - (int64_t)kbw * pamp;
+    const int64_t cg = fx_rshift64_round((int64_t)cn * g, FX_QBITS);
+    const int64_t den = fx_rshift64_round(d48, FX_QBITS) * dc - cg * pamp;
+
+    /* Sign of the thesis' denominator Delta T -+ C gamma = den / (dc |psi|), dc < 0. */
+    const int den_sign = (den < 0) - (den > 0);
+    const int want = e >= 0 ? 1 : -1;
+    if (den_sign != want) {
+        return FX_ONE;
+    }
+    return drr_ratio01(num, den);
+}
+
+q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                       q24_t psi_amp, q24_t omega_e)
+{
+    if (s == NULL) {
+        return 0;
+    }
+    const q24_t kbw = fx_mul(s->kb, drr_lim(omega_e));
+    if (vec < 1u || vec > 6u || psi_amp <= 0) {
+        return fx_neg(kbw); /* zero vector: (5.16) third term */
+    }
+    q24_t ux;
+    q24_t uy;
+    ctrl_drr_unit(vec, &ux, &uy);
+    const q24_t cross = fx_cross(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
+    return fx_sub(fx_div(fx_mul(s->a, cross), psi_amp), kbw);
+}
+
+q24_t ctrl_drr_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t torque)
+{
+    if (ref != NULL && ref->psi > 0) {
+        return ref->psi;
+    }
+    if (p->psi_ref > 0) {
+        return p->psi_ref;
+    }
+    return ctrl_mtpa_psi(p, torque);
+}
+
+void ctrl_drr_reset(void *state)
+{
+    ctrl_drr_state_t *s = state;
+    if (s == NULL) {
+        return;
+    }
+    s->gamma = 0;
+    s->dt_sel = 0;
+    s->vec_sel = 0u;
+    s->last_tvref = 0;
+    s->last_psiref = 0;
+    s->last_terr = 0;
+    s->last_psierr = 0;
+    s->last_duty = 0;
+    s->last_vec_51 = 0u;
+}
+
+q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e)
+{
+    /* (1 - D)/2 of zero vector precede the active vector in a centre-aligned
+     * period; D: the last duty (steady state, D(k+1) ~ D(k)). */
+    const q24_t half_zero = fx_rshift32_round(FX_ONE - fx_clamp(s->last_duty, 0, FX_ONE), 1u);
+    q24_t cn;
+    q24_t dc;
+    ctrl_drr_c_parts(s, omega_e, &cn, &dc);
+    /* Zero-vector torque deviation per period by (5.12): C gamma = cn gamma / dc
+     * (dc <= dc_max < 0: never a zero divisor). */
+    const q24_t cg = fx_mul(cn, drr_lim(s->gamma));
+    const q24_t dt0 = s->dc_fixed != 0 ? fx_neg(cg) : fx_div(cg, dc);
+    return fx_add(t_k1, fx_mul(half_zero, dt0));
+}
+
+/* (5.16): T(k+1) = T(k) + D(k) Delta T(k) - (1 - D(k)) B w / w_rn, with D(k) and
+ * the vector of the plan acting during [k, k+1) and its Delta T computed at k-1
+ * for the state predicted at k. */
+static q24_t drr_predict_516(const ctrl_drr_state_t *s, const ctrl_ctx_t *ctx)
+{
+    const ctrl_plan_t *ap = ctx->applied;
+    q24_t d = 0;
+    q24_t dt = 0;
+    if (ap != NULL && ap->n_seg >= 1u && s->vec_sel >= 1u && s->vec_sel <= 6u &&
+        ap->vec[0] == s->vec_sel) {
+        d = fx_clamp(ap->dur[0], 0, FX_ONE);
+        dt = s->dt_sel;
+    }
+    const q24_t kbw = fx_mul(s->kb, drr_lim(ctx->est->omega_e));
+    const q24_t t = fx_add(ctx->est->now.torque, fx_mul(d, dt));
+    return fx_sub(t, fx_mul(FX_ONE - d, kbw));
+}
+
+void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ctrl_drr_state_t *s = state;
+    if (out == NULL) {
+        return;
+    }
+    if (s == NULL || ctx == NULL || ctx->params == NULL || ctx->est == NULL || ctx->ref == NULL) {
+        ctrl_plan_single(out, 0u);
+        return;
+    }
+    const ctrl_mstate_t *nx = &ctx->est->next;
+    const q24_t w = ctx->est->omega_e;
+    const q24_t t_k1 = s->pred_516 != 0u ? drr_predict_516(s, ctx) : nx->torque;
+    const q24_t tref = ctx->ref->torque;
+    const q24_t te = s->centre != 0u ? ctrl_drr_t_start(s, t_k1, w) : t_k1;
+
+    /* Virtual reference (5.3)-(5.4): gamma = EMA of T_ref - T_min, T_min being
+     * the torque where the active vector starts (see ctrl_drr_t_start). */
+    q24_t g = ctrl_drr_ema(s->gamma, fx_sub(tref, te), s->lambda);
+    if (s->gamma_max > 0) {
+        g = fx_clamp(g, -s->gamma_max, s->gamma_max);
+    }
+    s->gamma = g;
+    const q24_t tv = fx_add(tref, g);
+
+    /* Flux reference by MTPA (4.15) of the corrected demand (§5.4). */
+    const q24_t psi_ref = ctrl_drr_psi_ref(ctx->params, ctx->ref, tv);
+    const q24_t terr = fx_sub(tv, te);
+    const q24_t psierr = fx_sub(psi_ref, nx->psi_amp);
+
+    uint8_t vec = ctrl_drr_select(nx->sector, terr, psierr); /* (5.1), x by (4.5) */
+    s->last_vec_51 = vec;
+    if (ctrl_drr_vreplace_active(s, psierr)) {
+        vec = ctrl_vreplace(&s->vr, vec, nx->sector, nx->psi_alpha, nx->psi_beta); /* §5.3.5 */
+    }
+    const q24_t duty =
+        ctrl_drr_duty(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, terr, g, w); /* (5.14) */
+    if (s->pred_516 != 0u) {
+        s->dt_sel = ctrl_drr_delta_t(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, w);
+    }
+    s->vec_sel = vec;
+    s->last_tvref = tv;
+    s->last_psiref = psi_ref;
+    s->last_terr = terr;
+    s->last_psierr = psierr;
+    s->last_duty = duty;
+    /* Active vector for D Ts, then V0 after V1/V3/V5, V7 after V2/V4/V6 (§5.4). */
+    ctrl_plan_active_zero(out, vec, duty);
+}

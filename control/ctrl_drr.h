@@ -1,0 +1,223 @@
+/*
+ * Duty-ratio-regulated DTC (thesis chapter 5) and the duty-ratio baselines of
+ * §5.5, all as "active vector for D Ts, then the zero vector" plans (§5.3.1).
+ *
+ *   drr     the thesis' multiobjective DRR-DTC (§5.3-§5.4):
+ *           active vector (5.1) from the error signs, sector x (4.5);
+ *           virtual reference T_vref = T_ref + gamma, gamma = EMA of
+ *           (T_ref - T_e) (5.3)-(5.5); flux reference MTPA (4.15) of T_vref;
+ *           voltage replacement (4.19)-(4.21) while |psi_err| < dpsi_max / 2
+ *           (§5.3.5); optimised duty (5.14) with Delta T+- (5.6)-(5.7),
+ *           A (5.9), B (5.10), C (5.13); zero vector of §5.4.
+ *   drr_d1  D1 (5.19): D = |T_err / C_T| + |psi_err / C_psi|.
+ *   drr_d2  D2 (5.21): torque deviation proportional to speed, K_a, K_b.
+ *   drr_pi  D_PI (5.20): back-EMF feed-forward + PI of the torque error.
+ *   drr_df  D_f (5.18) (or D_RMS (5.17)) with the deviations of (4.10).
+ * The baselines select the active vector by the same error-sign rule
+ * (Table 4.4, AST = (5.1)) without virtual reference and replacement.
+ *
+ * Delay compensation (REFERENCE §1, §5.4): every decision uses the state
+ * predicted for k+1 (est->next: flux by (5.15) with the plan applied during
+ * [k, k+1)). For the torque at k+1, drr uses by default the estimator's model
+ * prediction (est->next.torque: (4.6)/(4.7) evaluated on the (5.15) flux at the
+ * predicted rotor angle), which keeps the load angle and Rs that (5.16)
+ * neglects and needs no division; the tunable "pred_516" = 1 selects the
+ * thesis' (5.16) instead.
+ *
+ * Timing: plan.h realises every plan centre-aligned, while the thesis' period
+ * starts with the active vector (Fig. 5.4); drr therefore evaluates (5.3) and
+ * (5.8)-(5.14) at the torque where the active vector starts (ctrl_drr_t_start,
+ * tunable "centre" = 1, default). Without it the sampled torque is the period
+ * mean and a mean error of about gamma remains (measured: T_sse 0.11 N*m at
+ * 750 r/min, 1.8 N*m instead of 0.003 N*m).
+ *
+ * Divisions per sample (fx_div): one for the duty (5.14) (C and |psi| are
+ * folded into numerator and denominator), one for C gamma in
+ * ctrl_drr_t_start when C is speed-dependent (5.13), one more for Delta T
+ * with pred_516; the baselines D2, D_f/D_RMS one each, D1 and D_PI none.
+ *
+ * Units: every q24_t is Q24 per-unit (ctrl_params.h bases); in pu the torque
+ * is psi x i, so A (5.9) = (2/3) Vdc psi_pm Ts / Ls and B (5.10) / w_rn =
+ * psi_pm^2 Ts / Ls (speeds electrical, REFERENCE §1).
+ */
+#ifndef CONTROL_CTRL_DRR_H
+#define CONTROL_CTRL_DRR_H
+
+#include <stdint.h>
+
+#include "controller.h"
+#include "ctrl_params.h"
+#include "ctrl_types.h"
+#include "fx.h"
+#include "vreplace.h"
+
+#define CTRL_DRR_FS_HZ 10000u /* thesis §5.6: DRR methods at 10 kHz */
+#define CTRL_DRR_C_MAX 64     /* |C| of (5.13) is clamped to this (see ctrl_drr.c) */
+
+/* ---------------- drr: SI configuration (tunables are the doubles) ---------------- */
+typedef struct {
+    double a_nm;            /* A (5.9), N*m; 0 = from the machine at init */
+    double b_nm;            /* B (5.10), N*m; 0 = from the machine at init */
+    double c;               /* C (5.13), dimensionless, < 0; 0 = speed-dependent (5.13) */
+    double lambda;          /* EMA smoothing factor (5.4), thesis 0.03 */
+    double sigma;           /* subsector width (4.19) of the replacement, rad; 0 = off */
+    double dpsi_max_wb;     /* Delta psi_max of §5.3.5, Wb; 0 = sqrt(3) Vdc Ts / 3 */
+    double pred_516;        /* 0: model prediction of T(k+1) (default); 1: (5.16) */
+    double gamma_max_nm;    /* |gamma| limit, N*m; 0 = none (thesis) */
+    double centre;          /* 1: plans realised centre-aligned (plan.h, default): T_e is
+                               shifted to the active-vector start; 0: active vector first */
+    ctrl_machine_t machine; /* copied by cfg_default (not a tunable) */
+} ctrl_drr_cfg_t;
+
+/* ---------------- drr: runtime state ---------------- */
+typedef struct {
+    /* configuration, fixed point */
+    q24_t a;         /* A, pu torque */
+    q24_t kb;        /* B / w_rn, pu torque per pu electrical speed */
+    q24_t sqrt3_a;   /* sqrt(3) A: (5.13) denominator term */
+    q24_t c_num;     /* (5.13) numerator 2 sqrt(3) A; with a fixed C: -C */
+    q24_t dc_fixed;  /* 0: C = c_num / (2 kb |w| - sqrt(3) A); else -FX_ONE (C = -c_num) */
+    q24_t dc_max;    /* (5.13) denominator clamp, < 0: |C| <= CTRL_DRR_C_MAX */
+    q24_t lambda;    /* (5.4), Q24 */
+    q24_t half_dpsi; /* dpsi_max / 2, pu flux */
+    q24_t gamma_max; /* pu torque; 0 = no limit */
+    ctrl_vreplace_t vr;
+    uint8_t pred_516;
+    uint8_t centre; /* T_e taken at the active-vector start of a centre-aligned period */
+    /* dynamic */
+    q24_t gamma;     /* EMA output gamma[k-1] -> gamma[k], pu torque (5.4) */
+    q24_t dt_sel;    /* Delta T of the vector chosen at k-1 (for (5.16)), pu */
+    uint8_t vec_sel; /* vector chosen at k-1 (0 after reset) */
+    /* last decision, for telemetry and tests */
+    q24_t last_tvref; /* virtual reference T_vref (5.3) */
+    q24_t last_psiref;
+    q24_t last_terr, last_psierr;
+    q24_t last_duty;
+    uint8_t last_vec_51; /* vector by (5.1) before replacement */
+} ctrl_drr_state_t;
+
+/* ---------------- baselines: one SI configuration, each descriptor exposes its part ------ */
+typedef struct {
+    double c_t_nm;     /* D1 (5.19) C_T, N*m (thesis 1.2) */
+    double c_psi_wb;   /* D1 (5.19) C_psi, Wb (thesis 0.09427) */
+    double k_a_nm;     /* D2 (5.21) K_a, N*m (thesis 2) */
+    double k_b_nm_rpm; /* D2 (5.21) K_b, N*m/(r/min) (thesis 6e-4) */
+    double kp;         /* D_PI (5.20) K_P, 1/(N*m) */
+    double ki;         /* D_PI (5.20) K_I, 1/(N*m*s) */
+    double rms;        /* D_f: 0 = D_f (5.18), 1 = D_RMS (5.17) */
+    ctrl_machine_t machine;
+} ctrl_drr_base_cfg_t;
+
+typedef enum {
+    CTRL_DRR_BASE_D1 = 0,
+    CTRL_DRR_BASE_D2,
+    CTRL_DRR_BASE_PI,
+    CTRL_DRR_BASE_DF
+} ctrl_drr_base_kind_t;
+
+typedef struct {
+    uint8_t kind;   /* ctrl_drr_base_kind_t */
+    uint8_t rms;    /* D_f: 1 = D_RMS (5.17) */
+    q24_t inv_ct;   /* D1: 1 / C_T, Q24 per pu torque */
+    q24_t inv_cpsi; /* D1: 1 / C_psi, Q24 per pu flux */
+    q24_t ka;       /* D2: K_a, pu torque */
+    q24_t kb;       /* D2: K_b, pu torque per pu electrical speed */
+    q24_t kp;       /* D_PI: K_P, per pu torque */
+    q24_t ki_ts;    /* D_PI: K_I Ts, per pu torque */
+    q24_t ff;       /* D_PI: 3 psi_pm / (2 Vdc), per pu electrical speed */
+    q24_t ts_l;     /* D_f: Ts / Ls (pu) */
+    q24_t rs_l;     /* D_f: Rs / Ls (pu) */
+    q24_t integ;    /* D_PI integrator (duty units, clamped to [-1, 1]) */
+    q24_t last_duty;
+    q24_t last_terr, last_psierr;
+} ctrl_drr_base_state_t;
+
+/* ---------------- per-sample building blocks (ctrl_drr.c, integer-only) ---------------- */
+
+/* Active vector by (5.1) for sector x (1..6): V_{x+1} (T_err >= 0, psi_err >= 0),
+ * V_{x+2} (T_err >= 0, psi_err < 0), V_{x+4} (< 0, < 0), V_{x+5} (< 0, >= 0).
+ * A sector outside 1..6 is wrapped by ctrl_vec_wrap arithmetic. */
+uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err);
+
+/* One step of the EMA (5.4): gamma + lambda (chi - gamma), rounded, saturated. */
+q24_t ctrl_drr_ema(q24_t gamma, q24_t chi, q24_t lambda);
+
+/* Is the voltage replacement of §5.3.5 allowed: |psi_err| < dpsi_max / 2. */
+int ctrl_drr_vreplace_active(const ctrl_drr_state_t *s, q24_t psi_err);
+
+/* (5.13) as the pair (C numerator, denominator) used by ctrl_drr_duty:
+ * C = *c_num / *dc, with dc clamped to <= s->dc_max (< 0). */
+void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q24_t *dc);
+
+/*
+ * Optimised duty (5.14) of active vector vec (1..6) for the flux (psi_alpha,
+ * psi_beta) of amplitude psi_amp, torque error t_err = T_vref - T_e, EMA
+ * output gamma and electrical speed omega_e (all Q24 pu), with
+ * Delta T = A (psi x v_hat) / |psi| - (B / w_rn) w  ((5.6)/(5.7): psi x v_hat =
+ * |psi| |sin(theta_s - theta_v)| with the sign of the vector's family).
+ * The branch (numerator/denominator pair) is chosen by the sign of t_err (5.8).
+ * Result in [0, FX_ONE]; one fx_div. If the denominator has the sign opposite
+ * to the branch (C gamma overstates the zero-vector deviation, possible while
+ * gamma settles), the result is FX_ONE: by (5.6)/(5.7) the active vector always
+ * moves the torque further in the wanted direction than a zero vector.
+ */
+q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                    q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e);
+
+/*
+ * Torque where the active vector starts, for a plan realised centre-aligned
+ * (plan.h): the thesis' period begins with the active vector (Fig. 5.4), so
+ * T_e of (5.8)-(5.14) and T_min of (5.3) are taken there; in a centre-aligned
+ * period (1 - D)/2 of zero vector comes first:
+ *   T_start = T(k+1) + (1 - D)/2 C gamma    (zero-vector deviation (5.12)),
+ * D = s->last_duty (steady state), gamma = s->gamma. Without it the sampled
+ * torque sits half-way down the zero-vector slope (at the mean) and the
+ * virtual reference leaves a mean error of about gamma. One fx_div (C).
+ */
+q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e);
+
+/* Delta T of (5.6)/(5.7) for vector vec at flux psi and speed omega_e, pu (one fx_div;
+ * used by the (5.16) prediction and by tests). */
+q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                       q24_t psi_amp, q24_t omega_e);
+
+/* Unit vector of active vector idx 1..6 (angle (idx-1) pi/3), Q24; (0, 0) otherwise. */
+void ctrl_drr_unit(uint8_t idx, q24_t *ux, q24_t *uy);
+
+/* Duty of each baseline for the already selected vector (tests use these). */
+q24_t ctrl_drr_duty_d1(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t psi_err);
+q24_t ctrl_drr_duty_d2(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t omega_e);
+/* D_PI with the integrator value after this sample's update (s->integ not changed). */
+q24_t ctrl_drr_duty_pi(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t integ, q24_t omega_e);
+/* D_f / D_RMS with (4.10) at the predicted state m (flux, rotor angle sin/cos). */
+q24_t ctrl_drr_duty_df(const ctrl_drr_base_state_t *s, const ctrl_params_t *p,
+                       const ctrl_mstate_t *m, uint8_t vec, q24_t vdc, q24_t t_err, q24_t omega_e);
+
+/* Flux reference: ref->psi, else p->psi_ref, else MTPA (4.15) of torque. */
+q24_t ctrl_drr_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t torque);
+
+/* ---------------- configuration helpers (ctrl_drr_config.c, double) ---------------- */
+
+/* (5.9) A = p Vdc psi_pm Ts / Ls and (5.10) B = 3 p w_rn psi_pm^2 Ts / (2 Ls),
+ * w_rn = 2 pi n_rated / 60 * p (electrical), Ls = Ld, in N*m. CTRL_OK or
+ * CTRL_EINVAL (NULL, non-finite or non-positive data). */
+int ctrl_drr_ab_si(const ctrl_machine_t *m, double ts_s, double *a_nm, double *b_nm);
+
+/* (5.5): cut-off frequency of the EMA (5.4) with factor lambda at fs, Hz
+ * (NaN for lambda outside (0, 1) or fs <= 0). */
+double ctrl_drr_ema_cutoff_hz(double lambda, double fs_hz);
+
+/* The descriptors. */
+extern const ctrl_desc_t ctrl_desc_drr;
+extern const ctrl_desc_t ctrl_desc_drr_d1;
+extern const ctrl_desc_t ctrl_desc_drr_d2;
+extern const ctrl_desc_t ctrl_desc_drr_pi;
+extern const ctrl_desc_t ctrl_desc_drr_df;
+
+/* ---- Internal: shared by ctrl_drr*.c and ctrl_drr_config.c. ---- */
+void ctrl_drr_reset(void *state);
+void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_drr_base_reset(void *state);
+void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+
+#endif /* CONTROL_CTRL_DRR_H */
