@@ -42,6 +42,10 @@ typedef struct {
     double psi_wb, v_v, w_rad_s, t_s, i_a, torque_nm, r_ohm, l_h;
 } ctrl_bases_t;
 
+#define CTRL_MTPA_N 64                  /* segments of the IPMSM MTPA table */
+#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (README) */
+#define CTRL_DANGLE_SHIFT 28u           /* fractional bits of dangle_to_omega */
+
 /* Fixed-point parameters used per sample; all q24_t fields are Q24 per-unit. */
 typedef struct {
     uint32_t fs_hz;           /* control (sampling) frequency */
@@ -59,6 +63,27 @@ typedef struct {
     q24_t current_max;        /* pu */
     q24_t psi_ref;            /* fixed flux reference, pu; 0 = MTPA */
     uint8_t salient;          /* 1 when Ld != Lq (IPMSM) */
+    /* ---- appended by core (ctrl_params_config.c computes them) ---- */
+    /* Angle increment per control period for 1.0 pu electrical speed, in
+     * fx_angle_t units (2^32 = one turn), integer (Q0):
+     * omega_to_dangle = round(Ts_pu / (2 pi) * 2^32); then
+     * dtheta = round(omega_q24 * omega_to_dangle / 2^24) (ctrl_angle_step()). */
+    int32_t omega_to_dangle;
+    /* Inverse, Q28 (CTRL_DANGLE_SHIFT): omega_q24 = round(dtheta * dangle_to_omega
+     * / 2^28) for a signed angle difference dtheta (angle units per period). */
+    int32_t dangle_to_omega;
+    /* First-order low-pass (EMA) coefficient of the encoder speed, Q24:
+     * 1 - exp(-2 pi fc Ts), fc = CTRL_SPEED_LPF_HZ_DEFAULT unless changed with
+     * ctrl_params_set_speed_lpf(). */
+    q24_t speed_lpf_k;
+    /* MTPA (mtpa.c). SPMSM: psi_s = |(psi_pm, T * mtpa_k)|, mtpa_k = Lq / psi_pm, Q24.
+     * IPMSM: mtpa_psi[i] = psi_s at |T| = i * mtpa_t_max / CTRL_MTPA_N (Q24 pu),
+     * exact MTPA locus; index position = |T| * mtpa_scale / 2^16 (mtpa_scale is
+     * Q16: CTRL_MTPA_N / mtpa_t_max). Beyond mtpa_t_max: the last segment extended. */
+    q24_t mtpa_k;
+    q24_t mtpa_t_max;                /* torque at current_max on the MTPA locus, pu */
+    int32_t mtpa_scale;              /* Q16 */
+    q24_t mtpa_psi[CTRL_MTPA_N + 1]; /* Q24 pu */
 } ctrl_params_t;
 
 /* Error codes shared by configuration functions. */
@@ -78,5 +103,9 @@ int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t
 /* SI -> Q24 per-unit conversion helper for *_config.c files (saturates). */
 q24_t ctrl_q24_from_double(double pu);
 double ctrl_q24_to_double(q24_t x);
+
+/* Change the speed-filter cut-off (Hz, 0 < fc < fs/2): sets p->speed_lpf_k.
+ * Returns CTRL_OK or CTRL_EINVAL. */
+int ctrl_params_set_speed_lpf(ctrl_params_t *p, double fc_hz);
 
 #endif /* CONTROL_CTRL_PARAMS_H */

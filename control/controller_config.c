@@ -1,0 +1,59 @@
+/*
+ * Tunables by name over a controller's SI configuration struct (controller.h).
+ * Configuration only: floating point allowed.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "controller.h"
+
+static const ctrl_tunable_t *tunable_find(const ctrl_desc_t *d, const char *name)
+{
+    if (d->tunables == NULL) {
+        return NULL;
+    }
+    for (size_t i = 0; i < d->n_tunables; i++) {
+        if (d->tunables[i].name != NULL && strcmp(d->tunables[i].name, name) == 0) {
+            return &d->tunables[i];
+        }
+    }
+    return NULL;
+}
+
+/* The field must lie inside the configuration struct. */
+static int tunable_in_cfg(const ctrl_desc_t *d, const ctrl_tunable_t *t)
+{
+    return d->cfg_size >= sizeof(double) && t->offset <= d->cfg_size - sizeof(double);
+}
+
+int ctrl_tunable_set(const ctrl_desc_t *d, void *cfg, const char *name, double value)
+{
+    if (d == NULL || cfg == NULL || name == NULL) {
+        return CTRL_EINVAL;
+    }
+    const ctrl_tunable_t *t = tunable_find(d, name);
+    if (t == NULL) {
+        return CTRL_ENOENT;
+    }
+    if (!tunable_in_cfg(d, t) || !isfinite(value) || value < t->min || value > t->max) {
+        return CTRL_EINVAL;
+    }
+    memcpy((char *)cfg + t->offset, &value, sizeof value);
+    return CTRL_OK;
+}
+
+int ctrl_tunable_get(const ctrl_desc_t *d, const void *cfg, const char *name, double *value)
+{
+    if (d == NULL || cfg == NULL || name == NULL || value == NULL) {
+        return CTRL_EINVAL;
+    }
+    const ctrl_tunable_t *t = tunable_find(d, name);
+    if (t == NULL) {
+        return CTRL_ENOENT;
+    }
+    if (!tunable_in_cfg(d, t)) {
+        return CTRL_EINVAL;
+    }
+    memcpy(value, (const char *)cfg + t->offset, sizeof *value);
+    return CTRL_OK;
+}

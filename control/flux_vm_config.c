@@ -1,0 +1,21 @@
+/* Voltage-model flux: corner frequency -> per-period gain (configuration). */
+#include <math.h>
+#include <stddef.h>
+
+#include "flux_vm.h"
+
+#define PI_CONST 3.14159265358979323846
+
+int ctrl_flux_vm_gain(const ctrl_params_t *p, double fc_hz, q24_t *k_corr)
+{
+    if (p == NULL || k_corr == NULL || p->fs_hz == 0u || !isfinite(fc_hz) || fc_hz <= 0.0) {
+        return CTRL_EINVAL;
+    }
+    /* Discrete first-order section: k = w_c Ts (forward Euler). */
+    const double k = 2.0 * PI_CONST * fc_hz / (double)p->fs_hz;
+    if (k >= 0.5) {
+        return CTRL_EINVAL;
+    }
+    *k_corr = ctrl_q24_from_double(k);
+    return *k_corr > 0 ? CTRL_OK : CTRL_EINVAL;
+}

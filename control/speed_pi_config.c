@@ -1,0 +1,101 @@
+/*
+ * Speed PI: SI gains -> fixed point (configuration, floating point allowed).
+ *
+ * The controller works on electrical speed in pu (omega_pu * w_base = omega_e
+ * in rad/s) and outputs torque in pu (T_base). A gain given in N*m per speed
+ * unit u becomes  k_pu = k_SI * (w_base * f_u) / T_base  with f_u the size of
+ * one electrical rad/s in unit u: 1/p (mechanical rad/s), 60/(2 pi p) (r/min),
+ * 1 (electrical rad/s). The integral gain also gets Ts of the loop.
+ */
+#include <math.h>
+#include <stddef.h>
+
+#include "speed_pi.h"
+
+#define PI_CONST 3.14159265358979323846
+
+/* Normalise a positive gain g to a mantissa in [2^30, 2^31) and a shift in
+ * [1, max_shift]; a gain needing more than max_shift fractional bits keeps
+ * max_shift (fewer significant bits; reported as ERANGE if it rounds to 0). */
+static int gain_q(double g, unsigned max_shift, int32_t *mant, uint8_t *shift)
+{
+    if (g == 0.0) {
+        *mant = 0;
+        *shift = 1u;
+        return CTRL_OK;
+    }
+    int e;
+    (void)frexp(g, &e);
+    int s = 31 - e;
+    if (s < 1) {
+        return CTRL_ERANGE; /* gain >= 2^30 pu: absurd */
+    }
+    if (s > (int)max_shift) {
+        s = (int)max_shift;
+    }
+    double m = ldexp(g, s);
+    if (m > 2147483647.0) {
+        m = 2147483647.0;
+    }
+    const long long r = llround(m);
+    if (r == 0) {
+        return CTRL_ERANGE;
+    }
+    *mant = (int32_t)r;
+    *shift = (uint8_t)s;
+    return CTRL_OK;
+}
+
+int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs, double kp,
+                         double ki, ctrl_speed_unit_t unit, double out_limit_nm, uint32_t loop_hz)
+{
+    if (pi == NULL || bases == NULL || pole_pairs < 1 || loop_hz == 0u || !isfinite(kp) ||
+        !isfinite(ki) || kp < 0.0 || ki < 0.0 || !isfinite(out_limit_nm) || out_limit_nm <= 0.0 ||
+        !(bases->w_rad_s > 0.0) || !(bases->torque_nm > 0.0)) {
+        return CTRL_EINVAL;
+    }
+    double f_u;
+    switch (unit) {
+    case CTRL_SPEED_UNIT_RAD_S_MECH:
+        f_u = 1.0 / (double)pole_pairs;
+        break;
+    case CTRL_SPEED_UNIT_RPM:
+        f_u = 60.0 / (2.0 * PI_CONST * (double)pole_pairs);
+        break;
+    case CTRL_SPEED_UNIT_RAD_S_ELEC:
+        f_u = 1.0;
+        break;
+    default:
+        return CTRL_EINVAL;
+    }
+    const double scale = bases->w_rad_s * f_u / bases->torque_nm;
+    const double kp_pu = kp * scale;
+    const double ki_ts_pu = ki * scale / (double)loop_hz;
+    const double out_pu = out_limit_nm / bases->torque_nm;
+    if (!(out_pu * 16777216.0 < 2147483647.0) || out_pu * 16777216.0 < 1.0) {
+        return CTRL_ERANGE;
+    }
+    const q24_t out_max = (q24_t)llround(out_pu * 16777216.0);
+    /* integ <= out_max * 2^ki_shift must stay below 2^61 (no overflow of
+     * integ + e * ki_ts, each term < 2^62). */
+    unsigned bits = 0u;
+    while (bits < 32u && ((uint32_t)out_max >> bits) != 0u) {
+        bits++;
+    }
+    const unsigned ki_max_shift = 61u - bits;
+    int32_t kp_m;
+    int32_t ki_m;
+    uint8_t kp_s;
+    uint8_t ki_s;
+    if (gain_q(kp_pu, 62u, &kp_m, &kp_s) != CTRL_OK ||
+        gain_q(ki_ts_pu, ki_max_shift, &ki_m, &ki_s) != CTRL_OK) {
+        return CTRL_ERANGE;
+    }
+    pi->kp = kp_m;
+    pi->kp_shift = kp_s;
+    pi->ki_ts = ki_m;
+    pi->ki_shift = ki_s;
+    pi->out_max = out_max;
+    pi->integ = 0;
+    return CTRL_OK;
+}

@@ -1,0 +1,42 @@
+/*
+ * Clarke (3.3) and Park (3.7) transforms and their inverses, Q24.
+ * Each output is computed from 64-bit products with a single rounding.
+ */
+#include "transforms.h"
+
+/* Q30 constants. */
+#define K_INV_SQRT3_Q30 619925131 /* 1/sqrt(3) */
+#define K_2_SQRT3_Q30 1239850262  /* 2/sqrt(3) */
+#define K_SQRT3_2_Q30 929887697   /* sqrt(3)/2 */
+#define K_HALF_Q30 536870912      /* 1/2 */
+
+void ctrl_clarke(q24_t ia, q24_t ib, q24_t *al, q24_t *be)
+{
+    /* alpha = a; beta = (a + 2b)/sqrt(3) with c = -a - b (3.3). Products
+     * < 2^31 * 2^31 (sum < 2^62): no overflow. */
+    *al = ia;
+    *be = fx_sat32(
+        fx_rshift64_round((int64_t)ia * K_INV_SQRT3_Q30 + (int64_t)ib * K_2_SQRT3_Q30, 30u));
+}
+
+void ctrl_inv_clarke(q24_t al, q24_t be, q24_t *a, q24_t *b, q24_t *c)
+{
+    const int64_t half = (int64_t)al * K_HALF_Q30;
+    const int64_t bq = (int64_t)be * K_SQRT3_2_Q30;
+    *a = al;
+    *b = fx_sat32(fx_rshift64_round(bq - half, 30u));
+    *c = fx_sat32(fx_rshift64_round(-bq - half, 30u));
+}
+
+/* |s|, |c| <= 2^24, so each product < 2^55 and the sums cannot overflow. */
+void ctrl_park(q24_t al, q24_t be, q24_t s, q24_t c, q24_t *d, q24_t *q)
+{
+    *d = fx_sat32(fx_rshift64_round((int64_t)c * al + (int64_t)s * be, FX_QBITS));
+    *q = fx_sat32(fx_rshift64_round((int64_t)c * be - (int64_t)s * al, FX_QBITS));
+}
+
+void ctrl_inv_park(q24_t d, q24_t q, q24_t s, q24_t c, q24_t *al, q24_t *be)
+{
+    *al = fx_sat32(fx_rshift64_round((int64_t)c * d - (int64_t)s * q, FX_QBITS));
+    *be = fx_sat32(fx_rshift64_round((int64_t)s * d + (int64_t)c * q, FX_QBITS));
+}

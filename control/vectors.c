@@ -1,0 +1,103 @@
+/*
+ * Voltage vectors of the two-level inverter (Table 4.2) and sectors ((4.5), (4.18)).
+ */
+#include "vectors.h"
+
+/* Leg states per vector: bit 0 = leg a (S1), bit 1 = leg b (S2), bit 2 = leg c (S3).
+ * V0=000, V1=100, V2=110, V3=010, V4=011, V5=001, V6=101, V7=111 (Table 4.2). */
+static const uint8_t vec_legs[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+
+/* V_i / Vdc, Q30: alpha = 2/3 cos((i-1) pi/3), beta = 2/3 sin((i-1) pi/3). */
+#define K_2_3 715827883
+#define K_1_3 357913941
+#define K_1_SQRT3 619925131
+static const int32_t vec_alpha_q30[8] = {0, K_2_3, K_1_3, -K_1_3, -K_2_3, -K_1_3, K_1_3, 0};
+static const int32_t vec_beta_q30[8] = {0, 0, K_1_SQRT3, K_1_SQRT3, 0, -K_1_SQRT3, -K_1_SQRT3, 0};
+
+uint8_t ctrl_vector_leg(uint8_t idx, unsigned leg)
+{
+    if (idx > 7u || leg > 2u) {
+        return 0u;
+    }
+    return (uint8_t)((vec_legs[idx] >> leg) & 1u);
+}
+
+void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
+{
+    if (idx > 7u) {
+        idx = 0u;
+    }
+    *v_alpha = fx_sat32(fx_rshift64_round((int64_t)vdc * vec_alpha_q30[idx], 30u));
+    *v_beta = fx_sat32(fx_rshift64_round((int64_t)vdc * vec_beta_q30[idx], 30u));
+}
+
+uint8_t ctrl_vec_wrap(int x)
+{
+    /* ((x - 1) mod 6) + 1 without overflow at INT_MIN: reduce first. */
+    int m = x % 6 - 1; /* in [-6, 4] */
+    if (m < 0) {
+        m += 6;
+    }
+    return (uint8_t)(m + 1);
+}
+
+uint8_t ctrl_zero_after(uint8_t vec)
+{
+    /* One leg switches: V1, V3, V5 have one leg high -> V0; V2, V4, V6 two -> V7. */
+    if (vec == 7u || vec == 2u || vec == 4u || vec == 6u) {
+        return 7u;
+    }
+    return 0u;
+}
+
+/* 3 a^2 < b^2 exactly (|a|, |b| <= 2^31: 3 a^2 < 2^64). */
+static int sq3_less(q24_t a, q24_t b)
+{
+    const uint64_t ua = (uint64_t)(a < 0 ? -(int64_t)a : (int64_t)a);
+    const uint64_t ub = (uint64_t)(b < 0 ? -(int64_t)b : (int64_t)b);
+    return 3u * ua * ua < ub * ub;
+}
+
+uint8_t ctrl_sector(q24_t x, q24_t y)
+{
+    /* Boundaries at +-30, 90, 150 deg (4.5). |theta| < 30 deg from the alpha
+     * axis <=> 3 y^2 < x^2; a point on a 30-deg line would need sqrt(3)
+     * rational, so only x == 0 (90/270 deg) is an exact boundary: 90 deg
+     * belongs to sector 2, 270 deg to sector 5 (upper bound inclusive). */
+    if (x > 0) {
+        if (sq3_less(y, x)) {
+            return 1u;
+        }
+        return y > 0 ? 2u : 6u;
+    }
+    if (x < 0) {
+        if (sq3_less(y, x)) {
+            return 4u;
+        }
+        return y > 0 ? 3u : 5u;
+    }
+    if (y > 0) {
+        return 2u;
+    }
+    return y < 0 ? 5u : 1u; /* origin: theta taken as 0 */
+}
+
+uint8_t ctrl_sector_mbst(q24_t x, q24_t y)
+{
+    /* Boundaries at 0, 60, 120, 180 ... deg (4.18): within 30 deg of the beta
+     * axis <=> 3 x^2 < y^2. Exact boundaries only on y == 0: 0 deg belongs to
+     * sector 6, 180 deg to sector 3. */
+    if (y > 0) {
+        if (sq3_less(x, y)) {
+            return 2u;
+        }
+        return x > 0 ? 1u : 3u;
+    }
+    if (y < 0) {
+        if (sq3_less(x, y)) {
+            return 5u;
+        }
+        return x < 0 ? 4u : 6u;
+    }
+    return x < 0 ? 3u : 6u; /* origin: theta taken as 0 */
+}
