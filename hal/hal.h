@@ -46,6 +46,9 @@ typedef struct {
     double adc_vdc_v_per_count;     /* nominal gain (V per count) */
     uint32_t encoder_counts_per_rev; /* quadrature counts per mechanical revolution */
     bool has_i_c;               /* third phase-current channel present */
+    /* Appended by "loop": rate of hal_cycles() in Hz, for the deadline check
+     * (cycle budget = cycle_clock_hz / pwm_freq_hz); 0 = unknown, check off. */
+    uint32_t cycle_clock_hz;
 } hal_info_t;
 
 void hal_info_get(const hal_t *h, hal_info_t *info);

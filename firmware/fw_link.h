@@ -1,0 +1,50 @@
+/*
+ * The firmware side of the serial link: connects the command interpreter
+ * (cmd.h, owner "proto") to the pipeline (cmd_ops_t implemented on fw_t) and
+ * feeds the telemetry producer (telemetry.h) from the pipeline's per-period
+ * sample.
+ *
+ * Contexts: fw_link_isr() runs right after fw_isr() in the PWM interrupt (it
+ * only copies one sample into a ring when tel_due() says so); fw_link_rx() and
+ * fw_link_poll() run in the main loop (command execution, frame encoding and
+ * the byte output). The command ops run in the main loop: they only request
+ * state changes (fw_cmd_*), and the configuration ops (controller selection,
+ * tunables) are refused while the drive is running.
+ */
+#ifndef FIRMWARE_FW_LINK_H
+#define FIRMWARE_FW_LINK_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cmd.h"
+#include "pipeline.h"
+#include "telemetry.h"
+
+#define FW_LINK_QLEN 16u /* samples queued between ISR and main loop (power of 2) */
+
+typedef void (*fw_link_write_fn)(void *ctx, const uint8_t *bytes, size_t len);
+
+typedef struct {
+    fw_t *fw;
+    cmd_t cmd;
+    tel_t tel;
+    tel_sample_t q[FW_LINK_QLEN];
+    volatile uint32_t q_head; /* written by the ISR */
+    volatile uint32_t q_tail; /* written by the main loop */
+    uint32_t dropped;         /* samples lost to a full queue */
+    uint8_t send_meta;
+    double speed_max_rpm; /* |speed reference| limit (1.2 x rated) */
+    fw_link_write_fn write;
+    void *write_ctx;
+} fw_link_t;
+
+void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
+/* Main loop: one received byte. */
+void fw_link_rx(fw_link_t *l, uint8_t byte);
+/* ISR, after fw_isr: queue this period's telemetry sample when due. */
+void fw_link_isr(fw_link_t *l);
+/* Main loop: META frame after "tel start", then the queued sample frames. */
+void fw_link_poll(fw_link_t *l);
+
+#endif /* FIRMWARE_FW_LINK_H */

@@ -1,0 +1,97 @@
+/*
+ * Closed loop on the host: plant (sim_host) + HAL simulation back-end
+ * (hal/sim) + the firmware pipeline (firmware/), period by period.
+ *
+ * Time line: the firmware boots and calibrates its ADC offsets with the gates
+ * off (calib_samples periods, plant running: imposed speed or coasting), then
+ * it is armed; scenario time t = 0 is the arm instant. Traces and metrics use
+ * scenario time. In free mechanics the load torque is applied from t = 0 (a
+ * constant load on the unpowered rotor would spin it backwards meanwhile).
+ *
+ * Metrics (sim_host/metrics.h): true plant signals on a grid of Ts/10 over the
+ * window (plant sampling), and the true signals at the control instants
+ * (control sampling, the *_ctrl keys). The torque reference of T_sse is the
+ * reference the firmware used (output of the speed PI in speed mode).
+ */
+#ifndef FIRMWARE_HOST_SIM_RUN_H
+#define FIRMWARE_HOST_SIM_RUN_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "hal_sim.h"
+#include "metrics.h"
+#include "pipeline.h"
+#include "plant.h"
+#include "sim_machine.h"
+#include "sim_scenario.h"
+
+typedef struct {
+    sim_machine_t plant_machine; /* the simulated drive */
+    ctrl_machine_t ctrl_machine; /* what the controller is configured with */
+    const ctrl_desc_t *ctrl;
+    const void *ctrl_cfg; /* NULL = desc->cfg_default */
+    uint32_t fs_hz;
+    bool free_mech;   /* false: dynamometer at speed_rpm */
+    double speed_rpm; /* imposed speed, or initial speed (free) */
+    double load_nm;   /* free mechanics */
+    bool speed_mode;  /* speed reference (outer PI) instead of torque */
+    double torque_ref_nm, speed_ref_rpm;
+    double duration_s;             /* after arm */
+    double win_start_s, win_end_s; /* metrics window (scenario time) */
+    uint64_t seed;
+    const sim_scenario_t *scenario;    /* may be NULL */
+    FILE *trace;                       /* may be NULL */
+    uint32_t trace_decimation;         /* every n-th sample of the Ts/10 grid, >= 1 */
+    double trace_start_s, trace_end_s; /* rows written in [start, end] (scenario time) */
+    hal_sim_config_t hal;              /* filled by sim_run_config_default, adjustable */
+    uint32_t calib_samples;
+} sim_run_cfg_t;
+
+typedef struct {
+    sim_run_cfg_t cfg;
+    plant_t plant;
+    hal_t hal;
+    fw_t fw;
+    sim_scenario_t scn;
+    bool has_scn;
+    double t_arm; /* plant time of the arm instant */
+    double t_end;
+    double obs_dt;
+    metrics_acc_t m_plant, m_ctrl;
+    uint64_t tr_win_start; /* plant transitions at the window start */
+    double t_win_start;    /* scenario time of that period boundary */
+    bool win_started, win_done;
+    uint64_t obs_count;
+    bool obs_on;          /* plant observer installed */
+    double speed_sum_rpm; /* mean speed in the window (free-mode THD) */
+    uint64_t speed_n;
+    int plant_rc;
+    uint8_t vec_now; /* vector acting in the present period (chosen at k-1) */
+    double duty_now; /* its on-time fraction */
+} sim_run_t;
+
+/* Convert a machine file into the controller's machine description. */
+void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out);
+
+/* Defaults: fs = machine fs (the caller sets the controller's), dynamometer
+ * at 0 r/min, torque mode 0 N*m, 0.3 s, window 0.1 s .. end, seed 1. */
+void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl_desc_t *ctrl);
+
+/* Build everything and run boot + calibration + arm. Returns 0 or -1 with a message. */
+int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errlen);
+/* One PWM period (scenario, ISR, plant). Returns 0, or -1 if the plant failed. */
+int sim_run_period(sim_run_t *r);
+/* Scenario time of the next period start (seconds since arm). */
+double sim_run_time(const sim_run_t *r);
+/* Run until the end of the duration. */
+int sim_run_all(sim_run_t *r, char *err, size_t errlen);
+/* Metrics of the window (plant and control sampling). */
+int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctrl);
+/* {...} with the keys of the CLI's --metrics. */
+void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
+                                const metrics_result_t *mc);
+void sim_run_free(sim_run_t *r);
+
+#endif /* FIRMWARE_HOST_SIM_RUN_H */

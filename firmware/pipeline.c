@@ -1,0 +1,352 @@
+/* The PWM-period interrupt (order and Q formats in pipeline.h). Integer-only. */
+#include "pipeline.h"
+
+#include "plan.h"
+
+/* Plausible ADC offset: within 1/16 of full scale from mid-scale. */
+#define FW_CALIB_OFFSET_TOL_SHIFT 4u
+
+static void fw_fault_now(fw_t *fw, uint32_t code)
+{
+    /* Gates off before anything else, then latch the code. */
+    hal_gate_enable(fw->hal, false);
+    (void)fw_state_event(&fw->sm, FW_EV_FAULT, code);
+}
+
+static void fw_pwm_off(fw_t *fw)
+{
+    const hal_pwm_t off = {{0u, 0u, 0u}};
+    hal_gate_enable(fw->hal, false);
+    hal_pwm_write(fw->hal, &off);
+    ctrl_plan_single(&fw->applied, 0u);
+    fw->tm.legs[0] = fw->tm.legs[1] = fw->tm.legs[2] = 0;
+}
+
+/* Q8 counts -> Q24 pu with a Q30 gain. */
+static q24_t fw_current_pu(uint16_t raw, int32_t off_q8, int32_t gain_q30)
+{
+    const int64_t d = (int64_t)raw * 256 - off_q8;
+    return fx_sat32(fx_rshift64_round(d * gain_q30, 14u));
+}
+
+static void fw_calibrate(fw_t *fw, const hal_adc_raw_t *raw)
+{
+    fw->calib_sum[0] += raw->i_a;
+    fw->calib_sum[1] += raw->i_b;
+    fw->calib_sum[2] += raw->i_c;
+    fw->calib_n++;
+    if (fw->calib_n < fw->calib_samples) {
+        return;
+    }
+    /* Average in Q8 counts, rounded (sum < 2^16 * 2^16, times 2^8 fits 64 bits). */
+    const uint64_t n = fw->calib_n;
+    const int32_t tol = (int32_t)fw->adc_mid * 256 >> FW_CALIB_OFFSET_TOL_SHIFT;
+    bool ok = true;
+    for (int x = 0; x < 3; x++) {
+        const uint64_t avg = ((uint64_t)fw->calib_sum[x] * 256u + n / 2u) / n;
+        fw->off_q8[x] = (int32_t)avg;
+        const int32_t dev = fw->off_q8[x] - (int32_t)fw->adc_mid * 256;
+        if (x < 2 && (dev > tol || dev < -tol)) {
+            ok = false;
+        }
+    }
+    fw->calib_n = 0u;
+    fw->calib_sum[0] = fw->calib_sum[1] = fw->calib_sum[2] = 0u;
+    if (ok) {
+        (void)fw_state_event(&fw->sm, FW_EV_CALIB_DONE, 0u);
+    } else {
+        fw_fault_now(fw, FW_FAULT_CALIB);
+    }
+}
+
+/* A 32-bit counter value (or difference) read as two's complement. */
+static int64_t fw_signed32(uint32_t u)
+{
+    return u <= (uint32_t)INT32_MAX ? (int64_t)u : (int64_t)u - (int64_t)4294967296;
+}
+
+/* x modulo m in [0, m) (C's % truncates towards zero). */
+static uint32_t fw_mod(int64_t x, uint32_t m)
+{
+    int64_t r = x % (int64_t)m;
+    if (r < 0) {
+        r += (int64_t)m;
+    }
+    return (uint32_t)r;
+}
+
+/* Encoder counter -> position modulo cpr -> electrical angle. */
+static fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
+{
+    const uint32_t count = enc->count;
+    if (!fw->enc_primed) {
+        /* The counter is aligned (count 0 at the d axis on phase a) and read
+         * as a signed offset from there: 2^32 is not a multiple of cpr, so a
+         * counter below zero must not be reduced as an unsigned number. */
+        fw->enc_last = count;
+        fw->enc_pos = fw_mod(fw_signed32(count), fw->enc_cpr);
+        fw->enc_primed = true;
+    }
+    /* Signed modulo-2^32 difference, then the position modulo cpr. */
+    const int64_t delta = fw_signed32(count - fw->enc_last);
+    fw->enc_last = count;
+    fw->enc_pos = fw_mod((int64_t)fw->enc_pos + delta, fw->enc_cpr);
+    /* A new index pulse marks position 0: re-synchronise. */
+    if (enc->index_seen && (!fw->enc_index_valid || enc->index_count != fw->enc_index_last)) {
+        fw->enc_index_last = enc->index_count;
+        fw->enc_index_valid = true;
+        fw->enc_pos = fw_mod(fw_signed32(count - enc->index_count), fw->enc_cpr);
+    }
+    /* pos * p * 2^32 / cpr < p * 2^32: the low 32 bits are the angle modulo one
+     * electrical turn (cpr * p < 2^31 checked at init). */
+    const uint64_t num = (uint64_t)fw->enc_pos * (uint64_t)(uint32_t)fw->params.pole_pairs << 32;
+    const uint64_t e = num / (uint64_t)fw->enc_cpr;
+    return (fx_angle_t)(e & 0xFFFFFFFFu) + fw->enc_offset;
+}
+
+static void fw_apply_commands(fw_t *fw)
+{
+    if (fw->req_clear != 0u) {
+        fw->req_clear = 0u;
+        if (fw_state_event(&fw->sm, FW_EV_CLEAR, 0u)) {
+            hal_trip_clear(fw->hal);
+            fw_protect_reset(&fw->prot);
+            fw->enc_primed = false;
+        }
+    }
+    if (fw->req_disarm != 0u) {
+        fw->req_disarm = 0u;
+        (void)fw_state_event(&fw->sm, FW_EV_DISARM, 0u);
+    }
+    if (fw->req_arm != 0u) {
+        fw->req_arm = 0u;
+        if (fw_state_event(&fw->sm, FW_EV_ARM, 0u)) {
+            /* Fresh dynamic state; the first gated period is k+1. */
+            fw->ctrl->reset(fw->ctrl_state.bytes);
+            ctrl_estimator_reset(&fw->est);
+            ctrl_speed_pi_reset(&fw->speed_pi, 0);
+            fw->speed_tref = 0;
+            fw->speed_cnt = 0u;
+            ctrl_plan_single(&fw->applied, 0u);
+            hal_gate_enable(fw->hal, true);
+        }
+    }
+}
+
+/* Over-current and hardware trip: checked right after the current conversion,
+ * the gates go off before anything else is computed. */
+static void fw_protect_fast(fw_t *fw, q24_t i_a, q24_t i_b)
+{
+    uint32_t f = fw_protect_current(&fw->prot, i_a, i_b);
+    if (f == FW_FAULT_NONE && hal_trip_active(fw->hal)) {
+        f = FW_FAULT_HW_TRIP;
+    }
+    if (f != FW_FAULT_NONE) {
+        fw_fault_now(fw, f);
+    }
+}
+
+/* DC link and encoder; returns the first fault or 0. */
+static uint32_t fw_protect_slow(fw_t *fw, q24_t vdc, uint32_t enc_count)
+{
+    uint32_t f = fw_protect_vdc(&fw->prot, vdc);
+    if (f == FW_FAULT_NONE) {
+        f = fw_protect_encoder(&fw->prot, enc_count);
+    }
+    return f;
+}
+
+static void fw_control(fw_t *fw, const ctrl_meas_t *m)
+{
+    ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, &fw->estimate);
+
+    q24_t tref = fw->torque_ref;
+    if (fw->ref_mode == FW_REF_SPEED) {
+        /* The speed loop runs at its own, lower rate and holds its output in
+         * between: a piecewise-constant torque reference, as from a drive's
+         * outer loop (a reference that changes every period would also keep
+         * FST's reference-step logic, §4.5.3, permanently in its dynamic mode). */
+        if (fw->speed_cnt == 0u) {
+            fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, fw->estimate.omega_e);
+        }
+        fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
+        tref = fw->speed_tref;
+    }
+    fw->refs.torque = fx_clamp(tref, fx_neg(fw->torque_ref_max), fw->torque_ref_max);
+    fw->refs.psi = 0;
+
+    const ctrl_ctx_t ctx = {&fw->params, &fw->estimate, &fw->refs, &fw->applied};
+    ctrl_plan_t next;
+    ctrl_plan_single(&next, 0u);
+    fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &next);
+
+    ctrl_legs_t legs;
+    ctrl_plan_to_legs(&next, &legs);
+    hal_pwm_t pwm;
+    for (int x = 0; x < 3; x++) {
+        /* duty in [0, FX_ONE] (plan.h), so the compare value is in [0, N]. */
+        const q24_t d = fx_clamp(legs.duty[x], 0, FX_ONE);
+        const uint64_t c = ((uint64_t)(uint32_t)d * fw->info.period_counts + (1u << 23)) >> 24;
+        pwm.cmp[x] = (uint32_t)c;
+        fw->tm.legs[x] = d;
+    }
+    hal_pwm_write(fw->hal, &pwm);
+
+    /* The plan written now acts during [k+1, k+2): it is "applied" for the
+     * estimator's prediction at k+1. */
+    fw->applied = next;
+    fw->tm.vec = next.n_seg > 0u ? next.vec[0] : 0u;
+    fw->tm.duty = next.n_seg > 0u ? next.dur[0] : 0;
+    fw->tm.psi_amp = fw->estimate.now.psi_amp;
+    fw->tm.torque = fw->estimate.now.torque;
+    fw->tm.omega_e = fw->estimate.omega_e;
+    fw->tm.torque_ref = fw->refs.torque;
+}
+
+void fw_isr(fw_t *fw)
+{
+    if (fw == NULL || fw->hal == NULL || fw->ctrl == NULL) {
+        return;
+    }
+    const uint32_t t0 = hal_cycles(fw->hal);
+    if (fw->busy) {
+        /* Entered while the previous period's ISR was still running. */
+        fw_fault_now(fw, FW_FAULT_DEADLINE);
+        return;
+    }
+    fw->busy = true;
+    fw->period++;
+
+    hal_adc_raw_t raw;
+    hal_encoder_raw_t enc;
+    hal_adc_read(fw->hal, &raw);
+    hal_encoder_read(fw->hal, &enc);
+
+    fw_apply_commands(fw);
+
+    fw->tm.vec = 0u;
+    fw->tm.duty = 0;
+    if (fw->sm.state == FW_STATE_BOOT) {
+        (void)fw_state_event(&fw->sm, FW_EV_START, 0u);
+    }
+    if (fw->sm.state == FW_STATE_CALIB) {
+        fw_pwm_off(fw);
+        fw_calibrate(fw, &raw);
+    } else {
+        ctrl_meas_t m;
+        m.i_a = fw_current_pu(raw.i_a, fw->off_q8[0], fw->gain_q30[0]);
+        m.i_b = fw_current_pu(raw.i_b, fw->off_q8[1], fw->gain_q30[1]);
+        if (fw->sm.state != FW_STATE_FAULT) {
+            fw_protect_fast(fw, m.i_a, m.i_b);
+        }
+        m.vdc = fx_sat32(fx_rshift64_round((int64_t)raw.vdc * fw->vdc_gain_q30, 6u));
+        m.theta_e = fw_encoder_angle(fw, &enc);
+        fw->tm.i_a = m.i_a;
+        fw->tm.i_b = m.i_b;
+        fw->tm.vdc = m.vdc;
+        fw->tm.theta_e = m.theta_e;
+        if (fw->sm.state != FW_STATE_FAULT) {
+            const uint32_t f = fw_protect_slow(fw, m.vdc, enc.count);
+            if (f != FW_FAULT_NONE) {
+                fw_fault_now(fw, f);
+            }
+        }
+        if (fw->sm.state == FW_STATE_RUNNING) {
+            fw_control(fw, &m);
+        } else {
+            fw_pwm_off(fw);
+        }
+    }
+
+    const uint32_t wf = fw_protect_watchdog_tick(&fw->prot);
+    if (wf != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
+        fw_fault_now(fw, wf);
+    }
+
+    fw->tm.period = fw->period;
+    fw->tm.state = (uint8_t)fw->sm.state;
+    fw->tm.fault = (uint8_t)fw->sm.fault_code;
+    fw->tm.gates = fw_state_gates_allowed(&fw->sm) ? 1u : 0u;
+
+    /* Deadline: duration of this ISR against the period's cycle budget. */
+    const uint32_t elapsed = hal_cycles(fw->hal) - t0;
+    fw->tm.cycles = elapsed;
+    const uint32_t df = fw_protect_deadline(&fw->prot, elapsed);
+    if (df != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
+        fw_fault_now(fw, df);
+        fw->tm.state = (uint8_t)fw->sm.state;
+        fw->tm.fault = (uint8_t)fw->sm.fault_code;
+        fw->tm.gates = 0u;
+    }
+    fw->busy = false;
+}
+
+void fw_cmd_arm(fw_t *fw)
+{
+    if (fw != NULL) {
+        fw->req_arm = 1u;
+    }
+}
+
+void fw_cmd_disarm(fw_t *fw)
+{
+    if (fw != NULL) {
+        fw->req_disarm = 1u;
+    }
+}
+
+void fw_cmd_clear(fw_t *fw)
+{
+    if (fw != NULL) {
+        fw->req_clear = 1u;
+    }
+}
+
+void fw_watchdog_kick(fw_t *fw)
+{
+    if (fw != NULL) {
+        fw_protect_watchdog_kick(&fw->prot);
+    }
+}
+
+void fw_set_torque_ref(fw_t *fw, q24_t torque_pu)
+{
+    if (fw != NULL) {
+        fw->torque_ref = torque_pu;
+        fw->ref_mode = FW_REF_TORQUE;
+    }
+}
+
+void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu)
+{
+    if (fw != NULL) {
+        if (fw->ref_mode != FW_REF_SPEED) {
+            /* Bumpless: the integrator starts at the present torque reference. */
+            ctrl_speed_pi_reset(&fw->speed_pi, fw->refs.torque);
+            fw->speed_tref = fw->refs.torque;
+            fw->speed_cnt = 0u;
+        }
+        fw->speed_ref = omega_e_pu;
+        fw->ref_mode = FW_REF_SPEED;
+    }
+}
+
+fw_state_id_t fw_state(const fw_t *fw)
+{
+    return fw != NULL ? fw->sm.state : FW_STATE_FAULT;
+}
+
+uint32_t fw_fault(const fw_t *fw)
+{
+    return fw != NULL ? fw->sm.fault_code : FW_FAULT_NONE;
+}
+
+const fw_telemetry_t *fw_telemetry(const fw_t *fw)
+{
+    return fw != NULL ? &fw->tm : NULL;
+}
+
+void *fw_ctrl_state(fw_t *fw)
+{
+    return fw != NULL ? fw->ctrl_state.bytes : NULL;
+}

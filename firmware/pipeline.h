@@ -1,0 +1,186 @@
+/*
+ * The PWM-period interrupt of every target, top to bottom (TI MotorWare
+ * style), in fw_isr():
+ *
+ *   t0 = hal_cycles(); re-entry check
+ *   hal_adc_read, hal_encoder_read          samples of period start k
+ *   commands (arm / disarm / clear) requested from the main loop
+ *   boot/calib: gates off, average ADC offsets, then ready
+ *   counts -> per unit                      offsets and gains from init
+ *   protections                             over-current first: gates off now
+ *   ctrl_estimator_update                   estimate at k, predict k+1 with
+ *                                           the plan acting in [k, k+1)
+ *   speed PI (speed mode) -> torque reference
+ *   desc->step                              plan for [k+1, k+2)
+ *   ctrl_plan_to_legs -> compare values -> hal_pwm_write (effective at k+1)
+ *   telemetry sample
+ *   deadline check (hal_cycles against the period budget)
+ *
+ * Fixed-point formats of the conversion (computed at init, pipeline_config.c):
+ *   ADC offsets: Q8 counts (average of calib_samples samples, 8 fractional bits)
+ *   current gain: Q30 pu per count (nominal A/count from hal_info / i_base,
+ *                 times the optional per-channel correction)
+ *   i_pu (Q24) = ((raw << 8) - off_q8) * gain_q30 / 2^14 (rounded)
+ *   DC-link gain: Q30 pu per count; vdc_pu (Q24) = raw * gain_q30 / 2^6
+ *   encoder: position pos in [0, cpr); theta_e = pos * p * 2^32 / cpr (64-bit,
+ *            exact modulo one electrical turn) + enc_offset (fx_angle_t); the
+ *            counter is taken as aligned (0 at the d axis); every new index
+ *            pulse (at position 0) re-synchronises pos = count - index_count,
+ *            which removes counts gained or lost by glitches
+ *
+ * All state lives in fw_t (no globals); the controller's state is a static,
+ * aligned block of CTRL_STATE_MAX bytes inside it.
+ */
+#ifndef FIRMWARE_PIPELINE_H
+#define FIRMWARE_PIPELINE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "controller.h"
+#include "ctrl_params.h"
+#include "ctrl_types.h"
+#include "estimator.h"
+#include "fw_state.h"
+#include "hal.h"
+#include "protect.h"
+#include "speed_pi.h"
+
+#define FW_OK 0
+#define FW_EINVAL (-1) /* NULL, bad machine or configuration */
+#define FW_ECTRL (-2)  /* controller rejected its configuration / too large */
+#define FW_ERANGE (-3) /* a gain or limit does not fit its Q format */
+#define FW_EBUSY (-4)  /* not allowed while running */
+#define FW_ENOENT (-5) /* unknown name */
+
+/* One period's signals for telemetry, tests and the simulator. */
+typedef struct {
+    uint32_t period;    /* ISR count (modulo 2^32) */
+    uint8_t state;      /* fw_state_id_t */
+    uint8_t fault;      /* latched fault code (protect.h) */
+    uint8_t vec;        /* selected vector (plan segment 0) for [k+1, k+2) */
+    uint8_t gates;      /* 1 when the gates are requested on */
+    q24_t i_a, i_b;     /* measured phase currents, Q24 pu */
+    q24_t vdc;          /* measured DC link, Q24 pu */
+    q24_t psi_amp;      /* |psi_s| estimate at k, Q24 pu */
+    q24_t torque;       /* torque estimate at k, Q24 pu */
+    q24_t omega_e;      /* electrical speed estimate, Q24 pu */
+    q24_t torque_ref;   /* torque reference used at k, Q24 pu */
+    q24_t duty;         /* on-time of segment 0, Q24 fraction */
+    q24_t legs[3];      /* leg duties written at k, Q24 fraction */
+    fx_angle_t theta_e; /* electrical angle from the encoder */
+    uint32_t cycles;    /* ISR duration measured with hal_cycles */
+} fw_telemetry_t;
+
+typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
+
+/* Start-up configuration (SI, read once by fw_init). */
+typedef struct {
+    const ctrl_machine_t *machine; /* machine the controller is configured for */
+    const ctrl_desc_t *ctrl;       /* controller (registry entry or a test one) */
+    const void *ctrl_cfg;          /* its SI configuration (desc->cfg_size bytes);
+                                      NULL = desc->cfg_default(machine) */
+    uint32_t calib_samples;        /* ADC offset averaging (>= 1), default 256 */
+    double adc_gain_corr[3];       /* per-channel current gain correction (~1.0) */
+    fx_angle_t enc_offset;         /* electrical angle at encoder count 0 */
+    /* Outer speed loop (thesis §4.6.2.1: Kp = 0.006843, Ki = 0.78046). */
+    double speed_kp, speed_ki;
+    ctrl_speed_unit_t speed_unit;
+    double speed_out_max_nm; /* torque-reference limit (> 0) */
+    uint32_t speed_loop_hz;  /* speed PI update rate (divides fs), default 1000;
+                                0 = every period */
+} fw_config_t;
+
+typedef struct {
+    hal_t *hal;
+    hal_info_t info;
+    ctrl_params_t params;
+    ctrl_bases_t bases;
+    const ctrl_desc_t *ctrl;
+    const ctrl_machine_t *machine; /* the controller's machine (kept for re-selection) */
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_STATE_MAX];
+    } ctrl_state;
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } ctrl_cfg; /* SI configuration of the selected controller */
+    ctrl_estimator_t est;
+    ctrl_estimate_t estimate;
+    ctrl_plan_t applied; /* acting in [k, k+1): chosen at k-1 (or zero vector) */
+    ctrl_refs_t refs;
+    ctrl_speed_pi_t speed_pi;
+    fw_ref_mode_t ref_mode;
+    q24_t torque_ref;     /* Q24 pu (torque mode) */
+    q24_t speed_ref;      /* Q24 pu electrical (speed mode) */
+    q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
+    q24_t speed_tref;     /* last speed-PI output, Q24 pu (held between updates) */
+    uint32_t speed_div;   /* periods per speed-PI update (>= 1) */
+    uint32_t speed_cnt;   /* periods since the last update */
+    fw_state_t sm;
+    fw_protect_t prot;
+    /* calibration */
+    uint32_t calib_samples, calib_n;
+    uint32_t calib_sum[3];
+    int32_t off_q8[3];    /* Q8 counts */
+    int32_t gain_q30[3];  /* Q30 pu per count */
+    int32_t vdc_gain_q30; /* Q30 pu per count */
+    uint16_t adc_mid;     /* 2^(bits-1) */
+    /* encoder */
+    uint32_t enc_cpr;
+    uint32_t enc_last;
+    uint32_t enc_pos; /* [0, cpr) */
+    bool enc_primed;
+    bool enc_index_valid;    /* enc_index_last holds a latched index */
+    uint32_t enc_index_last; /* counter value at the last index pulse */
+    fx_angle_t enc_offset;
+    /* commands from the main loop, applied at the next period start */
+    volatile uint8_t req_arm, req_disarm, req_clear;
+    bool busy; /* re-entry flag */
+    uint32_t period;
+    fw_telemetry_t tm;
+} fw_t;
+
+/* Configuration defaults: thesis speed gains (r/min units of the thesis'
+ * experiments, see pipeline_config.c), limit = rated torque, 256 samples. */
+void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl);
+
+/* Bind the HAL, compute the fixed-point conversion, initialise the controller
+ * and protections; gates off, state boot. Returns FW_OK or FW_E*. */
+int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg);
+const char *fw_strerror(int code);
+
+/* The PWM-period interrupt. */
+void fw_isr(fw_t *fw);
+
+/* Main-loop side (called from the command interface or a test). */
+void fw_cmd_arm(fw_t *fw);
+void fw_cmd_disarm(fw_t *fw);
+void fw_cmd_clear(fw_t *fw);
+void fw_watchdog_kick(fw_t *fw);
+void fw_set_torque_ref(fw_t *fw, q24_t torque_pu); /* selects torque mode */
+void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu); /* selects speed mode */
+/* SI helpers (pipeline_config.c; not for the ISR). */
+void fw_set_torque_ref_nm(fw_t *fw, double nm);
+void fw_set_speed_ref_rpm(fw_t *fw, double rpm);
+
+fw_state_id_t fw_state(const fw_t *fw);
+uint32_t fw_fault(const fw_t *fw);
+const fw_telemetry_t *fw_telemetry(const fw_t *fw);
+/*
+ * Main-loop side, configuration time (double allowed; pipeline_config.c).
+ * Refused with FW_EBUSY while running (the ISR uses the controller state).
+ * fw_select_controller: cfg NULL = desc->cfg_default(machine); on failure the
+ * previous controller stays selected. fw_tunable_set re-initialises the
+ * controller with the changed value (FW_ENOENT unknown name, FW_EINVAL range).
+ */
+int fw_select_controller(fw_t *fw, const ctrl_desc_t *desc, const void *cfg);
+int fw_tunable_set(fw_t *fw, const char *name, double value);
+int fw_tunable_get(const fw_t *fw, const char *name, double *value);
+
+/* Controller state block (for tests). */
+void *fw_ctrl_state(fw_t *fw);
+
+#endif /* FIRMWARE_PIPELINE_H */

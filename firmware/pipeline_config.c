@@ -1,0 +1,232 @@
+/*
+ * Start-up of the pipeline: SI configuration -> fixed point (double allowed
+ * here: configuration time only, never called from the ISR).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "pipeline.h"
+#include "plan.h"
+
+#define FW_PI 3.14159265358979323846
+#define FW_CALIB_DEFAULT 256u
+
+void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl)
+{
+    if (c == NULL) {
+        return;
+    }
+    memset(c, 0, sizeof *c);
+    c->machine = machine;
+    c->ctrl = ctrl;
+    c->ctrl_cfg = NULL;
+    c->calib_samples = FW_CALIB_DEFAULT;
+    c->adc_gain_corr[0] = c->adc_gain_corr[1] = c->adc_gain_corr[2] = 1.0;
+    c->enc_offset = 0u;
+    /* Thesis §4.6.2.1. The gains are read as N*m per (r/min) and N*m per
+     * (r/min s): with J = 1.2e-4 kg m^2 this gives a crossover near
+     * Kp/J = 545 rad/s with the PI zero at Ki/Kp = 114 rad/s (78 deg phase
+     * margin); read per rad/s the zero would lie above the crossover (27 deg). */
+    c->speed_kp = 0.006843;
+    c->speed_ki = 0.78046;
+    c->speed_unit = CTRL_SPEED_UNIT_RPM;
+    c->speed_out_max_nm = machine != NULL ? machine->torque_rated_nm : 0.0;
+    c->speed_loop_hz = 1000u;
+}
+
+const char *fw_strerror(int code)
+{
+    switch (code) {
+    case FW_OK:
+        return "ok";
+    case FW_EINVAL:
+        return "invalid machine, HAL or pipeline configuration";
+    case FW_ECTRL:
+        return "controller rejected its configuration (or state/config too large)";
+    case FW_ERANGE:
+        return "a gain or limit does not fit its fixed-point format";
+    case FW_EBUSY:
+        return "not allowed while running";
+    case FW_ENOENT:
+        return "unknown name";
+    default:
+        return "unknown error";
+    }
+}
+
+/* x in [0, 2) -> Q30, or -1 when it does not fit. */
+static int32_t fw_q30(double x)
+{
+    if (!(x >= 0.0) || !(x < 2.0)) {
+        return -1;
+    }
+    return (int32_t)floor(x * 1073741824.0 + 0.5);
+}
+
+int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
+{
+    if (fw == NULL || hal == NULL || cfg == NULL || cfg->machine == NULL || cfg->ctrl == NULL ||
+        cfg->ctrl->step == NULL || cfg->ctrl->init == NULL || cfg->ctrl->reset == NULL) {
+        return FW_EINVAL;
+    }
+    memset(fw, 0, sizeof *fw);
+    fw->hal = hal;
+    hal_gate_enable(hal, false);
+    hal_info_get(hal, &fw->info);
+    const hal_info_t *in = &fw->info;
+    if (in->pwm_freq_hz == 0u || in->period_counts == 0u || in->adc_bits < 2u ||
+        in->adc_bits > 16u || !(in->adc_current_a_per_count > 0.0) ||
+        !(in->adc_vdc_v_per_count > 0.0) || in->encoder_counts_per_rev == 0u ||
+        cfg->calib_samples == 0u || cfg->calib_samples > 65536u) {
+        return FW_EINVAL;
+    }
+    if (ctrl_params_init(&fw->params, &fw->bases, cfg->machine, in->pwm_freq_hz) != CTRL_OK) {
+        return FW_EINVAL;
+    }
+    if ((uint64_t)in->encoder_counts_per_rev * (uint64_t)fw->params.pole_pairs >
+        (uint64_t)INT32_MAX) {
+        return FW_ERANGE;
+    }
+
+    fw->machine = cfg->machine;
+    const int sel = fw_select_controller(fw, cfg->ctrl, cfg->ctrl_cfg);
+    if (sel != FW_OK) {
+        return sel;
+    }
+    ctrl_estimator_init(&fw->est, &fw->params);
+
+    /* Conversion gains (formats in pipeline.h). */
+    for (int x = 0; x < 3; x++) {
+        const double corr = cfg->adc_gain_corr[x];
+        if (!(corr > 0.5) || !(corr < 1.5)) {
+            return FW_EINVAL;
+        }
+        fw->gain_q30[x] = fw_q30(corr * in->adc_current_a_per_count / fw->bases.i_a);
+        if (fw->gain_q30[x] <= 0) {
+            return FW_ERANGE;
+        }
+    }
+    fw->vdc_gain_q30 = fw_q30(in->adc_vdc_v_per_count / fw->bases.v_v);
+    if (fw->vdc_gain_q30 <= 0) {
+        return FW_ERANGE;
+    }
+    fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
+    fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
+    fw->calib_samples = cfg->calib_samples;
+    fw->enc_cpr = in->encoder_counts_per_rev;
+    fw->enc_offset = cfg->enc_offset;
+
+    fw_protect_cfg_t pc;
+    if (fw_protect_config(&pc, cfg->machine, &fw->bases, in->pwm_freq_hz,
+                          in->encoder_counts_per_rev, in->cycle_clock_hz) != CTRL_OK) {
+        return FW_EINVAL;
+    }
+    fw_protect_init(&fw->prot, &pc);
+
+    /* Speed loop rate: fs / speed_div, speed_div >= 1 rounded to the nearest. */
+    const uint32_t loop_hz = cfg->speed_loop_hz == 0u || cfg->speed_loop_hz > in->pwm_freq_hz
+                                 ? in->pwm_freq_hz
+                                 : cfg->speed_loop_hz;
+    fw->speed_div = (in->pwm_freq_hz + loop_hz / 2u) / loop_hz;
+    if (!(cfg->speed_out_max_nm > 0.0) ||
+        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, cfg->machine->pole_pairs, cfg->speed_kp,
+                             cfg->speed_ki, cfg->speed_unit, cfg->speed_out_max_nm,
+                             in->pwm_freq_hz / fw->speed_div) != CTRL_OK) {
+        return FW_ERANGE;
+    }
+    fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
+    fw->ref_mode = FW_REF_TORQUE;
+    ctrl_plan_single(&fw->applied, 0u);
+    fw_state_init(&fw->sm);
+    return FW_OK;
+}
+
+/* Initialise desc with cfg into the state block; keep both on success. */
+static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *cfg)
+{
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_STATE_MAX];
+    } st;
+    memset(&st, 0, sizeof st);
+    if (d->init(st.bytes, cfg, &fw->params) != CTRL_OK) {
+        return FW_ECTRL;
+    }
+    d->reset(st.bytes);
+    memcpy(fw->ctrl_state.bytes, st.bytes, sizeof st.bytes);
+    memcpy(fw->ctrl_cfg.bytes, cfg, CTRL_CFG_MAX);
+    fw->ctrl = d;
+    return FW_OK;
+}
+
+int fw_select_controller(fw_t *fw, const ctrl_desc_t *d, const void *cfg)
+{
+    if (fw == NULL || d == NULL || d->init == NULL || d->reset == NULL || d->step == NULL ||
+        fw->machine == NULL) {
+        return FW_EINVAL;
+    }
+    if (fw->sm.state == FW_STATE_RUNNING) {
+        return FW_EBUSY;
+    }
+    if (d->state_size > CTRL_STATE_MAX || d->cfg_size > CTRL_CFG_MAX) {
+        return FW_ECTRL;
+    }
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } c;
+    memset(&c, 0, sizeof c);
+    if (cfg != NULL) {
+        memcpy(c.bytes, cfg, d->cfg_size);
+    } else if (d->cfg_default != NULL) {
+        d->cfg_default(c.bytes, fw->machine);
+    }
+    return fw_ctrl_install(fw, d, c.bytes);
+}
+
+int fw_tunable_set(fw_t *fw, const char *name, double value)
+{
+    if (fw == NULL || fw->ctrl == NULL || name == NULL) {
+        return FW_EINVAL;
+    }
+    if (fw->sm.state == FW_STATE_RUNNING) {
+        return FW_EBUSY;
+    }
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } c;
+    memcpy(c.bytes, fw->ctrl_cfg.bytes, CTRL_CFG_MAX);
+    const int rc = ctrl_tunable_set(fw->ctrl, c.bytes, name, value);
+    if (rc == CTRL_ENOENT) {
+        return FW_ENOENT;
+    }
+    if (rc != CTRL_OK) {
+        return FW_EINVAL;
+    }
+    return fw_ctrl_install(fw, fw->ctrl, c.bytes);
+}
+
+int fw_tunable_get(const fw_t *fw, const char *name, double *value)
+{
+    if (fw == NULL || fw->ctrl == NULL || name == NULL || value == NULL) {
+        return FW_EINVAL;
+    }
+    const int rc = ctrl_tunable_get(fw->ctrl, fw->ctrl_cfg.bytes, name, value);
+    return rc == CTRL_OK ? FW_OK : (rc == CTRL_ENOENT ? FW_ENOENT : FW_EINVAL);
+}
+
+void fw_set_torque_ref_nm(fw_t *fw, double nm)
+{
+    if (fw != NULL && isfinite(nm)) {
+        fw_set_torque_ref(fw, ctrl_q24_from_double(nm / fw->bases.torque_nm));
+    }
+}
+
+void fw_set_speed_ref_rpm(fw_t *fw, double rpm)
+{
+    if (fw != NULL && isfinite(rpm)) {
+        const double we = rpm * 2.0 * FW_PI / 60.0 * (double)fw->params.pole_pairs;
+        fw_set_speed_ref(fw, ctrl_q24_from_double(we / fw->bases.w_rad_s));
+    }
+}

@@ -1,0 +1,51 @@
+/*
+ * Protection thresholds from SI data (configuration time only: double is
+ * allowed here, never in the per-period path). Derivations in protect.h.
+ */
+#include <math.h>
+#include <stddef.h>
+
+#include "protect.h"
+
+#define FW_PI 3.14159265358979323846
+
+/* DC-link window around the nominal voltage. */
+#define FW_VDC_MAX_REL 1.25
+#define FW_VDC_MIN_REL 0.70
+/* Watchdog: the main loop must kick at least every 100 ms. */
+#define FW_WDG_SECONDS 0.1
+/* Least number of periods for the stuck check (noise immunity at high rates). */
+#define FW_ENC_STUCK_MIN_PERIODS 8.0
+
+int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
+                      uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz)
+{
+    if (cfg == NULL || m == NULL || b == NULL || fs_hz == 0u || enc_counts_per_rev == 0u) {
+        return CTRL_EINVAL;
+    }
+    if (!(m->current_max_a > 0.0) || !(m->vdc_v > 0.0) || !(m->inertia_kgm2 > 0.0) ||
+        !(m->torque_rated_nm >= 0.0) || m->pole_pairs <= 0 || !(b->i_a > 0.0) || !(b->v_v > 0.0) ||
+        !isfinite(m->current_max_a) || !isfinite(m->inertia_kgm2)) {
+        return CTRL_EINVAL;
+    }
+    const double fs = (double)fs_hz;
+    cfg->i_max = ctrl_q24_from_double(m->current_max_a / b->i_a);
+    cfg->vdc_max = ctrl_q24_from_double(FW_VDC_MAX_REL * m->vdc_v / b->v_v);
+    cfg->vdc_min = ctrl_q24_from_double(FW_VDC_MIN_REL * m->vdc_v / b->v_v);
+
+    /* Largest torque at i_max (3.10), an upper bound for an IPMSM as well. */
+    const double dl = fabs(m->ld_h - m->lq_h);
+    const double t_imax =
+        1.5 * (double)m->pole_pairs * (m->psi_pm_wb + dl * m->current_max_a) * m->current_max_a;
+    const double a_mech = (t_imax + m->torque_rated_nm) / m->inertia_kgm2; /* rad/s^2 */
+    const double a_cpp2 = a_mech * (double)enc_counts_per_rev / (2.0 * FW_PI) / (fs * fs);
+    /* Quantisation moves each difference by +-1 count, the second difference by +-2. */
+    cfg->enc_jump_max = (int32_t)(4.0 + ceil(a_cpp2));
+    const double rate_min = sqrt(4.0 * a_cpp2); /* r^2 / (2 a) >= 2 counts */
+    cfg->enc_rate_min_q16 = (int32_t)fmin(ceil(rate_min * 65536.0), (double)INT32_MAX);
+    const double n_stuck = fmax(FW_ENC_STUCK_MIN_PERIODS, ceil(2.0 / sqrt(a_cpp2)));
+    cfg->enc_stuck_periods = (uint32_t)fmin(n_stuck, 1.0e6);
+    cfg->deadline_cycles = cycle_clock_hz / fs_hz;
+    cfg->wdg_periods = (uint32_t)ceil(FW_WDG_SECONDS * fs);
+    return CTRL_OK;
+}

@@ -1,0 +1,157 @@
+/*
+ * The serial link on the host closed loop: command lines through the proto
+ * owner's interpreter reach the pipeline (fw_link.c), and telemetry frames
+ * come out at the requested decimation.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "fw_link.h"
+#include "loop_util.h"
+#include "unity.h"
+
+void setUp(void)
+{
+}
+
+static sim_run_t run;
+static fw_link_t link;
+static char out[8192];
+static size_t out_len;
+static size_t zeros;
+
+void tearDown(void)
+{
+    sim_run_free(&run);
+}
+
+static void capture(void *ctx, const uint8_t *b, size_t n)
+{
+    (void)ctx;
+    for (size_t i = 0; i < n; i++) {
+        if (b[i] == 0u) {
+            zeros++;
+        }
+        if (out_len + 1u < sizeof out) {
+            out[out_len++] = b[i] != 0u ? (char)b[i] : '.';
+            out[out_len] = '\0';
+        }
+    }
+}
+
+static void send(const char *line)
+{
+    out_len = 0;
+    out[0] = '\0';
+    for (const char *p = line; *p != '\0'; p++) {
+        fw_link_rx(&link, (uint8_t)*p);
+    }
+    fw_link_rx(&link, (uint8_t)'\n');
+}
+
+static void periods(int n)
+{
+    for (int k = 0; k < n; k++) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+        fw_link_isr(&link);
+        fw_link_poll(&link);
+    }
+}
+
+static void test_commands_reach_the_pipeline(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_link_init(&link, &run.fw, capture, NULL);
+    periods(2);
+    send("status");
+    TEST_ASSERT_NOT_NULL(strstr(out, "state=running"));
+    TEST_ASSERT_NOT_NULL(strstr(out, "ctrl=fst"));
+
+    send("ref torque 1.5");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    periods(1);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 1.5,
+                              ctrl_q24_to_double(run.fw.refs.torque) * run.fw.bases.torque_nm);
+    send("ref torque 100");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 4", 5));
+
+    send("ctrl select bst"); /* armed: refused */
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 8", 5));
+    TEST_ASSERT_EQUAL_STRING("fst", run.fw.ctrl->name);
+
+    send("disarm");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    periods(1);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+
+    send("ctrl select bst");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    TEST_ASSERT_EQUAL_STRING("bst", run.fw.ctrl->name);
+    send("param set h_T 0.1");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    double v = 0.0;
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_get(&run.fw, "h_T", &v));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.1, v);
+    send("param get nosuch");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 5", 5));
+
+    send("arm");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    periods(2);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&run.fw));
+    TEST_ASSERT_TRUE(hal_sim_gates_on(&run.hal));
+}
+
+/* "tel start torque every 10": one META frame, then one SAMPLE frame every 10
+ * periods; each frame is delimited by two 0x00 bytes. */
+static void test_telemetry_frames(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 1.8, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_link_init(&link, &run.fw, capture, NULL);
+    periods(5);
+    send("tel start torque every 10");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok tel", 6));
+    zeros = 0;
+    periods(100);
+    TEST_ASSERT_EQUAL_UINT32(0u, link.dropped);
+    TEST_ASSERT_EQUAL_UINT32(2u * (1u + 10u), (uint32_t)zeros);
+    send("tel stop");
+    zeros = 0;
+    periods(50);
+    TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)zeros);
+}
+
+/* A fault is reported and cleared over the link. */
+static void test_fault_over_link(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 1.8, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_link_init(&link, &run.fw, capture, NULL);
+    periods(5);
+    hal_sim_inject_encoder_glitch(&run.hal, 500);
+    periods(2);
+    send("fault");
+    TEST_ASSERT_NOT_NULL(strstr(out, "encoder_jump"));
+    send("arm");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 9", 5));
+    hal_sim_inject_encoder_glitch(&run.hal, -500);
+    send("fault clear");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    periods(1);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_commands_reach_the_pipeline);
+    RUN_TEST(test_telemetry_frames);
+    RUN_TEST(test_fault_over_link);
+    return UNITY_END();
+}

@@ -1,0 +1,270 @@
+/*
+ * The pipeline with a trivial open-loop test controller (not registered):
+ * one-period delay of a real drive, compare values of a plan, ADC offset
+ * calibration; and the state machine and protection checks in isolation.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "loop_util.h"
+#include "plan.h"
+#include "unity.h"
+
+void setUp(void)
+{
+}
+
+static sim_run_t run;
+
+void tearDown(void)
+{
+    sim_run_free(&run);
+}
+
+/* ---- open-loop test controller: V(1 + k mod 6) for duty (k mod 4 + 1)/8,
+ * recording what it was given as "applied" ---- */
+#define OL_HIST 16
+typedef struct {
+    uint32_t k;
+    ctrl_plan_t out[OL_HIST];
+    ctrl_plan_t applied[OL_HIST];
+} ol_state_t;
+
+static void ol_cfg_default(void *cfg, const ctrl_machine_t *m)
+{
+    (void)cfg;
+    (void)m;
+}
+static int ol_init(void *state, const void *cfg, const ctrl_params_t *p)
+{
+    (void)cfg;
+    (void)p;
+    memset(state, 0, sizeof(ol_state_t));
+    return CTRL_OK;
+}
+static void ol_reset(void *state)
+{
+    memset(state, 0, sizeof(ol_state_t));
+}
+static void ol_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ol_state_t *s = (ol_state_t *)state;
+    ctrl_plan_active_zero(out, (uint8_t)(1u + s->k % 6u), (q24_t)((s->k % 4u + 1u) * (FX_ONE / 8)));
+    if (s->k < OL_HIST) {
+        s->out[s->k] = *out;
+        s->applied[s->k] = *ctx->applied;
+    }
+    s->k++;
+}
+static const ctrl_desc_t ol_desc = {"test_ol", "open-loop test sequence",
+                                    20000u,    sizeof(ol_state_t),
+                                    8u,        NULL,
+                                    0u,        ol_cfg_default,
+                                    ol_init,   ol_reset,
+                                    ol_step};
+
+static void plans_equal(const ctrl_plan_t *a, const ctrl_plan_t *b)
+{
+    TEST_ASSERT_EQUAL_UINT8(a->n_seg, b->n_seg);
+    for (unsigned i = 0; i < a->n_seg; i++) {
+        TEST_ASSERT_EQUAL_UINT8(a->vec[i], b->vec[i]);
+        TEST_ASSERT_EQUAL_INT32(a->dur[i], b->dur[i]);
+    }
+}
+
+/* The plan chosen at k is applied by the PWM in period k+1 and handed to the
+ * estimator/controller as "applied" at k+1. */
+static void test_one_period_delay(void)
+{
+    TEST_ASSERT_TRUE(sizeof(ol_state_t) <= CTRL_STATE_MAX);
+    sim_run_cfg_t c;
+    loop_cfg(&c, "bst", 300.0, 0.0, 0.3, 0.0);
+    c.ctrl = &ol_desc;
+    c.ctrl_cfg = NULL;
+    loop_start(&run, &c);
+    const uint32_t n = run.hal.period_counts;
+    TEST_ASSERT_EQUAL_UINT32(2500u, n); /* 100 MHz / (2 * 20 kHz) */
+    for (int k = 0; k < OL_HIST; k++) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+    }
+    const ol_state_t *s = (const ol_state_t *)fw_ctrl_state(&run.fw);
+    TEST_ASSERT_EQUAL_STRING("none", fw_fault_name(fw_fault(&run.fw)));
+    TEST_ASSERT_EQUAL_UINT32(OL_HIST, s->k);
+    /* First step after arm: the gates were off, nothing applied (zero vector). */
+    TEST_ASSERT_EQUAL_UINT8(0u, s->applied[0].vec[0]);
+    for (uint32_t k = 1; k < OL_HIST; k++) {
+        plans_equal(&s->out[k - 1u], &s->applied[k]);
+    }
+    /* The compare values active in the last period realise the plan chosen one
+     * period earlier: V(x) with duty d -> legs of Table 4.2 at d*N counts. */
+    hal_pwm_t act;
+    hal_sim_pwm_active(&run.hal, &act);
+    const ctrl_plan_t *p = &s->out[s->k - 2u];
+    ctrl_legs_t legs;
+    ctrl_plan_to_legs(p, &legs);
+    for (int x = 0; x < 3; x++) {
+        const uint32_t want = (uint32_t)(((uint64_t)(uint32_t)legs.duty[x] * n + (1u << 23)) >> 24);
+        TEST_ASSERT_EQUAL_UINT32(want, act.cmp[x]);
+    }
+    /* The active vector was V1..V6 for (k mod 4 + 1)/8: exactly one leg
+     * pattern away from the zero vector, duties in {0, d, 1}... check V(x). */
+    TEST_ASSERT_TRUE(p->vec[0] >= 1u && p->vec[0] <= 6u);
+}
+
+/* ADC offsets: +30 / -20 counts on i_a / i_b (noise 0.5 count rms, 256
+ * samples -> standard error 0.03 count); the firmware's averaged offset must
+ * match within 0.25 count (8 standard errors + Q8 rounding). */
+static void test_offset_calibration(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "bst", 750.0, 0.0, 0.3, 0.0);
+    c.calib_samples = 256u;
+    c.hal.adc_offset_counts[0] = 30.0;
+    c.hal.adc_offset_counts[1] = -20.0;
+    loop_start(&run, &c);
+    const double mid = 2048.0;
+    TEST_ASSERT_DOUBLE_WITHIN(0.25, mid + 30.0, run.fw.off_q8[0] / 256.0);
+    TEST_ASSERT_DOUBLE_WITHIN(0.25, mid - 20.0, run.fw.off_q8[1] / 256.0);
+    /* The first ISR after calibration samples a zero current (gates were off,
+     * back-EMF 30 V < Vdc: no diode conduction): converted within 2 counts of
+     * 7.7 mA (i_fullscale 15.75 A, 12 bit) despite the offsets. */
+    TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+    const double lsb_pu = 2.0 * 15.75 / 4096.0 / run.fw.bases.i_a;
+    const fw_telemetry_t *tm = fw_telemetry(&run.fw);
+    TEST_ASSERT_DOUBLE_WITHIN(2.0 * lsb_pu, 0.0, ctrl_q24_to_double(tm->i_a));
+    TEST_ASSERT_DOUBLE_WITHIN(2.0 * lsb_pu, 0.0, ctrl_q24_to_double(tm->i_b));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&run.fw));
+}
+
+/* An offset beyond 1/16 of full scale (128 counts) is a calibration fault. */
+static void test_offset_calibration_fault(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "bst", 0.0, 0.0, 0.3, 0.0);
+    c.hal.adc_offset_counts[0] = 300.0;
+    char err[256];
+    TEST_ASSERT_NOT_EQUAL(0, sim_run_init(&run, &c, err, sizeof err));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_FAULT, fw_state(&run.fw));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_CALIB, fw_fault(&run.fw));
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+}
+
+/* ---- state machine ---- */
+static void test_state_machine(void)
+{
+    fw_state_t s;
+    fw_state_init(&s);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_BOOT, s.state);
+    /* Commands are ignored before calibration. */
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_ARM, 0));
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_START, 0));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_CALIB, s.state);
+    TEST_ASSERT_FALSE(fw_state_gates_allowed(&s));
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_ARM, 0));
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_CALIB_DONE, 0));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, s.state);
+    TEST_ASSERT_FALSE(fw_state_gates_allowed(&s));
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_CLEAR, 0)); /* nothing to clear */
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_ARM, 0));
+    TEST_ASSERT_TRUE(fw_state_gates_allowed(&s));
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_DISARM, 0));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, s.state);
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_ARM, 0));
+    /* Fault: first code latches, commands other than clear are ignored. */
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_FAULT, FW_FAULT_DC_OVERVOLT));
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_FAULT, FW_FAULT_WATCHDOG));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DC_OVERVOLT, s.fault_code);
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_ARM, 0));
+    TEST_ASSERT_FALSE(fw_state_event(&s, FW_EV_DISARM, 0));
+    TEST_ASSERT_FALSE(fw_state_gates_allowed(&s));
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_CLEAR, 0));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, s.state);
+    TEST_ASSERT_EQUAL_UINT32(0u, s.fault_code);
+    /* A fault during calibration: clear restarts the calibration. */
+    fw_state_init(&s);
+    (void)fw_state_event(&s, FW_EV_START, 0);
+    (void)fw_state_event(&s, FW_EV_FAULT, FW_FAULT_CALIB);
+    TEST_ASSERT_TRUE(fw_state_event(&s, FW_EV_CLEAR, 0));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_CALIB, s.state);
+    TEST_ASSERT_EQUAL_STRING("running", fw_state_name(FW_STATE_RUNNING));
+}
+
+/* ---- protection checks with synthetic inputs ---- */
+static void test_protect_checks(void)
+{
+    fw_protect_cfg_t cfg = {FX_ONE / 2, FX_ONE + FX_ONE / 4, FX_ONE * 7 / 10, 5, 8, 65536, 1000u,
+                            10u};
+    fw_protect_t p;
+    fw_protect_init(&p, &cfg);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_current(&p, FX_ONE / 4, -FX_ONE / 4));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_OVERCURRENT, fw_protect_current(&p, FX_ONE / 2 + 1, 0));
+    /* i_c = -(i_a + i_b) is checked too. */
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_OVERCURRENT,
+                             fw_protect_current(&p, FX_ONE * 3 / 10, FX_ONE * 3 / 10));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DC_OVERVOLT, fw_protect_vdc(&p, FX_ONE * 13 / 10));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DC_UNDERVOLT, fw_protect_vdc(&p, FX_ONE * 6 / 10));
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_vdc(&p, FX_ONE));
+    /* Encoder: steady 3 counts per period across the 2^32 wrap, then a jump. */
+    uint32_t c = UINT32_MAX - 10u;
+    for (int k = 0; k < 20; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+        c += 3u;
+    }
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_ENC_JUMP, fw_protect_encoder(&p, c + 9u));
+    /* Stuck: rate 3 >= 1 count/period, 8 periods without motion. */
+    fw_protect_reset(&p);
+    for (int k = 0; k < 5; k++) {
+        (void)fw_protect_encoder(&p, c);
+        c += 3u;
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c)); /* last move */
+    for (int k = 1; k < 8; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+    }
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_ENC_STUCK, fw_protect_encoder(&p, c));
+    /* Slow rotation (1 count every 4 periods, below the armed rate): no fault. */
+    fw_protect_reset(&p);
+    for (int k = 0; k < 200; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+        if (k % 4 == 3) {
+            c++;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_deadline(&p, 1000u));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DEADLINE, fw_protect_deadline(&p, 1001u));
+    for (int k = 0; k < 10; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_watchdog_tick(&p));
+    }
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_WATCHDOG, fw_protect_watchdog_tick(&p));
+    fw_protect_watchdog_kick(&p);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_watchdog_tick(&p));
+    for (uint32_t f = 0; f < (uint32_t)FW_FAULT_COUNT; f++) {
+        TEST_ASSERT_NOT_NULL(fw_fault_name(f));
+        TEST_ASSERT_TRUE(strcmp(fw_fault_name(f), "unknown") != 0);
+    }
+    TEST_ASSERT_EQUAL_STRING("unknown", fw_fault_name(999u));
+}
+
+/* Bad configuration: NULLs and a controller without functions are rejected. */
+static void test_init_rejects(void)
+{
+    fw_t fw;
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(NULL, NULL, NULL));
+    fw_config_t fc;
+    fw_config_default(&fc, NULL, &ol_desc);
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&fw, (hal_t *)&run.hal, &fc));
+    TEST_ASSERT_NOT_NULL(fw_strerror(FW_ECTRL));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_one_period_delay);
+    RUN_TEST(test_offset_calibration);
+    RUN_TEST(test_offset_calibration_fault);
+    RUN_TEST(test_state_machine);
+    RUN_TEST(test_protect_checks);
+    RUN_TEST(test_init_rejects);
+    return UNITY_END();
+}
