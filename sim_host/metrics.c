@@ -1,0 +1,254 @@
+/*
+ * Performance indices, REFERENCE.md section 5 / thesis Appendix B. See metrics.h.
+ */
+#include "metrics.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define METRICS_PI 3.14159265358979323846
+
+void metrics_init(metrics_acc_t *m, metrics_sampling_t sampling, double f1_hz)
+{
+    if (m == NULL) {
+        return;
+    }
+    memset(m, 0, sizeof(*m));
+    m->sampling = sampling;
+    m->f1_hz = (isfinite(f1_hz) && f1_hz > 0.0) ? f1_hz : 0.0;
+    m->thd_fmax_hz = 10e3;
+    m->trans_window_s = 0.0;
+}
+
+void metrics_add(metrics_acc_t *m, double t, double torque_nm, double torque_ref_nm,
+                 double psi_amp_wb, double i_a)
+{
+    if (m == NULL) {
+        return;
+    }
+    if (m->n == 0) {
+        m->t_first = t;
+    }
+    m->t_last = t;
+    m->n++;
+    /* Welford: numerically stable mean and sum of squared deviations. */
+    const double nn = (double)m->n;
+    const double dt_ = torque_nm - m->tq_mean;
+    m->tq_mean += dt_ / nn;
+    m->tq_m2 += dt_ * (torque_nm - m->tq_mean);
+    const double dp = psi_amp_wb - m->psi_mean;
+    m->psi_mean += dp / nn;
+    m->psi_m2 += dp * (psi_amp_wb - m->psi_mean);
+    m->err_sum += torque_ref_nm - torque_nm;
+    if (m->f1_hz > 0.0 && !m->oom) {
+        if (m->ia_n == m->ia_cap) {
+            const size_t cap = m->ia_cap ? 2 * m->ia_cap : 4096;
+            double *nt = realloc(m->ia_t, cap * sizeof(double));
+            if (nt == NULL) {
+                m->oom = 1;
+                return;
+            }
+            m->ia_t = nt;
+            double *nv = realloc(m->ia_v, cap * sizeof(double));
+            if (nv == NULL) {
+                m->oom = 1;
+                return;
+            }
+            m->ia_v = nv;
+            m->ia_cap = cap;
+        }
+        m->ia_t[m->ia_n] = t;
+        m->ia_v[m->ia_n] = i_a;
+        m->ia_n++;
+    }
+}
+
+void metrics_set_transitions(metrics_acc_t *m, uint64_t transitions, double window_s)
+{
+    if (m == NULL) {
+        return;
+    }
+    m->transitions = transitions;
+    m->trans_window_s = (isfinite(window_s) && window_s > 0.0) ? window_s : 0.0;
+}
+
+double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz, double fmax_hz,
+                       int *n_harm, double *window_s, double *i1_amp)
+{
+    if (n_harm != NULL) {
+        *n_harm = 0;
+    }
+    if (window_s != NULL) {
+        *window_s = 0.0;
+    }
+    if (i1_amp != NULL) {
+        *i1_amp = NAN;
+    }
+    if (t == NULL || x == NULL || n < 3 || !(f1_hz > 0.0)) {
+        return NAN;
+    }
+    const double T1 = 1.0 / f1_hz;
+    const double span = t[n - 1] - t[0];
+    const double K = floor(span / T1 + 1e-9);
+    if (K < 1.0) {
+        return NAN;
+    }
+    const double t_end = t[0] + K * T1;
+    /* Highest harmonic: fmax and half the mean sample rate. */
+    const double fs_mean = (double)(n - 1) / span;
+    double fm = (fmax_hz > 0.0) ? fmax_hz : 10e3;
+    if (fm > 0.5 * fs_mean) {
+        fm = 0.5 * fs_mean;
+    }
+    const int N = (int)floor(fm / f1_hz + 1e-9);
+    if (N < 2) {
+        return NAN;
+    }
+    double *re = calloc((size_t)N + 1, sizeof(double));
+    double *im = calloc((size_t)N + 1, sizeof(double));
+    if (re == NULL || im == NULL) {
+        free(re);
+        free(im);
+        return NAN;
+    }
+    const double w1 = 2.0 * METRICS_PI * f1_hz;
+    /* Trapezoid as a weighted sum of points: every sample in the window gets
+     * half of each adjacent segment; the last segment is cut at t_end, whose
+     * value is interpolated. Harmonic k's phasor by repeated multiplication
+     * with the fundamental's (N products: rounding ~N * 1e-16). */
+    for (size_t j = 0; j < n && t[j] < t_end; ++j) {
+        double wgt = 0.0;
+        if (j > 0) {
+            wgt += 0.5 * (t[j] - t[j - 1]);
+        }
+        double x_end = 0.0, h_end = 0.0;
+        int cut = 0;
+        if (j + 1 < n) {
+            const double tb = t[j + 1] < t_end ? t[j + 1] : t_end;
+            h_end = tb - t[j];
+            wgt += 0.5 * h_end;
+            if (t[j + 1] >= t_end && h_end > 0.0) { /* last, cut segment */
+                const double u = (t_end - t[j]) / (t[j + 1] - t[j]);
+                x_end = x[j] + u * (x[j + 1] - x[j]);
+                cut = 1;
+            }
+        }
+        const double ph = w1 * (t[j] - t[0]);
+        const double br = cos(ph), bi = -sin(ph);
+        double zr = 1.0, zi = 0.0;
+        for (int k = 1; k <= N; ++k) {
+            const double nr = zr * br - zi * bi;
+            zi = zr * bi + zi * br;
+            zr = nr;
+            re[k] += wgt * x[j] * zr;
+            im[k] += wgt * x[j] * zi;
+        }
+        if (cut) {
+            /* the interpolated end point, weight h_end / 2, phase w1 K T1 = 2 pi K */
+            for (int k = 1; k <= N; ++k) {
+                re[k] += 0.5 * h_end * x_end;
+            }
+        }
+    }
+    const double W = K * T1;
+    double a1 = 0.0, sum = 0.0;
+    for (int k = 1; k <= N; ++k) {
+        const double amp = 2.0 / W * hypot(re[k], im[k]);
+        if (k == 1) {
+            a1 = amp;
+        } else {
+            sum += amp * amp;
+        }
+    }
+    free(re);
+    free(im);
+    if (n_harm != NULL) {
+        *n_harm = N;
+    }
+    if (window_s != NULL) {
+        *window_s = W;
+    }
+    if (i1_amp != NULL) {
+        *i1_amp = a1;
+    }
+    if (!(a1 > 0.0)) {
+        return NAN;
+    }
+    return 100.0 * sqrt(sum) / a1; /* (B.3) */
+}
+
+int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
+{
+    if (m == NULL || r == NULL) {
+        return -1;
+    }
+    memset(r, 0, sizeof(*r));
+    r->sampling = m->sampling;
+    r->f_av_hz = NAN;
+    r->thd_i_pct = NAN;
+    r->i1_amp_a = NAN;
+    if (m->n == 0 || m->oom) {
+        r->torque_mean_nm = r->torque_ripple_nm = NAN;
+        r->flux_mean_wb = r->flux_ripple_wb = r->torque_sse_nm = NAN;
+        return -1;
+    }
+    const double nn = (double)m->n;
+    r->samples = m->n;
+    r->window_s = m->t_last - m->t_first;
+    r->torque_mean_nm = m->tq_mean;
+    r->torque_ripple_nm = sqrt(m->tq_m2 / nn); /* (B.1), 1/m */
+    r->flux_mean_wb = m->psi_mean;
+    r->flux_ripple_wb = sqrt(m->psi_m2 / nn);
+    r->torque_sse_nm = m->err_sum / nn; /* (B.2) */
+    if (m->trans_window_s > 0.0) {
+        r->f_av_hz = (double)m->transitions / (2.0 * 3.0 * m->trans_window_s);
+    }
+    if (m->f1_hz > 0.0) {
+        r->thd_i_pct = metrics_thd_pct(m->ia_t, m->ia_v, m->ia_n, m->f1_hz, m->thd_fmax_hz,
+                                       &r->thd_harmonics, &r->thd_window_s, &r->i1_amp_a);
+    }
+    return 0;
+}
+
+void metrics_free(metrics_acc_t *m)
+{
+    if (m == NULL) {
+        return;
+    }
+    free(m->ia_t);
+    free(m->ia_v);
+    m->ia_t = m->ia_v = NULL;
+    m->ia_n = m->ia_cap = 0;
+}
+
+static void put_num(FILE *f, const char *key, double v, int last)
+{
+    if (isfinite(v)) {
+        fprintf(f, "  \"%s\": %.9g%s\n", key, v, last ? "" : ",");
+    } else {
+        fprintf(f, "  \"%s\": null%s\n", key, last ? "" : ",");
+    }
+}
+
+void metrics_write_json(FILE *f, const metrics_result_t *r)
+{
+    if (f == NULL || r == NULL) {
+        return;
+    }
+    fprintf(f, "{\n  \"sampling\": \"%s\",\n",
+            r->sampling == METRICS_SAMPLING_CONTROL ? "control_instants" : "plant_grid");
+    fprintf(f, "  \"samples\": %llu,\n", (unsigned long long)r->samples);
+    put_num(f, "window_s", r->window_s, 0);
+    put_num(f, "torque_mean_nm", r->torque_mean_nm, 0);
+    put_num(f, "torque_ripple_nm", r->torque_ripple_nm, 0);
+    put_num(f, "flux_mean_wb", r->flux_mean_wb, 0);
+    put_num(f, "flux_ripple_wb", r->flux_ripple_wb, 0);
+    put_num(f, "torque_sse_nm", r->torque_sse_nm, 0);
+    put_num(f, "f_av_hz", r->f_av_hz, 0);
+    put_num(f, "thd_i_pct", r->thd_i_pct, 0);
+    put_num(f, "thd_window_s", r->thd_window_s, 0);
+    fprintf(f, "  \"thd_harmonics\": %d,\n", r->thd_harmonics);
+    put_num(f, "i1_amp_a", r->i1_amp_a, 1);
+    fprintf(f, "}\n");
+}

@@ -1,0 +1,212 @@
+/*
+ * Plant model: two-level VSI (3.1) + PMSM in the rotor frame (3.8)-(3.10),
+ * optional flux-map saturation (3.11)-(3.14), mechanics (3.15). Double
+ * precision, host only; knows nothing of the controllers.
+ *
+ * Conventions (REFERENCE.md section 1): amplitude-invariant Clarke (3.3), alpha
+ * on phase a; Park (3.7) f_dq = f_ab e^{-j theta_e}; theta_e is the electrical
+ * angle of the d axis (magnet); positive torque accelerates positive speed.
+ *
+ * Integration (see plant.c for the derivation):
+ *  - linear model (no flux map, stiff DC link, no dead time, no forward drop):
+ *    EXACT between switching instants for constant speed in the sub-interval.
+ *    Over a sub-interval the alpha-beta voltage is constant, so in the rotor
+ *    frame it rotates at -omega_e; the current obeys x' = A x + B u(t) + c with
+ *    u a rotating phasor: closed form  x(t) = e^{At}(x0 - xp(0) - xc) + xp(t) + xc
+ *    (2x2 exponential in closed form, phasor particular solution xp, constant
+ *    particular solution xc). Checked against Eigen's matrix exponential.
+ *  - any non-ideality (flux map, DC link with capacitance, dead time, forward
+ *    drop, gates off): fixed-sub-step RK4 in flux coordinates (psi_d, psi_q,
+ *    vdc), sub-step cfg.rk4_step_s (default 0.5 us), still split at every
+ *    switching instant.
+ *  - free mechanics: omega is held in each sub-interval at the midpoint
+ *    prediction omega_k + dt/2 * (Te_k - T_L - B omega_k)/J, then updated
+ *    exactly for the interval's mean torque (Simpson on Te at 0, dt/2, dt).
+ *
+ * Every call splits additionally at the observer grid n * obs_dt (global time)
+ * and calls the observer with the plant state at exactly that instant, so
+ * metrics see the true continuous signals, not period-start samples.
+ */
+#ifndef SIM_HOST_PLANT_H
+#define SIM_HOST_PLANT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Error codes. */
+#define PLANT_OK 0
+#define PLANT_EINVAL (-1) /* NULL pointer, non-finite or out-of-range value */
+#define PLANT_ERANGE (-2) /* state left the valid domain (flux map, vdc < 0) */
+
+/* Leg states accepted by plant_advance: 0 = lower switch on, 1 = upper on,
+ * PLANT_LEG_OFF = both off (the leg voltage follows the current sign through
+ * the free-wheeling diodes: 0 V for i > 0, Vdc for i < 0). */
+#define PLANT_LEG_LOW 0u
+#define PLANT_LEG_HIGH 1u
+#define PLANT_LEG_OFF 2u
+
+/* Saturation flux map on a regular grid (thesis 3.2.3, theta-independent):
+ * psi_d(id, iq), psi_q(id, iq), row-major: psi[k_d * n_q + k_q] at
+ * id = id_min + k_d * did, iq = iq_min + k_q * diq. Bilinear interpolation;
+ * the inverse i(psi) by Newton on the interpolant. Loaded by plant_fluxmap_load. */
+typedef struct {
+    size_t n_d, n_q;
+    double id_min, id_max, iq_min, iq_max; /* A */
+    double *psi_d, *psi_q;                 /* Wb, n_d * n_q each (heap) */
+} plant_fluxmap_t;
+
+typedef enum {
+    PLANT_MECH_IMPOSED = 0, /* dynamometer: omega follows plant_set_speed */
+    PLANT_MECH_FREE = 1     /* (3.15): J dw_m/dt + B w_m = Te - T_L */
+} plant_mech_mode_t;
+
+typedef struct {
+    /* Machine, (3.8)-(3.10). */
+    int pole_pairs;   /* p >= 1 */
+    double rs_ohm;    /* > 0 */
+    double ld_h;      /* > 0 */
+    double lq_h;      /* > 0 */
+    double psi_pm_wb; /* >= 0 */
+    /* Optional saturation (NULL: linear model (3.9)). Not copied: must outlive
+     * the plant. psi_pm_wb, ld_h, lq_h are then only used for reporting. */
+    const plant_fluxmap_t *fluxmap;
+
+    /* Inverter (3.1). */
+    double vdc_v;        /* DC source voltage (> 0) */
+    double dc_cap_f;     /* 0: stiff DC link; > 0: link capacitor, then  */
+    double dc_src_r_ohm; /*    source resistance (> 0) between source and C */
+    double dead_time_s;  /* >= 0, default 0: both switches off after each
+                            leg transition, leg voltage follows current sign */
+    double v_fwd_v;      /* >= 0, default 0: device forward drop, leg voltage
+                            S*vdc - v_fwd*sign(i) */
+
+    /* Mechanics (3.15), mechanical units. */
+    plant_mech_mode_t mech;
+    double inertia_kgm2;   /* J > 0 (needed when mech == PLANT_MECH_FREE) */
+    double friction_nms;   /* B >= 0, N*m*s/rad (mechanical) */
+    double load_torque_nm; /* initial T_L */
+
+    /* Initial state. */
+    double theta0_e_rad; /* electrical rotor angle */
+    double id0_a, iq0_a; /* currents (with a flux map: psi from the map) */
+    double speed0_rpm;   /* mechanical speed (imposed or initial) */
+
+    /* Numerics. 0 = default. */
+    double rk4_step_s; /* sub-step of the RK4 path; default 0.5e-6 s */
+    int track_energy;  /* 1: integrate the energy terms (plant_energy), costs
+                          ~2x on the exact path (4-point Gauss-Legendre) */
+} plant_config_t;
+
+typedef struct plant plant_t;
+
+/* Observer: called at every grid instant n * obs_dt (n integer, global time)
+ * reached during an advance, with the true state at that instant. */
+typedef void (*plant_observer_fn)(void *ctx, const plant_t *p);
+
+/* Plant state. Fields are private: use the functions below. */
+struct plant {
+    plant_config_t cfg;
+    /* electrical state, rotor frame */
+    double id, iq;         /* A */
+    double psi_d, psi_q;   /* Wb */
+    double theta_e;        /* electrical angle, wrapped to [-pi, pi) */
+    double theta_m;        /* mechanical angle, unwrapped (rad) */
+    double omega_m;        /* mechanical speed, rad/s */
+    double vdc;            /* V */
+    double t;              /* simulated time, s */
+    double load_torque_nm; /* T_L */
+    uint8_t s[3];          /* last applied leg states (for transitions) */
+    uint8_t s_valid;
+    uint64_t transitions[3]; /* leg transitions since init (on and off) */
+    double dead_end[3];      /* leg x is off (dead time) until this time */
+    /* observer */
+    plant_observer_fn obs;
+    void *obs_ctx;
+    double obs_dt;
+    int64_t obs_next; /* index of the next grid instant */
+    /* linear-model constants */
+    int linear_exact;
+    /* cos, sin of theta_e == trig_key, carried by rotation on the exact path */
+    double trig_c, trig_s, trig_key;
+    int trig_n; /* rotations since the last direct evaluation; 0 = invalid */
+    /* energy accounting (cfg.track_energy): integrated over every advance */
+    double e_in_j;   /* inverter output energy into the machine, J (sum v_leg i) */
+    double e_cu_j;   /* copper loss, J: integral 1.5 Rs |i|^2 */
+    double e_mech_j; /* electromagnetic -> mechanical, J: integral Te w_m */
+    double e_src_j;  /* energy delivered by the DC source, J (= e_in_j when stiff) */
+};
+
+/* Validate cfg and set the initial state. Returns PLANT_OK or PLANT_EINVAL
+ * (p is then zeroed). */
+int plant_init(plant_t *p, const plant_config_t *cfg);
+
+/* Hold leg states s[0..2] (PLANT_LEG_*) for dt >= 0 seconds. Exact for the
+ * linear model. Returns PLANT_OK, PLANT_EINVAL (bad argument) or PLANT_ERANGE. */
+int plant_advance(plant_t *p, double dt, const uint8_t s[3]);
+
+/* Test / ideal-source input (linear model only, else PLANT_EINVAL): hold the
+ * stator voltage v_ab(t) = v_amp e^{j (omega_v t + phase)} (t = plant time)
+ * for dt, integrated exactly. omega_v = 0: a constant alpha-beta vector. Leg
+ * states and transition counts are not touched. */
+int plant_advance_voltage_ab(plant_t *p, double dt, double v_amp, double omega_v, double phase);
+
+/* One centre-aligned PWM period of length T: leg x is high during
+ * [T(1-d_x)/2, T(1+d_x)/2], duty d_x clamped to [0, 1]; the legs switch at
+ * their exact instants (sorted; integrated exactly between them). */
+int plant_advance_period(plant_t *p, double T, const double duty[3]);
+
+/* Observer on the grid n * obs_dt; fn == NULL or obs_dt <= 0 removes it. The
+ * first call is at the first grid instant strictly after the current time. */
+void plant_set_observer(plant_t *p, plant_observer_fn fn, void *ctx, double obs_dt);
+
+/* Time-varying inputs: call between advances (piecewise-constant profiles). */
+void plant_set_load_torque(plant_t *p, double t_load_nm);
+void plant_set_speed_rpm(plant_t *p, double rpm); /* imposed speed (and free: sets the state) */
+
+/* True state getters. */
+double plant_time(const plant_t *p);
+void plant_i_abc(const plant_t *p, double i_abc[3]);
+void plant_i_dq(const plant_t *p, double *id, double *iq);
+void plant_i_ab(const plant_t *p, double *i_alpha, double *i_beta);
+void plant_psi_dq(const plant_t *p, double *psi_d, double *psi_q);
+void plant_psi_ab(const plant_t *p, double *psi_alpha, double *psi_beta);
+double plant_psi_amp(const plant_t *p); /* |psi_s| (4.3) */
+double plant_torque(const plant_t *p);  /* (3.10): 1.5 p (psi_d iq - psi_q id) */
+double plant_theta_e(const plant_t *p); /* [-pi, pi) */
+double plant_omega_e(const plant_t *p); /* rad/s electrical */
+double plant_theta_m(const plant_t *p); /* rad mechanical, unwrapped */
+double plant_omega_m(const plant_t *p); /* rad/s mechanical */
+double plant_vdc(const plant_t *p);
+uint64_t plant_transitions(const plant_t *p); /* total of the three legs */
+/* Stored magnetic energy of the linear model, 1.5 (Ld id^2 + Lq iq^2)/2 J
+ * (with a flux map: NaN, not provided). Capacitor energy: C vdc^2 / 2. */
+double plant_magnetic_energy(const plant_t *p);
+/* Energy integrals since init (cfg.track_energy must be 1, else all 0):
+ * e_src = source output, e_in = inverter output to the machine, e_cu = copper
+ * loss, e_mech = integral Te * w_m. Balance: e_in = e_cu + e_mech + dW_mag. */
+void plant_energy(const plant_t *p, double *e_src_j, double *e_in_j, double *e_cu_j,
+                  double *e_mech_j);
+
+/* Flux maps: CSV "id_a,iq_a,psi_d_wb,psi_q_wb" (header line, then rows on a
+ * full regular grid in any order). Returns PLANT_OK or PLANT_EINVAL with a
+ * message (file, line) in err. plant_fluxmap_free releases the arrays. */
+int plant_fluxmap_load(plant_fluxmap_t *m, const char *path, char *err, size_t errlen);
+void plant_fluxmap_free(plant_fluxmap_t *m);
+/* psi(i) by bilinear interpolation (clamped extrapolation is linear). */
+void plant_fluxmap_psi(const plant_fluxmap_t *m, double id, double iq, double *psi_d,
+                       double *psi_q);
+/* i(psi) by damped Newton on the interpolant. *id, *iq on entry: initial
+ * guess (used if finite, else the map's origin secant). Converges to
+ * |psi(i) - psi| < 1e-12 Wb; returns PLANT_OK or PLANT_ERANGE. */
+int plant_fluxmap_current(const plant_fluxmap_t *m, double psi_d, double psi_q, double *id,
+                          double *iq);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIM_HOST_PLANT_H */

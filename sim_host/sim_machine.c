@@ -1,0 +1,210 @@
+/*
+ * Machine INI loader (libinih). Every key is checked for presence, syntax and
+ * range; unknown sections and keys are rejected. Errors name the key and,
+ * for malformed values, the line.
+ */
+#include "sim_machine.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum { K_TEXT, K_INT, K_REAL, K_PATH } key_kind_t;
+
+typedef struct {
+    const char *section, *name;
+    key_kind_t kind;
+    int required;
+    double lo, hi; /* accepted closed range (REAL / INT) */
+    int lo_open;   /* 1: lo excluded (strictly positive quantities) */
+    double scale;  /* stored value = parsed * scale */
+    size_t offset; /* into sim_machine_t */
+} key_t_;
+
+#define OFF(f) offsetof(sim_machine_t, f)
+static const key_t_ k_keys[] = {
+    {"machine", "name", K_TEXT, 1, 0, 0, 0, 1.0, OFF(name)},
+    {"machine", "pole_pairs", K_INT, 1, 1, 50, 0, 1.0, OFF(pole_pairs)},
+    {"machine", "rs_ohm", K_REAL, 1, 0, 100, 1, 1.0, OFF(rs_ohm)},
+    {"machine", "ld_mh", K_REAL, 1, 0, 1e4, 1, 1e-3, OFF(ld_h)},
+    {"machine", "lq_mh", K_REAL, 1, 0, 1e4, 1, 1e-3, OFF(lq_h)},
+    {"machine", "psi_pm_wb", K_REAL, 1, 0, 10, 0, 1.0, OFF(psi_pm_wb)},
+    {"rated", "torque_nm", K_REAL, 1, 0, 1e5, 1, 1.0, OFF(torque_rated_nm)},
+    {"rated", "speed_rpm", K_REAL, 1, 0, 1e6, 1, 1.0, OFF(speed_rated_rpm)},
+    {"rated", "current_a", K_REAL, 1, 0, 1e5, 1, 1.0, OFF(current_rated_a)},
+    {"rated", "current_max_a", K_REAL, 1, 0, 1e5, 1, 1.0, OFF(current_max_a)},
+    {"rated", "psi_ref_wb", K_REAL, 0, 0, 10, 0, 1.0, OFF(psi_ref_wb)},
+    {"inverter", "vdc_v", K_REAL, 1, 0, 1e5, 1, 1.0, OFF(vdc_v)},
+    {"inverter", "fs_hz", K_REAL, 1, 100, 1e6, 0, 1.0, OFF(fs_hz)},
+    {"inverter", "dead_time_ns", K_REAL, 0, 0, 1e5, 0, 1e-9, OFF(dead_time_s)},
+    {"inverter", "v_fwd_v", K_REAL, 0, 0, 100, 0, 1.0, OFF(v_fwd_v)},
+    {"inverter", "dc_cap_uf", K_REAL, 0, 0, 1e9, 0, 1e-6, OFF(dc_cap_f)},
+    {"inverter", "dc_src_r_ohm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(dc_src_r_ohm)},
+    {"mechanics", "inertia_kgm2", K_REAL, 1, 0, 1e6, 1, 1.0, OFF(inertia_kgm2)},
+    {"mechanics", "friction_nms", K_REAL, 0, 0, 1e6, 0, 1.0, OFF(friction_nms)},
+    {"fluxmap", "file", K_PATH, 0, 0, 0, 0, 1.0, OFF(fluxmap_path)},
+};
+#define N_KEYS (sizeof(k_keys) / sizeof(k_keys[0]))
+
+typedef struct {
+    sim_machine_t *m;
+    unsigned char seen[N_KEYS];
+    char msg[256];
+    const char *dir; /* folder of the INI file, for relative paths */
+    size_t dirlen;
+} ctx_t;
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    ctx_t *c = user;
+    int section_known = 0;
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        const key_t_ *K = &k_keys[k];
+        if (strcmp(section, K->section) != 0) {
+            continue;
+        }
+        section_known = 1;
+        if (strcmp(name, K->name) != 0) {
+            continue;
+        }
+        if (c->seen[k]) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s given twice", section, name);
+            return 0;
+        }
+        c->seen[k] = 1;
+        char *dst = (char *)c->m + K->offset;
+        if (K->kind == K_TEXT || K->kind == K_PATH) {
+            if (value[0] == '\0') {
+                snprintf(c->msg, sizeof c->msg, "[%s] %s is empty", section, name);
+                return 0;
+            }
+            size_t cap = (K->kind == K_TEXT) ? SIM_MACHINE_NAME_MAX : SIM_MACHINE_PATH_MAX;
+            int n;
+            if (K->kind == K_PATH && value[0] != '/' && c->dirlen > 0) {
+                n = snprintf(dst, cap, "%.*s/%s", (int)c->dirlen, c->dir, value);
+            } else {
+                n = snprintf(dst, cap, "%s", value);
+            }
+            if (n < 0 || (size_t)n >= cap) {
+                snprintf(c->msg, sizeof c->msg, "[%s] %s is too long", section, name);
+                return 0;
+            }
+            return 1;
+        }
+        char *end;
+        errno = 0;
+        const double v = strtod(value, &end);
+        if (end == value || *end != '\0' || errno != 0 || !isfinite(v)) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s = '%s' is not a number", section, name, value);
+            return 0;
+        }
+        const int below = K->lo_open ? !(v > K->lo) : !(v >= K->lo);
+        if (below || !(v <= K->hi)) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s = %g out of range %s%g, %g]", section, name, v,
+                     K->lo_open ? "(" : "[", K->lo, K->hi);
+            return 0;
+        }
+        if (K->kind == K_INT) {
+            if (v != floor(v)) {
+                snprintf(c->msg, sizeof c->msg, "[%s] %s = %g is not an integer", section, name, v);
+                return 0;
+            }
+            *(int *)(void *)dst = (int)v;
+        } else {
+            *(double *)(void *)dst = v * K->scale;
+        }
+        return 1;
+    }
+    if (!section_known) {
+        snprintf(c->msg, sizeof c->msg, "unknown section [%s] (key %s)", section, name);
+    } else {
+        snprintf(c->msg, sizeof c->msg, "unknown key %s in [%s]", name, section);
+    }
+    return 0;
+}
+
+int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen)
+{
+    char dummy[8];
+    if (err == NULL || errlen == 0) {
+        err = dummy;
+        errlen = sizeof dummy;
+    }
+    err[0] = '\0';
+    if (path == NULL || out == NULL) {
+        snprintf(err, errlen, "sim_machine_load: NULL argument");
+        return -1;
+    }
+    memset(out, 0, sizeof(*out));
+    ctx_t c;
+    memset(&c, 0, sizeof c);
+    c.m = out;
+    c.dir = path;
+    const char *slash = strrchr(path, '/');
+    c.dirlen = (slash != NULL) ? (size_t)(slash - path) : 0;
+    if (slash == NULL) {
+        c.dir = ".";
+        c.dirlen = 1;
+    }
+    FILE *f = fopen(path, "r");
+    if (f == NULL) {
+        snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+        return -1;
+    }
+    const int line = ini_parse_file(f, handler, &c);
+    fclose(f);
+    if (line != 0) {
+        if (c.msg[0] != '\0') {
+            snprintf(err, errlen, "%s:%d: %s", path, line, c.msg);
+        } else {
+            snprintf(err, errlen, "%s:%d: syntax error", path, line);
+        }
+        memset(out, 0, sizeof(*out));
+        return -1;
+    }
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        if (k_keys[k].required && !c.seen[k]) {
+            snprintf(err, errlen, "%s: missing key %s in [%s]", path, k_keys[k].name,
+                     k_keys[k].section);
+            memset(out, 0, sizeof(*out));
+            return -1;
+        }
+    }
+    /* Cross-field rules. */
+    const char *bad = NULL;
+    if (!(out->current_max_a > out->current_rated_a)) {
+        bad = "[rated] current_max_a must exceed current_a";
+    } else if (out->dc_cap_f > 0.0 && !(out->dc_src_r_ohm > 0.0)) {
+        bad = "[inverter] dc_src_r_ohm is required (> 0) when dc_cap_uf > 0";
+    } else if (out->dead_time_s * out->fs_hz > 0.1) {
+        bad = "[inverter] dead_time_ns exceeds 10 % of the PWM period";
+    }
+    if (bad != NULL) {
+        snprintf(err, errlen, "%s: %s", path, bad);
+        memset(out, 0, sizeof(*out));
+        return -1;
+    }
+    return 0;
+}
+
+void sim_machine_to_plant(const sim_machine_t *m, plant_config_t *cfg)
+{
+    memset(cfg, 0, sizeof(*cfg));
+    cfg->pole_pairs = m->pole_pairs;
+    cfg->rs_ohm = m->rs_ohm;
+    cfg->ld_h = m->ld_h;
+    cfg->lq_h = m->lq_h;
+    cfg->psi_pm_wb = m->psi_pm_wb;
+    cfg->fluxmap = NULL;
+    cfg->vdc_v = m->vdc_v;
+    cfg->dc_cap_f = m->dc_cap_f;
+    cfg->dc_src_r_ohm = m->dc_src_r_ohm;
+    cfg->dead_time_s = m->dead_time_s;
+    cfg->v_fwd_v = m->v_fwd_v;
+    cfg->mech = PLANT_MECH_IMPOSED;
+    cfg->inertia_kgm2 = m->inertia_kgm2;
+    cfg->friction_nms = m->friction_nms;
+}

@@ -1,0 +1,55 @@
+/*
+ * Machine description files (INI, parsed with libinih): everything the plant
+ * and the controller configuration need about one drive, in SI units.
+ *
+ * Sections and keys (all required unless marked optional):
+ *   [machine]   name (text), pole_pairs, rs_ohm, ld_mh, lq_mh, psi_pm_wb
+ *   [rated]     torque_nm, speed_rpm, current_a (peak), current_max_a (peak,
+ *               over-current trip, > current_a), psi_ref_wb (optional, 0 = MTPA)
+ *   [inverter]  vdc_v, fs_hz (default control/PWM frequency),
+ *               dead_time_ns (optional, 0), v_fwd_v (optional, 0),
+ *               dc_cap_uf (optional, 0 = stiff), dc_src_r_ohm (optional, needed if dc_cap_uf > 0)
+ *   [mechanics] inertia_kgm2, friction_nms (optional, 0)
+ *   [fluxmap]   file (optional, CSV path relative to the INI file's folder)
+ * Unknown sections and unknown keys are REJECTED (a typo must not silently
+ * fall back to a default). Values must be finite numbers in range.
+ */
+#ifndef SIM_HOST_SIM_MACHINE_H
+#define SIM_HOST_SIM_MACHINE_H
+
+#include <stddef.h>
+
+#include "plant.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SIM_MACHINE_NAME_MAX 64
+#define SIM_MACHINE_PATH_MAX 512
+
+typedef struct {
+    char name[SIM_MACHINE_NAME_MAX];
+    int pole_pairs;
+    double rs_ohm, ld_h, lq_h, psi_pm_wb;
+    double torque_rated_nm, speed_rated_rpm, current_rated_a, current_max_a, psi_ref_wb;
+    double vdc_v;
+    double fs_hz;
+    double dead_time_s, v_fwd_v, dc_cap_f, dc_src_r_ohm;
+    double inertia_kgm2, friction_nms;
+    char fluxmap_path[SIM_MACHINE_PATH_MAX]; /* "" = none; resolved path */
+} sim_machine_t;
+
+/* Returns 0 on success; otherwise -1 and a message naming the key (and the
+ * line for malformed values) in err. */
+int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen);
+
+/* Fill a plant configuration from a machine (mechanics imposed, zero initial
+ * state, no flux map: the caller loads cfg.fluxmap if it wants saturation). */
+void sim_machine_to_plant(const sim_machine_t *m, plant_config_t *cfg);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SIM_HOST_SIM_MACHINE_H */
