@@ -1,0 +1,43 @@
+/* Conventional M2PTFC (M1), thesis §6.4.2 with (5.18) and (6.13). Integer only. */
+#include "ctrl_m1.h"
+
+#include "plan.h"
+
+void ctrl_m1_reset(void *state)
+{
+    ctrl_m1_t *s = state;
+    s->trace.n = 0u;
+}
+
+void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ctrl_m1_t *s = state;
+    const q24_t t_ref = ctx->ref->torque;
+    ctrl_mpc_basis_t b;
+    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    const q24_t psi_ref = ctrl_mpc_ref_amp(&b, ctrl_mpc_psi_ref(ctx->params, ctx->ref));
+
+    /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
+    const q24_t num = fx_sub(t_ref, b.t0);
+    int64_t best_g = INT64_MAX;
+    uint8_t best_v = 1u;
+    q24_t best_d = 0;
+    for (uint8_t i = 1u; i <= 6u; i++) {
+        q24_t vd;
+        q24_t vq;
+        ctrl_mpc_vec_dq(&b, i, &vd, &vq);
+        const q24_t t_full = ctrl_mpc_torque(&s->model, b.d0 + vd, b.q0 + vq);
+        const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, b.t0)); /* (5.18) */
+        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &b, vd, vq, duty, t_ref, psi_ref,
+                                                 s->zeta); /* (6.13) */
+        s->trace.vec[i - 1u] = i;
+        s->trace.duty[i - 1u] = duty;
+        if (g < best_g) {
+            best_g = g;
+            best_v = i;
+            best_d = duty;
+        }
+    }
+    s->trace.n = 6u;
+    ctrl_plan_active_zero(out, best_v, best_d);
+}

@@ -1,0 +1,78 @@
+/* Discrete-duty M2PTFC (M2), thesis §6.4.2 with (6.15)-(6.17). Integer only. */
+#include "ctrl_m2.h"
+
+#include "plan.h"
+#include "vectors.h"
+
+uint8_t ctrl_m2_table(uint8_t sector, int torque_up, int flux_up)
+{
+    int n;
+    if (torque_up) {
+        n = flux_up ? 1 : 2;
+    } else {
+        n = flux_up ? 5 : 4;
+    }
+    return ctrl_vec_wrap((int)sector + n);
+}
+
+void ctrl_m2_reset(void *state)
+{
+    ctrl_m2_t *s = state;
+    s->trace.n = 0u;
+}
+
+void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ctrl_m2_t *s = state;
+    const q24_t t_ref = ctx->ref->torque;
+    const q24_t psi_ref = ctrl_mpc_psi_ref(ctx->params, ctx->ref);
+    ctrl_mpc_basis_t b;
+    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+
+    const int32_t r2 = ctrl_mpc_ref_amp2(&b, psi_ref);
+    const uint8_t vec =
+        ctrl_m2_table(ctx->est->next.sector, t_ref >= b.t0, r2 >= ctrl_mpc_amp2(b.d0, b.q0));
+    q24_t vd;
+    q24_t vq;
+    ctrl_mpc_vec_dq(&b, vec, &vd, &vq);
+
+    /* Band of (6.17) on squared amplitudes. */
+    const q24_t lo = fx_max(fx_sub(psi_ref, s->eps_psi), 0);
+    const int32_t lo2 = ctrl_mpc_ref_amp2(&b, lo);
+    const int32_t hi2 = ctrl_mpc_ref_amp2(&b, fx_add(psi_ref, s->eps_psi));
+
+    int64_t best_g = INT64_MAX; /* best feasible |T_ref - Te| (6.16) */
+    unsigned best = 0u;
+    unsigned best_flux = 0u; /* fallback: smallest |psi_ref - |psi|| */
+    int32_t best_flux_a2 = 0;
+    for (unsigned nu = 0; nu <= s->y; nu++) {
+        q24_t pd;
+        q24_t pq;
+        ctrl_mpc_flux(&b, vd, vq, s->d_nu[nu], &pd, &pq);
+        const int32_t a2 = ctrl_mpc_amp2(pd, pq);
+        if (nu == 0u || ctrl_mpc_closer(a2, best_flux_a2, r2) < 0) {
+            best_flux = nu;
+            best_flux_a2 = a2;
+        }
+        s->trace.vec[nu] = vec;
+        s->trace.duty[nu] = s->d_nu[nu];
+        if (a2 < lo2 || a2 > hi2) {
+            continue; /* phi = infinity (6.17) */
+        }
+        const int64_t e_t = (int64_t)t_ref - ctrl_mpc_torque(&s->model, pd, pq);
+        const int64_t g = e_t < 0 ? -e_t : e_t;
+        if (g < best_g) {
+            best_g = g;
+            best = nu;
+        }
+    }
+    s->trace.n = (uint8_t)(s->y + 1u);
+    if (best_g == INT64_MAX) {
+        best = best_flux;
+    }
+    if (best == 0u) {
+        ctrl_plan_single(out, ctrl_mpc_zero_vector(ctx->applied));
+    } else {
+        ctrl_plan_active_zero(out, vec, s->d_nu[best]);
+    }
+}

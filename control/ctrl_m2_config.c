@@ -1,0 +1,66 @@
+/* M2 configuration and descriptor (SI -> Q24; floating point allowed here). */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "ctrl_m2.h"
+
+static const ctrl_tunable_t m2_tunables[] = {
+    {"eps_psi", "Wb",
+     "flux band of the hard constraint (6.17); Table 6.2: 0.0066 at 750 r/min, 0.00942 at "
+     "2250 r/min",
+     offsetof(ctrl_m2_cfg_t, eps_psi), 1e-6, 1.0},
+    {"y", "1", "number of discrete duty steps D = nu/y (6.15); Table 6.1: 4",
+     offsetof(ctrl_m2_cfg_t, y), 1.0, (double)CTRL_M2_Y_MAX},
+    CTRL_MPC_MODEL_TUNABLES(ctrl_m2_cfg_t),
+};
+
+static void m2_cfg_default(void *cfg, const ctrl_machine_t *machine)
+{
+    ctrl_m2_cfg_t *c = cfg;
+    memset(c, 0, sizeof *c);
+    c->eps_psi = 6.60e-3; /* Table 6.2, 750 r/min */
+    c->y = 4.0;           /* Table 6.1 */
+    ctrl_mpc_model_cfg_default(&c->model, machine);
+}
+
+static int m2_init(void *state, const void *cfg, const ctrl_params_t *params)
+{
+    ctrl_m2_t *s = state;
+    const ctrl_m2_cfg_t *c = cfg;
+    if (s == NULL || c == NULL || params == NULL) {
+        return CTRL_EINVAL;
+    }
+    memset(s, 0, sizeof *s);
+    if (!isfinite(c->y) || c->y < 1.0 || c->y > (double)CTRL_M2_Y_MAX || c->y != floor(c->y) ||
+        !isfinite(c->eps_psi) || !(c->eps_psi > 0.0)) {
+        return CTRL_EINVAL;
+    }
+    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    if (rc == CTRL_OK) {
+        rc = ctrl_mpc_flux_pu(&c->model, params, c->eps_psi, &s->eps_psi);
+    }
+    if (rc != CTRL_OK) {
+        return rc;
+    }
+    s->y = (uint8_t)c->y;
+    for (unsigned nu = 0; nu <= s->y; nu++) {
+        s->d_nu[nu] = ctrl_q24_from_double((double)nu / c->y); /* (6.15) */
+    }
+    return CTRL_OK;
+}
+
+const ctrl_desc_t ctrl_desc_m2 = {
+    .name = "m2",
+    .title = "Discrete-duty M2PTFC: D = nu/y (6.15), cost (6.16) with flux band (6.17) "
+             "(thesis 6.4.2)",
+    .fs_default_hz = 10000u,
+    .state_size = sizeof(ctrl_m2_t),
+    .cfg_size = sizeof(ctrl_m2_cfg_t),
+    .tunables = m2_tunables,
+    .n_tunables = sizeof m2_tunables / sizeof m2_tunables[0],
+    .cfg_default = m2_cfg_default,
+    .init = m2_init,
+    .reset = ctrl_m2_reset,
+    .step = ctrl_m2_step,
+};

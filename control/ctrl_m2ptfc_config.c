@@ -1,0 +1,54 @@
+/* M2PTFC configuration and descriptor (SI -> Q24; floating point allowed here). */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "ctrl_m2ptfc.h"
+
+static const ctrl_tunable_t m2ptfc_tunables[] = {
+    {"lambda", "1", "EMA coefficient of sigma_T (6.8); Table 6.2: 0.03 (750 and 2250 r/min)",
+     offsetof(ctrl_m2ptfc_cfg_t, lambda), 1e-4, 1.0},
+    CTRL_MPC_MODEL_TUNABLES(ctrl_m2ptfc_cfg_t),
+};
+
+static void m2ptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
+{
+    ctrl_m2ptfc_cfg_t *c = cfg;
+    memset(c, 0, sizeof *c);
+    c->lambda = 0.03; /* Table 6.2 */
+    ctrl_mpc_model_cfg_default(&c->model, machine);
+}
+
+static int m2ptfc_init(void *state, const void *cfg, const ctrl_params_t *params)
+{
+    ctrl_m2ptfc_t *s = state;
+    const ctrl_m2ptfc_cfg_t *c = cfg;
+    if (s == NULL || c == NULL || params == NULL) {
+        return CTRL_EINVAL;
+    }
+    memset(s, 0, sizeof *s);
+    if (!isfinite(c->lambda) || !(c->lambda > 0.0) || c->lambda > 1.0) {
+        return CTRL_EINVAL;
+    }
+    const int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    if (rc != CTRL_OK) {
+        return rc;
+    }
+    s->lambda = ctrl_q24_from_double(c->lambda);
+    ctrl_m2ptfc_reset(s);
+    return CTRL_OK;
+}
+
+const ctrl_desc_t ctrl_desc_m2ptfc = {
+    .name = "m2ptfc",
+    .title = "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
+    .fs_default_hz = 10000u,
+    .state_size = sizeof(ctrl_m2ptfc_t),
+    .cfg_size = sizeof(ctrl_m2ptfc_cfg_t),
+    .tunables = m2ptfc_tunables,
+    .n_tunables = sizeof m2ptfc_tunables / sizeof m2ptfc_tunables[0],
+    .cfg_default = m2ptfc_cfg_default,
+    .init = m2ptfc_init,
+    .reset = ctrl_m2ptfc_reset,
+    .step = ctrl_m2ptfc_step,
+};

@@ -1,0 +1,167 @@
+/* k+2 prediction model of the chapter-6 predictive controllers (see the header). */
+#include "ctrl_m2ptfc_model.h"
+
+#include <stddef.h>
+
+#include "mtpa.h"
+#include "predict.h"
+#include "vectors.h"
+
+/* sqrt(3)/2 and 1/2 in Q24 (0.8660254037844386 * 2^24, rounded). */
+#define MPC_SQRT3_2 ((q24_t)14529495)
+#define MPC_HALF ((q24_t)(FX_ONE / 2))
+
+void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                    ctrl_mpc_basis_t *b)
+{
+    const ctrl_mstate_t *n = &est->next;
+    /* (6.10) with a zero vector, alpha/beta: psi(k+1) - Ts Rs i(k+1). The
+     * clamps only act on states far outside any machine's range; they give the
+     * fast arithmetic its bounds (ctrl_mpc_basis_t). */
+    const q24_t ia = fx_clamp(n->i_alpha, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
+    const q24_t ib = fx_clamp(n->i_beta, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
+    const q24_t fa = fx_clamp(n->psi_alpha, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t fb = fx_clamp(n->psi_beta, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    /* |Ts Rs i| <= 64 pu and |psi| <= 8 pu: the differences fit an int32_t. */
+    const q24_t pa =
+        fx_clamp(fa - ctrl_mpc_mulr(m->ts_rs, ia), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t pb =
+        fx_clamp(fb - ctrl_mpc_mulr(m->ts_rs, ib), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    /* theta(k+2) = theta(k+1) + omega Ts (unsigned angle arithmetic wraps a turn). */
+    const fx_angle_t th2 = n->theta_e + ctrl_angle_step(p, est->omega_e);
+    q24_t s;
+    q24_t c;
+    fx_sincos(th2, &s, &c);
+    /* Park (3.7): d = c a + s b, q = c b - s a. */
+    b->d0 = ctrl_mpc_dotr(c, s, pa, pb);
+    b->q0 = ctrl_mpc_dotr(c, -s, pb, pa);
+    b->t0 = ctrl_mpc_torque(m, b->d0, b->q0);
+    b->mag2 = ctrl_mpc_dotr(s, c, s, c);
+    /* Ts V1 = Ts 2/3 Vdc on alpha; in the rotor frame Ts|V| e^{-j th2}:
+     * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
+     * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
+    const q24_t mv = ctrl_mpc_mulr(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
+    const q24_t c1 = ctrl_mpc_dotr(c, s, MPC_HALF, MPC_SQRT3_2);
+    const q24_t s1 = ctrl_mpc_dotr(s, -c, MPC_HALF, MPC_SQRT3_2);
+    const q24_t w0d = ctrl_mpc_mulr(mv, c);
+    const q24_t w0q = -ctrl_mpc_mulr(mv, s);
+    const q24_t w1d = ctrl_mpc_mulr(mv, c1);
+    const q24_t w1q = -ctrl_mpc_mulr(mv, s1);
+    /* V3 = V1 e^{j 2pi/3} = V2 - V1; V_{i+3} = -V_i. */
+    const q24_t w2d = w1d - w0d;
+    const q24_t w2q = w1q - w0q;
+    b->wd[0] = w0d;
+    b->wq[0] = w0q;
+    b->wd[1] = w1d;
+    b->wq[1] = w1q;
+    b->wd[2] = w2d;
+    b->wq[2] = w2q;
+    b->wd[3] = -w0d;
+    b->wq[3] = -w0q;
+    b->wd[4] = -w1d;
+    b->wq[4] = -w1q;
+    b->wd[5] = -w2d;
+    b->wq[5] = -w2q;
+}
+
+q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref)
+{
+    if (ref->psi > 0) {
+        return ref->psi;
+    }
+    if (p->psi_ref > 0) {
+        return p->psi_ref;
+    }
+    return ctrl_mtpa_psi(p, ref->torque);
+}
+
+uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied)
+{
+    if (applied == NULL || applied->n_seg == 0u) {
+        return 0u;
+    }
+    return ctrl_zero_after(applied->vec[0]);
+}
+
+q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d)
+{
+    if (d == 0u || n >= d) {
+        return FX_ONE;
+    }
+    /* Keep d below 2^24 so that r * 2^8 < 2^32 below (never taken for
+     * realistic torque deviations, which are far below 1 pu = 2^24). */
+    while (d >= ((uint32_t)1 << 24)) {
+        d >>= 1;
+        n >>= 1;
+    }
+    /* Long division in three 8-bit digits: q = n 2^24 / d. */
+    uint32_t r = n << 8;
+    const uint32_t q1 = r / d;
+    r -= q1 * d;
+    r <<= 8;
+    const uint32_t q2 = r / d;
+    r -= q2 * d;
+    r <<= 8;
+    const uint32_t q3 = r / d;
+    r -= q3 * d;
+    uint32_t q = (q1 << 16) + (q2 << 8) + q3;
+    if (r >= d - r) {
+        q++; /* round to nearest: remainder >= d/2 */
+    }
+    return q > (uint32_t)FX_ONE ? FX_ONE : (q24_t)q;
+}
+
+q24_t ctrl_mpc_duty_sat(q24_t num, q24_t den)
+{
+    int64_t n = num;
+    int64_t d = den;
+    if (d == 0) {
+        return n > 0 ? FX_ONE : 0;
+    }
+    if (d < 0) {
+        n = -n;
+        d = -d;
+    }
+    if (n <= 0) {
+        return 0;
+    }
+    if (n >= d) {
+        return FX_ONE;
+    }
+    return ctrl_mpc_ratio((uint32_t)n, (uint32_t)d);
+}
+
+int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2)
+{
+    if (r2 > ((int32_t)1 << 28)) {
+        r2 = (int32_t)1 << 28; /* r <= 4 pu keeps the products below 2^63 */
+    }
+    const int sab = (a2 > b2) - (a2 < b2); /* sign(a - b) */
+    if (sab == 0) {
+        return 0;
+    }
+    /* sign(a + b - 2r): a + b > 2r <=> A + B + 2 sqrt(AB) > 4R
+     * <=> 2 sqrt(AB) > S = 4R - A - B <=> (S < 0) or 4AB > S^2. */
+    const int64_t sum = 4 * (int64_t)r2 - (int64_t)a2 - (int64_t)b2;
+    int ssum;
+    if (sum < 0) {
+        ssum = 1;
+    } else {
+        const int64_t lhs = 4 * (int64_t)a2 * (int64_t)b2;
+        const int64_t rhs = sum * sum;
+        ssum = (lhs > rhs) - (lhs < rhs);
+    }
+    return sab * ssum;
+}
+
+int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
+                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta)
+{
+    q24_t pd;
+    q24_t pq;
+    ctrl_mpc_flux(b, vd, vq, duty, &pd, &pq);
+    const q24_t te = ctrl_mpc_torque(m, pd, pq);
+    const int64_t e_t = (int64_t)t_ref - te;
+    const q24_t e_psi = fx_abs(fx_sub(psi_ref, fx_mag(pd, pq)));
+    return (e_t < 0 ? -e_t : e_t) + fx_mul(zeta, e_psi);
+}

@@ -1,0 +1,220 @@
+/*
+ * k+2 prediction model shared by the modulated predictive controllers of
+ * thesis chapter 6 (m2ptfc, m1, mptfc, m3, m2).
+ *
+ * Delay compensation (§6.3.4): the estimator hands over the state at k+1
+ * predicted with the plan applied during [k, k+1) ((6.10)-(6.12)); a vector
+ * chosen now acts during [k+1, k+2), so every candidate is evaluated at k+2.
+ *
+ * The prediction is (6.10)-(6.12) with the current in the rotor frame
+ * ((6.12) generalised to Ld != Lq, as ctrl_predict() in predict.h), but
+ * arranged so that one sample needs one fx_sincos and no square root:
+ *   psi(k+2) = psi0 + D Ts V_i,   psi0 = psi(k+1) - Ts Rs i(k+1)   (6.10)
+ * is linear in the duty D, so psi0 and every Ts V_i are rotated once into the
+ * rotor frame at theta(k+2) = theta(k+1) + omega Ts. There, from
+ * i_d = (psi_d - psi_pm)/Ld, i_q = psi_q/Lq and Te = psi x i (3.6)/(6.11):
+ *   Te = psi_q (psi_pm/Ld + psi_d (1/Lq - 1/Ld)) = psi_q (a + b psi_d)   [pu]
+ * and the amplitude is rotation invariant, |psi|^2 = psi_d^2 + psi_q^2.
+ * The six active vectors in the rotor frame follow from V1 by the exact
+ * rotations e^{j pi/3} (V2), e^{j 2pi/3} = e^{j pi/3} - 1 (V3), and V_{i+3} = -V_i.
+ *
+ * All q24_t values are Q24 per-unit (bases in ctrl_params.h).
+ */
+#ifndef CONTROL_CTRL_M2PTFC_MODEL_H
+#define CONTROL_CTRL_M2PTFC_MODEL_H
+
+#include <stdint.h>
+
+#include "ctrl_params.h"
+#include "ctrl_types.h"
+#include "fx.h"
+
+/* Model constants, computed once from the machine (ctrl_m2ptfc_model_config.c). */
+typedef struct {
+    q24_t a;     /* psi_pm / Ld, Q24 pu (1.0 with the project's bases) */
+    q24_t b;     /* 1/Lq - 1/Ld, Q24 pu (0 for an SPMSM, < 0 for an IPMSM) */
+    q24_t ts_rs; /* Ts Rs, Q24 pu */
+    q24_t ts_v;  /* Ts * 2/3: |V_i| Ts per pu of DC link, Q24 pu */
+} ctrl_mpc_model_t;
+
+/* SI overrides of the prediction model (0 = the machine's value) and the
+ * machine data needed to convert SI tunables to per unit. Part of each MPC
+ * controller's configuration struct; filled by ctrl_mpc_model_cfg_default(). */
+typedef struct {
+    double rs_ohm, ld_h, lq_h, psi_pm_wb; /* tunables "rs_model" ... (0 = machine) */
+    /* Copied from the machine (not tunables): */
+    double m_rs_ohm, m_ld_h, m_lq_h, m_psi_pm_wb, m_torque_rated_nm;
+} ctrl_mpc_model_cfg_t;
+
+/* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
+ * bounds the fast arithmetic below relies on): |d0|, |q0| <= 8 sqrt(2) pu
+ * (psi0 clamped to +-8 pu per alpha/beta component), |wd|, |wq| <= 1 pu. */
+typedef struct {
+    q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
+    q24_t wd[6], wq[6]; /* Ts V_1 .. Ts V_6 in the same frame (index i - 1), Q24 pu */
+    q24_t t0;           /* Te(k+2) with a zero vector, Q24 pu */
+    q24_t mag2;         /* sin^2 + cos^2 of theta(k+2) as fx_sincos gives them, Q24:
+                         * the rotation scales every amplitude by sqrt(mag2)
+                         * (|mag2 - 1| < 2.5e-6); references are scaled alike
+                         * so amplitude comparisons do not see it */
+} ctrl_mpc_basis_t;
+
+/* Model limits checked by ctrl_mpc_model_init (CTRL_ERANGE outside). */
+#define CTRL_MPC_AB_MAX (2 * FX_ONE)    /* |a|, |b| <= 2 pu */
+#define CTRL_MPC_TS_V_MAX (FX_ONE / 2)  /* Ts 2/3 <= 0.5 pu */
+#define CTRL_MPC_TS_RS_MAX FX_ONE       /* Ts Rs <= 1 pu */
+#define CTRL_MPC_PSI_CLAMP (8 * FX_ONE) /* psi0 components, pu */
+#define CTRL_MPC_I_CLAMP (64 * FX_ONE)  /* i(k+1) components, pu */
+#define CTRL_MPC_VDC_CLAMP (2 * FX_ONE) /* DC link, pu */
+
+/* Candidate trace of the last step (for tests and telemetry). */
+#define CTRL_MPC_TRACE_MAX 17
+typedef struct {
+    uint8_t n;                       /* number of candidates evaluated */
+    uint8_t vec[CTRL_MPC_TRACE_MAX]; /* candidate vector 0..7 (0/7: zero vector) */
+    q24_t duty[CTRL_MPC_TRACE_MAX];  /* its duty, Q24 fraction of the period */
+} ctrl_mpc_trace_t;
+
+/* ---- configuration (ctrl_m2ptfc_model_config.c, may use double) ---- */
+
+/* Tunable-table entries of the model overrides, for a cfg struct T with a
+ * member "model" (expanded only in *_config.c files). */
+/* clang-format off */
+#define CTRL_MPC_MODEL_TUNABLES(T)                                                  \
+    {"rs_model", "ohm", "Rs of the k+2 prediction (6.10); 0 = machine",            \
+     offsetof(T, model.rs_ohm), 0.0, 1000.0},                                      \
+    {"ld_model", "H", "Ld of the k+2 prediction (6.12); 0 = machine",              \
+     offsetof(T, model.ld_h), 0.0, 10.0},                                          \
+    {"lq_model", "H", "Lq of the k+2 prediction (6.12); 0 = machine",              \
+     offsetof(T, model.lq_h), 0.0, 10.0},                                          \
+    {"psi_pm_model", "Wb", "psi_pm of the k+2 prediction (6.12); 0 = machine",     \
+     offsetof(T, model.psi_pm_wb), 0.0, 10.0}
+/* clang-format on */
+
+/* Copy the machine data into c, overrides off. */
+void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *machine);
+
+/* Model constants for params (with the overrides of c). CTRL_OK or CTRL_EINVAL. */
+int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
+                        const ctrl_params_t *params);
+
+/* A torque per flux weight zeta (N*m/Wb) of (6.13) in pu (Q24); zeta == 0 gives
+ * the equal-importance value T_rated / psi_pm (§6.5). CTRL_OK or CTRL_EINVAL. */
+int ctrl_mpc_zeta_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double zeta,
+                     q24_t *out);
+
+/* A flux (Wb) in pu (Q24). CTRL_OK or CTRL_EINVAL. */
+int ctrl_mpc_flux_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double wb,
+                     q24_t *out);
+
+/* ---- per sample (ctrl_m2ptfc_model.c, integer only) ---- */
+
+/* Basis for the candidates of this sample from the k+1 state of est. */
+void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                    ctrl_mpc_basis_t *b);
+
+/* Stator-flux amplitude reference: ref->psi if > 0, else the machine's fixed
+ * reference p->psi_ref if > 0, else MTPA of the torque reference (4.15). */
+q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref);
+
+/* Zero vector for a whole period: the one that switches one leg from the end
+ * state of the applied plan (V0 after V0/V1/V3/V5, V7 after V7/V2/V4/V6). */
+uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied);
+
+/* n / d as a Q24 fraction for 0 <= n <= d, d > 0, rounded (<= FX_ONE). Three
+ * 32-bit divisions (one UDIV each on a Cortex-M4), no 64-bit division. */
+q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d);
+
+/* num / den clamped to [0, FX_ONE] (duty of (5.18)); den == 0 gives FX_ONE for
+ * num > 0, else 0. */
+q24_t ctrl_mpc_duty_sat(q24_t num, q24_t den);
+
+/* -1 when |r - a| < |r - b|, +1 when greater, 0 when equal, for amplitudes
+ * a, b >= 0 and reference r >= 0 given by their squares (Q24 pu^2 as returned
+ * by ctrl_mpc_amp2, r2 <= 16 pu^2). Exact integer test of
+ * sign((a - b)(a + b - 2r)) = sign(|r - a| - |r - b|): no square root. */
+int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2);
+
+/* Weighted cost (6.13) of a candidate: the active vector with Ts V = (vd, vq)
+ * on for duty, the zero vector the rest: |T_ref - Te(k+2)| + zeta |psi_ref - |psi(k+2)||,
+ * Q24 pu (64-bit, no overflow); psi_ref scaled by ctrl_mpc_ref_amp(). The
+ * amplitude needs one fx_mag (square root). */
+int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
+                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta);
+
+/* ---- bounded fast arithmetic of the k+2 model ----
+ * With the ranges of ctrl_mpc_basis_t and the model limits every product
+ * below is below 2^55 in magnitude, so its Q24 result fits an int32_t without
+ * saturation: a rounding multiply is a 32x32->64 multiply, an add and a
+ * shift (fx_mul's saturation and offset-binary rounding cost three times
+ * that on a Cortex-M4). Same rounding as fx_mul (to nearest, ties up). */
+
+/* uint32_t -> int32_t two's complement, without implementation-defined
+ * conversion (compiles to nothing). */
+static inline int32_t ctrl_mpc_u2i(uint32_t u)
+{
+    return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
+}
+
+/* a b / 2^24 rounded, for |a b| < 2^55. The low 32 bits of the rounded
+ * unsigned shift are the two's-complement result (no negative value shifted). */
+static inline q24_t ctrl_mpc_mulr(q24_t a, q24_t b)
+{
+    const uint64_t u = (uint64_t)((int64_t)a * b) + ((uint64_t)1 << 23);
+    return ctrl_mpc_u2i((uint32_t)(u >> 24));
+}
+
+/* (a c + b d) / 2^24 rounded once, for |a c| + |b d| < 2^55. */
+static inline q24_t ctrl_mpc_dotr(q24_t a, q24_t b, q24_t c, q24_t d)
+{
+    const uint64_t u = (uint64_t)((int64_t)a * c + (int64_t)b * d) + ((uint64_t)1 << 23);
+    return ctrl_mpc_u2i((uint32_t)(u >> 24));
+}
+
+/* Ts V_i (i = 1..6) in the rotor frame at k+2. */
+static inline void ctrl_mpc_vec_dq(const ctrl_mpc_basis_t *b, uint8_t i, q24_t *vd, q24_t *vq)
+{
+    *vd = b->wd[i - 1u];
+    *vq = b->wq[i - 1u];
+}
+
+/* Te = psi_q (a + b psi_d), (3.6)/(6.11) with (6.12) in the rotor frame, for a
+ * flux of the basis' range (|psi_d| <= 16 pu): b psi_d < 2^55; the last
+ * product saturates. */
+static inline q24_t ctrl_mpc_torque(const ctrl_mpc_model_t *m, q24_t psi_d, q24_t psi_q)
+{
+    return fx_mul(psi_q, m->a + ctrl_mpc_mulr(m->b, psi_d));
+}
+
+/* |psi|^2 in Q24 pu^2, rounded, clamped to [0, 64 pu^2] (|psi| <= 8 pu, far
+ * beyond any reachable flux; the clamp keeps ctrl_mpc_closer's products in range). */
+static inline int32_t ctrl_mpc_amp2(q24_t psi_d, q24_t psi_q)
+{
+    const uint64_t sq = (uint64_t)((int64_t)psi_d * psi_d) + (uint64_t)((int64_t)psi_q * psi_q);
+    const uint64_t a2 = (sq + ((uint64_t)1 << 23)) >> 24;
+    return a2 > ((uint64_t)1 << 30) ? (int32_t)1 << 30 : (int32_t)a2;
+}
+
+/* A flux-amplitude reference in the scale of the rotor-frame amplitudes:
+ * squared (ctrl_mpc_amp2 units) and linear. */
+static inline int32_t ctrl_mpc_ref_amp2(const ctrl_mpc_basis_t *b, q24_t psi)
+{
+    return fx_mul(ctrl_mpc_amp2(psi, 0), b->mag2);
+}
+
+static inline q24_t ctrl_mpc_ref_amp(const ctrl_mpc_basis_t *b, q24_t psi)
+{
+    /* sqrt(mag2) = 1 + (mag2 - 1)/2 to 1e-12 */
+    return fx_add(psi, fx_mul(psi, fx_rshift32_round(fx_sub(b->mag2, FX_ONE), 1u)));
+}
+
+/* Flux of a candidate: psi0 + D Ts V, rotor frame, for 0 <= duty <= FX_ONE
+ * and (vd, vq) from ctrl_mpc_vec_dq (or 0): |psi| components <= 12.4 pu. */
+static inline void ctrl_mpc_flux(const ctrl_mpc_basis_t *b, q24_t vd, q24_t vq, q24_t duty,
+                                 q24_t *psi_d, q24_t *psi_q)
+{
+    *psi_d = b->d0 + ctrl_mpc_mulr(duty, vd);
+    *psi_q = b->q0 + ctrl_mpc_mulr(duty, vq);
+}
+
+#endif /* CONTROL_CTRL_M2PTFC_MODEL_H */

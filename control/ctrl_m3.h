@@ -1,0 +1,37 @@
+/*
+ * Three-candidate M2PTFC, "M3" of thesis §6.4.2 / §6.6 (ref. [124]).
+ * Descriptor "m3".
+ *
+ * Each sample, with the k+1 state of the estimator (delay compensation §6.3.4):
+ * the set of (6.1) chosen by the sign of the torque error T_ref - Te(k+1):
+ *   >= 0: Set I  {V_{x+1}, V_{x+2}, ZVV},   < 0: Set II {V_{x+5}, V_{x+4}, ZVV};
+ * each active vector gets the duty D_f (5.18) saturated to [0, 1] (the same
+ * duty controller as M1, so a vector that cannot reach the reference gets
+ * D = 0, i.e. a zero vector all period, §6.6.2); the three candidates are
+ * evaluated with (6.13) and the argmin (first on ties) is applied.
+ * Table 6.2: 750 r/min fs 12 kHz, zeta 440 N*m/Wb (defaults);
+ * 2250 r/min fs 16 kHz, zeta 110 N*m/Wb (--set zeta=110 and fs 16000).
+ */
+#ifndef CONTROL_CTRL_M3_H
+#define CONTROL_CTRL_M3_H
+
+#include "controller.h"
+#include "ctrl_m2ptfc_model.h"
+
+typedef struct {
+    double zeta; /* "zeta", N*m/Wb, (6.13) */
+    ctrl_mpc_model_cfg_t model;
+} ctrl_m3_cfg_t;
+
+typedef struct {
+    ctrl_mpc_model_t model;
+    q24_t zeta;             /* Q24 pu */
+    ctrl_mpc_trace_t trace; /* the two active vectors with D_f, then (0, 0) */
+} ctrl_m3_t;
+
+extern const ctrl_desc_t ctrl_desc_m3;
+
+void ctrl_m3_reset(void *state);
+void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+
+#endif /* CONTROL_CTRL_M3_H */

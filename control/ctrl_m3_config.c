@@ -1,0 +1,50 @@
+/* M3 configuration and descriptor (SI -> Q24; floating point allowed here). */
+#include <stddef.h>
+#include <string.h>
+
+#include "ctrl_m3.h"
+
+static const ctrl_tunable_t m3_tunables[] = {
+    {"zeta", "N*m/Wb",
+     "weighting factor of (6.13); Table 6.2: 440 at 750 r/min (fs 12 kHz), 110 at 2250 r/min "
+     "(fs 16 kHz); 0 = T_rated/psi_pm (6.5)",
+     offsetof(ctrl_m3_cfg_t, zeta), 0.0, 1e5},
+    CTRL_MPC_MODEL_TUNABLES(ctrl_m3_cfg_t),
+};
+
+static void m3_cfg_default(void *cfg, const ctrl_machine_t *machine)
+{
+    ctrl_m3_cfg_t *c = cfg;
+    memset(c, 0, sizeof *c);
+    c->zeta = 440.0; /* Table 6.2, 750 r/min */
+    ctrl_mpc_model_cfg_default(&c->model, machine);
+}
+
+static int m3_init(void *state, const void *cfg, const ctrl_params_t *params)
+{
+    ctrl_m3_t *s = state;
+    const ctrl_m3_cfg_t *c = cfg;
+    if (s == NULL || c == NULL || params == NULL) {
+        return CTRL_EINVAL;
+    }
+    memset(s, 0, sizeof *s);
+    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    if (rc == CTRL_OK) {
+        rc = ctrl_mpc_zeta_pu(&c->model, params, c->zeta, &s->zeta);
+    }
+    return rc;
+}
+
+const ctrl_desc_t ctrl_desc_m3 = {
+    .name = "m3",
+    .title = "Three-candidate M2PTFC: set (6.1), duty (5.18), cost (6.13) (thesis 6.4.2)",
+    .fs_default_hz = 12000u,
+    .state_size = sizeof(ctrl_m3_t),
+    .cfg_size = sizeof(ctrl_m3_cfg_t),
+    .tunables = m3_tunables,
+    .n_tunables = sizeof m3_tunables / sizeof m3_tunables[0],
+    .cfg_default = m3_cfg_default,
+    .init = m3_init,
+    .reset = ctrl_m3_reset,
+    .step = ctrl_m3_step,
+};

@@ -1,0 +1,36 @@
+/*
+ * Finite-set model predictive torque and flux control, FS-MPTFC (thesis §6.4.1,
+ * cost (6.13)). Descriptor "mptfc".
+ *
+ * Each sample, with the k+1 state of the estimator (delay compensation §6.3.4),
+ * the eight inverter vectors are predicted to k+2 for the whole period (D = 1)
+ * and the one minimising g = |T_ref - Te| + zeta |psi_ref - |psi|| (6.13) is
+ * applied all period. V0 and V7 give the same prediction: they are one
+ * candidate, realised by the zero vector that switches one leg from the end
+ * state of the applied plan. Ties keep the first in the order V0, V1 .. V6.
+ * zeta defaults to 250 N*m/Wb (the M1 value of Table 6.2; the thesis gives no
+ * FS-MPTFC experiment), 0 = T_rated/psi_pm. fs 10 kHz.
+ */
+#ifndef CONTROL_CTRL_MPTFC_H
+#define CONTROL_CTRL_MPTFC_H
+
+#include "controller.h"
+#include "ctrl_m2ptfc_model.h"
+
+typedef struct {
+    double zeta; /* "zeta", N*m/Wb, (6.13) */
+    ctrl_mpc_model_cfg_t model;
+} ctrl_mptfc_cfg_t;
+
+typedef struct {
+    ctrl_mpc_model_t model;
+    q24_t zeta;             /* Q24 pu */
+    ctrl_mpc_trace_t trace; /* vec 0 (zero vector, duty 0), then V1..V6 (duty 1) */
+} ctrl_mptfc_t;
+
+extern const ctrl_desc_t ctrl_desc_mptfc;
+
+void ctrl_mptfc_reset(void *state);
+void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+
+#endif /* CONTROL_CTRL_MPTFC_H */

@@ -1,0 +1,580 @@
+/*
+ * Unit tests of the chapter-6 predictive controllers (control/ctrl_m2ptfc*,
+ * ctrl_m1*, ctrl_mptfc*, ctrl_m3*, ctrl_m2*). Needs only pmsm_control: also
+ * runs on the Cortex-M4 in QEMU.
+ *
+ * The brute-force checks evaluate every candidate with the core's
+ * ctrl_predict() (predict.h), independently of the controllers' fast k+2
+ * model, and assert the controllers' choice against it.
+ *
+ * Tolerances (Q24 LSB = 2^-24 pu): the fast model and ctrl_predict() use the
+ * same fx_sincos values at the same angle theta(k+2) (ctrl_angle_step), so
+ * they differ by roundings only; the rotation's scale error (|sin^2 + cos^2 - 1|
+ * < 2.5e-6) is cancelled in the controllers' amplitude comparisons by scaling
+ * the reference alike. The k+2 flux then differs by at most the roundings of
+ * Ts V (3), of the rotation (2 per axis) and of the sums (2): < 16 LSB. The
+ * torque multiplies that by |a + b psi_d| + |b psi_q| (< 3 pu for these
+ * machines and currents) plus its own 4 roundings: < 64 LSB.
+ * TOL_PSI = 16 LSB, TOL_T = 64 LSB.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "controller.h"
+#include "ctrl_m1.h"
+#include "ctrl_m2.h"
+#include "ctrl_m2ptfc.h"
+#include "ctrl_m3.h"
+#include "ctrl_mptfc.h"
+#include "mpc_machines.h"
+#include "plan.h"
+#include "predict.h"
+#include "unity.h"
+#include "vectors.h"
+
+#define LSB (1.0 / 16777216.0)
+#define TOL_PSI (16.0 * LSB)
+#define TOL_T (64.0 * LSB)
+#define N_RANDOM 400
+#define PI 3.14159265358979323846
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+static uint64_t rng = 0x9E3779B97F4A7C15u;
+
+static uint32_t rng_u32(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (uint32_t)(rng >> 32);
+}
+
+static double rng_uniform(double lo, double hi)
+{
+    return lo + (hi - lo) * ((double)rng_u32() / 4294967296.0);
+}
+
+static double d24(q24_t x)
+{
+    return (double)x / 16777216.0;
+}
+
+static q24_t q24(double x)
+{
+    return ctrl_q24_from_double(x);
+}
+
+static void params_for(const ctrl_machine_t *m, uint32_t fs, ctrl_params_t *p)
+{
+    ctrl_bases_t b;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(p, &b, m, fs));
+}
+
+/* A random operating point: rotor angle anywhere (all sectors), current up to
+ * 1.2 x rated in any direction (motoring and braking), speed +-1.1 x rated
+ * (both directions), DC link +-10 %, torque reference around the estimate. */
+static void random_point(const ctrl_params_t *p, ctrl_estimate_t *est, ctrl_refs_t *ref,
+                         ctrl_plan_t *applied)
+{
+    const double imax = 1.2 * d24(p->current_rated);
+    const double id = rng_uniform(-0.6 * imax, 0.3 * imax);
+    const double iq = rng_uniform(-imax, imax);
+    const double psid = d24(p->ld) * id + d24(p->psi_pm);
+    const double psiq = d24(p->lq) * iq;
+    const fx_angle_t theta = rng_u32();
+    const double th = (double)theta * (2.0 * PI / 4294967296.0);
+    const double pa = psid * cos(th) - psiq * sin(th);
+    const double pb = psid * sin(th) + psiq * cos(th);
+    memset(est, 0, sizeof *est);
+    ctrl_mstate_from_flux(p, q24(pa), q24(pb), theta, &est->next);
+    est->now = est->next;
+    est->omega_e = q24(rng_uniform(-1.1, 1.1) * d24(p->speed_rated_e));
+    est->vdc = q24(d24(p->vdc_nom) * rng_uniform(0.9, 1.1));
+    const double tr = d24(p->torque_rated);
+    ref->torque = q24(d24(est->next.torque) + rng_uniform(-0.3, 0.3) * tr);
+    ref->psi = (rng_u32() & 1u) ? 0 : q24(d24(est->next.psi_amp) * rng_uniform(0.95, 1.05));
+    ctrl_plan_active_zero(applied, (uint8_t)(1u + rng_u32() % 6u), q24(rng_uniform(0.0, 1.0)));
+}
+
+/* k+2 state with vec on for duty (zero vector the rest), by ctrl_predict(). */
+static void predict2(const ctrl_params_t *p, const ctrl_estimate_t *est, uint8_t vec, q24_t duty,
+                     ctrl_mstate_t *out)
+{
+    q24_t va;
+    q24_t vb;
+    ctrl_vector_ab(vec, est->vdc, &va, &vb);
+    ctrl_predict(p, &est->next, fx_mul(duty, va), fx_mul(duty, vb), est->omega_e, out);
+}
+
+static double psi_ref_of(const ctrl_params_t *p, const ctrl_refs_t *ref)
+{
+    return d24(ctrl_mpc_psi_ref(p, ref));
+}
+
+/* ---------------------------------------------------------------- (6.7) */
+
+static void test_candidates_table(void)
+{
+    /* (6.7) transcribed: sector x -> {V_{x+1}, V_{x+2}} when T_ref + sigma_T >= Te,
+     * {V_{x+4}, V_{x+5}} otherwise (indices wrapped in 1..6). */
+    static const uint8_t up[7][2] = {{0, 0}, {2, 3}, {3, 4}, {4, 5}, {5, 6}, {6, 1}, {1, 2}};
+    static const uint8_t down[7][2] = {{0, 0}, {5, 6}, {6, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}};
+    for (uint8_t x = 1u; x <= 6u; x++) {
+        uint8_t c[2];
+        ctrl_m2ptfc_candidates(x, FX_ONE / 10, FX_ONE / 20, c); /* upper > Te */
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(up[x], c, 2);
+        ctrl_m2ptfc_candidates(x, FX_ONE / 20, FX_ONE / 20, c); /* equal: ">=" */
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(up[x], c, 2);
+        ctrl_m2ptfc_candidates(x, -FX_ONE / 10, -FX_ONE / 20, c); /* negative torques */
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(down[x], c, 2);
+        ctrl_m2ptfc_candidates(x, FX_ONE / 20, FX_ONE / 20 + 1, c); /* just below */
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(down[x], c, 2);
+        ctrl_m2ptfc_candidates(x, -FX_ONE / 20, -FX_ONE / 10, c); /* braking, upper > Te */
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(up[x], c, 2);
+    }
+}
+
+static void test_m3_set_and_m2_table(void)
+{
+    /* M3 (6.1): Set I {V_{x+1}, V_{x+2}} / Set II {V_{x+5}, V_{x+4}}; M2 Table 4.1
+     * with two-level torque: (T up, psi up) V_{x+1}, (up, down) V_{x+2},
+     * (down, up) V_{x+5}, (down, down) V_{x+4}. Sector 1 and 4 written out. */
+    TEST_ASSERT_EQUAL_UINT8(2, ctrl_m2_table(1, 1, 1));
+    TEST_ASSERT_EQUAL_UINT8(3, ctrl_m2_table(1, 1, 0));
+    TEST_ASSERT_EQUAL_UINT8(6, ctrl_m2_table(1, 0, 1));
+    TEST_ASSERT_EQUAL_UINT8(5, ctrl_m2_table(1, 0, 0));
+    TEST_ASSERT_EQUAL_UINT8(5, ctrl_m2_table(4, 1, 1));
+    TEST_ASSERT_EQUAL_UINT8(6, ctrl_m2_table(4, 1, 0));
+    TEST_ASSERT_EQUAL_UINT8(3, ctrl_m2_table(4, 0, 1));
+    TEST_ASSERT_EQUAL_UINT8(2, ctrl_m2_table(4, 0, 0));
+    TEST_ASSERT_EQUAL_UINT8(1, ctrl_m2_table(6, 1, 1));
+    TEST_ASSERT_EQUAL_UINT8(4, ctrl_m2_table(6, 0, 0));
+}
+
+/* ---------------------------------------------------------- (6.5)-(6.6) */
+
+static void test_duty_clamp_edges(void)
+{
+    const q24_t den = FX_ONE / 7;
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(den, den));     /* D = 1 kept */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(den + 1, den)); /* D > 1 -> 1 */
+    TEST_ASSERT_EQUAL_INT32(0, ctrl_m2ptfc_duty(0, den));            /* D = 0 kept */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(-1, den));      /* D < 0 -> 1 (6.6) */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(1, -den));      /* D < 0 -> 1 */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(den, 0));       /* no finite D -> 1 */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(-den, 0));
+    TEST_ASSERT_EQUAL_INT32(0, ctrl_m2ptfc_duty(0, 0));            /* documented choice */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(-den, -den)); /* both negative */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(-den - 1, -den));
+    /* Just inside the edges: exact rounded quotient. */
+    const q24_t below = ctrl_m2ptfc_duty(den - 1, den);
+    TEST_ASSERT_TRUE(below < FX_ONE);
+    TEST_ASSERT_INT32_WITHIN(1, FX_ONE - FX_ONE / den, below);
+    TEST_ASSERT_INT32_WITHIN(1, FX_ONE / den, ctrl_m2ptfc_duty(1, den));
+    TEST_ASSERT_INT32_WITHIN(1, FX_ONE / 2, ctrl_m2ptfc_duty(-FX_ONE / 16, -FX_ONE / 8));
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_duty(FX_MAX, FX_MIN + 1)); /* |D|=1, D<0 */
+    /* D_f of M1/M3 saturates instead: */
+    TEST_ASSERT_EQUAL_INT32(0, ctrl_mpc_duty_sat(-1, den));
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_mpc_duty_sat(den + 1, den));
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_mpc_duty_sat(1, 0));
+    TEST_ASSERT_EQUAL_INT32(0, ctrl_mpc_duty_sat(-1, 0));
+}
+
+static void test_ratio_exact(void)
+{
+    /* ctrl_mpc_ratio == round(n 2^24 / d) for d < 2^24 (exact long division). */
+    for (int i = 0; i < 2000; i++) {
+        const uint32_t d = 1u + rng_u32() % ((1u << 24) - 1u);
+        const uint32_t n = (uint32_t)(((uint64_t)rng_u32() * d) >> 32);
+        const uint64_t want = (((uint64_t)n << 25) / d + 1u) >> 1;
+        TEST_ASSERT_EQUAL_INT32((int32_t)want, ctrl_mpc_ratio(n, d));
+    }
+    /* d >= 2^24: prescaled, relative error < 2^-23. */
+    const uint32_t d = 0x7FFFFFFFu;
+    TEST_ASSERT_INT32_WITHIN(4, FX_ONE / 3, ctrl_mpc_ratio(d / 3u, d));
+}
+
+static void test_closer_matches_sqrt(void)
+{
+    /* ctrl_mpc_closer on squares agrees with |r - a| vs |r - b| on amplitudes. */
+    for (int i = 0; i < 4000; i++) {
+        const double r = rng_uniform(0.5, 1.5);
+        const double a = r + rng_uniform(-0.2, 0.2);
+        const double b = r + rng_uniform(-0.2, 0.2);
+        const int32_t a2 = ctrl_mpc_amp2(q24(a), 0);
+        const int32_t b2 = ctrl_mpc_amp2(q24(b), 0);
+        const int32_t r2 = ctrl_mpc_amp2(q24(r), 0);
+        const double diff = fabs(r - a) - fabs(r - b);
+        if (fabs(diff) < 4.0 * LSB) {
+            continue; /* below the resolution of the squares */
+        }
+        TEST_ASSERT_EQUAL_INT(diff < 0.0 ? -1 : 1, ctrl_mpc_closer(a2, b2, r2));
+    }
+    TEST_ASSERT_EQUAL_INT(0, ctrl_mpc_closer(FX_ONE, FX_ONE, FX_ONE));
+}
+
+/* ------------------------------------------------------- brute force */
+
+static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs)
+{
+    ctrl_params_t p;
+    params_for(m, fs, &p);
+    const ctrl_desc_t *d = &ctrl_desc_m2ptfc;
+    uint8_t cfg[CTRL_CFG_MAX];
+    ctrl_m2ptfc_t s;
+    TEST_ASSERT_TRUE(d->cfg_size <= sizeof cfg);
+    TEST_ASSERT_TRUE(d->state_size == sizeof s);
+    d->cfg_default(cfg, m);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(&s, cfg, &p));
+    int checked_duty = 0;
+    for (int i = 0; i < N_RANDOM; i++) {
+        ctrl_estimate_t est;
+        ctrl_refs_t ref;
+        ctrl_plan_t applied;
+        ctrl_plan_t out;
+        random_point(&p, &est, &ref, &applied);
+        s.sigma = q24(rng_uniform(-0.03, 0.03) * d24(p.torque_rated));
+        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+        d->step(&s, &ctx, &out);
+        TEST_ASSERT_EQUAL_UINT8(2, s.trace.n);
+        /* Candidates (6.7) from the same sigma and k+1 estimate. */
+        const q24_t t_up = fx_add(ref.torque, s.sigma);
+        uint8_t c[2];
+        ctrl_m2ptfc_candidates(est.next.sector, t_up, est.next.torque, c);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(c, s.trace.vec, 2);
+        const double num = d24(t_up) - d24(est.next.torque);
+        const double psi_ref = psi_ref_of(&p, &ref);
+        double cost[2];
+        for (unsigned k = 0; k < 2u; k++) {
+            ctrl_mstate_t full;
+            ctrl_mstate_t dut;
+            predict2(&p, &est, c[k], FX_ONE, &full);
+            /* (6.5)-(6.6) from ctrl_predict's dTe. */
+            const double den = d24(full.torque) - d24(est.next.torque) + 2.0 * d24(s.sigma);
+            if (fabs(den) > 4.0 * TOL_T && num != 0.0) {
+                double dref = num / den;
+                const double tol = TOL_T * (1.0 + fabs(dref)) / fabs(den) + 2.0 * LSB;
+                if (dref < -tol || dref > 1.0 + tol) {
+                    dref = 1.0; /* (6.6) */
+                }
+                if (dref >= tol || dref < -tol) { /* not at the D = 0 edge */
+                    TEST_ASSERT_DOUBLE_WITHIN(tol, dref, d24(s.trace.duty[k]));
+                    checked_duty++;
+                }
+            }
+            predict2(&p, &est, c[k], s.trace.duty[k], &dut);
+            cost[k] = fabs(psi_ref - d24(dut.psi_amp)); /* (6.9) */
+        }
+        TEST_ASSERT_EQUAL_UINT8(2, out.n_seg);
+        const unsigned chosen = out.vec[0] == c[0] ? 0u : 1u;
+        TEST_ASSERT_EQUAL_UINT8(c[chosen], out.vec[0]);
+        TEST_ASSERT_EQUAL_INT32(s.trace.duty[chosen], out.dur[0]);
+        TEST_ASSERT_EQUAL_UINT8(ctrl_zero_after(out.vec[0]), out.vec[1]);
+        TEST_ASSERT_TRUE_MESSAGE(cost[chosen] <= cost[1u - chosen] + 2.0 * TOL_PSI,
+                                 "m2ptfc: chosen candidate does not minimise (6.9)");
+    }
+    TEST_ASSERT_TRUE(checked_duty > N_RANDOM); /* most duties were checked */
+}
+
+static void test_m2ptfc_minimises_cost_spmsm(void)
+{
+    check_m2ptfc(&mpc_spmsm, 10000u);
+}
+
+static void test_m2ptfc_minimises_cost_ipmsm(void)
+{
+    check_m2ptfc(&mpc_ipmsm80, 20000u);
+    check_m2ptfc(&mpc_chapter_ipmsm, 10000u);
+}
+
+/* g of (6.13) for the k+2 state st. */
+static double cost613(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t zeta,
+                      const ctrl_mstate_t *st)
+{
+    return fabs(d24(ref->torque) - d24(st->torque)) +
+           d24(zeta) * fabs(psi_ref_of(p, ref) - d24(st->psi_amp));
+}
+
+/* The applied vector and duty of a plan (duty 0 for a zero vector all period). */
+static void plan_choice(const ctrl_plan_t *out, uint8_t *vec, q24_t *duty)
+{
+    if (out->n_seg == 1u && (out->vec[0] == 0u || out->vec[0] == 7u)) {
+        *vec = 0u;
+        *duty = 0;
+    } else {
+        *vec = out->vec[0];
+        *duty = out->dur[0];
+    }
+}
+
+/* Brute-force (6.13) check over the candidates of the trace, and (5.18) for
+ * the duties when check_df. */
+static void check_weighted(const ctrl_machine_t *m, uint32_t fs, const ctrl_desc_t *d, void *state,
+                           const ctrl_mpc_trace_t *tr, const q24_t *zeta, int check_df)
+{
+    ctrl_params_t p;
+    params_for(m, fs, &p);
+    uint8_t cfg[CTRL_CFG_MAX];
+    d->cfg_default(cfg, m);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(state, cfg, &p));
+    for (int i = 0; i < N_RANDOM; i++) {
+        ctrl_estimate_t est;
+        ctrl_refs_t ref;
+        ctrl_plan_t applied;
+        ctrl_plan_t out;
+        random_point(&p, &est, &ref, &applied);
+        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+        d->step(state, &ctx, &out);
+        const q24_t z = *zeta; /* as initialised from the SI tunable */
+        ctrl_mstate_t zero;
+        predict2(&p, &est, 0u, 0, &zero);
+        uint8_t cv;
+        q24_t cd;
+        plan_choice(&out, &cv, &cd);
+        double best = 1e30;
+        double chosen = -1.0;
+        for (unsigned k = 0; k < tr->n; k++) {
+            ctrl_mstate_t st;
+            predict2(&p, &est, tr->vec[k], tr->duty[k], &st);
+            const double g = cost613(&p, &ref, z, &st);
+            best = g < best ? g : best;
+            if (tr->vec[k] == cv && (cv == 0u || tr->duty[k] == cd)) {
+                chosen = g;
+            }
+            if (check_df && tr->vec[k] != 0u) {
+                ctrl_mstate_t full;
+                predict2(&p, &est, tr->vec[k], FX_ONE, &full);
+                const double num = d24(ref.torque) - d24(zero.torque);
+                const double den = d24(full.torque) - d24(zero.torque);
+                if (fabs(den) > 8.0 * TOL_T) {
+                    double df = num / den; /* (5.18) */
+                    df = df < 0.0 ? 0.0 : (df > 1.0 ? 1.0 : df);
+                    const double tol = TOL_T * (1.0 + 2.0 * df) / fabs(den) + 2.0 * LSB;
+                    TEST_ASSERT_DOUBLE_WITHIN(tol, df, d24(tr->duty[k]));
+                }
+            }
+        }
+        TEST_ASSERT_TRUE_MESSAGE(chosen >= 0.0, "applied vector is not a candidate");
+        TEST_ASSERT_TRUE_MESSAGE(chosen <= best + 2.0 * (TOL_T + d24(z) * TOL_PSI),
+                                 "chosen candidate does not minimise (6.13)");
+    }
+}
+
+static void test_m1_argmin(void)
+{
+    ctrl_m1_t s;
+    TEST_ASSERT_TRUE(ctrl_desc_m1.state_size == sizeof s);
+    check_weighted(&mpc_spmsm, 10000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
+    TEST_ASSERT_EQUAL_UINT8(6, s.trace.n);
+    check_weighted(&mpc_ipmsm80, 20000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
+}
+
+static void test_mptfc_argmin(void)
+{
+    ctrl_mptfc_t s;
+    TEST_ASSERT_TRUE(ctrl_desc_mptfc.state_size == sizeof s);
+    check_weighted(&mpc_spmsm, 10000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
+    TEST_ASSERT_EQUAL_UINT8(7, s.trace.n);
+    check_weighted(&mpc_ipmsm80, 20000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
+}
+
+static void test_m3_argmin(void)
+{
+    ctrl_m3_t s;
+    TEST_ASSERT_TRUE(ctrl_desc_m3.state_size == sizeof s);
+    check_weighted(&mpc_spmsm, 12000u, &ctrl_desc_m3, &s, &s.trace, &s.zeta, 1);
+    TEST_ASSERT_EQUAL_UINT8(3, s.trace.n);
+}
+
+static void test_m2_band_and_argmin(void)
+{
+    ctrl_params_t p;
+    params_for(&mpc_spmsm, 10000u, &p);
+    uint8_t cfg[CTRL_CFG_MAX];
+    ctrl_m2_t s;
+    ctrl_desc_m2.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2.init(&s, cfg, &p));
+    TEST_ASSERT_EQUAL_UINT8(4, s.y);
+    const double eps = d24(s.eps_psi);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 6.60e-3 / mpc_spmsm.psi_pm_wb, eps);
+    for (int i = 0; i < N_RANDOM; i++) {
+        ctrl_estimate_t est;
+        ctrl_refs_t ref;
+        ctrl_plan_t applied;
+        ctrl_plan_t out;
+        random_point(&p, &est, &ref, &applied);
+        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+        ctrl_desc_m2.step(&s, &ctx, &out);
+        TEST_ASSERT_EQUAL_UINT8(5, s.trace.n);
+        uint8_t cv;
+        q24_t cd;
+        plan_choice(&out, &cv, &cd);
+        const double psi_ref = psi_ref_of(&p, &ref);
+        double best_t = 1e30;
+        int any = 0;
+        double chosen_t = -1.0;
+        int chosen_feasible = 0;
+        for (unsigned nu = 0; nu <= 4u; nu++) {
+            TEST_ASSERT_INT32_WITHIN(1, (q24_t)(FX_ONE / 4 * (int32_t)nu), s.trace.duty[nu]);
+            ctrl_mstate_t st;
+            predict2(&p, &est, s.trace.vec[nu], s.trace.duty[nu], &st);
+            const double ef = fabs(psi_ref - d24(st.psi_amp));
+            const double et = fabs(d24(ref.torque) - d24(st.torque));
+            const int feasible = ef <= eps - 2.0 * TOL_PSI;
+            const int maybe = ef <= eps + 2.0 * TOL_PSI;
+            if (feasible) {
+                any = 1;
+                best_t = et < best_t ? et : best_t;
+            }
+            const int is_chosen =
+                (nu == 0u) ? (cv == 0u) : (cv == s.trace.vec[nu] && cd == s.trace.duty[nu]);
+            if (is_chosen) {
+                chosen_t = et;
+                chosen_feasible = maybe;
+            }
+        }
+        TEST_ASSERT_TRUE(chosen_t >= 0.0);
+        if (any) { /* (6.16)-(6.17): a feasible minimum exists and was taken */
+            TEST_ASSERT_TRUE(chosen_feasible);
+            TEST_ASSERT_TRUE(chosen_t <= best_t + 2.0 * TOL_T);
+        }
+    }
+}
+
+/* -------------------------------------------------- registry, config */
+
+static void test_registry_and_tunables(void)
+{
+    static const char *const names[] = {"m2ptfc", "m1", "mptfc", "m3", "m2"};
+    static const uint32_t fs[] = {10000u, 10000u, 10000u, 12000u, 10000u};
+    for (unsigned i = 0; i < 5u; i++) {
+        const ctrl_desc_t *d = ctrl_find(names[i]);
+        TEST_ASSERT_NOT_NULL(d);
+        TEST_ASSERT_EQUAL_UINT32(fs[i], d->fs_default_hz);
+        TEST_ASSERT_TRUE(d->state_size <= CTRL_STATE_MAX);
+        TEST_ASSERT_TRUE(d->cfg_size <= CTRL_CFG_MAX);
+        uint8_t cfg[CTRL_CFG_MAX];
+        d->cfg_default(cfg, &mpc_spmsm);
+        double v;
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(d, cfg, "ld_model", &v));
+        TEST_ASSERT_EQUAL_INT(0, (int)(v * 1e6)); /* 0 = machine */
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(d, cfg, "ld_model", -1.0));
+        TEST_ASSERT_EQUAL_INT(CTRL_ENOENT, ctrl_tunable_set(d, cfg, "no_such", 1.0));
+    }
+    uint8_t cfg[CTRL_CFG_MAX];
+    double v;
+    ctrl_desc_m2ptfc.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m2ptfc, cfg, "lambda", &v));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.03, v);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2ptfc, cfg, "lambda", 1.5));
+    ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m1, cfg, "zeta", &v));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 250.0, v);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 640.0));
+    ctrl_desc_m3.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m3, cfg, "zeta", &v));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 440.0, v);
+    ctrl_desc_m2.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2, cfg, "y", 0.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m2, cfg, "eps_psi", 9.42e-3));
+}
+
+static void test_zeta_in_pu(void)
+{
+    /* zeta [N*m/Wb] -> pu: zeta psi_base / T_base, T_base = 1.5 p psi_pm^2 / Ld. */
+    ctrl_params_t p;
+    params_for(&mpc_spmsm, 10000u, &p);
+    uint8_t cfg[CTRL_CFG_MAX];
+    ctrl_m1_t s;
+    ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
+    const double t_base = 1.5 * 4.0 * 0.09427 * 0.09427 / 6.552e-3;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-5, 250.0 * 0.09427 / t_base, d24(s.zeta));
+    /* zeta = 0: T_rated / psi_pm (6.5): 2133 N*m/Wb for the 80 kW IPMSM. */
+    params_for(&mpc_ipmsm80, 20000u, &p);
+    ctrl_desc_m1.cfg_default(cfg, &mpc_ipmsm80);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 0.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
+    const double t_base80 = 1.5 * 4.0 * 0.1875 * 0.1875 / 0.6e-3;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-5, 400.0 / 0.1875 * 0.1875 / t_base80, d24(s.zeta));
+}
+
+static void test_bad_input(void)
+{
+    ctrl_params_t p;
+    params_for(&mpc_spmsm, 10000u, &p);
+    ctrl_m2ptfc_cfg_t c;
+    ctrl_m2ptfc_t s;
+    ctrl_desc_m2ptfc.cfg_default(&c, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(NULL, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, NULL, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, NULL));
+    c.lambda = 0.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    c.lambda = NAN;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    c.lambda = 0.03;
+    c.model.ld_h = -1.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    c.model.ld_h = 0.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    /* cfg_default without a machine: model overrides cannot be scaled. */
+    ctrl_desc_m2ptfc.cfg_default(&c, NULL);
+    c.model.ld_h = 1e-3;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+}
+
+static void test_sigma_ema(void)
+{
+    /* (6.8): a constant error e drives sigma to e with rate lambda:
+     * sigma_n = e (1 - (1 - lambda)^n). */
+    ctrl_params_t p;
+    params_for(&mpc_spmsm, 10000u, &p);
+    ctrl_m2ptfc_cfg_t c;
+    ctrl_m2ptfc_t s;
+    ctrl_desc_m2ptfc.cfg_default(&c, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    ctrl_estimate_t est;
+    ctrl_refs_t ref;
+    ctrl_plan_t applied;
+    ctrl_plan_t out;
+    random_point(&p, &est, &ref, &applied);
+    ref.torque = fx_add(est.next.torque, FX_ONE / 100);
+    const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+    for (int n = 1; n <= 50; n++) {
+        ctrl_desc_m2ptfc.step(&s, &ctx, &out);
+        const double want = 0.01 * (1.0 - pow(0.97, n));
+        TEST_ASSERT_DOUBLE_WITHIN(n * LSB, want, d24(s.sigma));
+    }
+    ctrl_desc_m2ptfc.reset(&s);
+    TEST_ASSERT_EQUAL_INT32(0, s.sigma);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_candidates_table);
+    RUN_TEST(test_m3_set_and_m2_table);
+    RUN_TEST(test_duty_clamp_edges);
+    RUN_TEST(test_ratio_exact);
+    RUN_TEST(test_closer_matches_sqrt);
+    RUN_TEST(test_m2ptfc_minimises_cost_spmsm);
+    RUN_TEST(test_m2ptfc_minimises_cost_ipmsm);
+    RUN_TEST(test_m1_argmin);
+    RUN_TEST(test_mptfc_argmin);
+    RUN_TEST(test_m3_argmin);
+    RUN_TEST(test_m2_band_and_argmin);
+    RUN_TEST(test_registry_and_tunables);
+    RUN_TEST(test_zeta_in_pu);
+    RUN_TEST(test_bad_input);
+    RUN_TEST(test_sigma_ema);
+    return UNITY_END();
+}
