@@ -1,0 +1,146 @@
+/*
+ * Rotor-field-oriented control (S1 §2, Algorithm 1), per-sample part
+ * (integer-only). Design, gains and delay compensation: ctrl_foc.h.
+ */
+#include "ctrl_foc.h"
+
+#include <stddef.h>
+
+#include "plan.h"
+#include "predict.h"
+#include "svpwm.h"
+#include "transforms.h"
+
+#define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
+#define FOC_KI_QBITS 30u
+
+/* Vector index of a leg mask (bit 0 = leg a), inverse of Table 4.2. */
+static const uint8_t foc_vec_of_mask[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
+
+void ctrl_foc_iref(const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d, q24_t *i_q)
+{
+    const q24_t a = fx_min(fx_abs(t), r->t_max);
+    /* Position on the table, Q24: a * (N / t_max), <= N * 2^24 (fits). */
+    const int64_t pos = fx_rshift64_round((int64_t)a * r->scale, 16u);
+    int64_t idx = pos >> FX_QBITS; /* pos >= 0: the shift is well defined */
+    q24_t frac = (q24_t)(pos & (FX_ONE - 1));
+    if (idx >= CTRL_FOC_MTPA_N) {
+        idx = CTRL_FOC_MTPA_N - 1;
+        frac = FX_ONE;
+    }
+    const size_t k = (size_t)idx;
+    const q24_t d = fx_add(r->id_tab[k], fx_mul(fx_sub(r->id_tab[k + 1u], r->id_tab[k]), frac));
+    const q24_t q = fx_add(r->iq_tab[k], fx_mul(fx_sub(r->iq_tab[k + 1u], r->iq_tab[k]), frac));
+    *i_d = d;
+    *i_q = t < 0 ? fx_neg(q) : q;
+}
+
+q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
+{
+    return fx_add(fx_mul(pi->kp, err), fx_sat32(fx_rshift64_round(pi->integ, FOC_INTEG_SHIFT)));
+}
+
+void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
+{
+    if (limited != 0u && fx_sign(err) * fx_sign(v) > 0) {
+        return; /* conditional integration: hold while pushing into the limit */
+    }
+    /* err Q24 * ki_ts Q30 = Q54 -> Q40; |product| < 2^62. */
+    const int64_t inc = fx_rshift64_round((int64_t)err * pi->ki_ts, FOC_KI_QBITS - FOC_INTEG_SHIFT);
+    const int64_t lim = (int64_t)FX_ONE << FOC_INTEG_SHIFT; /* 1 pu */
+    int64_t i = pi->integ + inc;                            /* |integ| <= 2^40, |inc| < 2^48 */
+    i = i > lim ? lim : (i < -lim ? -lim : i);
+    pi->integ = i;
+}
+
+void ctrl_foc_reset(void *state)
+{
+    ctrl_foc_state_t *s = state;
+    if (s == NULL) {
+        return;
+    }
+    s->legs = 0u;
+    s->limited = 0u;
+    s->pi_d.integ = 0;
+    s->pi_q.integ = 0;
+    s->v_d = 0;
+    s->v_q = 0;
+}
+
+static int foc_ctx_ok(const ctrl_ctx_t *ctx)
+{
+    return ctx != NULL && ctx->params != NULL && ctx->est != NULL && ctx->ref != NULL;
+}
+
+/* foc: PI current loops + SVPWM. */
+static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref, q24_t iq_ref,
+                        ctrl_plan_t *out)
+{
+    const ctrl_params_t *p = ctx->params;
+    const ctrl_mstate_t *nx = &ctx->est->next; /* state at k+1: delay compensation */
+    const q24_t w = ctx->est->omega_e;
+    const q24_t e_d = fx_sub(id_ref, nx->i_d);
+    const q24_t e_q = fx_sub(iq_ref, nx->i_q);
+    /* Decoupling feed-forward of S1(1): -omega Lq i_q and omega (Ld i_d + psi_pm). */
+    const q24_t v_d = fx_add(fx_neg(fx_mul(w, nx->psi_q)), ctrl_foc_pi_out(&s->pi_d, e_d));
+    const q24_t v_q = fx_add(fx_mul(w, nx->psi_d), ctrl_foc_pi_out(&s->pi_q, e_q));
+    s->v_d = v_d;
+    s->v_q = v_q;
+    /* Mean rotor angle over [k+1, k+2): theta(k+1) + omega Ts / 2. */
+    const fx_angle_t th = nx->theta_e + ctrl_angle_step(p, fx_rshift32_round(w, 1u));
+    q24_t sn;
+    q24_t cs;
+    fx_sincos(th, &sn, &cs);
+    q24_t va;
+    q24_t vb;
+    ctrl_inv_park(v_d, v_q, sn, cs, &va, &vb);
+    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, out);
+    ctrl_foc_pi_update(&s->pi_d, e_d, v_d, s->limited);
+    ctrl_foc_pi_update(&s->pi_q, e_q, v_q, s->limited);
+}
+
+/* foc_hyst: per-phase hysteresis current control, one vector per period. */
+static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref, q24_t iq_ref,
+                          ctrl_plan_t *out)
+{
+    const ctrl_mstate_t *nx = &ctx->est->next; /* currents at k+1 (delay compensation) */
+    q24_t ra;
+    q24_t rb;
+    ctrl_inv_park(id_ref, iq_ref, nx->sin_theta, nx->cos_theta, &ra, &rb);
+    q24_t ref[3];
+    q24_t mea[3];
+    ctrl_inv_clarke(ra, rb, &ref[0], &ref[1], &ref[2]);
+    ctrl_inv_clarke(nx->i_alpha, nx->i_beta, &mea[0], &mea[1], &mea[2]);
+    uint8_t legs = s->legs;
+    for (unsigned x = 0u; x < 3u; x++) {
+        const q24_t e = fx_sub(ref[x], mea[x]);
+        const uint8_t bit = (uint8_t)(1u << x);
+        if (e >= s->h_i) {
+            legs = (uint8_t)(legs | bit); /* current too low: leg high */
+        } else if (e <= -s->h_i) {
+            legs = (uint8_t)(legs & (uint8_t)~bit);
+        }
+    }
+    s->legs = legs;
+    ctrl_plan_single(out, foc_vec_of_mask[legs & 7u]);
+}
+
+void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ctrl_foc_state_t *s = state;
+    if (out == NULL) {
+        return;
+    }
+    if (s == NULL || !foc_ctx_ok(ctx)) {
+        ctrl_plan_single(out, 0u); /* no voltage */
+        return;
+    }
+    q24_t id_ref;
+    q24_t iq_ref;
+    ctrl_foc_iref(&s->iref, ctx->ref->torque, &id_ref, &iq_ref);
+    if (s->hyst != 0u) {
+        foc_hyst_step(s, ctx, id_ref, iq_ref, out);
+    } else {
+        foc_pi_step(s, ctx, id_ref, iq_ref, out);
+    }
+}

@@ -1,0 +1,307 @@
+/*
+ * Book-chapter DTC controllers (hdtc, svm_dtc, hpdtc): descriptors, tunables,
+ * defaults, SI -> fixed-point initialisation and the HP-DTC timing-table
+ * generator. Configuration only (may use double). Design: ctrl_s1_dtc.h.
+ */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "ctrl_params.h"
+#include "ctrl_s1_dtc.h"
+
+#define S1_FS_HZ 10000u /* S1: Ts = 100 us */
+#define S1_BAND 0.01    /* S1 §3.3, §6.1.4: +-0.01 (N*m and Wb) */
+#define S1_KP 1.0       /* S1 §4.1 predictive controller */
+#define S1_KI 0.03
+#define S1_PI 3.14159265358979323846
+#define S1_TILT_DEFAULT (S1_PI / 30.0) /* 6 deg: half a section */
+
+static const ctrl_tunable_t hdtc_tunables[] = {
+    {"h_T", "N*m", "torque hysteresis half band (S1 §3.3: +-0.01)", offsetof(ctrl_s1_cfg_t, h_t),
+     0.0, 1000.0},
+    {"h_psi", "Wb", "flux hysteresis half band (S1 §3.3: +-0.01)", offsetof(ctrl_s1_cfg_t, h_psi),
+     0.0, 10.0},
+    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 §4, §6.1.4)",
+     offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
+};
+
+static const ctrl_tunable_t svm_tunables[] = {
+    {"Kp", "rad/pu", "predictive-controller PI, Delta delta per pu torque error (S1 §4.1: 1)",
+     offsetof(ctrl_s1_cfg_t, kp), 0.0, 100.0},
+    {"Ki", "rad/(pu*sample)", "integral gain per sample (S1 §4.1: 0.03)",
+     offsetof(ctrl_s1_cfg_t, ki), 0.0, 10.0},
+    {"omega_ff", "-", "1: add the rotor advance omega_e Ts to Delta delta",
+     offsetof(ctrl_s1_cfg_t, omega_ff), 0.0, 1.0},
+    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 §4)", offsetof(ctrl_s1_cfg_t, psi_ref), 0.0,
+     100.0},
+};
+
+static const ctrl_tunable_t hpdtc_tunables[] = {
+    {"h_T", "N*m", "torque two-level hysteresis half band (tau of S1 Table 4)",
+     offsetof(ctrl_s1_cfg_t, h_t), 0.0, 1000.0},
+    {"h_psi", "Wb", "flux two-level hysteresis half band (phi of S1 Table 4)",
+     offsetof(ctrl_s1_cfg_t, h_psi), 0.0, 10.0},
+    {"psi_ref", "Wb", "flux reference; 0 = psi_pm", offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
+    {"e_fs", "N*m",
+     "|T_err| of the full voltage level (5 levels of e_fs/5); 0 = Ts Lq-based, see ctrl_s1_dtc.h",
+     offsetof(ctrl_s1_cfg_t, e_fs), 0.0, 1000.0},
+    {"tilt", "rad", "timing-table reference tilted from the flux tangent towards V_k1",
+     offsetof(ctrl_s1_cfg_t, tilt), 0.0, S1_PI / 6.0},
+};
+
+static void s1_cfg_default(void *cfg, const ctrl_machine_t *m)
+{
+    ctrl_s1_cfg_t *c = cfg;
+    if (c == NULL) {
+        return;
+    }
+    memset(c, 0, sizeof *c);
+    c->h_t = S1_BAND;
+    c->h_psi = S1_BAND;
+    c->psi_ref = 0.0;
+    c->kp = S1_KP;
+    c->ki = S1_KI;
+    c->omega_ff = 1.0;
+    c->tilt = S1_TILT_DEFAULT;
+    ctrl_params_t p;
+    ctrl_bases_t b;
+    if (m == NULL || ctrl_params_init(&p, &b, m, S1_FS_HZ) != CTRL_OK) {
+        return; /* bases stay 0: init refuses */
+    }
+    c->torque_base_nm = b.torque_nm;
+    c->psi_base_wb = b.psi_wb;
+    c->psi_pm_wb = m->psi_pm_wb;
+}
+
+static int s1_in_range(const ctrl_tunable_t *t, size_t n, const ctrl_s1_cfg_t *c)
+{
+    for (size_t i = 0; i < n; i++) {
+        double v;
+        memcpy(&v, (const char *)c + t[i].offset, sizeof v);
+        if (!isfinite(v) || v < t[i].min || v > t[i].max) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* SI / base -> Q24 pu in [0, 127). */
+static int s1_q24(double si, double base, q24_t *out)
+{
+    const double pu = si / base;
+    if (!isfinite(pu) || pu < 0.0 || pu >= 127.0) {
+        return CTRL_ERANGE;
+    }
+    *out = ctrl_q24_from_double(pu);
+    return CTRL_OK;
+}
+
+/* Bases present and those of the params' machine (psi_base = psi_pm). */
+static int s1_check(const ctrl_s1_cfg_t *c, const ctrl_params_t *p)
+{
+    if (!(c->torque_base_nm > 0.0) || !(c->psi_base_wb > 0.0) || !isfinite(c->torque_base_nm) ||
+        !isfinite(c->psi_base_wb) || p->fs_hz == 0u) {
+        return CTRL_EINVAL;
+    }
+    if (fabs(c->psi_pm_wb / c->psi_base_wb - ctrl_q24_to_double(p->psi_pm)) > 1e-5) {
+        return CTRL_EINVAL;
+    }
+    return CTRL_OK;
+}
+
+/* Flux reference: tunable, else params->psi_ref, else psi_pm. */
+static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_params_t *p, q24_t *out)
+{
+    if (c->psi_ref > 0.0) {
+        return s1_q24(c->psi_ref, c->psi_base_wb, out);
+    }
+    *out = p->psi_ref > 0 ? p->psi_ref : p->psi_pm;
+    return *out > 0 ? CTRL_OK : CTRL_EINVAL;
+}
+
+static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+{
+    if (state == NULL || cfg == NULL || p == NULL) {
+        return CTRL_EINVAL;
+    }
+    const ctrl_s1_cfg_t *c = cfg;
+    ctrl_hdtc_state_t *s = state;
+    memset(s, 0, sizeof *s);
+    if (!s1_in_range(hdtc_tunables, sizeof hdtc_tunables / sizeof hdtc_tunables[0], c)) {
+        return CTRL_EINVAL;
+    }
+    q24_t ht;
+    q24_t hp;
+    int rc = s1_check(c, p);
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_t, c->torque_base_nm, &ht);
+    }
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_psi, c->psi_base_wb, &hp);
+    }
+    if (rc == CTRL_OK) {
+        rc = s1_psi_ref(c, p, &s->psi_ref);
+    }
+    if (rc != CTRL_OK) {
+        memset(s, 0, sizeof *s);
+        return rc;
+    }
+    ctrl_hyst2_init(&s->flux, hp);
+    ctrl_hyst3_init(&s->torque, ht);
+    ctrl_hdtc_reset(s);
+    return CTRL_OK;
+}
+
+static int svm_dtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+{
+    if (state == NULL || cfg == NULL || p == NULL) {
+        return CTRL_EINVAL;
+    }
+    const ctrl_s1_cfg_t *c = cfg;
+    ctrl_svm_dtc_state_t *s = state;
+    memset(s, 0, sizeof *s);
+    if (!s1_in_range(svm_tunables, sizeof svm_tunables / sizeof svm_tunables[0], c)) {
+        return CTRL_EINVAL;
+    }
+    int rc = s1_check(c, p);
+    if (rc == CTRL_OK) {
+        rc = s1_psi_ref(c, p, &s->psi_ref);
+    }
+    const double ts = ctrl_q24_to_double(p->ts);
+    if (rc == CTRL_OK && (!(ts > 0.0) || 1.0 / ts >= 127.0)) {
+        rc = CTRL_ERANGE; /* 1/Ts does not fit Q24 */
+    }
+    if (rc != CTRL_OK) {
+        memset(s, 0, sizeof *s);
+        return rc;
+    }
+    s->kp = ctrl_q24_from_double(c->kp);
+    s->ki = (int32_t)llround(c->ki * 1073741824.0); /* Q30, ki <= 10 < 2: checked below */
+    if (c->ki >= 1.99) {
+        memset(s, 0, sizeof *s);
+        return CTRL_ERANGE;
+    }
+    s->inv_ts = ctrl_q24_from_double(1.0 / ts);
+    s->ff = (uint8_t)(c->omega_ff >= 0.5);
+    ctrl_svm_dtc_reset(s);
+    return CTRL_OK;
+}
+
+int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTIONS][2])
+{
+    if (pts == NULL || !isfinite(tilt) || tilt < 0.0 || tilt > S1_PI / 6.0) {
+        return CTRL_EINVAL;
+    }
+    const double deg = S1_PI / 180.0;
+    for (int l = 0; l < HPDTC_LEVELS; l++) {
+        /* Amplitude m of the inscribed circle Vdc/sqrt(3) = (sqrt(3)/2) |V_k|. */
+        const double m = (double)(l + 1) / HPDTC_LEVELS;
+        for (int j = 0; j < HPDTC_SECTIONS; j++) {
+            /* Section centre rho (seen from V_k1) and the angle of the flux
+             * tangent from V_k1 towards V_k2: 30 deg + rho, tilted to V_k1. */
+            const double rho = (j - 2) * 12.0 * deg;
+            double a = 30.0 * deg + rho - tilt;
+            a = a < 0.0 ? 0.0 : (a > 60.0 * deg ? 60.0 * deg : a);
+            /* SVM dwell times: v = t1 V_k1 + t2 V_k2 (Ts = 1) gives
+             * t1 = |v| sin(60 - a) / (|V_k| sin 60) = m sin(60 - a), t2 = m sin(a). */
+            long p1 = lround(HPDTC_POINTS * m * sin(60.0 * deg - a));
+            long p2 = lround(HPDTC_POINTS * m * sin(a));
+            while (p1 + p2 > HPDTC_POINTS) { /* rounding only: never beyond the hexagon */
+                if (p1 >= p2) {
+                    p1--;
+                } else {
+                    p2--;
+                }
+            }
+            pts[l][j][0] = (uint8_t)p1;
+            pts[l][j][1] = (uint8_t)p2;
+        }
+    }
+    return CTRL_OK;
+}
+
+static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+{
+    if (state == NULL || cfg == NULL || p == NULL) {
+        return CTRL_EINVAL;
+    }
+    const ctrl_s1_cfg_t *c = cfg;
+    ctrl_hpdtc_state_t *s = state;
+    memset(s, 0, sizeof *s);
+    if (!s1_in_range(hpdtc_tunables, sizeof hpdtc_tunables / sizeof hpdtc_tunables[0], c)) {
+        return CTRL_EINVAL;
+    }
+    q24_t ht;
+    q24_t hp;
+    q24_t efs = 0;
+    int rc = s1_check(c, p);
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_t, c->torque_base_nm, &ht);
+    }
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_psi, c->psi_base_wb, &hp);
+    }
+    if (rc == CTRL_OK && c->e_fs > 0.0) {
+        rc = s1_q24(c->e_fs, c->torque_base_nm, &efs);
+    } else if (rc == CTRL_OK) {
+        /* One level step (0.2 Vdc/sqrt(3)) turns the flux by 0.2 Ts Vdc/(sqrt(3) psi_pm)
+         * per period; at delta = 0 dT/d delta = psi_pm^2 / Lq (pu, from S1(7)), so
+         * the torque moves by 0.2 ts / (sqrt(3) lq) pu per period and level step.
+         * e_fs = 5 x that: one level step corrects one level's error width in one
+         * period (loop gain 1 of the level quantiser). */
+        const double e = ctrl_q24_to_double(p->ts) / (sqrt(3.0) * ctrl_q24_to_double(p->lq));
+        rc = (isfinite(e) && e > 0.0 && e < 127.0) ? CTRL_OK : CTRL_ERANGE;
+        efs = ctrl_q24_from_double(rc == CTRL_OK ? e : 0.0);
+    }
+    if (rc == CTRL_OK && efs <= 0) {
+        rc = CTRL_ERANGE; /* e_fs below the Q24 resolution */
+    }
+    if (rc == CTRL_OK) {
+        rc = s1_psi_ref(c, p, &s->psi_ref);
+    }
+    if (rc == CTRL_OK) {
+        rc = ctrl_hpdtc_timing_table(c->tilt, s->pts);
+    }
+    if (rc != CTRL_OK) {
+        memset(s, 0, sizeof *s);
+        return rc;
+    }
+    for (int i = 0; i < HPDTC_LEVELS - 1; i++) {
+        s->lvl_thr[i] = ctrl_q24_from_double(ctrl_q24_to_double(efs) * (i + 1) / HPDTC_LEVELS);
+    }
+    for (int l = 0; l < HPDTC_LEVELS; l++) {
+        for (int j = 0; j < HPDTC_SECTIONS; j++) {
+            for (int k = 0; k < 2; k++) {
+                const int64_t num = (int64_t)s->pts[l][j][k] * FX_ONE;
+                s->dur[l][j][k] = (q24_t)((num + HPDTC_POINTS / 2) / HPDTC_POINTS);
+            }
+        }
+    }
+    ctrl_hyst2_init(&s->flux, hp);
+    ctrl_hyst2_init(&s->torque, ht);
+    ctrl_hpdtc_reset(s);
+    return CTRL_OK;
+}
+
+#define S1_DESC(id, label, st, tun, initfn, resetfn, stepfn)                                       \
+    const ctrl_desc_t ctrl_desc_##id = {                                                           \
+        #id,                                                                                       \
+        label,                                                                                     \
+        S1_FS_HZ,                                                                                  \
+        sizeof(st),                                                                                \
+        sizeof(ctrl_s1_cfg_t),                                                                     \
+        tun,                                                                                       \
+        sizeof tun / sizeof tun[0],                                                                \
+        s1_cfg_default,                                                                            \
+        initfn,                                                                                    \
+        resetfn,                                                                                   \
+        stepfn,                                                                                    \
+    }
+
+S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 §3, Table 3)",
+        ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step);
+S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 §4, S1(17)-(20))",
+        ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step);
+S1_DESC(hpdtc, "HP-DTC, two adjacent vectors + 20-point timing table (S1 §5, Table 4)",
+        ctrl_hpdtc_state_t, hpdtc_tunables, hpdtc_init, ctrl_hpdtc_reset, ctrl_hpdtc_step);

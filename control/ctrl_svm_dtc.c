@@ -1,0 +1,91 @@
+/*
+ * SVM-DTC with the predictive controller of the book chapter (S1 §4,
+ * S1(17)-(20), Fig. 25), per-sample part (integer-only). See ctrl_s1_dtc.h.
+ */
+#include <stddef.h>
+
+#include "ctrl_s1_dtc.h"
+#include "plan.h"
+#include "predict.h"
+#include "svpwm.h"
+
+#define SVM_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
+#define SVM_KI_QBITS 30u
+#define SVM_DD_MAX 17569060        /* pi/3 rad, Q24 */
+#define SVM_INTEG_MAX 8784530      /* pi/6 rad, Q24 */
+#define SVM_RAD_TO_ANGLE 683565276 /* 2^32 / (2 pi), Q24 of fx_angle_t per rad */
+#define SVM_PSI_MIN (FX_ONE / 64)  /* below this the flux has no usable direction */
+
+void ctrl_svm_dtc_reset(void *state)
+{
+    ctrl_svm_dtc_state_t *s = state;
+    if (s == NULL) {
+        return;
+    }
+    s->integ = 0;
+    s->limited = 0u;
+    s->dd = 0;
+    s->v_alpha = 0;
+    s->v_beta = 0;
+}
+
+void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+{
+    ctrl_svm_dtc_state_t *s = state;
+    if (out == NULL) {
+        return;
+    }
+    if (s == NULL || ctx == NULL || ctx->params == NULL || ctx->est == NULL || ctx->ref == NULL) {
+        ctrl_plan_single(out, 0u);
+        return;
+    }
+    const ctrl_params_t *p = ctx->params;
+    const ctrl_mstate_t *nx = &ctx->est->next; /* starting flux psi_s(k+1): delay compensation */
+    const q24_t psi_ref = ctx->ref->psi > 0 ? ctx->ref->psi : s->psi_ref;
+    const q24_t e = fx_sub(ctx->ref->torque, nx->torque);
+
+    /* PI -> Delta delta (rad, Q24). */
+    const q24_t integ = fx_sat32(fx_rshift64_round(s->integ, SVM_INTEG_SHIFT));
+    q24_t dd = fx_add(fx_mul(s->kp, e), integ);
+    dd = fx_clamp(dd, -SVM_DD_MAX, SVM_DD_MAX);
+    const uint8_t pi_sat = (dd == SVM_DD_MAX || dd == -SVM_DD_MAX) ? 1u : 0u;
+    if (s->ff != 0u) {
+        dd = fx_add(dd, fx_mul(ctx->est->omega_e, p->ts)); /* rotor advance omega Ts */
+    }
+    s->dd = dd;
+
+    /* Unit vector of the present flux (lambda_s), no atan: psi / |psi|. */
+    q24_t ux;
+    q24_t uy;
+    if (nx->psi_amp >= SVM_PSI_MIN) {
+        ux = fx_div(nx->psi_alpha, nx->psi_amp);
+        uy = fx_div(nx->psi_beta, nx->psi_amp);
+    } else {
+        ux = nx->cos_theta; /* no flux yet: start from the magnet axis */
+        uy = nx->sin_theta;
+    }
+    /* psi_ref e^{j(lambda + dd)}: rotate u by dd (|dd| < pi/2 + |omega Ts|, the
+     * product dd * 2^32/(2 pi) fits 64 bits), scale by psi_ref. */
+    const int64_t ang = fx_rshift64_round((int64_t)dd * SVM_RAD_TO_ANGLE, FX_QBITS);
+    q24_t sn;
+    q24_t cs;
+    fx_sincos((fx_angle_t)(uint64_t)ang, &sn, &cs);
+    const q24_t tx = fx_mul(psi_ref, fx_sub(fx_mul(cs, ux), fx_mul(sn, uy)));
+    const q24_t ty = fx_mul(psi_ref, fx_add(fx_mul(sn, ux), fx_mul(cs, uy)));
+    /* S1(19)-(20): V = (psi_target - psi) / Ts + Rs i. */
+    q24_t va = fx_add(fx_mul(fx_sub(tx, nx->psi_alpha), s->inv_ts), fx_mul(p->rs, nx->i_alpha));
+    q24_t vb = fx_add(fx_mul(fx_sub(ty, nx->psi_beta), s->inv_ts), fx_mul(p->rs, nx->i_beta));
+    s->v_alpha = va;
+    s->v_beta = vb;
+    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, out);
+
+    /* Integrator: conditional integration (hold while the PI output or the
+     * voltage is saturated and the error pushes further), clamped to pi/6. */
+    if (!((pi_sat != 0u || s->limited != 0u) && fx_sign(e) == fx_sign(dd))) {
+        const int64_t lim = (int64_t)SVM_INTEG_MAX << SVM_INTEG_SHIFT;
+        int64_t i =
+            s->integ + fx_rshift64_round((int64_t)e * s->ki, SVM_KI_QBITS - SVM_INTEG_SHIFT);
+        i = i > lim ? lim : (i < -lim ? -lim : i);
+        s->integ = i;
+    }
+}

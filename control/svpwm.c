@@ -1,0 +1,122 @@
+/*
+ * Space-vector PWM, min-max injection form (see svpwm.h). Integer-only.
+ */
+#include "svpwm.h"
+
+#include "transforms.h"
+
+/* Vector index for a leg mask (bit 0 = leg a, 1 = b, 2 = c), inverse of Table 4.2:
+ * 000->V0, 100->V1, 010->V3, 110->V2, 001->V5, 101->V6, 011->V4, 111->V7. */
+static const uint8_t svpwm_vec_of_mask[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
+
+/* Phase voltages of (v_alpha, v_beta) and their max and min (inverse Clarke). */
+static void svpwm_phases(q24_t va, q24_t vb, q24_t ph[3], q24_t *mx, q24_t *mn)
+{
+    ctrl_inv_clarke(va, vb, &ph[0], &ph[1], &ph[2]);
+    *mx = fx_max(ph[0], fx_max(ph[1], ph[2]));
+    *mn = fx_min(ph[0], fx_min(ph[1], ph[2]));
+}
+
+uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
+{
+    if (vdc <= 0) {
+        *v_alpha = 0;
+        *v_beta = 0;
+        return 1u;
+    }
+    q24_t ph[3];
+    q24_t mx;
+    q24_t mn;
+    svpwm_phases(*v_alpha, *v_beta, ph, &mx, &mn);
+    const int64_t span = (int64_t)mx - mn; /* line-voltage span, >= 0, < 2^32 */
+    if (span <= (int64_t)vdc) {
+        return 0u;
+    }
+    /* k = vdc / span < 1 in Q30 (span < 2^32, vdc < 2^31: the quotient fits),
+     * truncated so the scaled vector does not land outside by rounding. */
+    const int64_t k = ((int64_t)vdc * ((int64_t)1 << 30)) / span;
+    *v_alpha = fx_sat32(fx_rshift64_round((int64_t)*v_alpha * k, 30u));
+    *v_beta = fx_sat32(fx_rshift64_round((int64_t)*v_beta * k, 30u));
+    return 1u;
+}
+
+void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs)
+{
+    if (vdc <= 0) {
+        legs->duty[0] = 0;
+        legs->duty[1] = 0;
+        legs->duty[2] = 0;
+        return;
+    }
+    q24_t ph[3];
+    q24_t mx;
+    q24_t mn;
+    svpwm_phases(v_alpha, v_beta, ph, &mx, &mn);
+    const q24_t inv_vdc = fx_div(FX_ONE, vdc); /* Q24, one division per period */
+    for (unsigned x = 0u; x < 3u; x++) {
+        /* d_x = 1/2 + (2 v_x - max - min) / (2 Vdc). The difference is clamped
+         * to 2^30 (64 pu: beyond any hexagon) so that times |inv_vdc| < 2^31 the
+         * product stays below 2^61. */
+        int64_t diff = 2 * (int64_t)ph[x] - mx - mn;
+        const int64_t lim = (int64_t)1 << 30;
+        diff = diff > lim ? lim : (diff < -lim ? -lim : diff);
+        const int64_t d = fx_rshift64_round(diff * inv_vdc, FX_QBITS + 1u) + FX_ONE / 2;
+        legs->duty[x] = (q24_t)(d < 0 ? 0 : (d > FX_ONE ? FX_ONE : d));
+    }
+}
+
+void ctrl_svpwm_plan_from_legs(const ctrl_legs_t *legs, ctrl_plan_t *out)
+{
+    /* Sort legs by duty: hi >= mid >= lo. */
+    unsigned hi = 0u;
+    unsigned mid = 1u;
+    unsigned lo = 2u;
+    unsigned t;
+    if (legs->duty[mid] > legs->duty[hi]) {
+        t = hi;
+        hi = mid;
+        mid = t;
+    }
+    if (legs->duty[lo] > legs->duty[mid]) {
+        t = mid;
+        mid = lo;
+        lo = t;
+    }
+    if (legs->duty[mid] > legs->duty[hi]) {
+        t = hi;
+        hi = mid;
+        mid = t;
+    }
+    const q24_t d_hi = fx_clamp(legs->duty[hi], 0, FX_ONE);
+    const q24_t d_mid = fx_clamp(legs->duty[mid], 0, d_hi);
+    const q24_t d_lo = fx_clamp(legs->duty[lo], 0, d_mid);
+    const uint8_t v_one = svpwm_vec_of_mask[1u << hi];                 /* one leg high */
+    const uint8_t v_two = svpwm_vec_of_mask[(1u << hi) | (1u << mid)]; /* two legs high */
+    const q24_t t_one = d_hi - d_mid;
+    const q24_t t_two = d_mid - d_lo;
+    out->n_seg = 4u;
+    if (t_one >= t_two) {
+        out->vec[0] = v_one;
+        out->dur[0] = t_one;
+        out->vec[1] = v_two;
+        out->dur[1] = t_two;
+    } else {
+        out->vec[0] = v_two;
+        out->dur[0] = t_two;
+        out->vec[1] = v_one;
+        out->dur[1] = t_one;
+    }
+    out->vec[2] = 0u;
+    out->dur[2] = FX_ONE - d_hi;
+    out->vec[3] = 7u;
+    out->dur[3] = d_lo;
+}
+
+uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_plan_t *out)
+{
+    const uint8_t lim = ctrl_svpwm_limit(vdc, v_alpha, v_beta);
+    ctrl_legs_t legs;
+    ctrl_svpwm_duties(*v_alpha, *v_beta, vdc, &legs);
+    ctrl_svpwm_plan_from_legs(&legs, out);
+    return lim;
+}

@@ -1,0 +1,49 @@
+/*
+ * Space-vector PWM for the chapter's controllers (S1 §2 FOC, §4 SVM-DTC).
+ *
+ * Centre-aligned SVPWM by min-max zero-sequence injection, which is the
+ * classical sector/dwell-time SVM with the zero time split equally between V0
+ * and V7: with phase voltages v_x of the reference (inverse Clarke, (3.3)),
+ *   d_x = 1/2 + (v_x - (max + min) / 2) / Vdc          (leg x duty)
+ * The plan lists the same thing as vectors: sorting the legs by duty
+ * d_hi >= d_mid >= d_lo gives V7 for d_lo, the two-legs-high active vector for
+ * d_mid - d_lo, the one-leg-high active vector for d_hi - d_mid, and V0 for
+ * 1 - d_hi, i.e. the two active vectors adjacent to the reference with the
+ * dwell times of the sector formulas, and t0/2 for each zero vector. So
+ * ctrl_plan_to_legs() of the plan gives back exactly the duties above.
+ *
+ * Over-modulation: the two-level inverter can synthesise v iff
+ * max(v_x) - min(v_x) <= Vdc (the hexagon spanned by V1..V6). Outside, v is
+ * scaled by Vdc / (max - min): the result lies on the hexagon and keeps its
+ * angle (one division, only when limiting).
+ *
+ * All voltages Q24 per-unit (v_base = nominal Vdc, ctrl_params.h).
+ */
+#ifndef CONTROL_SVPWM_H
+#define CONTROL_SVPWM_H
+
+#include <stdint.h>
+
+#include "ctrl_types.h"
+#include "fx.h"
+
+/* Scale (v_alpha, v_beta) onto the voltage hexagon of DC link vdc if it lies
+ * outside, keeping its angle. Returns 1 if it was limited, 0 if unchanged.
+ * vdc <= 0 (nothing can be synthesised): the vector becomes 0, returns 1. */
+uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
+
+/* Leg duties (Q24 fraction of the period, [0, FX_ONE]) of a reference inside
+ * the hexagon by min-max injection (formula above). Call ctrl_svpwm_limit
+ * first; residual rounding is clamped. vdc <= 0 gives 0, 0, 0 (V0). */
+void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs);
+
+/* Plan realising leg duties as vectors: segment 0 = the active vector with the
+ * longer dwell time, segment 1 = the other active vector, segments 2 and 3 =
+ * V0 and V7 (durations sum to FX_ONE; zero durations are kept). */
+void ctrl_svpwm_plan_from_legs(const ctrl_legs_t *legs, ctrl_plan_t *out);
+
+/* Limit + duties + plan in one call. Returns the ctrl_svpwm_limit result; the
+ * limited reference is written back to *v_alpha, *v_beta. */
+uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_plan_t *out);
+
+#endif /* CONTROL_SVPWM_H */

@@ -1,0 +1,170 @@
+/*
+ * hdtc and svm_dtc (control/ctrl_s1_dtc.h): registry entries and defaults
+ * (S1 §3.3 bands +-0.01, S1 §4.1 Kp = 1, Ki = 0.03), the HDTC decisions
+ * against S1 Table 3 as printed (every sector, phi, tau, including its fixed
+ * V0/V7 entries reached after the preceding active vector), and the SVM-DTC
+ * predictive controller's basic behaviour (hold, advance, PI integration).
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "chapter_machines.h"
+#include "controller.h"
+#include "ctrl_params.h"
+#include "ctrl_s1_dtc.h"
+#include "plan.h"
+#include "unity.h"
+
+void setUp(void)
+{
+}
+void tearDown(void)
+{
+}
+
+#define PI 3.14159265358979323846
+
+static double q(q24_t x)
+{
+    return (double)x / 16777216.0;
+}
+
+typedef struct {
+    ctrl_params_t params;
+    ctrl_bases_t bases;
+    ctrl_estimate_t est;
+    ctrl_refs_t ref;
+    ctrl_ctx_t ctx;
+    _Alignas(8) unsigned char state[CTRL_STATE_MAX];
+    _Alignas(8) unsigned char cfg[CTRL_CFG_MAX];
+    const ctrl_desc_t *d;
+} rig_t;
+
+static rig_t rig;
+
+static void rig_init(const char *name)
+{
+    memset(&rig, 0, sizeof rig);
+    rig.d = ctrl_find(name);
+    TEST_ASSERT_NOT_NULL(rig.d);
+    TEST_ASSERT_TRUE(rig.d->state_size <= CTRL_STATE_MAX);
+    TEST_ASSERT_TRUE(rig.d->cfg_size <= CTRL_CFG_MAX);
+    TEST_ASSERT_EQUAL_UINT32(10000u, rig.d->fs_default_hz);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK,
+                          ctrl_params_init(&rig.params, &rig.bases, &chapter_ipmsm, 10000u));
+    rig.d->cfg_default(rig.cfg, &chapter_ipmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
+    rig.ctx.params = &rig.params;
+    rig.ctx.est = &rig.est;
+    rig.ctx.ref = &rig.ref;
+    rig.est.vdc = rig.params.vdc_nom;
+}
+
+static void set_next(double lam, double amp, double t)
+{
+    ctrl_mstate_t *nx = &rig.est.next;
+    memset(nx, 0, sizeof *nx);
+    nx->psi_alpha = ctrl_q24_from_double(amp * cos(lam));
+    nx->psi_beta = ctrl_q24_from_double(amp * sin(lam));
+    nx->psi_amp = ctrl_q24_from_double(amp);
+    nx->torque = ctrl_q24_from_double(t);
+    nx->cos_theta = FX_ONE;
+}
+
+/* S1 Table 3 as printed: [phi 1/0][tau 1/0/-1][sector 1..6]. */
+static const uint8_t s1_table3[2][3][6] = {
+    {{2, 3, 4, 5, 6, 1}, {7, 0, 7, 0, 7, 0}, {6, 1, 2, 3, 4, 5}},
+    {{3, 4, 5, 6, 1, 2}, {0, 7, 0, 7, 0, 7}, {5, 6, 1, 2, 3, 4}},
+};
+
+static void test_hdtc_table3(void)
+{
+    rig_init("hdtc");
+    double v;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(rig.d, rig.cfg, "h_T", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(0.01, v);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(rig.d, rig.cfg, "h_psi", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(0.01, v);
+    const double big = 0.05; /* pu, beyond both bands (0.01 Wb = 0.019 pu, 0.01 N*m) */
+    for (int ph = 0; ph < 2; ph++) {
+        for (int sec = 1; sec <= 6; sec++) {
+            const double lam = (sec - 1) * PI / 3.0 + 0.1;      /* inside sector sec (4.5) */
+            const double amp = ph == 0 ? 1.0 - big : 1.0 + big; /* psi_ref = psi_pm = 1 pu */
+            /* tau = +1 */
+            rig.d->reset(rig.state);
+            set_next(lam, amp, 0.1);
+            rig.ref.torque = ctrl_q24_from_double(0.1 + big);
+            ctrl_plan_t out;
+            rig.d->step(rig.state, &rig.ctx, &out);
+            TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][0][sec - 1], out.vec[0]);
+            /* tau = 0: torque reached the reference after an increase; Table 3's
+             * zero vector is the one after the active vector just applied. */
+            rig.ref.torque = ctrl_q24_from_double(0.1);
+            rig.d->step(rig.state, &rig.ctx, &out);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][1][sec - 1], out.vec[0]);
+            /* tau = -1 */
+            rig.ref.torque = ctrl_q24_from_double(0.1 - big);
+            rig.d->step(rig.state, &rig.ctx, &out);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][2][sec - 1], out.vec[0]);
+        }
+    }
+    ctrl_plan_t out;
+    rig.d->step(rig.state, NULL, &out); /* no context: a zero vector, no crash */
+    TEST_ASSERT_TRUE(out.vec[0] == 0u || out.vec[0] == 7u);
+}
+
+static void test_svm_dtc_basics(void)
+{
+    rig_init("svm_dtc");
+    double v;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(rig.d, rig.cfg, "Kp", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(1.0, v);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(rig.d, rig.cfg, "Ki", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(0.03, v);
+    const ctrl_svm_dtc_state_t *s = (const ctrl_svm_dtc_state_t *)rig.state;
+    /* No error, no speed, flux at its reference, no current: no voltage. */
+    set_next(0.3, 1.0, 0.2);
+    rig.ref.torque = ctrl_q24_from_double(0.2);
+    ctrl_plan_t out;
+    rig.d->step(rig.state, &rig.ctx, &out);
+    TEST_ASSERT_INT32_WITHIN(64, 0, s->v_alpha);
+    TEST_ASSERT_INT32_WITHIN(64, 0, s->v_beta);
+    /* Positive torque error: Delta delta = Kp e (first sample, empty
+     * integrator) and the voltage advances the flux (positive tangential). */
+    rig.d->reset(rig.state);
+    rig.ref.torque = ctrl_q24_from_double(0.21);
+    rig.d->step(rig.state, &rig.ctx, &out);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.01, q(s->dd));
+    const double vt = -q(s->v_alpha) * sin(0.3) + q(s->v_beta) * cos(0.3);
+    const double ts = q(rig.params.ts);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-4, sin(0.01) / ts, vt);
+    /* Second sample: the integrator added Ki e = 0.0003 rad. */
+    rig.d->step(rig.state, &rig.ctx, &out);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.01 + 0.03 * 0.01, q(s->dd));
+    /* Speed feed-forward: omega Ts added. */
+    rig.d->reset(rig.state);
+    rig.ref.torque = ctrl_q24_from_double(0.2);
+    rig.est.omega_e = ctrl_q24_from_double(0.3);
+    rig.d->step(rig.state, &rig.ctx, &out);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.3 * ts, q(s->dd));
+    /* A large error saturates: the voltage is limited, the plan still sums to 1. */
+    rig.ref.torque = ctrl_q24_from_double(5.0);
+    rig.d->step(rig.state, &rig.ctx, &out);
+    TEST_ASSERT_EQUAL_UINT8(1, s->limited);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, out.dur[0] + out.dur[1] + out.dur[2] + out.dur[3]);
+    /* Integrator bounded (pi/6) whatever the error. */
+    for (int k = 0; k < 1000; k++) {
+        rig.d->step(rig.state, &rig.ctx, &out);
+    }
+    TEST_ASSERT_TRUE(fabs(q(s->dd) - 0.3 * ts) <= PI / 3.0 + 1e-6);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_hdtc_table3);
+    RUN_TEST(test_svm_dtc_basics);
+    return UNITY_END();
+}
