@@ -90,7 +90,18 @@ static fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
     /* Signed modulo-2^32 difference, then the position modulo cpr. */
     const int64_t delta = fw_signed32(count - fw->enc_last);
     fw->enc_last = count;
-    fw->enc_pos = fw_mod((int64_t)fw->enc_pos + delta, fw->enc_cpr);
+    {
+        const int64_t np = (int64_t)fw->enc_pos + delta;
+        if (np >= 0 && np < (int64_t)fw->enc_cpr) {
+            fw->enc_pos = (uint32_t)np;
+        } else if (np >= (int64_t)fw->enc_cpr && np < 2 * (int64_t)fw->enc_cpr) {
+            fw->enc_pos = (uint32_t)(np - (int64_t)fw->enc_cpr);
+        } else if (np < 0 && np >= -(int64_t)fw->enc_cpr) {
+            fw->enc_pos = (uint32_t)(np + (int64_t)fw->enc_cpr);
+        } else {
+            fw->enc_pos = fw_mod(np, fw->enc_cpr);
+        }
+    }
     /* A new index pulse marks position 0: re-synchronise. */
     if (enc->index_seen && (!fw->enc_index_valid || enc->index_count != fw->enc_index_last)) {
         fw->enc_index_last = enc->index_count;
@@ -99,6 +110,11 @@ static fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
     }
     /* pos * p * 2^32 / cpr < p * 2^32: the low 32 bits are the angle modulo one
      * electrical turn (cpr * p < 2^31 checked at init). */
+    if (fw->enc_cpr < 65536u) {
+        /* pos p 2^32 / cpr = pos q + pos r / cpr; pos r < cpr^2 < 2^32. */
+        const uint32_t e = fw->enc_pos * fw->enc_q32 + fw->enc_pos * fw->enc_r / fw->enc_cpr;
+        return (fx_angle_t)e + fw->enc_offset;
+    }
     const uint64_t num = (uint64_t)fw->enc_pos * (uint64_t)(uint32_t)fw->params.pole_pairs << 32;
     const uint64_t e = num / (uint64_t)fw->enc_cpr;
     return (fx_angle_t)(e & 0xFFFFFFFFu) + fw->enc_offset;

@@ -130,6 +130,8 @@ typedef struct {
     uint16_t adc_mid;     /* 2^(bits-1) */
     /* encoder */
     uint32_t enc_cpr;
+    uint32_t enc_q32; /* floor(p 2^32 / cpr) mod 2^32 (angle per count, integer part) */
+    uint32_t enc_r;   /* p 2^32 mod cpr (remainder), cpr < 2^16 */
     uint32_t enc_last;
     uint32_t enc_pos; /* [0, cpr) */
     bool enc_primed;

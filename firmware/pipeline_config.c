@@ -114,6 +114,11 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
     fw->calib_samples = cfg->calib_samples;
     fw->enc_cpr = in->encoder_counts_per_rev;
+    {
+        const uint64_t num = (uint64_t)(uint32_t)fw->params.pole_pairs << 32;
+        fw->enc_q32 = (uint32_t)((num / fw->enc_cpr) & 0xFFFFFFFFu);
+        fw->enc_r = (uint32_t)(num % fw->enc_cpr);
+    }
     fw->enc_offset = cfg->enc_offset;
 
     fw_protect_cfg_t pc;

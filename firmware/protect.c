@@ -84,7 +84,10 @@ uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count)
         }
         /* Rate at this move: counts over the periods it took (Q16.16). */
         const int64_t mag = delta < 0 ? -(int64_t)delta : (int64_t)delta;
-        const int64_t rate = mag * 65536 / (int64_t)(p->enc_still + 1u);
+        /* mag < 2^15: the Q16.16 rate fits 32 bits, a 32-bit UDIV (no
+         * 64-bit division, __aeabi_ldivmod, in the interrupt). */
+        const int64_t rate = mag < 32768 ? (int64_t)(((uint32_t)mag << 16) / (p->enc_still + 1u))
+                                         : mag * 65536 / (int64_t)(p->enc_still + 1u);
         p->enc_rate_q16 = rate > INT32_MAX ? INT32_MAX : (int32_t)rate;
         p->enc_still = 0u;
     } else {
