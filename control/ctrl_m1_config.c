@@ -7,8 +7,8 @@
 
 static const ctrl_tunable_t m1_tunables[] = {
     {"zeta", "N*m/Wb",
-     "weighting factor of (6.13); Table 6.2: 250 at 750 r/min, 640 at 2250 r/min; "
-     "0 = T_rated/psi_pm (6.5)",
+     "weighting factor of (6.13); 0 = T_rated/psi_pm (default, equal importance, 6.5); "
+     "Table 6.2's 250 / 640 exceed the stability limit sqrt(3) 1.5 p psi_pm/Ls (ctrl_m1.h)",
      offsetof(ctrl_m1_cfg_t, zeta), 0.0, 1e5},
     CTRL_MPC_MODEL_TUNABLES(ctrl_m1_cfg_t),
 };
@@ -17,7 +17,7 @@ static void m1_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
     ctrl_m1_cfg_t *c = cfg;
     memset(c, 0, sizeof *c);
-    c->zeta = 250.0; /* Table 6.2, 750 r/min */
+    c->zeta = 0.0; /* T_rated/psi_pm; Table 6.2's 250 loses torque control (ctrl_m1.h) */
     ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 

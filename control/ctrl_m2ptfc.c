@@ -35,6 +35,12 @@ q24_t ctrl_m2ptfc_duty(q24_t num, q24_t den)
     return ctrl_mpc_ratio(n, d);
 }
 
+q24_t ctrl_m2ptfc_t_eval(const ctrl_m2ptfc_t *s, q24_t t1, q24_t t0)
+{
+    /* (**) of ctrl_m2ptfc.h: Te(k+1) + dT0/2 = Te(k+1) + (Te0(k+2) - Te(k+1))/2. */
+    return s->centre != 0u ? fx_add(t1, fx_rshift32_round(fx_sub(t0, t1), 1u)) : t1;
+}
+
 void ctrl_m2ptfc_reset(void *state)
 {
     ctrl_m2ptfc_t *s = state;
@@ -50,20 +56,22 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     const q24_t t_ref = ctx->ref->torque;
     const q24_t t1 = est->next.torque;
 
+    ctrl_mpc_basis_t b;
+    ctrl_mpc_basis(&s->model, p, est, &b);
+    /* Te of (6.5), (6.7), (6.8): Te(k+1), or Te_c for centre-aligned PWM (header). */
+    const q24_t te = ctrl_m2ptfc_t_eval(s, t1, b.t0);
+
     /* (6.8) sigma_T = lambda (T_ref - Te) + (1 - lambda) sigma_T(k-1). */
-    s->sigma = fx_add(s->sigma, fx_mul(s->lambda, fx_sub(fx_sub(t_ref, t1), s->sigma)));
+    s->sigma = fx_add(s->sigma, fx_mul(s->lambda, fx_sub(fx_sub(t_ref, te), s->sigma)));
     const q24_t t_upper = fx_add(t_ref, s->sigma);
-    const q24_t num = fx_sub(t_upper, t1); /* numerator of (6.5) */
+    const q24_t num = fx_sub(t_upper, te); /* numerator of (6.5) */
     const q24_t two_sigma = fx_add(s->sigma, s->sigma);
 
     uint8_t cand[2];
-    ctrl_m2ptfc_candidates(est->next.sector, t_upper, t1, cand);
+    ctrl_m2ptfc_candidates(est->next.sector, t_upper, te, cand);
 
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, p, est, &b);
-
-    const q24_t psi_ref = ctrl_mpc_psi_ref(p, ctx->ref);
-    const int32_t r2 = ctrl_mpc_ref_amp2(&b, psi_ref);
+    /* psi_ref^2 of (6.9), compared on squares: no square root (MTPA (4.15) squared). */
+    const int32_t r2 = ctrl_mpc_ref2_amp2(&b, ctrl_mpc_psi_ref2(p, ctx->ref));
 
     q24_t duty[2];
     int32_t a2[2];

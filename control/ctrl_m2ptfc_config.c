@@ -8,6 +8,10 @@
 static const ctrl_tunable_t m2ptfc_tunables[] = {
     {"lambda", "1", "EMA coefficient of sigma_T (6.8); Table 6.2: 0.03 (750 and 2250 r/min)",
      offsetof(ctrl_m2ptfc_cfg_t, lambda), 1e-4, 1.0},
+    {"centre", "0/1",
+     "1: Te of (6.5)-(6.8) shifted by half the zero-vector change, mean torque on T_ref with "
+     "centre-aligned PWM (default); 0: the thesis' literal equations (ctrl_m2ptfc.h)",
+     offsetof(ctrl_m2ptfc_cfg_t, centre), 0.0, 1.0},
     CTRL_MPC_MODEL_TUNABLES(ctrl_m2ptfc_cfg_t),
 };
 
@@ -16,6 +20,7 @@ static void m2ptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
     ctrl_m2ptfc_cfg_t *c = cfg;
     memset(c, 0, sizeof *c);
     c->lambda = 0.03; /* Table 6.2 */
+    c->centre = 1.0;  /* plan.h realises plans centre-aligned */
     ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 
@@ -27,7 +32,8 @@ static int m2ptfc_init(void *state, const void *cfg, const ctrl_params_t *params
         return CTRL_EINVAL;
     }
     memset(s, 0, sizeof *s);
-    if (!isfinite(c->lambda) || !(c->lambda > 0.0) || c->lambda > 1.0) {
+    if (!isfinite(c->lambda) || !(c->lambda > 0.0) || c->lambda > 1.0 ||
+        !(c->centre == 0.0 || c->centre == 1.0)) {
         return CTRL_EINVAL;
     }
     const int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
@@ -35,6 +41,7 @@ static int m2ptfc_init(void *state, const void *cfg, const ctrl_params_t *params
         return rc;
     }
     s->lambda = ctrl_q24_from_double(c->lambda);
+    s->centre = c->centre != 0.0 ? 1u : 0u;
     ctrl_m2ptfc_reset(s);
     return CTRL_OK;
 }

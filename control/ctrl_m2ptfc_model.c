@@ -75,6 +75,21 @@ q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref)
     return ctrl_mtpa_psi(p, ref->torque);
 }
 
+int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref)
+{
+    if (ref->psi > 0) {
+        return ctrl_mpc_amp2(ref->psi, 0);
+    }
+    if (p->psi_ref > 0) {
+        return ctrl_mpc_amp2(p->psi_ref, 0);
+    }
+    if (p->salient == 0u) {
+        /* (4.15) squared, the argument of ctrl_mtpa_psi's fx_mag. */
+        return ctrl_mpc_amp2(p->psi_pm, fx_mul(fx_abs(ref->torque), p->mtpa_k));
+    }
+    return ctrl_mpc_amp2(ctrl_mtpa_psi(p, ref->torque), 0); /* table, no square root */
+}
+
 uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied)
 {
     if (applied == NULL || applied->n_seg == 0u) {

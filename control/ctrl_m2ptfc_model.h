@@ -117,6 +117,13 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
  * reference p->psi_ref if > 0, else MTPA of the torque reference (4.15). */
 q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref);
 
+/* The same reference squared, in ctrl_mpc_amp2 units (Q24 pu^2), for the
+ * amplitude comparisons on squares: for the SPMSM MTPA, (4.15) squared,
+ * psi_pm^2 + (Lq T / psi_pm)^2, needs no square root (saves 69 of the
+ * m2ptfc step's 697 Cortex-M4 instructions, tests/mpc/bench_mpc_qemu.c); the
+ * other cases square the amplitude. */
+int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref);
+
 /* Zero vector for a whole period: the one that switches one leg from the end
  * state of the applied plan (V0 after V0/V1/V3/V5, V7 after V7/V2/V4/V6). */
 uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied);
@@ -196,7 +203,12 @@ static inline int32_t ctrl_mpc_amp2(q24_t psi_d, q24_t psi_q)
 }
 
 /* A flux-amplitude reference in the scale of the rotor-frame amplitudes:
- * squared (ctrl_mpc_amp2 units) and linear. */
+ * from its square (ctrl_mpc_psi_ref2), squared (ctrl_mpc_amp2 units) and linear. */
+static inline int32_t ctrl_mpc_ref2_amp2(const ctrl_mpc_basis_t *b, int32_t psi2)
+{
+    return fx_mul(psi2, b->mag2);
+}
+
 static inline int32_t ctrl_mpc_ref_amp2(const ctrl_mpc_basis_t *b, q24_t psi)
 {
     return fx_mul(ctrl_mpc_amp2(psi, 0), b->mag2);

@@ -6,8 +6,8 @@
 
 static const ctrl_tunable_t m3_tunables[] = {
     {"zeta", "N*m/Wb",
-     "weighting factor of (6.13); Table 6.2: 440 at 750 r/min (fs 12 kHz), 110 at 2250 r/min "
-     "(fs 16 kHz); 0 = T_rated/psi_pm (6.5)",
+     "weighting factor of (6.13); 0 = T_rated/psi_pm (default, 6.5); Table 6.2: 110 at "
+     "2250 r/min (fs 16 kHz) works, 440 at 750 r/min exceeds the limit of ctrl_m1.h",
      offsetof(ctrl_m3_cfg_t, zeta), 0.0, 1e5},
     CTRL_MPC_MODEL_TUNABLES(ctrl_m3_cfg_t),
 };
@@ -16,7 +16,7 @@ static void m3_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
     ctrl_m3_cfg_t *c = cfg;
     memset(c, 0, sizeof *c);
-    c->zeta = 440.0; /* Table 6.2, 750 r/min */
+    c->zeta = 0.0; /* T_rated/psi_pm; Table 6.2's 440 loses torque control (ctrl_m1.h) */
     ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 

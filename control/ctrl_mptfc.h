@@ -8,8 +8,10 @@
  * applied all period. V0 and V7 give the same prediction: they are one
  * candidate, realised by the zero vector that switches one leg from the end
  * state of the applied plan. Ties keep the first in the order V0, V1 .. V6.
- * zeta defaults to 250 N*m/Wb (the M1 value of Table 6.2; the thesis gives no
- * FS-MPTFC experiment), 0 = T_rated/psi_pm. fs 10 kHz.
+ * zeta defaults to 0 = T_rated/psi_pm (25.5 N*m/Wb for the thesis SPMSM; the
+ * thesis gives no FS-MPTFC experiment): M1's 250 of Table 6.2 is above the
+ * limit sqrt(3) (3p/2) psi_pm/Ls = 149.5 N*m/Wb derived in ctrl_m1.h and trips
+ * over-current at 750 r/min in simulation. fs 10 kHz.
  */
 #ifndef CONTROL_CTRL_MPTFC_H
 #define CONTROL_CTRL_MPTFC_H

@@ -6,8 +6,8 @@
 
 static const ctrl_tunable_t mptfc_tunables[] = {
     {"zeta", "N*m/Wb",
-     "weighting factor of (6.13); default the M1 value of Table 6.2 (250); "
-     "0 = T_rated/psi_pm (6.5)",
+     "weighting factor of (6.13); 0 = T_rated/psi_pm (default, 6.5); see ctrl_m1.h for "
+     "the stability limit",
      offsetof(ctrl_mptfc_cfg_t, zeta), 0.0, 1e5},
     CTRL_MPC_MODEL_TUNABLES(ctrl_mptfc_cfg_t),
 };
@@ -16,7 +16,7 @@ static void mptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
     ctrl_mptfc_cfg_t *c = cfg;
     memset(c, 0, sizeof *c);
-    c->zeta = 250.0;
+    c->zeta = 0.0; /* T_rated/psi_pm (ctrl_m1.h) */
     ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 

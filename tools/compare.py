@@ -7,7 +7,8 @@ automatically):
     thesis' 1.8 N*m load held by its speed loop: in steady state the speed PI outputs
     the load torque, so the dynamometer with T_ref = 1.8 N*m is the same operating
     point without the PI transient), each controller at its default fs, M3 at the
-    fs of thesis Table 6.2 (12 kHz at 750, 16 kHz at 2250 r/min);
+    fs of thesis Table 6.2 (12 kHz at 750, 16 kHz at 2250 r/min) and the per-speed
+    tunables of SET_OVERRIDE (Table 6.2 where they keep torque control);
     simulated DURATION s (default 0.3) of which the first SETTLE s (0.1) are not
     measured;
   * the dynamic test of thesis Fig. 4.14: free mechanics, load 1.6 N*m (passive: it
@@ -40,7 +41,14 @@ MACHINE = os.path.join(ROOT, "sim_host", "machines", "thesis_spmsm.ini")
 SPEEDS = (750, 2250)
 LOAD_NM = 1.8
 # Per-controller sampling-frequency overrides (thesis Table 6.2).
-FS_OVERRIDE = {("m3", 750): 12000, ("m3", 2250): 16000}
+FS_OVERRIDE = {("m3", 750): 12000, ("m3", 2250): 16000, ("m2ptfc", 2250): 11000}
+# Per-speed controller tunables of thesis Table 6.2 where they keep torque control
+# (owner mpc2): M3's zeta = 110 N*m/Wb at 2250 r/min. Table 6.2's M1 250 / 640 and
+# M3 440 N*m/Wb exceed the limit sqrt(3)*1.5*p*psi_pm/Ls = 149.5 N*m/Wb of
+# control/ctrl_m1.h (they trip over-current); those runs keep the controllers'
+# default zeta = T_rated/psi_pm (equal importance). M2's eps_psi: 6.60 mWb is its
+# default, 9.42 mWb at 2250 r/min.
+SET_OVERRIDE = {("m3", 2250): ["zeta=110"], ("m2", 2250): ["eps_psi=0.00942"]}
 T_RATED = 2.4
 # The load is passive (like friction or a loading machine): it acts against the
 # rotation once the rotor turns, so it starts with the torque step and changes sign
@@ -147,6 +155,8 @@ def main():
                    "--duration", str(a.duration), "--window", f"{a.settle}:{a.duration}",
                    "--seed", str(a.seed), "--metrics", base + ".json", "--trace", base + ".csv",
                    "--trace-window", f"{a.duration - 0.005}:{a.duration}"]
+            for kv in SET_OVERRIDE.get((name, rpm), []):
+                cmd += ["--set", kv]
             jobs.append(("steady", name, rpm, fs, base, cmd))
         base = os.path.join(runs_dir, f"{name}_dynamic")
         cmd = [sim, "--machine", MACHINE, "--controller", name, "--free", "--scenario", scn,
@@ -311,7 +321,10 @@ def main():
                 "(REFERENCE.md §5; T_rip = std of torque, ψ_rip = std of |ψs|, T_sse = mean(T_ref − T), "
                 "f_av = mean per-leg switching frequency, THD_I of phase a up to 10 kHz). The last "
                 "column is the torque ripple sampled at the control instants only. Each controller at "
-                "its default fs; M3 at 12/16 kHz (thesis Table 6.2).\n\n")
+                "its default fs; M3 at 12/16 kHz and M2PTFC at 11 kHz at 2250 r/min (thesis "
+                "Table 6.2). Tunables set per speed (Table 6.2 where it keeps torque control): "
+                f"{', '.join(f'{n} {r} r/min {chr(32).join(v)}' for (n, r), v in SET_OVERRIDE.items())}; "
+                "M1/M3/FS-MPTFC weights otherwise T_rated/psi_pm (control/ctrl_m1.h).\n\n")
         f.write("## Steady state\n\n" + "\n".join(md) + "\n\n")
         for title, fn in figs:
             f.write(f"![{title}]({fn})\n\n")

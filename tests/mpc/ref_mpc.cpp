@@ -279,7 +279,9 @@ static void test_model_reference(void)
 
 /* ---------------------------------------------------------- m2ptfc */
 
-static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
+/* centre: the tunable; 1 takes Te of (6.5), (6.7), (6.8) as Te(k+1) + dT0/2
+ * (ctrl_m2ptfc.h (**)), dT0 the k+2 zero-vector change of the reference model. */
+static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, double centre, Stats &st)
 {
     ctrl_params_t p;
     ctrl_bases_t b;
@@ -288,6 +290,7 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
     ctrl_m2ptfc_t s;
     ctrl_m2ptfc_cfg_t cfg;
     ctrl_desc_m2ptfc.cfg_default(&cfg, &mach);
+    cfg.centre = centre;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &cfg, &p));
     for (int n = 0; n < N_POINTS; n++) {
         ctrl_estimate_t est;
@@ -303,15 +306,19 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
 
         const RefPoint rp(rm, est);
         const double t_ref = d24(ref.torque), psi_ref = d24(ref.psi);
-        const double sigma = 0.03 * (t_ref - rp.t1) + 0.97 * sigma_old; /* (6.8) */
+        double t0, amp0, tol0;
+        rp.at(0, 0.0, &t0, &amp0, &tol0);
+        const double d_num = LSB + (centre != 0.0 ? 0.5 * tol0 : 0.0); /* budget of up */
+        const double te = centre != 0.0 ? rp.t1 + 0.5 * (t0 - rp.t1) : rp.t1;
+        const double sigma = 0.03 * (t_ref - te) + 0.97 * sigma_old; /* (6.8) */
         const int x = ref_sector(rp.psi1);
         if (x < 0) {
             st.ties++;
             continue;
         }
         TEST_ASSERT_EQUAL_INT(x, est.next.sector);
-        const double up = t_ref + sigma - rp.t1; /* numerator of (6.5) */
-        if (std::fabs(up) < 2.0 * LSB) {
+        const double up = t_ref + sigma - te; /* numerator of (6.5) */
+        if (std::fabs(up) < 2.0 * d_num) {
             st.ties++; /* (6.7) set undecided within the sigma rounding */
             continue;
         }
@@ -325,7 +332,7 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
             const double den = t_full - rp.t1 + 2.0 * sigma;
             const double d_den = tol_full + 2.0 * LSB;
             double d = up / den;
-            bound[k] = (LSB + std::fabs(d) * d_den) / std::fabs(den) + LSB;
+            bound[k] = (d_num + std::fabs(d) * d_den) / std::fabs(den) + LSB;
             if (std::fabs(den) <= d_den || std::fabs(d) <= bound[k]) {
                 tie = true; /* (6.6) edge: D = 0 vs 1 flips within the budget */
             }
@@ -362,8 +369,9 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
 static void test_m2ptfc_reference(void)
 {
     Stats st{"m2ptfc"};
-    run_m2ptfc(mpc_spmsm, 10000u, st);
-    run_m2ptfc(mpc_ipmsm80, 20000u, st);
+    run_m2ptfc(mpc_spmsm, 10000u, 1.0, st);
+    run_m2ptfc(mpc_ipmsm80, 20000u, 1.0, st);
+    run_m2ptfc(mpc_spmsm, 10000u, 0.0, st);
     st.report();
 }
 
@@ -390,6 +398,9 @@ static void run_weighted(Kind kind, const ctrl_machine_t &mach, uint32_t fs, Sta
     double zeta_si = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(d, cfg, "zeta", &zeta_si));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(state, cfg, &p));
+    if (zeta_si == 0.0) {
+        zeta_si = mach.torque_rated_nm / mach.psi_pm_wb; /* 0 = equal importance (6.5) */
+    }
     const double zeta = zeta_si * rm.psi_base / rm.t_base; /* N*m/Wb -> pu */
     for (int n = 0; n < N_POINTS; n++) {
         ctrl_estimate_t est;

@@ -223,7 +223,9 @@ static void test_closer_matches_sqrt(void)
 
 /* ------------------------------------------------------- brute force */
 
-static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs)
+/* centre: the tunable (1: Te_c = Te(k+1) + dT0/2 in (6.5), (6.7), (6.8), the
+ * zero-vector change dT0 from ctrl_predict(); 0: Te(k+1), the thesis literally). */
+static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs, double centre)
 {
     ctrl_params_t p;
     params_for(m, fs, &p);
@@ -233,24 +235,38 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs)
     TEST_ASSERT_TRUE(d->cfg_size <= sizeof cfg);
     TEST_ASSERT_TRUE(d->state_size == sizeof s);
     d->cfg_default(cfg, m);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(d, cfg, "centre", centre));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(&s, cfg, &p));
     int checked_duty = 0;
+    int checked_set = 0;
     for (int i = 0; i < N_RANDOM; i++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         ctrl_plan_t applied;
         ctrl_plan_t out;
         random_point(&p, &est, &ref, &applied);
-        s.sigma = q24(rng_uniform(-0.03, 0.03) * d24(p.torque_rated));
+        const double sigma_old = rng_uniform(-0.03, 0.03) * d24(p.torque_rated);
+        s.sigma = q24(sigma_old);
         const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
         d->step(&s, &ctx, &out);
         TEST_ASSERT_EQUAL_UINT8(2, s.trace.n);
-        /* Candidates (6.7) from the same sigma and k+1 estimate. */
-        const q24_t t_up = fx_add(ref.torque, s.sigma);
+        /* Te of (6.5)-(6.8): Te(k+1), with centre + half the zero-vector change. */
+        ctrl_mstate_t zero;
+        predict2(&p, &est, 1u, 0, &zero);
+        const double t1 = d24(est.next.torque);
+        const double te = centre != 0.0 ? t1 + 0.5 * (d24(zero.torque) - t1) : t1;
+        /* (6.8) */
+        const double sigma = sigma_old + 0.03 * (d24(ref.torque) - te - sigma_old);
+        TEST_ASSERT_DOUBLE_WITHIN(TOL_T, sigma, d24(s.sigma));
+        /* Candidates (6.7), unless T_ref + sigma_T and Te are within the budget. */
+        const double num = d24(ref.torque) + sigma - te;
         uint8_t c[2];
-        ctrl_m2ptfc_candidates(est.next.sector, t_up, est.next.torque, c);
+        ctrl_m2ptfc_candidates(est.next.sector, num >= 0.0 ? 0 : -1, 0, c);
+        if (fabs(num) <= 2.0 * TOL_T) {
+            continue;
+        }
         TEST_ASSERT_EQUAL_UINT8_ARRAY(c, s.trace.vec, 2);
-        const double num = d24(t_up) - d24(est.next.torque);
+        checked_set++;
         const double psi_ref = psi_ref_of(&p, &ref);
         double cost[2];
         for (unsigned k = 0; k < 2u; k++) {
@@ -258,10 +274,10 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs)
             ctrl_mstate_t dut;
             predict2(&p, &est, c[k], FX_ONE, &full);
             /* (6.5)-(6.6) from ctrl_predict's dTe. */
-            const double den = d24(full.torque) - d24(est.next.torque) + 2.0 * d24(s.sigma);
-            if (fabs(den) > 4.0 * TOL_T && num != 0.0) {
+            const double den = d24(full.torque) - t1 + 2.0 * sigma;
+            if (fabs(den) > 4.0 * TOL_T) {
                 double dref = num / den;
-                const double tol = TOL_T * (1.0 + fabs(dref)) / fabs(den) + 2.0 * LSB;
+                const double tol = 2.0 * TOL_T * (1.0 + fabs(dref)) / fabs(den) + 2.0 * LSB;
                 if (dref < -tol || dref > 1.0 + tol) {
                     dref = 1.0; /* (6.6) */
                 }
@@ -282,17 +298,20 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs)
                                  "m2ptfc: chosen candidate does not minimise (6.9)");
     }
     TEST_ASSERT_TRUE(checked_duty > N_RANDOM); /* most duties were checked */
+    TEST_ASSERT_TRUE(checked_set > N_RANDOM * 9 / 10);
 }
 
 static void test_m2ptfc_minimises_cost_spmsm(void)
 {
-    check_m2ptfc(&mpc_spmsm, 10000u);
+    check_m2ptfc(&mpc_spmsm, 10000u, 1.0);
+    check_m2ptfc(&mpc_spmsm, 10000u, 0.0);
 }
 
 static void test_m2ptfc_minimises_cost_ipmsm(void)
 {
-    check_m2ptfc(&mpc_ipmsm80, 20000u);
-    check_m2ptfc(&mpc_chapter_ipmsm, 10000u);
+    check_m2ptfc(&mpc_ipmsm80, 20000u, 1.0);
+    check_m2ptfc(&mpc_chapter_ipmsm, 10000u, 1.0);
+    check_m2ptfc(&mpc_ipmsm80, 20000u, 0.0);
 }
 
 /* g of (6.13) for the k+2 state st. */
@@ -477,11 +496,11 @@ static void test_registry_and_tunables(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2ptfc, cfg, "lambda", 1.5));
     ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m1, cfg, "zeta", &v));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 250.0, v);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, v); /* equal importance, see ctrl_m1.h */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 640.0));
     ctrl_desc_m3.cfg_default(cfg, &mpc_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m3, cfg, "zeta", &v));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 440.0, v);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, v);
     ctrl_desc_m2.cfg_default(cfg, &mpc_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2, cfg, "y", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m2, cfg, "eps_psi", 9.42e-3));
@@ -495,6 +514,7 @@ static void test_zeta_in_pu(void)
     uint8_t cfg[CTRL_CFG_MAX];
     ctrl_m1_t s;
     ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 250.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
     const double t_base = 1.5 * 4.0 * 0.09427 * 0.09427 / 6.552e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-5, 250.0 * 0.09427 / t_base, d24(s.zeta));
@@ -522,6 +542,9 @@ static void test_bad_input(void)
     c.lambda = NAN;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
     c.lambda = 0.03;
+    c.centre = 0.5; /* 0 or 1 only */
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    c.centre = 1.0;
     c.model.ld_h = -1.0;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
     c.model.ld_h = 0.0;
@@ -530,6 +553,50 @@ static void test_bad_input(void)
     ctrl_desc_m2ptfc.cfg_default(&c, NULL);
     c.model.ld_h = 1e-3;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+}
+
+/* (**) of ctrl_m2ptfc.h: Te_c = t1 + (t0 - t1)/2 (rounded half), t1 when off;
+ * saturating at the Q24 range ends instead of overflowing. */
+static void test_t_eval(void)
+{
+    ctrl_m2ptfc_t s;
+    memset(&s, 0, sizeof s);
+    s.centre = 1u;
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_m2ptfc_t_eval(&s, FX_ONE, FX_ONE));
+    TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, ctrl_m2ptfc_t_eval(&s, FX_ONE, 0));
+    TEST_ASSERT_EQUAL_INT32(-FX_ONE / 4, ctrl_m2ptfc_t_eval(&s, 0, -FX_ONE / 2));
+    for (int i = 0; i < 2000; i++) {
+        const q24_t t1 = (q24_t)(int32_t)(rng_u32() >> 4) - (q24_t)(1 << 27);
+        const q24_t t0 = (q24_t)(int32_t)(rng_u32() >> 4) - (q24_t)(1 << 27);
+        const double want = (double)t1 + 0.5 * ((double)t0 - (double)t1);
+        TEST_ASSERT_DOUBLE_WITHIN(0.5, want, (double)ctrl_m2ptfc_t_eval(&s, t1, t0));
+    }
+    const q24_t hi = ctrl_m2ptfc_t_eval(&s, FX_MAX, FX_MIN);
+    const q24_t lo = ctrl_m2ptfc_t_eval(&s, FX_MIN, FX_MAX);
+    TEST_ASSERT_TRUE(hi >= -1 && hi <= FX_MAX); /* no wrap-around */
+    TEST_ASSERT_TRUE(lo <= 1 && lo >= FX_MIN);
+    s.centre = 0u;
+    TEST_ASSERT_EQUAL_INT32(12345, ctrl_m2ptfc_t_eval(&s, 12345, -FX_ONE));
+}
+
+/* ctrl_mpc_psi_ref2 == ctrl_mpc_psi_ref squared within the roundings: the
+ * square of a rounded square root differs by up to 2 |psi| LSB (+1 rounding). */
+static void test_psi_ref2(void)
+{
+    const ctrl_machine_t *ms[3] = {&mpc_spmsm, &mpc_ipmsm80, &mpc_chapter_ipmsm};
+    for (int k = 0; k < 3; k++) {
+        ctrl_params_t p;
+        params_for(ms[k], 10000u, &p);
+        for (int i = 0; i < 500; i++) {
+            ctrl_refs_t ref;
+            ref.torque = q24(rng_uniform(-2.0, 2.0) * d24(p.torque_rated));
+            ref.psi = (i % 3 == 0) ? q24(rng_uniform(0.5, 1.5)) : 0;
+            const q24_t lin = ctrl_mpc_psi_ref(&p, &ref);
+            const double want = d24(lin) * d24(lin) * 16777216.0;
+            const double tol = 2.0 * d24(lin) + 2.0;
+            TEST_ASSERT_DOUBLE_WITHIN(tol, want, (double)ctrl_mpc_psi_ref2(&p, &ref));
+        }
+    }
 }
 
 static void test_sigma_ema(void)
@@ -541,6 +608,7 @@ static void test_sigma_ema(void)
     ctrl_m2ptfc_cfg_t c;
     ctrl_m2ptfc_t s;
     ctrl_desc_m2ptfc.cfg_default(&c, &mpc_spmsm);
+    c.centre = 0.0; /* Te = Te(k+1): the error below is exactly T_ref - Te */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
     ctrl_estimate_t est;
     ctrl_refs_t ref;
@@ -576,5 +644,7 @@ int main(void)
     RUN_TEST(test_zeta_in_pu);
     RUN_TEST(test_bad_input);
     RUN_TEST(test_sigma_ema);
+    RUN_TEST(test_t_eval);
+    RUN_TEST(test_psi_ref2);
     return UNITY_END();
 }
