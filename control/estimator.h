@@ -22,6 +22,16 @@
 #include "flux_vm.h"
 #include "fx.h"
 
+/* Optional outputs (ctrl_estimator_t.outputs, a bit set = computed). The rest
+ * of ctrl_estimate_t is always computed. A field not computed is set to 0
+ * (psi_amp 0, sector 0 = "none"). Default CTRL_EST_ALL: clear bits only when no
+ * consumer (controller, telemetry) reads the field; each square root costs
+ * ~75 Cortex-M4 instructions, the sector ~20 (tests/perf). */
+#define CTRL_EST_AMP_NOW 0x01u    /* est->now.psi_amp (4.3) */
+#define CTRL_EST_AMP_NEXT 0x02u   /* est->next.psi_amp */
+#define CTRL_EST_SECTOR_NOW 0x04u /* est->now.sector (4.5); next.sector is always computed */
+#define CTRL_EST_ALL 0x07u
+
 #define CTRL_FLUX_CURRENT_MODEL 0u /* default: (3.4) from the encoder angle */
 #define CTRL_FLUX_VOLTAGE_MODEL 1u /* flux_vm.h, drift-compensated */
 
@@ -32,10 +42,12 @@ typedef struct {
     uint8_t primed;                  /* 0 before the first update after reset */
     uint8_t flux_source;             /* CTRL_FLUX_*; set after init, kept by reset */
     ctrl_flux_vm_t vm;               /* voltage model (used if flux_source says so) */
+    uint8_t outputs;                 /* CTRL_EST_* optional outputs; init: CTRL_EST_ALL,
+                                      * set after init, kept by reset */
 } ctrl_estimator_t;
 
-/* Current model, default flux source, voltage model configured without
- * correction (call ctrl_flux_vm_init on e->vm to choose another). */
+/* Current model, default flux source, every output, voltage model configured
+ * without correction (call ctrl_flux_vm_init on e->vm to choose another). */
 void ctrl_estimator_init(ctrl_estimator_t *e, const ctrl_params_t *p);
 
 /* Forget the history (speed, previous angle, voltage model), keep the settings. */

@@ -54,23 +54,16 @@ static const uint16_t fx_sqrt_seed[192] = {
 };
 
 /*
- * floor(sqrt(x)), exact for every uint64_t. Steps (Cortex-M4: two 32-bit
- * UDIV, a few UMULL, no 64-bit division):
- *   1. normalise: m = x * 4^k in [2^62, 2^64), so sqrt(m) in [2^31, 2^32);
- *   2. y = floor(sqrt(m_hi)), m_hi = m >> 32 in [2^30, 2^32): table seed, one
+ * floor(sqrt(m)) for a normalised m in [2^62, 2^64) (result in [2^31, 2^32)).
+ * Steps (Cortex-M4: two 32-bit UDIV, a few UMULL, no 64-bit division):
+ *   1. y = floor(sqrt(m_hi)), m_hi = m >> 32 in [2^30, 2^32): table seed, one
  *      Newton step, one exact -1 correction;
- *   3. s = Y + r / (2Y), Y = y * 2^16, r = m - Y^2 (one Newton step in 64 bits,
+ *   2. s = Y + r / (2Y), Y = y * 2^16, r = m - Y^2 (one Newton step in 64 bits,
  *      done as a 32-bit division): floor(sqrt(m)) or one more;
- *   4. one exact correction of s against m, then floor(s / 2^k) (= floor(sqrt(x))
- *      because floor(floor(a) / n) == floor(a / n) for an integer n).
+ *   3. one exact correction of s against m.
  */
-uint32_t fx_isqrt64(uint64_t x)
+static inline uint32_t fx_isqrt_norm(uint64_t m)
 {
-    if (x == 0u) {
-        return 0u;
-    }
-    const unsigned sh = fx_clz64(x) & ~1u; /* even shift */
-    const uint64_t m = x << sh;
     const uint32_t m_hi = (uint32_t)(m >> 32);
 
     /* Integer Newton step from the seed: floor((y + floor(n/y))/2) is never
@@ -96,21 +89,45 @@ uint32_t fx_isqrt64(uint64_t x)
     if ((uint64_t)s * s > m) {
         s--;
     }
-    return s >> (sh / 2u);
+    return s;
+}
+
+/*
+ * floor(sqrt(x)), exact for every uint64_t: normalise to m = x * 4^k in
+ * [2^62, 2^64) by an even shift, floor(sqrt(m)) (fx_isqrt_norm), then
+ * floor(s / 2^k) (= floor(sqrt(x)) because floor(floor(a) / n) == floor(a / n)
+ * for an integer n).
+ */
+uint32_t fx_isqrt64(uint64_t x)
+{
+    if (x == 0u) {
+        return 0u;
+    }
+    const unsigned sh = fx_clz64(x) & ~1u; /* even shift */
+    return fx_isqrt_norm(x << sh) >> (sh / 2u);
 }
 
 q24_t fx_mag(q24_t x, q24_t y)
 {
-    /* x^2 + y^2 <= 2^63 fits uint64_t; sqrt of a Q48 value is Q24. Round to
-     * nearest: sqrt(sum) > r + 1/2 exactly when sum - r^2 > r (integers). */
-    const uint64_t ax = (uint64_t)(x < 0 ? -(int64_t)x : (int64_t)x);
-    const uint64_t ay = (uint64_t)(y < 0 ? -(int64_t)y : (int64_t)y);
-    const uint64_t sum = ax * ax + ay * ay;
-    uint64_t r = fx_isqrt64(sum);
-    if (sum - r * r > r) {
-        r++;
+    /* x^2 + y^2 <= 2^63 fits uint64_t; sqrt of a Q48 value is Q24. Rounded to
+     * nearest without a separate correction: round(sqrt(S)) =
+     * floor((floor(2 sqrt(S)) + 1) / 2), and floor(2 sqrt(S)) =
+     * floor(sqrt(m) / 2^(k-1)) = floor(floor(sqrt(m)) / 2^(k-1)) for the
+     * normalised m = S 4^k, k >= 1. k == 0 means S >= 2^62, sqrt(S) >= 2^31:
+     * saturated, as is a rounded result of 2^31. */
+    const uint32_t ax = x < 0 ? 0u - (uint32_t)x : (uint32_t)x;
+    const uint32_t ay = y < 0 ? 0u - (uint32_t)y : (uint32_t)y;
+    const uint64_t sum = (uint64_t)ax * ax + (uint64_t)ay * ay;
+    if (sum == 0u) {
+        return 0;
     }
-    return r > (uint64_t)FX_MAX ? FX_MAX : (q24_t)r;
+    const unsigned sh = fx_clz64(sum) & ~1u;
+    if (sh == 0u) {
+        return FX_MAX;
+    }
+    const uint32_t t = fx_isqrt_norm(sum << sh) >> (sh / 2u - 1u); /* floor(2 sqrt(S)) */
+    const uint32_t r = (t >> 1) + (t & 1u);                        /* (t + 1) / 2, no wrap */
+    return r > (uint32_t)FX_MAX ? FX_MAX : (q24_t)r;
 }
 
 /* round(sin(i * pi / 1024) * 2^24), i = 0..512: a quarter wave (+ one pad). */

@@ -5,25 +5,37 @@
 
 #include "vectors.h"
 
+_Static_assert(CTRL_PLAN_MAX_SEG == 4, "the plan helpers fill exactly four segments");
+
 void ctrl_plan_single(ctrl_plan_t *p, uint8_t vec)
 {
     p->n_seg = 1u;
     p->vec[0] = vec;
+    p->vec[1] = 0u;
+    p->vec[2] = 0u;
+    p->vec[3] = 0u;
     p->dur[0] = FX_ONE;
-    for (unsigned i = 1u; i < CTRL_PLAN_MAX_SEG; i++) {
-        p->vec[i] = 0u;
-        p->dur[i] = 0;
-    }
+    p->dur[1] = 0;
+    p->dur[2] = 0;
+    p->dur[3] = 0;
 }
+
+/* ctrl_zero_after() as a table (V0 after V0, V1, V3, V5; V7 after V7, V2, V4,
+ * V6; indices > 7 give V0): the plan helpers run every period. */
+static const uint8_t plan_zero_after[8] = {0u, 0u, 7u, 0u, 7u, 0u, 7u, 7u};
 
 void ctrl_plan_active_zero(ctrl_plan_t *p, uint8_t vec, q24_t duty)
 {
     const q24_t d = fx_clamp(duty, 0, FX_ONE);
-    ctrl_plan_single(p, vec);
     p->n_seg = 2u;
+    p->vec[0] = vec;
+    p->vec[1] = vec <= 7u ? plan_zero_after[vec] : 0u;
+    p->vec[2] = 0u;
+    p->vec[3] = 0u;
     p->dur[0] = d;
-    p->vec[1] = ctrl_zero_after(vec);
     p->dur[1] = FX_ONE - d;
+    p->dur[2] = 0;
+    p->dur[3] = 0;
 }
 
 void ctrl_plan_two_active(ctrl_plan_t *p, uint8_t v1, q24_t d1, uint8_t v2, q24_t d2)
@@ -78,18 +90,22 @@ void ctrl_plan_voltage(const ctrl_plan_t *p, q24_t vdc, q24_t *v_alpha, q24_t *v
      * [0, FX_ONE] and bad indices skipped as in ctrl_plan_to_legs; for every
      * plan whose durations sum to at most FX_ONE (all plans the helpers build)
      * this is exactly the voltage of the leg duties the PWM stage realises.
-     * The coefficient sum (Q54, < 2^57) is rounded to Q24 once, then times Vdc. */
+     * Zero vectors (0, 7) contribute nothing and are skipped with the bad
+     * indices (one unsigned compare). The coefficient sum (Q54, |.| <= 4 * 2^24
+     * * 2^30 = 2^56) is rounded to Q24 once (< 2^26: no saturation needed),
+     * then times Vdc. */
     int64_t sa = 0;
     int64_t sb = 0;
     const unsigned n = p->n_seg < CTRL_PLAN_MAX_SEG ? p->n_seg : CTRL_PLAN_MAX_SEG;
     for (unsigned i = 0u; i < n; i++) {
-        if (p->vec[i] > 7u) {
-            continue;
+        const unsigned v = p->vec[i];
+        if (v - 1u > 5u) {
+            continue; /* V0, V7 or an index > 7 */
         }
         const q24_t dur = fx_clamp(p->dur[i], 0, FX_ONE);
-        sa += (int64_t)dur * plan_v_alpha_q30[p->vec[i]];
-        sb += (int64_t)dur * plan_v_beta_q30[p->vec[i]];
+        sa += (int64_t)dur * plan_v_alpha_q30[v];
+        sb += (int64_t)dur * plan_v_beta_q30[v];
     }
-    *v_alpha = fx_mul(vdc, (q24_t)fx_rshift64_round(sa, 30u));
-    *v_beta = fx_mul(vdc, (q24_t)fx_rshift64_round(sb, 30u));
+    *v_alpha = fx_mul(vdc, fx_round_nosat(sa, 30u));
+    *v_beta = fx_mul(vdc, fx_round_nosat(sb, 30u));
 }

@@ -32,6 +32,13 @@ void ctrl_mstate_from_flux_sc(const ctrl_params_t *p, q24_t psi_alpha, q24_t psi
                               fx_angle_t theta_e, q24_t sin_theta, q24_t cos_theta,
                               ctrl_mstate_t *out);
 
+/* Same as ctrl_mstate_from_flux_sc without the amplitude: out->psi_amp = 0
+ * (not computed; saves the square root, ~75 Cortex-M4 instructions). For
+ * callers that need the state but not |psi| (or compare squared amplitudes). */
+void ctrl_mstate_from_flux_noamp(const ctrl_params_t *p, q24_t psi_alpha, q24_t psi_beta,
+                                 fx_angle_t theta_e, q24_t sin_theta, q24_t cos_theta,
+                                 ctrl_mstate_t *out);
+
 /* Flux only, (5.15): psi + Ts (v - Rs i) from the state now (no angle, no current). */
 void ctrl_predict_flux(const ctrl_params_t *p, const ctrl_mstate_t *now, q24_t v_alpha,
                        q24_t v_beta, q24_t *psi_alpha, q24_t *psi_beta);

@@ -12,11 +12,10 @@
 
 void ctrl_clarke(q24_t ia, q24_t ib, q24_t *al, q24_t *be)
 {
-    /* alpha = a; beta = (a + 2b)/sqrt(3) with c = -a - b (3.3). Products
-     * < 2^31 * 2^31 (sum < 2^62): no overflow. */
+    /* alpha = a; beta = (a + 2b)/sqrt(3) with c = -a - b (3.3). |sum| <=
+     * 2^31 (1/sqrt3 + 2/sqrt3) 2^30 < 2^62: no overflow. */
     *al = ia;
-    *be = fx_sat32(
-        fx_rshift64_round((int64_t)ia * K_INV_SQRT3_Q30 + (int64_t)ib * K_2_SQRT3_Q30, 30u));
+    *be = fx_round_sat((int64_t)ia * K_INV_SQRT3_Q30 + (int64_t)ib * K_2_SQRT3_Q30, 30u);
 }
 
 void ctrl_inv_clarke(q24_t al, q24_t be, q24_t *a, q24_t *b, q24_t *c)
@@ -24,19 +23,19 @@ void ctrl_inv_clarke(q24_t al, q24_t be, q24_t *a, q24_t *b, q24_t *c)
     const int64_t half = (int64_t)al * K_HALF_Q30;
     const int64_t bq = (int64_t)be * K_SQRT3_2_Q30;
     *a = al;
-    *b = fx_sat32(fx_rshift64_round(bq - half, 30u));
-    *c = fx_sat32(fx_rshift64_round(-bq - half, 30u));
+    *b = fx_round_sat(bq - half, 30u);
+    *c = fx_round_sat(-bq - half, 30u);
 }
 
 /* |s|, |c| <= 2^24, so each product < 2^55 and the sums cannot overflow. */
 void ctrl_park(q24_t al, q24_t be, q24_t s, q24_t c, q24_t *d, q24_t *q)
 {
-    *d = fx_sat32(fx_rshift64_round((int64_t)c * al + (int64_t)s * be, FX_QBITS));
-    *q = fx_sat32(fx_rshift64_round((int64_t)c * be - (int64_t)s * al, FX_QBITS));
+    *d = fx_round_sat((int64_t)c * al + (int64_t)s * be, FX_QBITS);
+    *q = fx_round_sat((int64_t)c * be - (int64_t)s * al, FX_QBITS);
 }
 
 void ctrl_inv_park(q24_t d, q24_t q, q24_t s, q24_t c, q24_t *al, q24_t *be)
 {
-    *al = fx_sat32(fx_rshift64_round((int64_t)c * d - (int64_t)s * q, FX_QBITS));
-    *be = fx_sat32(fx_rshift64_round((int64_t)s * d + (int64_t)c * q, FX_QBITS));
+    *al = fx_round_sat((int64_t)c * d - (int64_t)s * q, FX_QBITS);
+    *be = fx_round_sat((int64_t)s * d + (int64_t)c * q, FX_QBITS);
 }

@@ -27,8 +27,8 @@ void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
     if (idx > 7u) {
         idx = 0u;
     }
-    *v_alpha = fx_sat32(fx_rshift64_round((int64_t)vdc * vec_alpha_q30[idx], 30u));
-    *v_beta = fx_sat32(fx_rshift64_round((int64_t)vdc * vec_beta_q30[idx], 30u));
+    *v_alpha = fx_round_sat((int64_t)vdc * vec_alpha_q30[idx], 30u);
+    *v_beta = fx_round_sat((int64_t)vdc * vec_beta_q30[idx], 30u);
 }
 
 uint8_t ctrl_vec_wrap(int x)

@@ -189,6 +189,80 @@ static void test_flux_current_roundtrip(void)
     }
 }
 
+/* Optional outputs (CTRL_EST_*): a cleared bit leaves exactly that field at 0
+ * and changes nothing else; every bit set gives the full state, whose |psi|
+ * and sectors equal fx_mag / ctrl_sector of the returned fluxes (k: rotor
+ * frame, k+1: alpha/beta), and ctrl_mstate_from_flux_noamp equals
+ * ctrl_mstate_from_flux_sc but for psi_amp. */
+static void test_optional_outputs(void)
+{
+    ctrl_estimator_t full;
+    ctrl_estimator_t lean;
+    ctrl_estimator_init(&full, &P);
+    ctrl_estimator_init(&lean, &P);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_EST_ALL, full.outputs);
+    lean.outputs = 0u;
+    ctrl_plan_t plan;
+    ctrl_plan_active_zero(&plan, 2u, FX_ONE / 3);
+    for (int k = 0; k < 200; k++) {
+        ctrl_meas_t m;
+        const fx_angle_t th = (fx_angle_t)(uint32_t)k * 0x01234567u;
+        meas_from_dq(0.1 * sin(0.3 * k), 0.25 * cos(0.17 * k), th, &m);
+        ctrl_estimate_t ef;
+        ctrl_estimate_t el;
+        ctrl_estimator_update(&full, &P, &m, &plan, &ef);
+        ctrl_estimator_update(&lean, &P, &m, &plan, &el);
+        TEST_ASSERT_EQUAL_INT32(fx_mag(ef.now.psi_d, ef.now.psi_q), ef.now.psi_amp);
+        TEST_ASSERT_EQUAL_INT32(fx_mag(ef.next.psi_alpha, ef.next.psi_beta), ef.next.psi_amp);
+        TEST_ASSERT_EQUAL_UINT8(ctrl_sector(ef.now.psi_alpha, ef.now.psi_beta), ef.now.sector);
+        TEST_ASSERT_EQUAL_UINT8(ctrl_sector(ef.next.psi_alpha, ef.next.psi_beta), ef.next.sector);
+        TEST_ASSERT_EQUAL_INT32(0, el.now.psi_amp);
+        TEST_ASSERT_EQUAL_INT32(0, el.next.psi_amp);
+        TEST_ASSERT_EQUAL_UINT8(0u, el.now.sector);
+        el.now.psi_amp = ef.now.psi_amp;
+        el.next.psi_amp = ef.next.psi_amp;
+        el.now.sector = ef.now.sector;
+        /* field by field (no padding compared) */
+        const ctrl_mstate_t *a[2] = {&ef.now, &ef.next};
+        const ctrl_mstate_t *b[2] = {&el.now, &el.next};
+        for (int j = 0; j < 2; j++) {
+            TEST_ASSERT_EQUAL_INT32(a[j]->i_alpha, b[j]->i_alpha);
+            TEST_ASSERT_EQUAL_INT32(a[j]->i_beta, b[j]->i_beta);
+            TEST_ASSERT_EQUAL_INT32(a[j]->i_d, b[j]->i_d);
+            TEST_ASSERT_EQUAL_INT32(a[j]->i_q, b[j]->i_q);
+            TEST_ASSERT_EQUAL_INT32(a[j]->psi_alpha, b[j]->psi_alpha);
+            TEST_ASSERT_EQUAL_INT32(a[j]->psi_beta, b[j]->psi_beta);
+            TEST_ASSERT_EQUAL_INT32(a[j]->psi_d, b[j]->psi_d);
+            TEST_ASSERT_EQUAL_INT32(a[j]->psi_q, b[j]->psi_q);
+            TEST_ASSERT_EQUAL_INT32(a[j]->psi_amp, b[j]->psi_amp);
+            TEST_ASSERT_EQUAL_INT32(a[j]->torque, b[j]->torque);
+            TEST_ASSERT_EQUAL_UINT32(a[j]->theta_e, b[j]->theta_e);
+            TEST_ASSERT_EQUAL_INT32(a[j]->sin_theta, b[j]->sin_theta);
+            TEST_ASSERT_EQUAL_INT32(a[j]->cos_theta, b[j]->cos_theta);
+            TEST_ASSERT_EQUAL_UINT8(a[j]->sector, b[j]->sector);
+        }
+        TEST_ASSERT_EQUAL_INT32(ef.omega_e, el.omega_e);
+        TEST_ASSERT_EQUAL_INT32(ef.vdc, el.vdc);
+        /* outputs survive a reset */
+        if (k == 100) {
+            ctrl_estimator_reset(&full);
+            ctrl_estimator_reset(&lean);
+            TEST_ASSERT_EQUAL_UINT8(0u, lean.outputs);
+        }
+        ctrl_mstate_t x;
+        ctrl_mstate_t y;
+        ctrl_mstate_from_flux_sc(&P, ef.next.psi_alpha, ef.next.psi_beta, th, ef.now.sin_theta,
+                                 ef.now.cos_theta, &x);
+        ctrl_mstate_from_flux_noamp(&P, ef.next.psi_alpha, ef.next.psi_beta, th, ef.now.sin_theta,
+                                    ef.now.cos_theta, &y);
+        TEST_ASSERT_EQUAL_INT32(0, y.psi_amp);
+        TEST_ASSERT_EQUAL_INT32(x.torque, y.torque);
+        TEST_ASSERT_EQUAL_INT32(x.i_alpha, y.i_alpha);
+        TEST_ASSERT_EQUAL_INT32(x.i_beta, y.i_beta);
+        TEST_ASSERT_EQUAL_UINT8(x.sector, y.sector);
+    }
+}
+
 static void test_flux_vm(void)
 {
     ctrl_flux_vm_t vm;
@@ -288,6 +362,7 @@ int main(void)
     RUN_TEST(test_current_model_spmsm);
     RUN_TEST(test_prediction_with_plan);
     RUN_TEST(test_flux_current_roundtrip);
+    RUN_TEST(test_optional_outputs);
     RUN_TEST(test_flux_vm);
     RUN_TEST(test_estimator_voltage_model_source);
     return UNITY_END();

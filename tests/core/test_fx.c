@@ -78,6 +78,154 @@ static void check_div(q24_t num, q24_t den)
     TEST_ASSERT_TRUE_MESSAGE(2 * ar <= ad, "fx_div not rounded to nearest");
 }
 
+/* ---- independent references of the fast forms (fx_round_sat, fx_sat32,
+ * fx_add/sub, fx_mul/dot/cross and the _nosat variants) ---- */
+
+static int32_t ref_sat(int64_t x)
+{
+    if (x > INT32_MAX) {
+        return INT32_MAX;
+    }
+    if (x < INT32_MIN) {
+        return INT32_MIN;
+    }
+    return (int32_t)x;
+}
+
+/* floor((x + 2^(n-1)) / 2^n) for every int64_t x, 1 <= n <= 31, by C's
+ * truncating division and a remainder correction (no overflow). */
+static int64_t ref_round(int64_t x, unsigned n)
+{
+    const int64_t d = (int64_t)1 << n;
+    int64_t q = x / d;
+    int64_t r = x % d;
+    if (r < 0) {
+        q -= 1;
+        r += d;
+    }
+    return q + (r + d / 2 >= d ? 1 : 0);
+}
+
+static int64_t rnd_i64(void)
+{
+    return (int64_t)(rng() >> 1) - (int64_t)(rng() >> 1); /* spans most of int64 */
+}
+
+static void check_round_sat(int64_t x, unsigned n)
+{
+    const int64_t r = ref_round(x, n);
+    TEST_ASSERT_EQUAL_INT32(ref_sat(r), fx_round_sat(x, n));
+    if (r >= INT32_MIN && r <= INT32_MAX && n <= 31u) {
+        TEST_ASSERT_EQUAL_INT32((int32_t)r, fx_round_nosat(x, n));
+    }
+}
+
+/* round-and-saturate of p1 + p2 when the sum may overflow int64_t */
+static int32_t ref_sum(int64_t p1, int64_t p2, unsigned n)
+{
+    if (p1 > 0 && p2 > INT64_MAX - p1) {
+        return INT32_MAX;
+    }
+    if (p1 < 0 && p2 < INT64_MIN - p1) {
+        return INT32_MIN;
+    }
+    return ref_sat(ref_round(p1 + p2, n));
+}
+
+static void test_fast_forms_match_reference(void)
+{
+    /* dot/cross at the ends of the range: the sum of two products reaches
+     * 2^63 (does not fit int64_t), e.g. fx_dot(FX_MIN, FX_MIN, FX_MIN, FX_MIN). */
+    static const int32_t ex[] = {INT32_MIN, INT32_MIN + 1, -1, 0, 1, INT32_MAX};
+    const unsigned nx = sizeof ex / sizeof ex[0];
+    for (unsigned i = 0; i < nx * nx * nx * nx; i++) {
+        const int32_t a = ex[i % nx];
+        const int32_t b = ex[(i / nx) % nx];
+        const int32_t c = ex[(i / nx / nx) % nx];
+        const int32_t e = ex[i / nx / nx / nx];
+        TEST_ASSERT_EQUAL_INT32(ref_sum((int64_t)a * c, (int64_t)b * e, 24u), fx_dot(a, b, c, e));
+        TEST_ASSERT_EQUAL_INT32(ref_sum((int64_t)a * e, -((int64_t)b * c), 24u),
+                                fx_cross(a, b, c, e));
+    }
+    TEST_ASSERT_EQUAL_INT32(FX_MAX, fx_dot(FX_MIN, FX_MIN, FX_MIN, FX_MIN));
+    TEST_ASSERT_EQUAL_INT32(FX_MAX, fx_cross(FX_MIN, FX_MIN, FX_MAX, FX_MIN)); /* 2^63 - 2^31 */
+    TEST_ASSERT_EQUAL_INT32(FX_MIN, fx_cross(FX_MIN, FX_MIN, FX_MIN, FX_MAX)); /* -2^63 + 2^31 */
+
+    static const unsigned ns[] = {1u, 2u, 16u, 23u, 24u, 28u, 30u, 31u};
+    for (unsigned i = 0; i < sizeof ns / sizeof ns[0]; i++) {
+        const unsigned n = ns[i];
+        const int64_t d = (int64_t)1 << n;
+        /* Edges: around +-2^31 2^n (saturation thresholds with the rounding
+         * half), zero, and the ends of int64_t. */
+        const int64_t top = (((int64_t)1 << 31) * d) - d / 2;  /* rounds to 2^31 */
+        const int64_t bot = -(((int64_t)1 << 31) * d) - d / 2; /* rounds to -2^31 */
+        for (int64_t k = -3; k <= 3; k++) {
+            check_round_sat(top + k, n);
+            check_round_sat(bot + k, n);
+            check_round_sat(k, n);
+            check_round_sat(d / 2 + k, n);
+            check_round_sat(-d / 2 + k, n);
+        }
+        check_round_sat(INT64_MAX, n);
+        check_round_sat(INT64_MIN, n);
+        check_round_sat(INT64_MIN + 1, n);
+        for (int k = 0; k < 20000; k++) {
+            const int64_t x = rnd_i64();
+            check_round_sat(x, n);
+            check_round_sat(x / ((int64_t)1 << (rng() % 40u)), n);
+        }
+    }
+    const int64_t sat_edges[] = {0,
+                                 1,
+                                 -1,
+                                 INT32_MAX,
+                                 INT32_MIN,
+                                 (int64_t)INT32_MAX + 1,
+                                 (int64_t)INT32_MIN - 1,
+                                 INT64_MAX,
+                                 INT64_MIN};
+    for (unsigned i = 0; i < sizeof sat_edges / sizeof sat_edges[0]; i++) {
+        TEST_ASSERT_EQUAL_INT32(ref_sat(sat_edges[i]), fx_sat32(sat_edges[i]));
+    }
+    const int32_t e32[] = {
+        0, 1, -1, 2, -2, FX_ONE, -FX_ONE, INT32_MAX, INT32_MIN, INT32_MAX - 1, INT32_MIN + 1};
+    const unsigned ne = sizeof e32 / sizeof e32[0];
+    for (int k = 0; k < 40000; k++) {
+        const int32_t a = k < 121 ? e32[(unsigned)k % ne] : rnd_i32((unsigned)(rng() % 8u));
+        const int32_t b = k < 121 ? e32[(unsigned)k / ne] : rnd_i32((unsigned)(rng() % 8u));
+        const int32_t c = rnd_i32(0u);
+        const int32_t dd = rnd_i32(7u);
+        TEST_ASSERT_EQUAL_INT32(ref_sat(ref_sat((int64_t)a + b)), fx_add(a, b));
+        TEST_ASSERT_EQUAL_INT32(ref_sat((int64_t)a - b), fx_sub(a, b));
+        TEST_ASSERT_EQUAL_INT32(ref_sat(-(int64_t)a), fx_neg(a));
+        TEST_ASSERT_EQUAL_INT32(ref_sat(a < 0 ? -(int64_t)a : a), fx_abs(a));
+        TEST_ASSERT_EQUAL_INT32(ref_sat(ref_round((int64_t)a * b, 24u)), fx_mul(a, b));
+        TEST_ASSERT_EQUAL_INT32(ref_sat(ref_round((int64_t)a * b, 30u)), fx_mul_qn(a, b, 30u));
+        const int64_t dot = (int64_t)a * c + (int64_t)b * dd;
+        const int64_t cross = (int64_t)a * dd - (int64_t)b * c;
+        TEST_ASSERT_EQUAL_INT32(ref_sat(ref_round(dot, 24u)), fx_dot(a, b, c, dd));
+        TEST_ASSERT_EQUAL_INT32(ref_sat(ref_round(cross, 24u)), fx_cross(a, b, c, dd));
+        /* full-range operands (products up to 2^62) */
+        const int32_t f1 = rnd_i32(0u);
+        const int32_t f2 = rnd_i32(0u);
+        TEST_ASSERT_EQUAL_INT32(ref_sum((int64_t)f1 * c, (int64_t)f2 * a, 24u),
+                                fx_dot(f1, f2, c, a));
+        TEST_ASSERT_EQUAL_INT32(ref_sum((int64_t)f1 * a, -((int64_t)f2 * c), 24u),
+                                fx_cross(f1, f2, c, a));
+        /* _nosat: equal wherever the documented bound holds (result fits) */
+        const int64_t m = ref_round((int64_t)a * dd, 24u);
+        if (m == ref_sat(m)) {
+            TEST_ASSERT_EQUAL_INT32((int32_t)m, fx_mul_nosat(a, dd));
+        }
+        if (ref_round(dot, 24u) == ref_sat(ref_round(dot, 24u))) {
+            TEST_ASSERT_EQUAL_INT32(fx_dot(a, b, c, dd), fx_dot_nosat(a, b, c, dd));
+        }
+        if (ref_round(cross, 24u) == ref_sat(ref_round(cross, 24u))) {
+            TEST_ASSERT_EQUAL_INT32(fx_cross(a, b, c, dd), fx_cross_nosat(a, b, c, dd));
+        }
+    }
+}
+
 static void test_div(void)
 {
     TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, fx_div(FX_ONE, 2 * FX_ONE));
@@ -168,6 +316,28 @@ static void test_mag(void)
         const q24_t m = fx_mag(x, y);
         TEST_ASSERT_TRUE_MESSAGE(fabs((double)m - exact) <= 0.5 + 1e-6, "fx_mag rounding");
     }
+    /* Whole range (x^2 + y^2 up to 2^63: every normalisation shift, and the
+     * saturation at sqrt >= 2^31 - 0.5), exact integer check of the rounding:
+     * (m - 1/2)^2 <= S < (m + 1/2)^2  <=>  4m^2 - 4m + 1 <= 4S < 4m^2 + 4m + 1. */
+    TEST_ASSERT_EQUAL_INT32(FX_MAX, fx_mag(FX_MAX, 0));
+    TEST_ASSERT_EQUAL_INT32(FX_MAX, fx_mag(0, FX_MIN + 1));
+    TEST_ASSERT_EQUAL_INT32(46341, fx_mag(32768, 32768)); /* sqrt(2) 2^15 = 46340.95 */
+    for (int i = 0; i < 50000; i++) {
+        const q24_t x = rnd_i32((unsigned)(rng() % 32u));
+        const q24_t y = rnd_i32((unsigned)(rng() % 32u));
+        const double exact = sqrt((double)x * (double)x + (double)y * (double)y);
+        const q24_t m = fx_mag(x, y);
+        if (exact >= 2147483647.5) {
+            TEST_ASSERT_EQUAL_INT32(FX_MAX, m);
+            continue;
+        }
+        const uint64_t ax = (uint64_t)(x < 0 ? -(int64_t)x : x);
+        const uint64_t ay = (uint64_t)(y < 0 ? -(int64_t)y : y);
+        const uint64_t s4 = 4u * (ax * ax + ay * ay); /* < 2^64 here: S < 2^62 */
+        const uint64_t um = (uint64_t)m;
+        TEST_ASSERT_TRUE_MESSAGE(4u * um * um - 4u * um + 1u <= s4 || m == 0, "fx_mag low");
+        TEST_ASSERT_TRUE_MESSAGE(s4 < 4u * um * um + 4u * um + 1u, "fx_mag high");
+    }
 }
 
 static void test_sincos(void)
@@ -214,6 +384,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_inline_saturation_and_rounding);
+    RUN_TEST(test_fast_forms_match_reference);
     RUN_TEST(test_div);
     RUN_TEST(test_isqrt_exact);
     RUN_TEST(test_mag);
