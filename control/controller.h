@@ -72,4 +72,17 @@ const ctrl_desc_t *ctrl_find(const char *name); /* NULL if unknown */
 int ctrl_tunable_set(const ctrl_desc_t *d, void *cfg, const char *name, double value);
 int ctrl_tunable_get(const ctrl_desc_t *d, const void *cfg, const char *name, double *value);
 
+/* (appended by review) Every field listed in t[0..n) of cfg is finite and inside
+ * [min, max]: CTRL_OK, else CTRL_EINVAL (also for NULL t or cfg with n > 0).
+ * For init functions that validate a whole SI configuration struct. */
+int ctrl_tunables_check(const ctrl_tunable_t *t, size_t n, const void *cfg);
+
+/* (appended by review) 1 when ctx and every pointer a step needs (params,
+ * est, ref) are non-NULL; ctx->applied may be NULL. Steps answer an invalid
+ * context with the zero vector. */
+static inline int ctrl_ctx_ok(const ctrl_ctx_t *ctx)
+{
+    return ctx != NULL && ctx->params != NULL && ctx->est != NULL && ctx->ref != NULL;
+}
+
 #endif /* CONTROL_CONTROLLER_H */

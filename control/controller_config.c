@@ -57,3 +57,18 @@ int ctrl_tunable_get(const ctrl_desc_t *d, const void *cfg, const char *name, do
     memcpy(value, (const char *)cfg + t->offset, sizeof *value);
     return CTRL_OK;
 }
+
+int ctrl_tunables_check(const ctrl_tunable_t *t, size_t n, const void *cfg)
+{
+    if (n > 0u && (t == NULL || cfg == NULL)) {
+        return CTRL_EINVAL;
+    }
+    for (size_t i = 0; i < n; i++) {
+        double v;
+        memcpy(&v, (const char *)cfg + t[i].offset, sizeof v);
+        if (!isfinite(v) || v < t[i].min || v > t[i].max) {
+            return CTRL_EINVAL;
+        }
+    }
+    return CTRL_OK;
+}

@@ -7,6 +7,7 @@
 
 #include "mtpa.h"
 #include "plan.h"
+#include "st_tables.h"
 #include "vectors.h"
 
 /* Inputs of the duty formulas are clamped to +-4 pu (rated torque is ~0.3 pu,
@@ -40,13 +41,9 @@ void ctrl_drr_unit(uint8_t idx, q24_t *ux, q24_t *uy)
 
 uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err)
 {
-    int n;
-    if (t_err >= 0) {
-        n = psi_err >= 0 ? 1 : 2; /* (5.1) first two rows */
-    } else {
-        n = psi_err < 0 ? 4 : 5; /* (5.1) last two rows */
-    }
-    return ctrl_vec_wrap((int)sector + n);
+    /* (5.1) is Table 4.4 (two-level torque, ">= 0" = increase): the
+     * switching-table module's lookup; any sector is wrapped into 1..6 (4.14). */
+    return st_lookup_ast(ctrl_vec_wrap((int)sector), psi_err >= 0 ? 1 : -1, t_err >= 0 ? 1 : -1);
 }
 
 q24_t ctrl_drr_ema(q24_t gamma, q24_t chi, q24_t lambda)
@@ -251,7 +248,7 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || ctx == NULL || ctx->params == NULL || ctx->est == NULL || ctx->ref == NULL) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, 0u);
         return;
     }

@@ -89,11 +89,11 @@ typedef struct {
     q24_t dt_sel;    /* Delta T of the vector chosen at k-1 (for (5.16)), pu */
     uint8_t vec_sel; /* vector chosen at k-1 (0 after reset) */
     /* last decision, for telemetry and tests */
-    q24_t last_tvref; /* virtual reference T_vref (5.3) */
-    q24_t last_psiref;
-    q24_t last_terr, last_psierr;
-    q24_t last_duty;
-    uint8_t last_vec_51; /* vector by (5.1) before replacement */
+    q24_t last_tvref;             /* virtual reference T_vref (5.3), Q24 pu torque */
+    q24_t last_psiref;            /* flux reference, Q24 pu flux */
+    q24_t last_terr, last_psierr; /* T_vref - Te, Q24 pu torque; psi_ref - |psi|, Q24 pu flux */
+    q24_t last_duty;              /* duty (5.14), Q24 fraction of the period */
+    uint8_t last_vec_51;          /* vector by (5.1) before replacement */
 } ctrl_drr_state_t;
 
 /* ---------------- baselines: one SI configuration, each descriptor exposes its part ------ */
@@ -116,20 +116,20 @@ typedef enum {
 } ctrl_drr_base_kind_t;
 
 typedef struct {
-    uint8_t kind;   /* ctrl_drr_base_kind_t */
-    uint8_t rms;    /* D_f: 1 = D_RMS (5.17) */
-    q24_t inv_ct;   /* D1: 1 / C_T, Q24 per pu torque */
-    q24_t inv_cpsi; /* D1: 1 / C_psi, Q24 per pu flux */
-    q24_t ka;       /* D2: K_a, pu torque */
-    q24_t kb;       /* D2: K_b, pu torque per pu electrical speed */
-    q24_t kp;       /* D_PI: K_P, per pu torque */
-    q24_t ki_ts;    /* D_PI: K_I Ts, per pu torque */
-    q24_t ff;       /* D_PI: 3 psi_pm / (2 Vdc), per pu electrical speed */
-    q24_t ts_l;     /* D_f: Ts / Ls (pu) */
-    q24_t rs_l;     /* D_f: Rs / Ls (pu) */
-    q24_t integ;    /* D_PI integrator (duty units, clamped to [-1, 1]) */
-    q24_t last_duty;
-    q24_t last_terr, last_psierr;
+    uint8_t kind;                 /* ctrl_drr_base_kind_t */
+    uint8_t rms;                  /* D_f: 1 = D_RMS (5.17) */
+    q24_t inv_ct;                 /* D1: 1 / C_T, Q24 per pu torque */
+    q24_t inv_cpsi;               /* D1: 1 / C_psi, Q24 per pu flux */
+    q24_t ka;                     /* D2: K_a, pu torque */
+    q24_t kb;                     /* D2: K_b, pu torque per pu electrical speed */
+    q24_t kp;                     /* D_PI: K_P, per pu torque */
+    q24_t ki_ts;                  /* D_PI: K_I Ts, per pu torque */
+    q24_t ff;                     /* D_PI: 3 psi_pm / (2 Vdc), per pu electrical speed */
+    q24_t ts_l;                   /* D_f: Ts / Ls (pu) */
+    q24_t rs_l;                   /* D_f: Rs / Ls (pu) */
+    q24_t integ;                  /* D_PI integrator (duty units, clamped to [-1, 1]) */
+    q24_t last_duty;              /* last duty, Q24 fraction of the period */
+    q24_t last_terr, last_psierr; /* T_ref - Te, Q24 pu torque; psi_ref - |psi|, Q24 pu flux */
 } ctrl_drr_base_state_t;
 
 /* ---------------- per-sample building blocks (ctrl_drr.c, integer-only) ---------------- */

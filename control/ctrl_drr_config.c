@@ -73,18 +73,6 @@ static const ctrl_tunable_t df_tunables[] = {
      offsetof(ctrl_drr_base_cfg_t, rms), 0.0, 1.0},
 };
 
-static int drr_in_range(const ctrl_tunable_t *t, size_t n, const void *cfg)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v;
-        memcpy(&v, (const char *)cfg + t[i].offset, sizeof v);
-        if (!isfinite(v) || v < t[i].min || v > t[i].max) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 int ctrl_drr_ab_si(const ctrl_machine_t *m, double ts_s, double *a_nm, double *b_nm)
 {
     if (m == NULL || a_nm == NULL || b_nm == NULL) {
@@ -168,7 +156,8 @@ static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
     const ctrl_drr_cfg_t *c = cfg;
     ctrl_drr_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!drr_in_range(drr_tunables, sizeof drr_tunables / sizeof drr_tunables[0], c)) {
+    if (ctrl_tunables_check(drr_tunables, sizeof drr_tunables / sizeof drr_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     ctrl_bases_t b;
@@ -297,7 +286,7 @@ static int base_init(void *state, const void *cfg, const ctrl_params_t *p,
     const ctrl_drr_base_cfg_t *c = cfg;
     ctrl_drr_base_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!drr_in_range(tun, ntun, c)) {
+    if (ctrl_tunables_check(tun, ntun, c) != CTRL_OK) {
         return CTRL_EINVAL;
     }
     ctrl_bases_t b;

@@ -14,15 +14,12 @@
 #define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
 #define FOC_KI_QBITS 30u
 
-/* Vector index of a leg mask (bit 0 = leg a), inverse of Table 4.2. */
-static const uint8_t foc_vec_of_mask[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
-
 void ctrl_foc_iref(const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d, q24_t *i_q)
 {
     const q24_t a = fx_min(fx_abs(t), r->t_max);
     /* Position on the table, Q24: a * (N / t_max), <= N * 2^24 (fits). */
     const int64_t pos = fx_rshift64_round((int64_t)a * r->scale, 16u);
-    int64_t idx = pos >> FX_QBITS; /* pos >= 0: the shift is well defined */
+    int64_t idx = (int64_t)((uint64_t)pos >> FX_QBITS); /* pos >= 0 */
     q24_t frac = (q24_t)(pos & (FX_ONE - 1));
     if (idx >= CTRL_FOC_MTPA_N) {
         idx = CTRL_FOC_MTPA_N - 1;
@@ -47,8 +44,8 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
     }
     /* err Q24 * ki_ts Q30 = Q54 -> Q40; |product| < 2^62. */
     const int64_t inc = fx_rshift64_round((int64_t)err * pi->ki_ts, FOC_KI_QBITS - FOC_INTEG_SHIFT);
-    const int64_t lim = (int64_t)FX_ONE << FOC_INTEG_SHIFT; /* 1 pu */
-    int64_t i = pi->integ + inc;                            /* |integ| <= 2^40, |inc| < 2^48 */
+    const int64_t lim = (int64_t)FX_ONE * ((int64_t)1 << FOC_INTEG_SHIFT); /* 1 pu */
+    int64_t i = pi->integ + inc; /* |integ| <= 2^40, |inc| < 2^48 */
     i = i > lim ? lim : (i < -lim ? -lim : i);
     pi->integ = i;
 }
@@ -65,11 +62,6 @@ void ctrl_foc_reset(void *state)
     s->pi_q.integ = 0;
     s->v_d = 0;
     s->v_q = 0;
-}
-
-static int foc_ctx_ok(const ctrl_ctx_t *ctx)
-{
-    return ctx != NULL && ctx->params != NULL && ctx->est != NULL && ctx->ref != NULL;
 }
 
 /* foc: PI current loops + SVPWM. */
@@ -122,7 +114,7 @@ static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_r
         }
     }
     s->legs = legs;
-    ctrl_plan_single(out, foc_vec_of_mask[legs & 7u]);
+    ctrl_plan_single(out, ctrl_svpwm_vec_of_mask(legs));
 }
 
 void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
@@ -131,7 +123,7 @@ void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || !foc_ctx_ok(ctx)) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, 0u); /* no voltage */
         return;
     }

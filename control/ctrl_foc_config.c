@@ -56,18 +56,6 @@ static void foc_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->h_i = FOC_HI_REL * m->current_rated_a;
 }
 
-static int foc_in_range(const ctrl_tunable_t *t, size_t n, const ctrl_foc_cfg_t *c)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v;
-        memcpy(&v, (const char *)c + t[i].offset, sizeof v);
-        if (!isfinite(v) || v < t[i].min || v > t[i].max) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 /* MTPA point at current amplitude i (pu, psi_pm = 1): i_d, i_q and torque. */
 static void foc_mtpa_point(double ld, double lq, double i, double *id, double *iq, double *te)
 {
@@ -151,9 +139,10 @@ static int foc_init_common(void *state, const void *cfg, const ctrl_params_t *p,
     const ctrl_foc_cfg_t *c = cfg;
     ctrl_foc_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!foc_in_range(foc_tunables, sizeof foc_tunables / sizeof foc_tunables[0], c) ||
-        !foc_in_range(foc_hyst_tunables, sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0],
-                      c)) {
+    if (ctrl_tunables_check(foc_tunables, sizeof foc_tunables / sizeof foc_tunables[0], c) !=
+            CTRL_OK ||
+        ctrl_tunables_check(foc_hyst_tunables,
+                            sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0], c) != CTRL_OK) {
         return CTRL_EINVAL;
     }
     if (!(c->r_base_ohm > 0.0) || !(c->i_base_a > 0.0) || !isfinite(c->r_base_ohm) ||

@@ -27,7 +27,7 @@ void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || ctx == NULL || ctx->est == NULL || ctx->ref == NULL) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, s != NULL ? ctrl_zero_after(s->prev_vec) : 0u);
         return;
     }

@@ -91,7 +91,7 @@ void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || ctx == NULL || ctx->est == NULL || ctx->ref == NULL) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, 0u);
         return;
     }

@@ -3,18 +3,14 @@
 
 #include "plan.h"
 
-void ctrl_m1_reset(void *state)
-{
-    ctrl_m1_t *s = state;
-    s->trace.n = 0u;
-}
-
 void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
     ctrl_m1_t *s = state;
-    const q24_t t_ref = ctx->ref->torque;
     ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
+        return;
+    }
+    const q24_t t_ref = ctx->ref->torque;
     const q24_t psi_ref = ctrl_mpc_ref_amp(&b, ctrl_mpc_psi_ref(ctx->params, ctx->ref));
 
     /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */

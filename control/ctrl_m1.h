@@ -44,20 +44,13 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-typedef struct {
-    double zeta;                /* "zeta", N*m/Wb, (6.13) */
-    ctrl_mpc_model_cfg_t model; /* model overrides, see ctrl_m2ptfc_model.h */
-} ctrl_m1_cfg_t;
-
-typedef struct {
-    ctrl_mpc_model_t model;
-    q24_t zeta; /* Q24 pu (T_base / psi_base) */
-    ctrl_mpc_trace_t trace;
-} ctrl_m1_t;
+/* SI configuration and state: the layout shared by m1, m3 and mptfc
+ * (ctrl_m2ptfc_model.h); trace the six active vectors with D_f (5.18). */
+typedef ctrl_mpc_wcfg_t ctrl_m1_cfg_t;
+typedef ctrl_mpc_wstate_t ctrl_m1_t;
 
 extern const ctrl_desc_t ctrl_desc_m1;
 
-void ctrl_m1_reset(void *state);
 void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
 
 #endif /* CONTROL_CTRL_M1_H */

@@ -2,32 +2,33 @@
 #include "ctrl_m2.h"
 
 #include "plan.h"
+#include "st_tables.h"
 #include "vectors.h"
 
 uint8_t ctrl_m2_table(uint8_t sector, int torque_up, int flux_up)
 {
-    int n;
-    if (torque_up) {
-        n = flux_up ? 1 : 2;
-    } else {
-        n = flux_up ? 5 : 4;
-    }
-    return ctrl_vec_wrap((int)sector + n);
+    /* Table 4.4 (two-level torque), the switching-table module's lookup; any
+     * sector value is wrapped into 1..6 as V_{x+n} arithmetic does (4.14). */
+    return st_lookup_ast(ctrl_vec_wrap((int)sector), flux_up ? 1 : -1, torque_up ? 1 : -1);
 }
 
 void ctrl_m2_reset(void *state)
 {
     ctrl_m2_t *s = state;
-    s->trace.n = 0u;
+    if (s != NULL) {
+        s->trace.n = 0u;
+    }
 }
 
 void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
     ctrl_m2_t *s = state;
+    ctrl_mpc_basis_t b;
+    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
+        return;
+    }
     const q24_t t_ref = ctx->ref->torque;
     const q24_t psi_ref = ctrl_mpc_psi_ref(ctx->params, ctx->ref);
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
 
     const int32_t r2 = ctrl_mpc_ref_amp2(&b, psi_ref);
     const uint8_t vec =

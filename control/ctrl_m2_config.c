@@ -18,6 +18,9 @@ static const ctrl_tunable_t m2_tunables[] = {
 static void m2_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
     ctrl_m2_cfg_t *c = cfg;
+    if (c == NULL) {
+        return;
+    }
     memset(c, 0, sizeof *c);
     c->eps_psi = 6.60e-3; /* Table 6.2, 750 r/min */
     c->y = 4.0;           /* Table 6.1 */
@@ -32,8 +35,9 @@ static int m2_init(void *state, const void *cfg, const ctrl_params_t *params)
         return CTRL_EINVAL;
     }
     memset(s, 0, sizeof *s);
-    if (!isfinite(c->y) || c->y < 1.0 || c->y > (double)CTRL_M2_Y_MAX || c->y != floor(c->y) ||
-        !isfinite(c->eps_psi) || !(c->eps_psi > 0.0)) {
+    if (ctrl_tunables_check(m2_tunables, sizeof m2_tunables / sizeof m2_tunables[0], c) !=
+            CTRL_OK ||
+        c->y != floor(c->y)) {
         return CTRL_EINVAL;
     }
     int rc = ctrl_mpc_model_init(&s->model, &c->model, params);

@@ -44,6 +44,9 @@ q24_t ctrl_m2ptfc_t_eval(const ctrl_m2ptfc_t *s, q24_t t1, q24_t t0)
 void ctrl_m2ptfc_reset(void *state)
 {
     ctrl_m2ptfc_t *s = state;
+    if (s == NULL) {
+        return;
+    }
     s->sigma = 0;
     s->trace.n = 0u;
 }
@@ -51,13 +54,15 @@ void ctrl_m2ptfc_reset(void *state)
 void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
     ctrl_m2ptfc_t *s = state;
+    ctrl_mpc_basis_t b;
+    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
+        return;
+    }
     const ctrl_params_t *p = ctx->params;
     const ctrl_estimate_t *est = ctx->est;
     const q24_t t_ref = ctx->ref->torque;
     const q24_t t1 = est->next.torque;
 
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, p, est, &b);
     /* Te of (6.5), (6.7), (6.8): Te(k+1), or Te_c for centre-aligned PWM (header). */
     const q24_t te = ctrl_m2ptfc_t_eval(s, t1, b.t0);
 

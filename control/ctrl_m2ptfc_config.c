@@ -18,6 +18,9 @@ static const ctrl_tunable_t m2ptfc_tunables[] = {
 static void m2ptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
     ctrl_m2ptfc_cfg_t *c = cfg;
+    if (c == NULL) {
+        return;
+    }
     memset(c, 0, sizeof *c);
     c->lambda = 0.03; /* Table 6.2 */
     c->centre = 1.0;  /* plan.h realises plans centre-aligned */

@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "mtpa.h"
+#include "plan.h"
 #include "predict.h"
 #include "vectors.h"
 
@@ -24,29 +25,29 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
     const q24_t fb = fx_clamp(n->psi_beta, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
     /* |Ts Rs i| <= 64 pu and |psi| <= 8 pu: the differences fit an int32_t. */
     const q24_t pa =
-        fx_clamp(fa - ctrl_mpc_mulr(m->ts_rs, ia), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+        fx_clamp(fa - fx_mul_nosat(m->ts_rs, ia), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
     const q24_t pb =
-        fx_clamp(fb - ctrl_mpc_mulr(m->ts_rs, ib), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+        fx_clamp(fb - fx_mul_nosat(m->ts_rs, ib), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
     /* theta(k+2) = theta(k+1) + omega Ts (unsigned angle arithmetic wraps a turn). */
     const fx_angle_t th2 = n->theta_e + ctrl_angle_step(p, est->omega_e);
     q24_t s;
     q24_t c;
     fx_sincos(th2, &s, &c);
     /* Park (3.7): d = c a + s b, q = c b - s a. */
-    b->d0 = ctrl_mpc_dotr(c, s, pa, pb);
-    b->q0 = ctrl_mpc_dotr(c, -s, pb, pa);
+    b->d0 = fx_dot_nosat(c, s, pa, pb);
+    b->q0 = fx_dot_nosat(c, -s, pb, pa);
     b->t0 = ctrl_mpc_torque(m, b->d0, b->q0);
-    b->mag2 = ctrl_mpc_dotr(s, c, s, c);
+    b->mag2 = fx_dot_nosat(s, c, s, c);
     /* Ts V1 = Ts 2/3 Vdc on alpha; in the rotor frame Ts|V| e^{-j th2}:
      * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
      * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
-    const q24_t mv = ctrl_mpc_mulr(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
-    const q24_t c1 = ctrl_mpc_dotr(c, s, MPC_HALF, MPC_SQRT3_2);
-    const q24_t s1 = ctrl_mpc_dotr(s, -c, MPC_HALF, MPC_SQRT3_2);
-    const q24_t w0d = ctrl_mpc_mulr(mv, c);
-    const q24_t w0q = -ctrl_mpc_mulr(mv, s);
-    const q24_t w1d = ctrl_mpc_mulr(mv, c1);
-    const q24_t w1q = -ctrl_mpc_mulr(mv, s1);
+    const q24_t mv = fx_mul_nosat(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
+    const q24_t c1 = fx_dot_nosat(c, s, MPC_HALF, MPC_SQRT3_2);
+    const q24_t s1 = fx_dot_nosat(s, -c, MPC_HALF, MPC_SQRT3_2);
+    const q24_t w0d = fx_mul_nosat(mv, c);
+    const q24_t w0q = -fx_mul_nosat(mv, s);
+    const q24_t w1d = fx_mul_nosat(mv, c1);
+    const q24_t w1q = -fx_mul_nosat(mv, s1);
     /* V3 = V1 e^{j 2pi/3} = V2 - V1; V_{i+3} = -V_i. */
     const q24_t w2d = w1d - w0d;
     const q24_t w2q = w1q - w0q;
@@ -62,6 +63,28 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
     b->wq[4] = -w1q;
     b->wd[5] = -w2d;
     b->wq[5] = -w2q;
+}
+
+int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_plan_t *out,
+                        ctrl_mpc_basis_t *b)
+{
+    if (out == NULL) {
+        return 0;
+    }
+    if (m == NULL || b == NULL || !ctrl_ctx_ok(ctx)) {
+        ctrl_plan_single(out, 0u); /* no voltage */
+        return 0;
+    }
+    ctrl_mpc_basis(m, ctx->params, ctx->est, b);
+    return 1;
+}
+
+void ctrl_mpc_wreset(void *state)
+{
+    ctrl_mpc_wstate_t *s = state;
+    if (s != NULL) {
+        s->trace.n = 0u;
+    }
 }
 
 q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref)

@@ -25,6 +25,7 @@
 
 #include <stdint.h>
 
+#include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
@@ -75,26 +76,53 @@ typedef struct {
     q24_t duty[CTRL_MPC_TRACE_MAX];  /* its duty, Q24 fraction of the period */
 } ctrl_mpc_trace_t;
 
+/* Configuration and state shared by the weighted-cost controllers m1, m3 and
+ * mptfc (cost (6.13) with one weight zeta and the k+2 model): one
+ * cfg_default / init / reset serves the three descriptors. */
+typedef struct {
+    double zeta;                /* "zeta", N*m/Wb, (6.13); 0 = T_rated/psi_pm (6.5) */
+    ctrl_mpc_model_cfg_t model; /* model overrides, see ctrl_mpc_model_cfg_t */
+} ctrl_mpc_wcfg_t;
+
+typedef struct {
+    ctrl_mpc_model_t model;
+    q24_t zeta;             /* Q24 pu (T_base / psi_base) */
+    ctrl_mpc_trace_t trace; /* candidates of the last step (see each controller) */
+} ctrl_mpc_wstate_t;
+
 /* ---- configuration (ctrl_m2ptfc_model_config.c, may use double) ---- */
+
+/* ctrl_desc_t.cfg_default of m1, m3, mptfc: zeta 0 (T_rated/psi_pm), model
+ * overrides off. cfg is a ctrl_mpc_wcfg_t. */
+void ctrl_mpc_wcfg_default(void *cfg, const ctrl_machine_t *machine);
+
+/* ctrl_desc_t.init of m1, m3, mptfc: model constants and zeta in pu; state
+ * is a ctrl_mpc_wstate_t, cfg a ctrl_mpc_wcfg_t. CTRL_OK, CTRL_EINVAL (NULL,
+ * zeta < 0 or not finite, bad model) or CTRL_ERANGE. */
+int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_params_t *params);
 
 /* Tunable-table entries of the model overrides, for a cfg struct T with a
  * member "model" (expanded only in *_config.c files). */
+#define CTRL_MPC_RS_MODEL_MAX 1000.0 /* ohm, upper bound of "rs_model" */
+#define CTRL_MPC_LPSI_MODEL_MAX 10.0 /* H or Wb, upper bound of "ld/lq/psi_pm_model" */
 /* clang-format off */
 #define CTRL_MPC_MODEL_TUNABLES(T)                                                  \
     {"rs_model", "ohm", "Rs of the k+2 prediction (6.10); 0 = machine",            \
-     offsetof(T, model.rs_ohm), 0.0, 1000.0},                                      \
+     offsetof(T, model.rs_ohm), 0.0, CTRL_MPC_RS_MODEL_MAX},                       \
     {"ld_model", "H", "Ld of the k+2 prediction (6.12); 0 = machine",              \
-     offsetof(T, model.ld_h), 0.0, 10.0},                                          \
+     offsetof(T, model.ld_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
     {"lq_model", "H", "Lq of the k+2 prediction (6.12); 0 = machine",              \
-     offsetof(T, model.lq_h), 0.0, 10.0},                                          \
+     offsetof(T, model.lq_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
     {"psi_pm_model", "Wb", "psi_pm of the k+2 prediction (6.12); 0 = machine",     \
-     offsetof(T, model.psi_pm_wb), 0.0, 10.0}
+     offsetof(T, model.psi_pm_wb), 0.0, CTRL_MPC_LPSI_MODEL_MAX}
 /* clang-format on */
 
 /* Copy the machine data into c, overrides off. */
 void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *machine);
 
-/* Model constants for params (with the overrides of c). CTRL_OK or CTRL_EINVAL. */
+/* Model constants for params (with the overrides of c). CTRL_OK, CTRL_EINVAL
+ * (NULL, an override negative, not finite or above its tunable's maximum) or
+ * CTRL_ERANGE (model outside the limits below). */
 int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
                         const ctrl_params_t *params);
 
@@ -108,6 +136,16 @@ int ctrl_mpc_flux_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params,
                      q24_t *out);
 
 /* ---- per sample (ctrl_m2ptfc_model.c, integer only) ---- */
+
+/* ctrl_desc_t.reset of m1, m3, mptfc (ctrl_mpc_wstate_t): clears the trace;
+ * the controllers keep no other dynamic state. NULL is ignored. */
+void ctrl_mpc_wreset(void *state);
+
+/* Common start of the chapter-6 steps: with valid inputs (m, out non-NULL,
+ * ctrl_ctx_ok(ctx)) fills the basis b of this sample and returns 1; else
+ * writes the zero-vector plan to out (if any) and returns 0. */
+int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_plan_t *out,
+                        ctrl_mpc_basis_t *b);
 
 /* Basis for the candidates of this sample from the k+1 state of est. */
 void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
@@ -153,30 +191,8 @@ int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t
  * With the ranges of ctrl_mpc_basis_t and the model limits every product
  * below is below 2^55 in magnitude, so its Q24 result fits an int32_t without
  * saturation: a rounding multiply is a 32x32->64 multiply, an add and a
- * shift (fx_mul's saturation and offset-binary rounding cost three times
- * that on a Cortex-M4). Same rounding as fx_mul (to nearest, ties up). */
-
-/* uint32_t -> int32_t two's complement, without implementation-defined
- * conversion (compiles to nothing). */
-static inline int32_t ctrl_mpc_u2i(uint32_t u)
-{
-    return u <= (uint32_t)INT32_MAX ? (int32_t)u : -(int32_t)(~u) - 1;
-}
-
-/* a b / 2^24 rounded, for |a b| < 2^55. The low 32 bits of the rounded
- * unsigned shift are the two's-complement result (no negative value shifted). */
-static inline q24_t ctrl_mpc_mulr(q24_t a, q24_t b)
-{
-    const uint64_t u = (uint64_t)((int64_t)a * b) + ((uint64_t)1 << 23);
-    return ctrl_mpc_u2i((uint32_t)(u >> 24));
-}
-
-/* (a c + b d) / 2^24 rounded once, for |a c| + |b d| < 2^55. */
-static inline q24_t ctrl_mpc_dotr(q24_t a, q24_t b, q24_t c, q24_t d)
-{
-    const uint64_t u = (uint64_t)((int64_t)a * c + (int64_t)b * d) + ((uint64_t)1 << 23);
-    return ctrl_mpc_u2i((uint32_t)(u >> 24));
-}
+ * shift: fx_mul_nosat / fx_dot_nosat of fx.h (fx_mul's saturation costs
+ * more on a Cortex-M4). Same rounding as fx_mul (to nearest, ties up). */
 
 /* Ts V_i (i = 1..6) in the rotor frame at k+2. */
 static inline void ctrl_mpc_vec_dq(const ctrl_mpc_basis_t *b, uint8_t i, q24_t *vd, q24_t *vq)
@@ -190,7 +206,7 @@ static inline void ctrl_mpc_vec_dq(const ctrl_mpc_basis_t *b, uint8_t i, q24_t *
  * product saturates. */
 static inline q24_t ctrl_mpc_torque(const ctrl_mpc_model_t *m, q24_t psi_d, q24_t psi_q)
 {
-    return fx_mul(psi_q, m->a + ctrl_mpc_mulr(m->b, psi_d));
+    return fx_mul(psi_q, m->a + fx_mul_nosat(m->b, psi_d));
 }
 
 /* |psi|^2 in Q24 pu^2, rounded, clamped to [0, 64 pu^2] (|psi| <= 8 pu, far
@@ -225,8 +241,8 @@ static inline q24_t ctrl_mpc_ref_amp(const ctrl_mpc_basis_t *b, q24_t psi)
 static inline void ctrl_mpc_flux(const ctrl_mpc_basis_t *b, q24_t vd, q24_t vq, q24_t duty,
                                  q24_t *psi_d, q24_t *psi_q)
 {
-    *psi_d = b->d0 + ctrl_mpc_mulr(duty, vd);
-    *psi_q = b->q0 + ctrl_mpc_mulr(duty, vq);
+    *psi_d = b->d0 + fx_mul_nosat(duty, vd);
+    *psi_q = b->q0 + fx_mul_nosat(duty, vq);
 }
 
 #endif /* CONTROL_CTRL_M2PTFC_MODEL_H */

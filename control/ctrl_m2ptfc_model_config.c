@@ -17,10 +17,11 @@ void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *m
     c->m_torque_rated_nm = machine->torque_rated_nm;
 }
 
-/* value_SI / machine_SI for an override, 1 when the override is off (0). */
-static int model_ratio(double override, double machine, double *ratio)
+/* value_SI / machine_SI for an override, 1 when the override is off (0);
+ * an override outside [0, max] (the tunable's range) is refused. */
+static int model_ratio(double override, double max, double machine, double *ratio)
 {
-    if (!(override >= 0.0) || !isfinite(override)) {
+    if (!(override >= 0.0) || !isfinite(override) || override > max) {
         return CTRL_EINVAL;
     }
     if (override == 0.0) {
@@ -45,10 +46,10 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
     double k_ld;
     double k_lq;
     double k_psi;
-    if (model_ratio(c->rs_ohm, c->m_rs_ohm, &k_rs) != CTRL_OK ||
-        model_ratio(c->ld_h, c->m_ld_h, &k_ld) != CTRL_OK ||
-        model_ratio(c->lq_h, c->m_lq_h, &k_lq) != CTRL_OK ||
-        model_ratio(c->psi_pm_wb, c->m_psi_pm_wb, &k_psi) != CTRL_OK) {
+    if (model_ratio(c->rs_ohm, CTRL_MPC_RS_MODEL_MAX, c->m_rs_ohm, &k_rs) != CTRL_OK ||
+        model_ratio(c->ld_h, CTRL_MPC_LPSI_MODEL_MAX, c->m_ld_h, &k_ld) != CTRL_OK ||
+        model_ratio(c->lq_h, CTRL_MPC_LPSI_MODEL_MAX, c->m_lq_h, &k_lq) != CTRL_OK ||
+        model_ratio(c->psi_pm_wb, CTRL_MPC_LPSI_MODEL_MAX, c->m_psi_pm_wb, &k_psi) != CTRL_OK) {
         return CTRL_EINVAL;
     }
     const double ts = ctrl_q24_to_double(params->ts);
@@ -127,4 +128,30 @@ int ctrl_mpc_flux_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params,
     }
     *out = ctrl_q24_from_double(pu);
     return CTRL_OK;
+}
+
+void ctrl_mpc_wcfg_default(void *cfg, const ctrl_machine_t *machine)
+{
+    ctrl_mpc_wcfg_t *c = cfg;
+    if (c == NULL) {
+        return;
+    }
+    memset(c, 0, sizeof *c);
+    c->zeta = 0.0; /* T_rated/psi_pm; Table 6.2's 250 / 440 / 640 lose torque control (ctrl_m1.h) */
+    ctrl_mpc_model_cfg_default(&c->model, machine);
+}
+
+int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_params_t *params)
+{
+    ctrl_mpc_wstate_t *s = state;
+    const ctrl_mpc_wcfg_t *c = cfg;
+    if (s == NULL || c == NULL || params == NULL) {
+        return CTRL_EINVAL;
+    }
+    memset(s, 0, sizeof *s);
+    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    if (rc == CTRL_OK) {
+        rc = ctrl_mpc_zeta_pu(&c->model, params, c->zeta, &s->zeta);
+    }
+    return rc;
 }

@@ -4,19 +4,15 @@
 #include "plan.h"
 #include "vectors.h"
 
-void ctrl_m3_reset(void *state)
-{
-    ctrl_m3_t *s = state;
-    s->trace.n = 0u;
-}
-
 void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
     ctrl_m3_t *s = state;
+    ctrl_mpc_basis_t b;
+    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
+        return;
+    }
     const q24_t t_ref = ctx->ref->torque;
     const ctrl_mstate_t *n = &ctx->est->next;
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
     const q24_t psi_ref = ctrl_mpc_ref_amp(&b, ctrl_mpc_psi_ref(ctx->params, ctx->ref));
 
     /* (6.1) by the sign of the torque error. */

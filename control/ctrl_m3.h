@@ -32,20 +32,13 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-typedef struct {
-    double zeta; /* "zeta", N*m/Wb, (6.13) */
-    ctrl_mpc_model_cfg_t model;
-} ctrl_m3_cfg_t;
-
-typedef struct {
-    ctrl_mpc_model_t model;
-    q24_t zeta;             /* Q24 pu */
-    ctrl_mpc_trace_t trace; /* the two active vectors with D_f, then (0, 0) */
-} ctrl_m3_t;
+/* SI configuration and state: the layout shared by m1, m3 and mptfc
+ * (ctrl_m2ptfc_model.h); trace the two active vectors with D_f, then (0, 0). */
+typedef ctrl_mpc_wcfg_t ctrl_m3_cfg_t;
+typedef ctrl_mpc_wstate_t ctrl_m3_t;
 
 extern const ctrl_desc_t ctrl_desc_m3;
 
-void ctrl_m3_reset(void *state);
 void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
 
 #endif /* CONTROL_CTRL_M3_H */

@@ -1,6 +1,5 @@
 /* M3 configuration and descriptor (SI -> Q24; floating point allowed here). */
 #include <stddef.h>
-#include <string.h>
 
 #include "ctrl_m3.h"
 
@@ -12,29 +11,6 @@ static const ctrl_tunable_t m3_tunables[] = {
     CTRL_MPC_MODEL_TUNABLES(ctrl_m3_cfg_t),
 };
 
-static void m3_cfg_default(void *cfg, const ctrl_machine_t *machine)
-{
-    ctrl_m3_cfg_t *c = cfg;
-    memset(c, 0, sizeof *c);
-    c->zeta = 0.0; /* T_rated/psi_pm; Table 6.2's 440 loses torque control (ctrl_m1.h) */
-    ctrl_mpc_model_cfg_default(&c->model, machine);
-}
-
-static int m3_init(void *state, const void *cfg, const ctrl_params_t *params)
-{
-    ctrl_m3_t *s = state;
-    const ctrl_m3_cfg_t *c = cfg;
-    if (s == NULL || c == NULL || params == NULL) {
-        return CTRL_EINVAL;
-    }
-    memset(s, 0, sizeof *s);
-    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
-    if (rc == CTRL_OK) {
-        rc = ctrl_mpc_zeta_pu(&c->model, params, c->zeta, &s->zeta);
-    }
-    return rc;
-}
-
 const ctrl_desc_t ctrl_desc_m3 = {
     .name = "m3",
     .title = "Three-candidate M2PTFC: set (6.1), duty (5.18), cost (6.13) (thesis 6.4.2)",
@@ -43,8 +19,8 @@ const ctrl_desc_t ctrl_desc_m3 = {
     .cfg_size = sizeof(ctrl_m3_cfg_t),
     .tunables = m3_tunables,
     .n_tunables = sizeof m3_tunables / sizeof m3_tunables[0],
-    .cfg_default = m3_cfg_default,
-    .init = m3_init,
-    .reset = ctrl_m3_reset,
+    .cfg_default = ctrl_mpc_wcfg_default,
+    .init = ctrl_mpc_winit,
+    .reset = ctrl_mpc_wreset,
     .step = ctrl_m3_step,
 };

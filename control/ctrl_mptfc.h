@@ -19,20 +19,13 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-typedef struct {
-    double zeta; /* "zeta", N*m/Wb, (6.13) */
-    ctrl_mpc_model_cfg_t model;
-} ctrl_mptfc_cfg_t;
-
-typedef struct {
-    ctrl_mpc_model_t model;
-    q24_t zeta;             /* Q24 pu */
-    ctrl_mpc_trace_t trace; /* vec 0 (zero vector, duty 0), then V1..V6 (duty 1) */
-} ctrl_mptfc_t;
+/* SI configuration and state: the layout shared by m1, m3 and mptfc
+ * (ctrl_m2ptfc_model.h); trace vec 0 (zero vector, duty 0), then V1..V6 (duty 1). */
+typedef ctrl_mpc_wcfg_t ctrl_mptfc_cfg_t;
+typedef ctrl_mpc_wstate_t ctrl_mptfc_t;
 
 extern const ctrl_desc_t ctrl_desc_mptfc;
 
-void ctrl_mptfc_reset(void *state);
 void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
 
 #endif /* CONTROL_CTRL_MPTFC_H */

@@ -1,6 +1,5 @@
 /* FS-MPTFC configuration and descriptor (SI -> Q24; floating point allowed here). */
 #include <stddef.h>
-#include <string.h>
 
 #include "ctrl_mptfc.h"
 
@@ -12,29 +11,6 @@ static const ctrl_tunable_t mptfc_tunables[] = {
     CTRL_MPC_MODEL_TUNABLES(ctrl_mptfc_cfg_t),
 };
 
-static void mptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
-{
-    ctrl_mptfc_cfg_t *c = cfg;
-    memset(c, 0, sizeof *c);
-    c->zeta = 0.0; /* T_rated/psi_pm (ctrl_m1.h) */
-    ctrl_mpc_model_cfg_default(&c->model, machine);
-}
-
-static int mptfc_init(void *state, const void *cfg, const ctrl_params_t *params)
-{
-    ctrl_mptfc_t *s = state;
-    const ctrl_mptfc_cfg_t *c = cfg;
-    if (s == NULL || c == NULL || params == NULL) {
-        return CTRL_EINVAL;
-    }
-    memset(s, 0, sizeof *s);
-    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
-    if (rc == CTRL_OK) {
-        rc = ctrl_mpc_zeta_pu(&c->model, params, c->zeta, &s->zeta);
-    }
-    return rc;
-}
-
 const ctrl_desc_t ctrl_desc_mptfc = {
     .name = "mptfc",
     .title = "Finite-set MPTFC: 8 vectors at D = 1, cost (6.13) (thesis 6.4.1)",
@@ -43,8 +19,8 @@ const ctrl_desc_t ctrl_desc_mptfc = {
     .cfg_size = sizeof(ctrl_mptfc_cfg_t),
     .tunables = mptfc_tunables,
     .n_tunables = sizeof mptfc_tunables / sizeof mptfc_tunables[0],
-    .cfg_default = mptfc_cfg_default,
-    .init = mptfc_init,
-    .reset = ctrl_mptfc_reset,
+    .cfg_default = ctrl_mpc_wcfg_default,
+    .init = ctrl_mpc_winit,
+    .reset = ctrl_mpc_wreset,
     .step = ctrl_mptfc_step,
 };

@@ -74,18 +74,6 @@ static void s1_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->psi_pm_wb = m->psi_pm_wb;
 }
 
-static int s1_in_range(const ctrl_tunable_t *t, size_t n, const ctrl_s1_cfg_t *c)
-{
-    for (size_t i = 0; i < n; i++) {
-        double v;
-        memcpy(&v, (const char *)c + t[i].offset, sizeof v);
-        if (!isfinite(v) || v < t[i].min || v > t[i].max) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 /* SI / base -> Q24 pu in [0, 127). */
 static int s1_q24(double si, double base, q24_t *out)
 {
@@ -120,6 +108,20 @@ static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_params_t *p, q24_t *out
     return *out > 0 ? CTRL_OK : CTRL_EINVAL;
 }
 
+/* Machine consistency and the hysteresis half bands h_T, h_psi in Q24 pu
+ * (hdtc and hpdtc share them, S1 §3.3). */
+static int s1_bands(const ctrl_s1_cfg_t *c, const ctrl_params_t *p, q24_t *ht, q24_t *hp)
+{
+    int rc = s1_check(c, p);
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_t, c->torque_base_nm, ht);
+    }
+    if (rc == CTRL_OK) {
+        rc = s1_q24(c->h_psi, c->psi_base_wb, hp);
+    }
+    return rc;
+}
+
 static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
 {
     if (state == NULL || cfg == NULL || p == NULL) {
@@ -128,18 +130,13 @@ static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_hdtc_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!s1_in_range(hdtc_tunables, sizeof hdtc_tunables / sizeof hdtc_tunables[0], c)) {
+    if (ctrl_tunables_check(hdtc_tunables, sizeof hdtc_tunables / sizeof hdtc_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     q24_t ht;
     q24_t hp;
-    int rc = s1_check(c, p);
-    if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_t, c->torque_base_nm, &ht);
-    }
-    if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_psi, c->psi_base_wb, &hp);
-    }
+    int rc = s1_bands(c, p, &ht, &hp);
     if (rc == CTRL_OK) {
         rc = s1_psi_ref(c, p, &s->psi_ref);
     }
@@ -161,7 +158,8 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_svm_dtc_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!s1_in_range(svm_tunables, sizeof svm_tunables / sizeof svm_tunables[0], c)) {
+    if (ctrl_tunables_check(svm_tunables, sizeof svm_tunables / sizeof svm_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     int rc = s1_check(c, p);
@@ -229,19 +227,14 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_hpdtc_state_t *s = state;
     memset(s, 0, sizeof *s);
-    if (!s1_in_range(hpdtc_tunables, sizeof hpdtc_tunables / sizeof hpdtc_tunables[0], c)) {
+    if (ctrl_tunables_check(hpdtc_tunables, sizeof hpdtc_tunables / sizeof hpdtc_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     q24_t ht;
     q24_t hp;
     q24_t efs = 0;
-    int rc = s1_check(c, p);
-    if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_t, c->torque_base_nm, &ht);
-    }
-    if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_psi, c->psi_base_wb, &hp);
-    }
+    int rc = s1_bands(c, p, &ht, &hp);
     if (rc == CTRL_OK && c->e_fs > 0.0) {
         rc = s1_q24(c->e_fs, c->torque_base_nm, &efs);
     } else if (rc == CTRL_OK) {

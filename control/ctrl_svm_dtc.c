@@ -35,7 +35,7 @@ void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || ctx == NULL || ctx->params == NULL || ctx->est == NULL || ctx->ref == NULL) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, 0u);
         return;
     }
@@ -82,7 +82,7 @@ void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     /* Integrator: conditional integration (hold while the PI output or the
      * voltage is saturated and the error pushes further), clamped to pi/6. */
     if (!((pi_sat != 0u || s->limited != 0u) && fx_sign(e) == fx_sign(dd))) {
-        const int64_t lim = (int64_t)SVM_INTEG_MAX << SVM_INTEG_SHIFT;
+        const int64_t lim = (int64_t)SVM_INTEG_MAX * ((int64_t)1 << SVM_INTEG_SHIFT);
         int64_t i =
             s->integ + fx_rshift64_round((int64_t)e * s->ki, SVM_KI_QBITS - SVM_INTEG_SHIFT);
         i = i > lim ? lim : (i < -lim ? -lim : i);

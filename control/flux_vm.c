@@ -6,7 +6,7 @@
 #include "flux_vm.h"
 
 /* |flux| kept below 127 pu in Q48 so the Q24 view always fits an int32_t. */
-#define VM_ACC_MAX ((int64_t)127 << 48)
+#define VM_ACC_MAX ((int64_t)127 * ((int64_t)1 << 48))
 
 static int64_t vm_clamp(int64_t x)
 {

@@ -35,11 +35,6 @@ static void st_emit(ctrl_plan_t *out, uint8_t *prev_vec, uint8_t n)
     *prev_vec = v;
 }
 
-static int st_ctx_ok(const ctrl_ctx_t *ctx)
-{
-    return ctx != NULL && ctx->params != NULL && ctx->est != NULL && ctx->ref != NULL;
-}
-
 void st_hyst_reset(void *state)
 {
     st_hyst_state_t *s = state;
@@ -58,7 +53,7 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || !st_ctx_ok(ctx)) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, s != NULL ? ctrl_zero_after(s->prev_vec) : 0u); /* no voltage */
         return;
     }
@@ -140,7 +135,7 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     if (out == NULL) {
         return;
     }
-    if (s == NULL || !st_ctx_ok(ctx)) {
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
         ctrl_plan_single(out, s != NULL ? ctrl_zero_after(s->prev_vec) : 0u);
         return;
     }

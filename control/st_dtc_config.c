@@ -72,11 +72,6 @@ static int st_to_q24(double si, double base, q24_t *out)
     return CTRL_OK;
 }
 
-static int st_in_range(const ctrl_tunable_t *t, double v)
-{
-    return isfinite(v) && v >= t->min && v <= t->max;
-}
-
 static void st_hyst_cfg_default(void *cfg, const ctrl_machine_t *m)
 {
     st_hyst_cfg_t *c = cfg;
@@ -115,7 +110,8 @@ static int st_hyst_init(void *state, const void *cfg, const ctrl_params_t *p, st
     if (rc != CTRL_OK) {
         return rc;
     }
-    if (!st_in_range(&hyst_tunables[0], c->h_t) || !st_in_range(&hyst_tunables[1], c->h_psi)) {
+    if (ctrl_tunables_check(hyst_tunables, sizeof hyst_tunables / sizeof hyst_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     q24_t h_t;
@@ -167,7 +163,8 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_params_t *p)
     if (rc != CTRL_OK) {
         return rc;
     }
-    if (!st_in_range(&fst_tunables[0], c->sigma) || !st_in_range(&fst_tunables[1], c->dt_step)) {
+    if (ctrl_tunables_check(fst_tunables, sizeof fst_tunables / sizeof fst_tunables[0], c) !=
+        CTRL_OK) {
         return CTRL_EINVAL;
     }
     rc = ctrl_vreplace_config(&s->vr, c->sigma);

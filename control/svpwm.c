@@ -9,6 +9,11 @@
  * 000->V0, 100->V1, 010->V3, 110->V2, 001->V5, 101->V6, 011->V4, 111->V7. */
 static const uint8_t svpwm_vec_of_mask[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
 
+uint8_t ctrl_svpwm_vec_of_mask(unsigned mask)
+{
+    return svpwm_vec_of_mask[mask & 7u];
+}
+
 /* Phase voltages of (v_alpha, v_beta) and their max and min (inverse Clarke). */
 static void svpwm_phases(q24_t va, q24_t vb, q24_t ph[3], q24_t *mx, q24_t *mn)
 {

@@ -27,6 +27,10 @@
 #include "ctrl_types.h"
 #include "fx.h"
 
+/* Vector index 0..7 of Table 4.2 for the leg states mask (bit 0 = leg a,
+ * bit 1 = b, bit 2 = c; 1 = upper switch on); bits above 2 are ignored. */
+uint8_t ctrl_svpwm_vec_of_mask(unsigned mask);
+
 /* Scale (v_alpha, v_beta) onto the voltage hexagon of DC link vdc if it lies
  * outside, keeping its angle. Returns 1 if it was limited, 0 if unchanged.
  * vdc <= 0 (nothing can be synthesised): the vector becomes 0, returns 1. */

@@ -15,11 +15,12 @@ static const q24_t bound_sin[6] = {-HALF, HALF, FX_ONE, HALF, -HALF, -FX_ONE};
 static const q24_t centre_cos[6] = {FX_ONE, HALF, -HALF, -FX_ONE, -HALF, HALF};
 static const q24_t centre_sin[6] = {0, SQ3_2, SQ3_2, 0, -SQ3_2, -SQ3_2};
 
-/* (c1*c2 - s1*s2, s1*c2 + c1*s2) rounded once: u(phi1 + phi2) from the parts. */
+/* (c1*c2 - s1*s2, s1*c2 + c1*s2) rounded once: u(phi1 + phi2) from the parts
+ * (fx_cross / fx_dot: one rounding, saturated, defined for any inputs). */
 static void rotate(q24_t c1, q24_t s1, q24_t c2, q24_t s2, q24_t *c, q24_t *s)
 {
-    *c = fx_sat32(fx_rshift64_round((int64_t)c1 * c2 - (int64_t)s1 * s2, FX_QBITS));
-    *s = fx_sat32(fx_rshift64_round((int64_t)s1 * c2 + (int64_t)c1 * s2, FX_QBITS));
+    *c = fx_cross(c1, s1, s2, c2);
+    *s = fx_dot(s1, c1, c2, s2);
 }
 
 /* Sign of u x psi = ux*py - uy*px, exact (|u| <= 2^25, |psi| <= 2^31: < 2^57). */

@@ -254,6 +254,23 @@ static void cmd_help(cmd_t *c)
     }
 }
 
+/* One "key=value" item of a list reply. */
+static void cmd_item_str(cmd_t *c, const char *key, const char *value)
+{
+    cmd_item_begin(c);
+    cmd_out_str(c, key);
+    cmd_out_str(c, value);
+    cmd_out_flush(c);
+}
+
+static void cmd_item_num(cmd_t *c, const char *key, double value)
+{
+    cmd_item_begin(c);
+    cmd_out_str(c, key);
+    cmd_out_num(c, value);
+    cmd_out_flush(c);
+}
+
 static void cmd_status_cmd(cmd_t *c)
 {
     cmd_status_t st;
@@ -262,44 +279,20 @@ static void cmd_status_cmd(cmd_t *c)
         return;
     }
     cmd_ok_list(c, 10);
-    cmd_item_begin(c);
-    cmd_out_str(c, "state=");
-    cmd_out_str(c, st.state);
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "armed=");
-    cmd_out_u32(c, st.armed ? 1u : 0u);
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "ctrl=");
-    cmd_out_str(c, st.ctrl);
-    cmd_out_flush(c);
+    cmd_item_str(c, "state=", st.state);
+    cmd_item_str(c, "armed=", st.armed ? "1" : "0");
+    cmd_item_str(c, "ctrl=", st.ctrl);
     cmd_item_begin(c);
     cmd_out_str(c, "fault=");
     cmd_out_u32(c, st.fault);
     cmd_out_char(c, ' ');
     cmd_out_str(c, st.fault == 0u ? "none" : st.fault_name);
     cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "mode=");
-    cmd_out_str(c, st.mode == CMD_MODE_SPEED ? "speed" : "torque");
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "speed_rpm=");
-    cmd_out_num(c, st.speed_rpm);
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "torque_nm=");
-    cmd_out_num(c, st.torque_nm);
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "speed_ref_rpm=");
-    cmd_out_num(c, st.speed_ref_rpm);
-    cmd_out_flush(c);
-    cmd_item_begin(c);
-    cmd_out_str(c, "torque_ref_nm=");
-    cmd_out_num(c, st.torque_ref_nm);
-    cmd_out_flush(c);
+    cmd_item_str(c, "mode=", st.mode == CMD_MODE_SPEED ? "speed" : "torque");
+    cmd_item_num(c, "speed_rpm=", st.speed_rpm);
+    cmd_item_num(c, "torque_nm=", st.torque_nm);
+    cmd_item_num(c, "speed_ref_rpm=", st.speed_ref_rpm);
+    cmd_item_num(c, "torque_ref_nm=", st.torque_ref_nm);
     cmd_item_begin(c);
     cmd_out_str(c, "tel_mask=");
     cmd_out_hex32(c, st.tel_mask);

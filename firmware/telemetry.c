@@ -135,16 +135,32 @@ size_t tel_wire_size(uint32_t mask)
     return TEL_COBS_SIZE(tel_payload_size(TEL_TYPE_SAMPLE, mask)) + 2u;
 }
 
+/* A frame of this stream: type, sequence number and signal mask. */
+static void tel_frame_start(const tel_t *t, uint8_t type, tel_frame_t *f)
+{
+    memset(f, 0, sizeof *f);
+    f->type = type;
+    f->seq = t->seq;
+    f->mask = t->mask;
+}
+
+/* Encode f; the sequence number advances only for a frame written. */
+static size_t tel_frame_finish(tel_t *t, const tel_frame_t *f, uint8_t *wire, size_t cap)
+{
+    const size_t len = tel_frame_encode(f, wire, cap);
+    if (len != 0) {
+        t->seq++;
+    }
+    return len;
+}
+
 size_t tel_encode_sample(tel_t *t, const tel_sample_t *s, uint8_t *wire, size_t cap)
 {
     if (t == NULL || s == NULL || wire == NULL || t->mask == 0u || cap < TEL_WIRE_MAX) {
         return 0;
     }
     tel_frame_t f;
-    memset(&f, 0, sizeof f);
-    f.type = TEL_TYPE_SAMPLE;
-    f.seq = t->seq;
-    f.mask = t->mask;
+    tel_frame_start(t, TEL_TYPE_SAMPLE, &f);
     f.tick = s->tick;
     unsigned n = 0;
     for (size_t i = 0; i < (size_t)TEL_SIG_COUNT; i++) {
@@ -154,11 +170,7 @@ size_t tel_encode_sample(tel_t *t, const tel_sample_t *s, uint8_t *wire, size_t 
             f.value[n++] = v;
         }
     }
-    const size_t len = tel_frame_encode(&f, wire, cap);
-    if (len != 0) {
-        t->seq++;
-    }
-    return len;
+    return tel_frame_finish(t, &f, wire, cap);
 }
 
 size_t tel_encode_meta(tel_t *t, uint32_t fs_hz, const ctrl_bases_t *bases, int32_t pole_pairs,
@@ -168,10 +180,7 @@ size_t tel_encode_meta(tel_t *t, uint32_t fs_hz, const ctrl_bases_t *bases, int3
         return 0;
     }
     tel_frame_t f;
-    memset(&f, 0, sizeof f);
-    f.type = TEL_TYPE_META;
-    f.seq = t->seq;
-    f.mask = t->mask;
+    tel_frame_start(t, TEL_TYPE_META, &f);
     f.fs_hz = fs_hz;
     f.every = t->every;
     unsigned n = 0;
@@ -180,9 +189,5 @@ size_t tel_encode_meta(tel_t *t, uint32_t fs_hz, const ctrl_bases_t *bases, int3
             f.scale[n++] = (float)tel_signal_scale(i, bases, pole_pairs);
         }
     }
-    const size_t len = tel_frame_encode(&f, wire, cap);
-    if (len != 0) {
-        t->seq++;
-    }
-    return len;
+    return tel_frame_finish(t, &f, wire, cap);
 }

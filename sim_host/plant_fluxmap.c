@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "plant.h"
+#include "sim_csv.h"
 
 void plant_fluxmap_free(plant_fluxmap_t *m)
 {
@@ -68,21 +69,18 @@ int plant_fluxmap_load(plant_fluxmap_t *m, const char *path, char *err, size_t e
     int rc = PLANT_OK;
     while (fgets(line, sizeof line, f) != NULL) {
         ++lineno;
-        if (strchr(line, '\n') == NULL && !feof(f)) {
+        if (!sim_csv_line_complete(line, f)) {
             snprintf(err, errlen, "%s:%ld: line too long", path, lineno);
             rc = PLANT_EINVAL;
             break;
         }
-        char *s = line;
-        while (*s == ' ' || *s == '\t') {
-            ++s;
-        }
-        if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0') {
+        const char *s = sim_csv_content(line);
+        if (s == NULL) {
             continue;
         }
         if (!header_seen) {
             header_seen = 1;
-            if (strncmp(s, "id_a,iq_a,psi_d_wb,psi_q_wb", 27) != 0) {
+            if (!sim_csv_is_header(s, "id_a,iq_a,psi_d_wb,psi_q_wb")) {
                 snprintf(err, errlen, "%s:%ld: expected header id_a,iq_a,psi_d_wb,psi_q_wb", path,
                          lineno);
                 rc = PLANT_EINVAL;
@@ -91,30 +89,7 @@ int plant_fluxmap_load(plant_fluxmap_t *m, const char *path, char *err, size_t e
             continue;
         }
         double v[4];
-        char *p = s;
-        int okrow = 1;
-        for (int k = 0; k < 4 && okrow; ++k) {
-            char *end;
-            errno = 0;
-            v[k] = strtod(p, &end);
-            if (end == p || errno != 0 || !isfinite(v[k])) {
-                okrow = 0;
-                break;
-            }
-            while (*end == ' ' || *end == '\t') {
-                ++end;
-            }
-            if (k < 3) {
-                if (*end != ',') {
-                    okrow = 0;
-                    break;
-                }
-                p = end + 1;
-            } else if (*end != '\0' && *end != '\n' && *end != '\r') {
-                okrow = 0;
-            }
-        }
-        if (!okrow) {
+        if (sim_csv_numbers(s, v, 4) != 0) {
             snprintf(err, errlen, "%s:%ld: expected 4 numbers id_a,iq_a,psi_d_wb,psi_q_wb", path,
                      lineno);
             rc = PLANT_EINVAL;

@@ -11,30 +11,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *k_header = "t_start_s,duration_s,S1,S2,S3";
+#include "sim_csv.h"
 
-/* Parse a number terminated by ',' (sep = 1) or end of line (sep = 0). */
-static int parse_field(char **p, double *v, int sep)
-{
-    char *end;
-    errno = 0;
-    *v = strtod(*p, &end);
-    if (end == *p || errno != 0 || !isfinite(*v)) {
-        return -1;
-    }
-    while (*end == ' ' || *end == '\t') {
-        ++end;
-    }
-    if (sep) {
-        if (*end != ',') {
-            return -1;
-        }
-        *p = end + 1;
-    } else if (*end != '\0' && *end != '\n' && *end != '\r') {
-        return -1;
-    }
-    return 0;
-}
+static const char k_header[] = "t_start_s,duration_s,S1,S2,S3";
 
 int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FILE *in,
                    const char *in_name, FILE *trace, char *err, size_t errlen)
@@ -72,20 +51,16 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
     int first = 1;
     while (fgets(line, sizeof line, in) != NULL) {
         ++lineno;
-        if (strchr(line, '\n') == NULL && !feof(in)) {
+        if (!sim_csv_line_complete(line, in)) {
             snprintf(err, errlen, "%s:%ld: line too long", in_name, lineno);
             return -1;
         }
-        char *s = line;
-        while (*s == ' ' || *s == '\t') {
-            ++s;
-        }
-        if (*s == '#' || *s == '\n' || *s == '\r' || *s == '\0') {
+        const char *s = sim_csv_content(line);
+        if (s == NULL) {
             continue;
         }
         if (!header_seen) {
-            const size_t n = strlen(k_header);
-            if (strncmp(s, k_header, n) != 0 || (s[n] != '\0' && s[n] != '\n' && s[n] != '\r')) {
+            if (!sim_csv_is_header(s, k_header)) {
                 snprintf(err, errlen, "%s:%ld: expected header %s", in_name, lineno, k_header);
                 return -1;
             }
@@ -93,13 +68,10 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
             continue;
         }
         double v[5];
-        char *q = s;
-        for (int k = 0; k < 5; ++k) {
-            if (parse_field(&q, &v[k], k < 4) != 0) {
-                snprintf(err, errlen, "%s:%ld: expected 5 numeric fields %s", in_name, lineno,
-                         k_header);
-                return -1;
-            }
+        if (sim_csv_numbers(s, v, 5) != 0) {
+            snprintf(err, errlen, "%s:%ld: expected 5 numeric fields %s", in_name, lineno,
+                     k_header);
+            return -1;
         }
         if (!(v[1] >= 0.0) || v[1] > 1e3) {
             snprintf(err, errlen, "%s:%ld: duration_s = %g must be in [0, 1000] s", in_name, lineno,

@@ -153,7 +153,7 @@ static void rig_init(const char *name, const ctrl_machine_t *m)
 static void test_svm_dtc_reference(void)
 {
     for (int mi = 0; mi < 2; mi++) {
-        rig_init("svm_dtc", mi == 0 ? &chapter_ipmsm : &chapter_spmsm);
+        rig_init("svm_dtc", mi == 0 ? &ini_chapter_ipmsm : &ini_thesis_spmsm);
         const ctrl_svm_dtc_state_t *s = (const ctrl_svm_dtc_state_t *)rig.state;
         const double ts = q(rig.params.ts);
         const double rs = q(rig.params.rs);
@@ -199,7 +199,7 @@ static void test_svm_dtc_reference(void)
 
 static void test_foc_reference(void)
 {
-    rig_init("foc", &chapter_spmsm);
+    rig_init("foc", &ini_thesis_spmsm);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     const double ts = q(rig.params.ts);
     const double kp_d = q(s->pi_d.kp);

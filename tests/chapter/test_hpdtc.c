@@ -157,8 +157,8 @@ static void rig_init(void)
     TEST_ASSERT_TRUE(rig.d->cfg_size <= CTRL_CFG_MAX);
     TEST_ASSERT_EQUAL_UINT32(10000u, rig.d->fs_default_hz);
     TEST_ASSERT_EQUAL_INT(CTRL_OK,
-                          ctrl_params_init(&rig.params, &rig.bases, &chapter_ipmsm, 10000u));
-    rig.d->cfg_default(rig.cfg, &chapter_ipmsm);
+                          ctrl_params_init(&rig.params, &rig.bases, &ini_chapter_ipmsm, 10000u));
+    rig.d->cfg_default(rig.cfg, &ini_chapter_ipmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
     rig.ctx.params = &rig.params;
     rig.ctx.est = &rig.est;

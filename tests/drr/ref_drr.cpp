@@ -129,7 +129,7 @@ void *make(const char *name, void (*tweak)(void *))
 {
     const ctrl_desc_t *desc = ctrl_find(name);
     TEST_ASSERT_NOT_NULL(desc);
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     if (tweak != nullptr) {
         tweak(CFG);
     }
@@ -175,7 +175,7 @@ struct DrrConst {
 DrrConst drr_const()
 {
     // (5.9), (5.10) in SI (electrical w_rn), then per unit.
-    const ctrl_machine_t &m = drr_spmsm;
+    const ctrl_machine_t &m = ini_thesis_spmsm;
     const double ts = 1.0 / CTRL_DRR_FS_HZ;
     const double w_rn = 2.0 * kPi * m.speed_rated_rpm / 60.0 * m.pole_pairs;
     const double a_nm = m.pole_pairs * m.vdc_v * m.psi_pm_wb * ts / m.ld_h;
@@ -326,7 +326,7 @@ void run_baseline(const char *name, Kind kind)
     std::mt19937_64 rng(7u + static_cast<unsigned>(kind));
     const ctrl_desc_t *desc = ctrl_find(name);
     const double tb = B.torque_nm;
-    const ctrl_machine_t &m = drr_spmsm;
+    const ctrl_machine_t &m = ini_thesis_spmsm;
     // Table 5.1 (thesis SPMSM): C_T = 1.2 N*m, C_psi = 0.09427 Wb, K_a = 2 N*m, K_b = 6e-4
     // N*m/(r/min)
     const double c_t = 1.2 / tb, c_psi = 0.09427 / B.psi_wb;
@@ -461,7 +461,7 @@ void test_drms_vs_reference(void)
 
 void setUp(void)
 {
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &B, &drr_spmsm, CTRL_DRR_FS_HZ));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &B, &ini_thesis_spmsm, CTRL_DRR_FS_HZ));
 }
 
 void tearDown(void)

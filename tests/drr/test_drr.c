@@ -25,7 +25,7 @@ static _Alignas(8) unsigned char CFG[CTRL_CFG_MAX];
 
 void setUp(void)
 {
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &BASES, &drr_spmsm, CTRL_DRR_FS_HZ));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &BASES, &ini_thesis_spmsm, CTRL_DRR_FS_HZ));
 }
 
 void tearDown(void)
@@ -49,7 +49,7 @@ static void *make(const char *name, void (*tweak)(void *cfg))
     TEST_ASSERT_NOT_NULL(desc);
     TEST_ASSERT_TRUE(desc->state_size <= sizeof STATE);
     TEST_ASSERT_TRUE(desc->cfg_size <= sizeof CFG);
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     if (tweak != NULL) {
         tweak(CFG);
     }
@@ -63,7 +63,7 @@ static void test_ab_thesis_spmsm(void)
 {
     double a;
     double b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_drr_ab_si(&drr_spmsm, 100e-6, &a, &b));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_drr_ab_si(&ini_thesis_spmsm, 100e-6, &a, &b));
     TEST_ASSERT_DOUBLE_WITHIN(0.5e-3, 1.266, a);
     TEST_ASSERT_DOUBLE_WITHIN(0.5e-3, 1.023, b);
 
@@ -82,11 +82,11 @@ static void test_ab_thesis_spmsm(void)
     TEST_ASSERT_EQUAL_INT(0, s->dc_fixed);
 
     /* Bad machine data: clear error, no crash. */
-    ctrl_machine_t bad = drr_spmsm;
+    ctrl_machine_t bad = ini_thesis_spmsm;
     bad.ld_h = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_drr_ab_si(&bad, 100e-6, &a, &b));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_drr_ab_si(NULL, 100e-6, &a, &b));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_drr_ab_si(&drr_spmsm, 0.0, &a, &b));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_drr_ab_si(&ini_thesis_spmsm, 0.0, &a, &b));
 }
 
 /* ---- (5.5): lambda = 0.03 at 10 kHz -> 48.5 Hz (REFERENCE §4, 3 digits). ---- */
@@ -433,7 +433,7 @@ static void test_descriptors(void)
         TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, NULL, &P));
         TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, NULL));
         /* cfg made for another machine */
-        desc->cfg_default(CFG, &drr_ipmsm80);
+        desc->cfg_default(CFG, &ini_thesis_ipmsm80);
         TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
         /* cfg_default without a machine: init refuses */
         desc->cfg_default(CFG, NULL);
@@ -448,17 +448,17 @@ static void test_descriptors(void)
         desc->reset(NULL);
     }
     const ctrl_desc_t *desc = ctrl_find("drr");
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     bad_lambda(CFG);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_cfg_t *)CFG)->c = 1.0; /* C must be < 0 */
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_cfg_t *)CFG)->sigma = NAN;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
     desc = ctrl_find("drr_d1");
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_base_cfg_t *)CFG)->c_t_nm = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
 }
@@ -468,7 +468,7 @@ static void test_descriptors(void)
 static void test_tunables_by_name(void)
 {
     const ctrl_desc_t *desc = ctrl_find("drr");
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     double v = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, "lambda", &v));
     TEST_ASSERT_EQUAL_DOUBLE(0.03, v);
@@ -494,20 +494,20 @@ static void test_tunables_by_name(void)
     const char *first[] = {"C_T", "K_a", "K_P", "rms"};
     for (size_t i = 0; i < 4; i++) {
         desc = ctrl_find(base_names[i]);
-        desc->cfg_default(CFG, &drr_spmsm);
+        desc->cfg_default(CFG, &ini_thesis_spmsm);
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, first[i], &v));
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(desc, CFG, first[i], v));
         TEST_ASSERT_EQUAL_INT(CTRL_OK, desc->init(STATE, CFG, &P));
     }
     /* Table 5.1 defaults for the thesis SPMSM */
     desc = ctrl_find("drr_d1");
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, "C_T", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1.2, v);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, "C_psi", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.09427, v);
     desc = ctrl_find("drr_d2");
-    desc->cfg_default(CFG, &drr_spmsm);
+    desc->cfg_default(CFG, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, "K_a", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 2.0, v);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, "K_b", &v));

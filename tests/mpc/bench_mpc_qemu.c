@@ -95,7 +95,7 @@ static void test_instruction_counts(void)
 
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &mpc_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &ini_thesis_spmsm, 10000u));
     static const char *const names[] = {"m2ptfc", "m1", "mptfc", "m3", "m2"};
     enum { NC = 5 };
     static unsigned char state[NC][CTRL_STATE_MAX] __attribute__((aligned(8)));
@@ -111,7 +111,7 @@ static void test_instruction_counts(void)
     for (int c = 0; c < NC; c++) {
         d[c] = ctrl_find(names[c]);
         TEST_ASSERT_NOT_NULL(d[c]);
-        d[c]->cfg_default(cfg[c], &mpc_spmsm);
+        d[c]->cfg_default(cfg[c], &ini_thesis_spmsm);
         TEST_ASSERT_EQUAL_INT(CTRL_OK, d[c]->init(state[c], cfg[c], &p));
         ctrl_plan_single(&applied[c], 0u);
     }

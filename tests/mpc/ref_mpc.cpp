@@ -268,8 +268,8 @@ static void run_model(const ctrl_machine_t &mach, uint32_t fs, double *e_t, doub
 static void test_model_reference(void)
 {
     double e_t = 0.0, e_psi = 0.0;
-    run_model(mpc_spmsm, 10000u, &e_t, &e_psi);
-    run_model(mpc_ipmsm80, 20000u, &e_t, &e_psi);
+    run_model(ini_thesis_spmsm, 10000u, &e_t, &e_psi);
+    run_model(ini_thesis_ipmsm80, 20000u, &e_t, &e_psi);
     printf("  k+2 model: worst torque error %.2f of its budget, worst |psi| error %.1f LSB "
            "(budget %.0f)\n",
            e_t, e_psi / LSB, TOL_PSI / LSB);
@@ -369,9 +369,9 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, double centre, S
 static void test_m2ptfc_reference(void)
 {
     Stats st{"m2ptfc"};
-    run_m2ptfc(mpc_spmsm, 10000u, 1.0, st);
-    run_m2ptfc(mpc_ipmsm80, 20000u, 1.0, st);
-    run_m2ptfc(mpc_spmsm, 10000u, 0.0, st);
+    run_m2ptfc(ini_thesis_spmsm, 10000u, 1.0, st);
+    run_m2ptfc(ini_thesis_ipmsm80, 20000u, 1.0, st);
+    run_m2ptfc(ini_thesis_spmsm, 10000u, 0.0, st);
     st.report();
 }
 
@@ -510,24 +510,24 @@ static void run_weighted(Kind kind, const ctrl_machine_t &mach, uint32_t fs, Sta
 static void test_m1_reference(void)
 {
     Stats st{"m1"};
-    run_weighted(K_M1, mpc_spmsm, 10000u, st);
-    run_weighted(K_M1, mpc_ipmsm80, 20000u, st);
+    run_weighted(K_M1, ini_thesis_spmsm, 10000u, st);
+    run_weighted(K_M1, ini_thesis_ipmsm80, 20000u, st);
     st.report();
 }
 
 static void test_mptfc_reference(void)
 {
     Stats st{"mptfc"};
-    run_weighted(K_MPTFC, mpc_spmsm, 10000u, st);
-    run_weighted(K_MPTFC, mpc_ipmsm80, 20000u, st);
+    run_weighted(K_MPTFC, ini_thesis_spmsm, 10000u, st);
+    run_weighted(K_MPTFC, ini_thesis_ipmsm80, 20000u, st);
     st.report();
 }
 
 static void test_m3_reference(void)
 {
     Stats st{"m3"};
-    run_weighted(K_M3, mpc_spmsm, 12000u, st);
-    run_weighted(K_M3, mpc_ipmsm80, 20000u, st);
+    run_weighted(K_M3, ini_thesis_spmsm, 12000u, st);
+    run_weighted(K_M3, ini_thesis_ipmsm80, 20000u, st);
     st.report();
 }
 
@@ -618,8 +618,8 @@ static void run_m2(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
 static void test_m2_reference(void)
 {
     Stats st{"m2"};
-    run_m2(mpc_spmsm, 10000u, st);
-    run_m2(mpc_ipmsm80, 20000u, st);
+    run_m2(ini_thesis_spmsm, 10000u, st);
+    run_m2(ini_thesis_ipmsm80, 20000u, st);
     st.report();
 }
 

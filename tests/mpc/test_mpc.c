@@ -303,15 +303,15 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs, double centre)
 
 static void test_m2ptfc_minimises_cost_spmsm(void)
 {
-    check_m2ptfc(&mpc_spmsm, 10000u, 1.0);
-    check_m2ptfc(&mpc_spmsm, 10000u, 0.0);
+    check_m2ptfc(&ini_thesis_spmsm, 10000u, 1.0);
+    check_m2ptfc(&ini_thesis_spmsm, 10000u, 0.0);
 }
 
 static void test_m2ptfc_minimises_cost_ipmsm(void)
 {
-    check_m2ptfc(&mpc_ipmsm80, 20000u, 1.0);
-    check_m2ptfc(&mpc_chapter_ipmsm, 10000u, 1.0);
-    check_m2ptfc(&mpc_ipmsm80, 20000u, 0.0);
+    check_m2ptfc(&ini_thesis_ipmsm80, 20000u, 1.0);
+    check_m2ptfc(&ini_chapter_ipmsm, 10000u, 1.0);
+    check_m2ptfc(&ini_thesis_ipmsm80, 20000u, 0.0);
 }
 
 /* g of (6.13) for the k+2 state st. */
@@ -391,39 +391,39 @@ static void test_m1_argmin(void)
 {
     ctrl_m1_t s;
     TEST_ASSERT_TRUE(ctrl_desc_m1.state_size == sizeof s);
-    check_weighted(&mpc_spmsm, 10000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
+    check_weighted(&ini_thesis_spmsm, 10000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
     TEST_ASSERT_EQUAL_UINT8(6, s.trace.n);
-    check_weighted(&mpc_ipmsm80, 20000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
+    check_weighted(&ini_thesis_ipmsm80, 20000u, &ctrl_desc_m1, &s, &s.trace, &s.zeta, 1);
 }
 
 static void test_mptfc_argmin(void)
 {
     ctrl_mptfc_t s;
     TEST_ASSERT_TRUE(ctrl_desc_mptfc.state_size == sizeof s);
-    check_weighted(&mpc_spmsm, 10000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
+    check_weighted(&ini_thesis_spmsm, 10000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
     TEST_ASSERT_EQUAL_UINT8(7, s.trace.n);
-    check_weighted(&mpc_ipmsm80, 20000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
+    check_weighted(&ini_thesis_ipmsm80, 20000u, &ctrl_desc_mptfc, &s, &s.trace, &s.zeta, 0);
 }
 
 static void test_m3_argmin(void)
 {
     ctrl_m3_t s;
     TEST_ASSERT_TRUE(ctrl_desc_m3.state_size == sizeof s);
-    check_weighted(&mpc_spmsm, 12000u, &ctrl_desc_m3, &s, &s.trace, &s.zeta, 1);
+    check_weighted(&ini_thesis_spmsm, 12000u, &ctrl_desc_m3, &s, &s.trace, &s.zeta, 1);
     TEST_ASSERT_EQUAL_UINT8(3, s.trace.n);
 }
 
 static void test_m2_band_and_argmin(void)
 {
     ctrl_params_t p;
-    params_for(&mpc_spmsm, 10000u, &p);
+    params_for(&ini_thesis_spmsm, 10000u, &p);
     uint8_t cfg[CTRL_CFG_MAX];
     ctrl_m2_t s;
-    ctrl_desc_m2.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m2.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2.init(&s, cfg, &p));
     TEST_ASSERT_EQUAL_UINT8(4, s.y);
     const double eps = d24(s.eps_psi);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 6.60e-3 / mpc_spmsm.psi_pm_wb, eps);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 6.60e-3 / ini_thesis_spmsm.psi_pm_wb, eps);
     for (int i = 0; i < N_RANDOM; i++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
@@ -481,7 +481,7 @@ static void test_registry_and_tunables(void)
         TEST_ASSERT_TRUE(d->state_size <= CTRL_STATE_MAX);
         TEST_ASSERT_TRUE(d->cfg_size <= CTRL_CFG_MAX);
         uint8_t cfg[CTRL_CFG_MAX];
-        d->cfg_default(cfg, &mpc_spmsm);
+        d->cfg_default(cfg, &ini_thesis_spmsm);
         double v;
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(d, cfg, "ld_model", &v));
         TEST_ASSERT_EQUAL_INT(0, (int)(v * 1e6)); /* 0 = machine */
@@ -490,18 +490,18 @@ static void test_registry_and_tunables(void)
     }
     uint8_t cfg[CTRL_CFG_MAX];
     double v;
-    ctrl_desc_m2ptfc.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m2ptfc.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m2ptfc, cfg, "lambda", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.03, v);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2ptfc, cfg, "lambda", 1.5));
-    ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m1.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m1, cfg, "zeta", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, v); /* equal importance, see ctrl_m1.h */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 640.0));
-    ctrl_desc_m3.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m3.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(&ctrl_desc_m3, cfg, "zeta", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, v);
-    ctrl_desc_m2.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m2.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(&ctrl_desc_m2, cfg, "y", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m2, cfg, "eps_psi", 9.42e-3));
 }
@@ -510,17 +510,17 @@ static void test_zeta_in_pu(void)
 {
     /* zeta [N*m/Wb] -> pu: zeta psi_base / T_base, T_base = 1.5 p psi_pm^2 / Ld. */
     ctrl_params_t p;
-    params_for(&mpc_spmsm, 10000u, &p);
+    params_for(&ini_thesis_spmsm, 10000u, &p);
     uint8_t cfg[CTRL_CFG_MAX];
     ctrl_m1_t s;
-    ctrl_desc_m1.cfg_default(cfg, &mpc_spmsm);
+    ctrl_desc_m1.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 250.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
     const double t_base = 1.5 * 4.0 * 0.09427 * 0.09427 / 6.552e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-5, 250.0 * 0.09427 / t_base, d24(s.zeta));
     /* zeta = 0: T_rated / psi_pm (6.5): 2133 N*m/Wb for the 80 kW IPMSM. */
-    params_for(&mpc_ipmsm80, 20000u, &p);
-    ctrl_desc_m1.cfg_default(cfg, &mpc_ipmsm80);
+    params_for(&ini_thesis_ipmsm80, 20000u, &p);
+    ctrl_desc_m1.cfg_default(cfg, &ini_thesis_ipmsm80);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
     const double t_base80 = 1.5 * 4.0 * 0.1875 * 0.1875 / 0.6e-3;
@@ -530,10 +530,10 @@ static void test_zeta_in_pu(void)
 static void test_bad_input(void)
 {
     ctrl_params_t p;
-    params_for(&mpc_spmsm, 10000u, &p);
+    params_for(&ini_thesis_spmsm, 10000u, &p);
     ctrl_m2ptfc_cfg_t c;
     ctrl_m2ptfc_t s;
-    ctrl_desc_m2ptfc.cfg_default(&c, &mpc_spmsm);
+    ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(NULL, &c, &p));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, NULL, &p));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, NULL));
@@ -553,6 +553,51 @@ static void test_bad_input(void)
     ctrl_desc_m2ptfc.cfg_default(&c, NULL);
     c.model.ld_h = 1e-3;
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+}
+
+/* Every chapter-6 descriptor: NULL state / cfg / params refused, NaN and
+ * out-of-range SI values refused at init (each tunable's own [min, max], also
+ * when written into the cfg directly), NULL tolerated by cfg_default and
+ * reset, and a step without a valid context answers with the zero vector. */
+static void test_bad_input_all(void)
+{
+    const ctrl_desc_t *const descs[] = {&ctrl_desc_m2ptfc, &ctrl_desc_m1, &ctrl_desc_mptfc,
+                                        &ctrl_desc_m3, &ctrl_desc_m2};
+    ctrl_params_t p;
+    params_for(&ini_thesis_spmsm, 10000u, &p);
+    static _Alignas(16) uint8_t st[CTRL_STATE_MAX];
+    static _Alignas(16) uint8_t cfg[CTRL_CFG_MAX];
+    for (size_t i = 0; i < sizeof descs / sizeof descs[0]; i++) {
+        const ctrl_desc_t *d = descs[i];
+        d->cfg_default(NULL, &ini_thesis_spmsm);
+        d->reset(NULL);
+        d->cfg_default(cfg, &ini_thesis_spmsm);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_OK, d->init(st, cfg, &p), d->name);
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(NULL, cfg, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, NULL, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, NULL));
+        for (size_t k = 0; k < d->n_tunables; k++) {
+            const ctrl_tunable_t *t = &d->tunables[k];
+            const double bad[3] = {NAN, t->max * 2.0 + 1.0, t->min - 1.0};
+            for (int b = 0; b < 3; b++) {
+                d->cfg_default(cfg, &ini_thesis_spmsm);
+                memcpy(cfg + t->offset, &bad[b], sizeof bad[b]);
+                const int rc = d->init(st, cfg, &p);
+                TEST_ASSERT_TRUE_MESSAGE(rc == CTRL_EINVAL || rc == CTRL_ERANGE, t->name);
+            }
+        }
+        d->cfg_default(cfg, &ini_thesis_spmsm);
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(st, cfg, &p));
+        ctrl_plan_t out;
+        memset(&out, 0xA5, sizeof out);
+        d->step(st, NULL, &out);
+        TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
+        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
+        d->step(st, NULL, NULL);
+        const ctrl_ctx_t no_est = {&p, NULL, NULL, NULL};
+        d->step(st, &no_est, &out);
+        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
+    }
 }
 
 /* (**) of ctrl_m2ptfc.h: Te_c = t1 + (t0 - t1)/2 (rounded half), t1 when off;
@@ -583,7 +628,7 @@ static void test_t_eval(void)
  * square of a rounded square root differs by up to 2 |psi| LSB (+1 rounding). */
 static void test_psi_ref2(void)
 {
-    const ctrl_machine_t *ms[3] = {&mpc_spmsm, &mpc_ipmsm80, &mpc_chapter_ipmsm};
+    const ctrl_machine_t *ms[3] = {&ini_thesis_spmsm, &ini_thesis_ipmsm80, &ini_chapter_ipmsm};
     for (int k = 0; k < 3; k++) {
         ctrl_params_t p;
         params_for(ms[k], 10000u, &p);
@@ -604,10 +649,10 @@ static void test_sigma_ema(void)
     /* (6.8): a constant error e drives sigma to e with rate lambda:
      * sigma_n = e (1 - (1 - lambda)^n). */
     ctrl_params_t p;
-    params_for(&mpc_spmsm, 10000u, &p);
+    params_for(&ini_thesis_spmsm, 10000u, &p);
     ctrl_m2ptfc_cfg_t c;
     ctrl_m2ptfc_t s;
-    ctrl_desc_m2ptfc.cfg_default(&c, &mpc_spmsm);
+    ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
     c.centre = 0.0; /* Te = Te(k+1): the error below is exactly T_ref - Te */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
     ctrl_estimate_t est;
@@ -643,6 +688,7 @@ int main(void)
     RUN_TEST(test_registry_and_tunables);
     RUN_TEST(test_zeta_in_pu);
     RUN_TEST(test_bad_input);
+    RUN_TEST(test_bad_input_all);
     RUN_TEST(test_sigma_ema);
     RUN_TEST(test_t_eval);
     RUN_TEST(test_psi_ref2);

@@ -152,7 +152,7 @@ static void assert_running(const mpc_ctrl_t *k, const mpc_res_t *r)
  * ctrl_m2ptfc.h). */
 static double spmsm_sigma0(double t_nm, double rpm, double ts)
 {
-    const ctrl_machine_t *m = &mpc_spmsm;
+    const ctrl_machine_t *m = &ini_thesis_spmsm;
     const double k = 1.5 * m->pole_pairs;
     const double iq = t_nm / (k * m->psi_pm_wb);
     const double pd = m->psi_pm_wb;                       /* i_d = 0: no Rs drop on d */
@@ -265,7 +265,7 @@ static void test_m2ptfc_four_quadrants(void)
  * and that the proposed method (no weight) holds it. */
 static void test_table62_weights_report(void)
 {
-    const ctrl_machine_t *m = &mpc_spmsm;
+    const ctrl_machine_t *m = &ini_thesis_spmsm;
     const double zeta_max = sqrt(3.0) * 1.5 * m->pole_pairs * m->psi_pm_wb / m->ld_h;
     const mpc_ctrl_t m1_750 = {"m1", 10000u, "zeta", 250.0};
     const mpc_ctrl_t m1_lim = {"m1", 10000u, "zeta", 0.9 * zeta_max};

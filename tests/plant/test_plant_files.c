@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ini_machines.h"
 #include "plant.h"
 #include "sim_machine.h"
 #include "sim_replay.h"
@@ -124,6 +125,54 @@ static void expect_ini_error(const char *from, const char *to, const char *must_
     TEST_ASSERT_EQUAL_INT(-1, load_variant(from, to, err, sizeof err));
     TEST_MESSAGE(err);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, must_contain), err);
+}
+
+/* tests/plant/ini_machines.h (the machines the controller unit tests use
+ * without the INI loader) transcribes the shipped INI files: every field
+ * equal, up to the rounding of the mH -> H conversion (relative 1e-12). */
+static void check_mirror(const char *file, const ctrl_machine_t *c)
+{
+    char path[512];
+    char err[256];
+    snprintf(path, sizeof path, "%s/%s", PLANT_MACHINES_DIR, file);
+    sim_machine_t m;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+    TEST_ASSERT_EQUAL_STRING(m.name, c->name);
+    TEST_ASSERT_EQUAL_INT(m.pole_pairs, c->pole_pairs);
+    const double ini[] = {m.rs_ohm,
+                          m.ld_h,
+                          m.lq_h,
+                          m.psi_pm_wb,
+                          m.vdc_v,
+                          m.inertia_kgm2,
+                          m.torque_rated_nm,
+                          m.speed_rated_rpm,
+                          m.current_rated_a,
+                          m.current_max_a,
+                          m.psi_ref_wb};
+    const double mir[] = {c->rs_ohm,
+                          c->ld_h,
+                          c->lq_h,
+                          c->psi_pm_wb,
+                          c->vdc_v,
+                          c->inertia_kgm2,
+                          c->torque_rated_nm,
+                          c->speed_rated_rpm,
+                          c->current_rated_a,
+                          c->current_max_a,
+                          c->psi_ref_wb};
+    for (size_t i = 0; i < sizeof ini / sizeof ini[0]; i++) {
+        char msg[96];
+        snprintf(msg, sizeof msg, "%s field %zu", file, i);
+        TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(1e-12 * fabs(ini[i]), ini[i], mir[i], msg);
+    }
+}
+
+static void test_ini_mirror_header(void)
+{
+    check_mirror("thesis_spmsm.ini", &ini_thesis_spmsm);
+    check_mirror("thesis_ipmsm_80kw.ini", &ini_thesis_ipmsm80);
+    check_mirror("chapter_ipmsm.ini", &ini_chapter_ipmsm);
 }
 
 static void test_ini_bad_input(void)
@@ -418,6 +467,9 @@ static void test_fluxmap_malformed(void)
     const char *h = "id_a,iq_a,psi_d_wb,psi_q_wb\n";
     char buf[512];
     expect_fluxmap_error("id,iq,pd,pq\n0,0,0,0\n", ":1: expected header");
+    /* the header exactly (sim_csv.h): a fifth column is not silently ignored */
+    expect_fluxmap_error("# map\nid_a,iq_a,psi_d_wb,psi_q_wb,extra\n0,0,0.1,0\n",
+                         ":2: expected header");
     snprintf(buf, sizeof buf, "%s0,0,0.1,0\n0,1,0.1,x\n", h);
     expect_fluxmap_error(buf, ":3: expected 4 numbers");
     snprintf(buf, sizeof buf, "%s0,0,0.1,0\n0,1,0.1,0.1\n1,0,0.2,0\n", h);
@@ -439,6 +491,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_ini_shipped_machines);
+    RUN_TEST(test_ini_mirror_header);
     RUN_TEST(test_ini_bad_input);
     RUN_TEST(test_replay_round_trip);
     RUN_TEST(test_replay_malformed_rows);
