@@ -21,10 +21,10 @@
 
 /* Everything a controller sees at sample k. */
 typedef struct {
-    const ctrl_params_t *params;  /* machine parameters for this fs */
-    const ctrl_estimate_t *est;   /* estimates at k and predictions for k+1 */
-    const ctrl_refs_t *ref;       /* references */
-    const ctrl_plan_t *applied;   /* plan acting during [k, k+1) (chosen at k-1) */
+    const ctrl_params_t *params; /* machine parameters for this fs */
+    const ctrl_estimate_t *est;  /* estimates at k and predictions for k+1 */
+    const ctrl_refs_t *ref;      /* references */
+    const ctrl_plan_t *applied;  /* plan acting during [k, k+1) (chosen at k-1) */
 } ctrl_ctx_t;
 
 /*
@@ -33,19 +33,19 @@ typedef struct {
  * "compute from the machine at init"; a non-zero value overrides.
  */
 typedef struct {
-    const char *name;   /* e.g. "h_T" */
-    const char *unit;   /* e.g. "N*m" */
-    const char *help;   /* one line, cites the seed */
-    size_t offset;      /* offsetof(cfg struct, field), field is a double */
-    double min, max;    /* accepted range (inclusive) */
+    const char *name; /* e.g. "h_T" */
+    const char *unit; /* e.g. "N*m" */
+    const char *help; /* one line, cites the seed */
+    size_t offset;    /* offsetof(cfg struct, field), field is a double */
+    double min, max;  /* accepted range (inclusive) */
 } ctrl_tunable_t;
 
 typedef struct ctrl_desc {
-    const char *name;          /* run-time selector: "bst", "fst", "drr", "m2ptfc", ... */
-    const char *title;         /* one line with the seed reference */
-    uint32_t fs_default_hz;    /* the sampling frequency the seed uses */
-    size_t state_size;         /* bytes of runtime state */
-    size_t cfg_size;           /* bytes of the SI configuration struct */
+    const char *name;       /* run-time selector: "bst", "fst", "drr", "m2ptfc", ... */
+    const char *title;      /* one line with the seed reference */
+    uint32_t fs_default_hz; /* the sampling frequency the seed uses */
+    size_t state_size;      /* bytes of runtime state */
+    size_t cfg_size;        /* bytes of the SI configuration struct */
     const ctrl_tunable_t *tunables;
     size_t n_tunables;
     /* Fill cfg with the seed's default parameters for this machine. */

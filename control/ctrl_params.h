@@ -24,17 +24,17 @@
 /* What a user fills in from a data sheet, SI units. */
 typedef struct {
     const char *name;
-    int pole_pairs;           /* p */
-    double rs_ohm;            /* stator resistance per phase */
-    double ld_h, lq_h;        /* d and q inductances */
-    double psi_pm_wb;         /* permanent-magnet flux linkage (peak, per phase) */
-    double vdc_v;             /* nominal DC-link voltage */
-    double inertia_kgm2;      /* J, for the speed loop */
-    double torque_rated_nm;   /* rated torque */
-    double speed_rated_rpm;   /* rated mechanical speed */
-    double current_rated_a;   /* rated current (peak of the phase current) */
-    double current_max_a;     /* over-current trip level (peak), > rated */
-    double psi_ref_wb;        /* stator-flux reference; 0 = MTPA (4.15) */
+    int pole_pairs;         /* p */
+    double rs_ohm;          /* stator resistance per phase */
+    double ld_h, lq_h;      /* d and q inductances */
+    double psi_pm_wb;       /* permanent-magnet flux linkage (peak, per phase) */
+    double vdc_v;           /* nominal DC-link voltage */
+    double inertia_kgm2;    /* J, for the speed loop */
+    double torque_rated_nm; /* rated torque */
+    double speed_rated_rpm; /* rated mechanical speed */
+    double current_rated_a; /* rated current (peak of the phase current) */
+    double current_max_a;   /* over-current trip level (peak), > rated */
+    double psi_ref_wb;      /* stator-flux reference; 0 = MTPA (4.15) */
 } ctrl_machine_t;
 
 /* SI value of 1 pu of each quantity (configuration and host tools only). */
@@ -48,21 +48,21 @@ typedef struct {
 
 /* Fixed-point parameters used per sample; all q24_t fields are Q24 per-unit. */
 typedef struct {
-    uint32_t fs_hz;           /* control (sampling) frequency */
-    int32_t pole_pairs;       /* p (integer) */
-    q24_t ts;                 /* control period Ts, pu time (Ts * w_base) */
-    q24_t rs;                 /* stator resistance, pu */
-    q24_t ts_rs;              /* Ts * Rs, pu (precomputed product) */
-    q24_t ld, lq;             /* pu (ld == FX_ONE by the choice of base) */
-    q24_t inv_ld, inv_lq;     /* 1/Ld, 1/Lq, pu */
-    q24_t psi_pm;             /* pu (== FX_ONE) */
-    q24_t vdc_nom;            /* nominal DC link, pu (== FX_ONE) */
-    q24_t torque_rated;       /* pu */
-    q24_t speed_rated_e;      /* rated electrical speed, pu */
-    q24_t current_rated;      /* pu */
-    q24_t current_max;        /* pu */
-    q24_t psi_ref;            /* fixed flux reference, pu; 0 = MTPA */
-    uint8_t salient;          /* 1 when Ld != Lq (IPMSM) */
+    uint32_t fs_hz;       /* control (sampling) frequency */
+    int32_t pole_pairs;   /* p (integer) */
+    q24_t ts;             /* control period Ts, pu time (Ts * w_base) */
+    q24_t rs;             /* stator resistance, pu */
+    q24_t ts_rs;          /* Ts * Rs, pu (precomputed product) */
+    q24_t ld, lq;         /* pu (ld == FX_ONE by the choice of base) */
+    q24_t inv_ld, inv_lq; /* 1/Ld, 1/Lq, pu */
+    q24_t psi_pm;         /* pu (== FX_ONE) */
+    q24_t vdc_nom;        /* nominal DC link, pu (== FX_ONE) */
+    q24_t torque_rated;   /* pu */
+    q24_t speed_rated_e;  /* rated electrical speed, pu */
+    q24_t current_rated;  /* pu */
+    q24_t current_max;    /* pu */
+    q24_t psi_ref;        /* fixed flux reference, pu; 0 = MTPA */
+    uint8_t salient;      /* 1 when Ld != Lq (IPMSM) */
     /* ---- appended by core (ctrl_params_config.c computes them) ---- */
     /* Angle increment per control period for 1.0 pu electrical speed, in
      * fx_angle_t units (2^32 = one turn), integer (Q0):
@@ -88,9 +88,9 @@ typedef struct {
 
 /* Error codes shared by configuration functions. */
 #define CTRL_OK 0
-#define CTRL_EINVAL (-1)   /* a parameter is missing, non-finite or out of range */
-#define CTRL_ERANGE (-2)   /* a parameter does not fit the Q format */
-#define CTRL_ENOENT (-3)   /* unknown name */
+#define CTRL_EINVAL (-1) /* a parameter is missing, non-finite or out of range */
+#define CTRL_ERANGE (-2) /* a parameter does not fit the Q format */
+#define CTRL_ENOENT (-3) /* unknown name */
 
 /*
  * Validate the machine data and compute bases and fixed-point parameters for a

@@ -16,36 +16,36 @@
 
 /* Measurements after conversion from raw counts (done by the firmware). */
 typedef struct {
-    q24_t i_a, i_b;       /* phase currents a, b (i_c = -i_a - i_b), pu */
-    q24_t vdc;            /* DC-link voltage, pu */
-    fx_angle_t theta_e;   /* electrical rotor angle (d axis), from the encoder */
+    q24_t i_a, i_b;     /* phase currents a, b (i_c = -i_a - i_b), pu */
+    q24_t vdc;          /* DC-link voltage, pu */
+    fx_angle_t theta_e; /* electrical rotor angle (d axis), from the encoder */
 } ctrl_meas_t;
 
 /* Machine state at one instant (measured at k, or predicted for k+1). */
 typedef struct {
-    q24_t i_alpha, i_beta;     /* stator current, pu */
-    q24_t i_d, i_q;            /* rotor frame, pu */
-    q24_t psi_alpha, psi_beta; /* stator flux linkage, pu */
-    q24_t psi_d, psi_q;        /* rotor frame, pu */
-    q24_t psi_amp;             /* |psi_s|, pu (4.3) */
-    q24_t torque;              /* Te, pu: psi x i (3.6) */
-    fx_angle_t theta_e;        /* rotor electrical angle */
-    q24_t sin_theta, cos_theta;/* of theta_e, Q24 */
-    uint8_t sector;            /* stator-flux sector 1..6 (4.5) */
+    q24_t i_alpha, i_beta;      /* stator current, pu */
+    q24_t i_d, i_q;             /* rotor frame, pu */
+    q24_t psi_alpha, psi_beta;  /* stator flux linkage, pu */
+    q24_t psi_d, psi_q;         /* rotor frame, pu */
+    q24_t psi_amp;              /* |psi_s|, pu (4.3) */
+    q24_t torque;               /* Te, pu: psi x i (3.6) */
+    fx_angle_t theta_e;         /* rotor electrical angle */
+    q24_t sin_theta, cos_theta; /* of theta_e, Q24 */
+    uint8_t sector;             /* stator-flux sector 1..6 (4.5) */
 } ctrl_mstate_t;
 
 /* What the estimator hands every controller at sample k. */
 typedef struct {
-    ctrl_mstate_t now;         /* at sample k, from the measurements (3.4)/(4.1) */
-    ctrl_mstate_t next;        /* predicted for k+1 with the plan applied in [k, k+1) (5.15) */
-    q24_t omega_e;             /* electrical speed, pu (filtered encoder difference) */
-    q24_t vdc;                 /* DC link, pu */
+    ctrl_mstate_t now;  /* at sample k, from the measurements (3.4)/(4.1) */
+    ctrl_mstate_t next; /* predicted for k+1 with the plan applied in [k, k+1) (5.15) */
+    q24_t omega_e;      /* electrical speed, pu (filtered encoder difference) */
+    q24_t vdc;          /* DC link, pu */
 } ctrl_estimate_t;
 
 /* References from the outer loop / command interface. */
 typedef struct {
-    q24_t torque;              /* torque reference, pu */
-    q24_t psi;                 /* stator-flux amplitude reference, pu; 0 = controller's own (MTPA) */
+    q24_t torque; /* torque reference, pu */
+    q24_t psi;    /* stator-flux amplitude reference, pu; 0 = controller's own (MTPA) */
 } ctrl_refs_t;
 
 /*

@@ -26,9 +26,9 @@ typedef struct {
 
 /* Incremental encoder, quadrature counter. */
 typedef struct {
-    uint32_t count;        /* free-running counter, wraps modulo 2^32 */
-    bool index_seen;       /* an index pulse has been seen since start */
-    uint32_t index_count;  /* counter value latched at the last index pulse */
+    uint32_t count;       /* free-running counter, wraps modulo 2^32 */
+    bool index_seen;      /* an index pulse has been seen since start */
+    uint32_t index_count; /* counter value latched at the last index pulse */
 } hal_encoder_raw_t;
 
 /* Centre-aligned PWM compare values: leg x is high while the up/down counter
@@ -39,13 +39,13 @@ typedef struct {
 
 /* Static description of the hardware, read once by the firmware at start-up. */
 typedef struct {
-    uint32_t pwm_freq_hz;       /* PWM period frequency (== control frequency) */
-    uint32_t period_counts;     /* compare value for 100 % duty */
-    uint8_t adc_bits;           /* ADC resolution */
-    double adc_current_a_per_count; /* nominal gain (A per count); firmware calibrates offset */
-    double adc_vdc_v_per_count;     /* nominal gain (V per count) */
+    uint32_t pwm_freq_hz;            /* PWM period frequency (== control frequency) */
+    uint32_t period_counts;          /* compare value for 100 % duty */
+    uint8_t adc_bits;                /* ADC resolution */
+    double adc_current_a_per_count;  /* nominal gain (A per count); firmware calibrates offset */
+    double adc_vdc_v_per_count;      /* nominal gain (V per count) */
     uint32_t encoder_counts_per_rev; /* quadrature counts per mechanical revolution */
-    bool has_i_c;               /* third phase-current channel present */
+    bool has_i_c;                    /* third phase-current channel present */
     /* Appended by "loop": rate of hal_cycles() in Hz, for the deadline check
      * (cycle budget = cycle_clock_hz / pwm_freq_hz); 0 = unknown, check off. */
     uint32_t cycle_clock_hz;
