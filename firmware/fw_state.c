@@ -59,7 +59,7 @@ bool fw_state_event(fw_state_t *s, fw_event_t ev, uint32_t fault_code)
 
 bool fw_state_gates_allowed(const fw_state_t *s)
 {
-    return s != NULL && s->state == FW_STATE_RUNNING;
+    return s != NULL && fw_state_gates_on(s);
 }
 
 const char *fw_state_name(fw_state_id_t st)

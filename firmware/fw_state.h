@@ -47,6 +47,12 @@ bool fw_state_event(fw_state_t *s, fw_event_t ev, uint32_t fault_code);
 /* Whether the gates may be on in this state. */
 bool fw_state_gates_allowed(const fw_state_t *s);
 
+/* fw_state_gates_allowed for a valid s, inlined into the interrupt. */
+static inline bool fw_state_gates_on(const fw_state_t *s)
+{
+    return s->state == FW_STATE_RUNNING;
+}
+
 const char *fw_state_name(fw_state_id_t st);
 
 #endif /* FIRMWARE_FW_STATE_H */

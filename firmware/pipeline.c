@@ -1,6 +1,7 @@
 /* The PWM-period interrupt (order and Q formats in pipeline.h). Integer-only. */
 #include "pipeline.h"
 
+#include "legs_fast.h"
 #include "plan.h"
 
 /* Plausible ADC offset: within 1/16 of full scale from mid-scale. */
@@ -22,11 +23,31 @@ static void fw_pwm_off(fw_t *fw)
     fw->tm.legs[0] = fw->tm.legs[1] = fw->tm.legs[2] = 0;
 }
 
-/* Q8 counts -> Q24 pu with a Q30 gain. */
-static q24_t fw_current_pu(uint16_t raw, int32_t off_q8, int32_t gain_q30)
+/* Q8 counts -> Q24 pu with a Q30 gain: round(d gain / 2^14), saturated. raw
+ * < 2^16 and 0 <= off_q8 < 2^24 (an average of raw * 2^8), so |d| < 2^24 fits
+ * 32 bits and d * gain (|.| < 2^55) is one 32x32 multiply; fx_round_sat is
+ * fx_sat32(fx_rshift64_round(., 14)) on that range. */
+static inline q24_t fw_current_pu(uint16_t raw, int32_t off_q8, int32_t gain_q30)
 {
-    const int64_t d = (int64_t)raw * 256 - off_q8;
-    return fx_sat32(fx_rshift64_round(d * gain_q30, 14u));
+    const int32_t d = (int32_t)raw * 256 - off_q8;
+    return fx_round_sat((int64_t)d * gain_q30, 14u);
+}
+
+/* DC link: raw * gain (< 2^16 * 2^31) / 2^6, rounded, saturated. */
+static inline q24_t fw_vdc_pu(uint16_t raw, int32_t gain_q30)
+{
+    return fx_round_sat((int64_t)(int32_t)raw * gain_q30, 6u);
+}
+
+/* Leg duties of a plan fw_legs_fast does not take (n_seg 0 or above 4, an
+ * on-time outside [0, FX_ONE]); plan.h: each in [0, FX_ONE], clamped here as
+ * well since the compare values rely on it. */
+static void fw_legs_general(const ctrl_plan_t *p, ctrl_legs_t *legs)
+{
+    ctrl_plan_to_legs(p, legs);
+    for (int x = 0; x < 3; x++) {
+        legs->duty[x] = fx_clamp(legs->duty[x], 0, FX_ONE);
+    }
 }
 
 static void fw_calibrate(fw_t *fw, const hal_adc_raw_t *raw)
@@ -65,6 +86,18 @@ static int64_t fw_signed32(uint32_t u)
     return u <= (uint32_t)INT32_MAX ? (int64_t)u : (int64_t)u - (int64_t)4294967296;
 }
 
+/* A 32-bit counter difference u, read as two's complement, modulo m in
+ * [0, m): fw_mod(fw_signed32(u), m) with one 32-bit division (the index
+ * re-synchronisation runs once per revolution inside the interrupt). */
+static uint32_t fw_mod_u32(uint32_t u, uint32_t m)
+{
+    if (u <= (uint32_t)INT32_MAX) {
+        return u % m;
+    }
+    const uint32_t r = (0u - u) % m; /* |x| mod m for x = u - 2^32 < 0 */
+    return r == 0u ? 0u : m - r;
+}
+
 /* x modulo m in [0, m) (C's % truncates towards zero). */
 static uint32_t fw_mod(int64_t x, uint32_t m)
 {
@@ -75,38 +108,54 @@ static uint32_t fw_mod(int64_t x, uint32_t m)
     return (uint32_t)r;
 }
 
-/* Encoder counter -> position modulo cpr -> electrical angle. */
-static fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
+/* Position tracking in full (first sample after (re)start, or a move out of
+ * [0, cpr) in one step): the counter read as a signed offset or difference. */
+static void fw_encoder_track(fw_t *fw, uint32_t count)
 {
-    const uint32_t count = enc->count;
     if (!fw->enc_primed) {
         /* The counter is aligned (count 0 at the d axis on phase a) and read
          * as a signed offset from there: 2^32 is not a multiple of cpr, so a
          * counter below zero must not be reduced as an unsigned number. */
         fw->enc_last = count;
-        fw->enc_pos = fw_mod(fw_signed32(count), fw->enc_cpr);
+        fw->enc_pos = fw_mod_u32(count, fw->enc_cpr);
         fw->enc_primed = true;
     }
     /* Signed modulo-2^32 difference, then the position modulo cpr. */
     const int64_t delta = fw_signed32(count - fw->enc_last);
     fw->enc_last = count;
-    {
-        const int64_t np = (int64_t)fw->enc_pos + delta;
-        if (np >= 0 && np < (int64_t)fw->enc_cpr) {
-            fw->enc_pos = (uint32_t)np;
-        } else if (np >= (int64_t)fw->enc_cpr && np < 2 * (int64_t)fw->enc_cpr) {
-            fw->enc_pos = (uint32_t)(np - (int64_t)fw->enc_cpr);
-        } else if (np < 0 && np >= -(int64_t)fw->enc_cpr) {
-            fw->enc_pos = (uint32_t)(np + (int64_t)fw->enc_cpr);
-        } else {
-            fw->enc_pos = fw_mod(np, fw->enc_cpr);
-        }
+    const int64_t np = (int64_t)fw->enc_pos + delta;
+    if (np >= 0 && np < (int64_t)fw->enc_cpr) {
+        fw->enc_pos = (uint32_t)np;
+    } else if (np >= (int64_t)fw->enc_cpr && np < 2 * (int64_t)fw->enc_cpr) {
+        fw->enc_pos = (uint32_t)(np - (int64_t)fw->enc_cpr);
+    } else if (np < 0 && np >= -(int64_t)fw->enc_cpr) {
+        fw->enc_pos = (uint32_t)(np + (int64_t)fw->enc_cpr);
+    } else {
+        fw->enc_pos = fw_mod(np, fw->enc_cpr);
+    }
+}
+
+/* Encoder counter -> position modulo cpr -> electrical angle. */
+static inline fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
+{
+    const uint32_t count = enc->count;
+    /* Usual period: the new position pos + delta stays in [0, cpr). With
+     * delta in [-2^31, 2^31) and pos < cpr <= 2^31, pos + delta lies in that
+     * range exactly when its value modulo 2^32 is below cpr (outside it, the
+     * unsigned sum is >= cpr or wrapped to >= 2^31), so one unsigned sum and
+     * compare decide it; everything else takes fw_encoder_track. */
+    const uint32_t np = fw->enc_pos + (count - fw->enc_last);
+    if (fw->enc_primed && np < fw->enc_cpr) {
+        fw->enc_last = count;
+        fw->enc_pos = np;
+    } else {
+        fw_encoder_track(fw, count);
     }
     /* A new index pulse marks position 0: re-synchronise. */
-    if (enc->index_seen && (!fw->enc_index_valid || enc->index_count != fw->enc_index_last)) {
+    if (enc->index_seen && (enc->index_count != fw->enc_index_last || !fw->enc_index_valid)) {
         fw->enc_index_last = enc->index_count;
         fw->enc_index_valid = true;
-        fw->enc_pos = fw_mod(fw_signed32(count - enc->index_count), fw->enc_cpr);
+        fw->enc_pos = fw_mod_u32(count - enc->index_count, fw->enc_cpr);
     }
     /* pos * p * 2^32 / cpr < p * 2^32: the low 32 bits are the angle modulo one
      * electrical turn (cpr * p < 2^31 checked at init). */
@@ -150,33 +199,65 @@ static void fw_apply_commands(fw_t *fw)
 }
 
 /* Over-current and hardware trip: checked right after the current conversion,
- * the gates go off before anything else is computed. */
-static void fw_protect_fast(fw_t *fw, q24_t i_a, q24_t i_b)
+ * the gates go off before anything else is computed. Returns the fault or 0. */
+static inline uint32_t fw_protect_fast(fw_t *fw, hal_t *hal, q24_t i_a, q24_t i_b)
 {
-    uint32_t f = fw_protect_current(&fw->prot, i_a, i_b);
-    if (f == FW_FAULT_NONE && hal_trip_active(fw->hal)) {
+    uint32_t f = fw_protect_current_fast(&fw->prot, i_a, i_b);
+    if (f == FW_FAULT_NONE && hal_trip_active(hal)) {
         f = FW_FAULT_HW_TRIP;
     }
     if (f != FW_FAULT_NONE) {
         fw_fault_now(fw, f);
     }
+    return f;
 }
 
-/* DC link and encoder; returns the first fault or 0. */
-static uint32_t fw_protect_slow(fw_t *fw, q24_t vdc, uint32_t enc_count)
+/* DC link, then the encoder (not checked in a period whose DC link faults);
+ * returns the first fault or 0. */
+static inline uint32_t fw_protect_slow(fw_t *fw, q24_t vdc, uint32_t enc_count)
 {
-    uint32_t f = fw_protect_vdc(&fw->prot, vdc);
+    uint32_t f = fw_protect_vdc_fast(&fw->prot, vdc);
     if (f == FW_FAULT_NONE) {
-        f = fw_protect_encoder(&fw->prot, enc_count);
+        f = fw_protect_encoder_fast(&fw->prot, enc_count);
     }
     return f;
 }
 
-static void fw_control(fw_t *fw, const ctrl_meas_t *m)
+/* DC link counts -> per unit and the encoder angle, into the measurements. */
+static inline void fw_measure_rest(fw_t *fw, const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc,
+                                   ctrl_meas_t *m)
+{
+    m->vdc = fw_vdc_pu(raw->vdc, fw->vdc_gain_q30);
+    m->theta_e = fw_encoder_angle(fw, enc);
+}
+
+/* Leg duties (each in [0, FX_ONE], so the compare values are in [0, N]) ->
+ * telemetry, compare values -> hal_pwm_write (effective at k+1). */
+static inline void fw_pwm_out(fw_t *fw, hal_t *hal, const ctrl_legs_t *legs)
+{
+    fw->tm.legs[0] = legs->duty[0];
+    fw->tm.legs[1] = legs->duty[1];
+    fw->tm.legs[2] = legs->duty[2];
+    hal_pwm_t pwm;
+    const uint32_t n8 = fw->pwm_n8;
+    if (n8 != 0u) {
+        pwm.cmp[0] = fw_pwm_compare8((uint32_t)legs->duty[0], n8);
+        pwm.cmp[1] = fw_pwm_compare8((uint32_t)legs->duty[1], n8);
+        pwm.cmp[2] = fw_pwm_compare8((uint32_t)legs->duty[2], n8);
+    } else {
+        const uint32_t n = fw->info.period_counts;
+        pwm.cmp[0] = fw_pwm_compare((uint32_t)legs->duty[0], n);
+        pwm.cmp[1] = fw_pwm_compare((uint32_t)legs->duty[1], n);
+        pwm.cmp[2] = fw_pwm_compare((uint32_t)legs->duty[2], n);
+    }
+    hal_pwm_write(hal, &pwm);
+}
+
+static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
 {
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, &fw->estimate);
 
-    q24_t tref = fw->torque_ref;
+    q24_t tref;
     if (fw->ref_mode == FW_REF_SPEED) {
         /* The speed loop runs at its own, lower rate and holds its output in
          * between: a piecewise-constant torque reference, as from a drive's
@@ -186,37 +267,94 @@ static void fw_control(fw_t *fw, const ctrl_meas_t *m)
             fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, fw->estimate.omega_e);
         }
         fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
-        tref = fw->speed_tref;
+        tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
+    } else {
+        tref = fw->torque_ref_lim; /* torque_ref clamped by fw_set_torque_ref */
     }
-    fw->refs.torque = fx_clamp(tref, fx_neg(fw->torque_ref_max), fw->torque_ref_max);
+    fw->refs.torque = tref;
     fw->refs.psi = 0;
 
     const ctrl_ctx_t ctx = {&fw->params, &fw->estimate, &fw->refs, &fw->applied};
-    ctrl_plan_t next;
-    ctrl_plan_single(&next, 0u);
+    /* Pre-set to the zero vector for the whole period (ctrl_plan_single(0)). */
+    ctrl_plan_t next = {1u, {0u, 0u, 0u, 0u}, {FX_ONE, 0, 0, 0}};
     fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &next);
 
+    /* Separate variables for the two forms keep the fast one in registers. */
     ctrl_legs_t legs;
-    ctrl_plan_to_legs(&next, &legs);
-    hal_pwm_t pwm;
-    for (int x = 0; x < 3; x++) {
-        /* duty in [0, FX_ONE] (plan.h), so the compare value is in [0, N]. */
-        const q24_t d = fx_clamp(legs.duty[x], 0, FX_ONE);
-        const uint64_t c = ((uint64_t)(uint32_t)d * fw->info.period_counts + (1u << 23)) >> 24;
-        pwm.cmp[x] = (uint32_t)c;
-        fw->tm.legs[x] = d;
+    if (fw_legs_fast(&next, &legs)) {
+        fw_pwm_out(fw, hal, &legs);
+        fw->tm.vec = next.vec[0]; /* n_seg >= 1 */
+        fw->tm.duty = next.dur[0];
+    } else {
+        ctrl_legs_t legs_g;
+        fw_legs_general(&next, &legs_g);
+        fw_pwm_out(fw, hal, &legs_g);
+        fw->tm.vec = next.n_seg > 0u ? next.vec[0] : 0u;
+        fw->tm.duty = next.n_seg > 0u ? next.dur[0] : 0;
     }
-    hal_pwm_write(fw->hal, &pwm);
-
     /* The plan written now acts during [k+1, k+2): it is "applied" for the
      * estimator's prediction at k+1. */
     fw->applied = next;
-    fw->tm.vec = next.n_seg > 0u ? next.vec[0] : 0u;
-    fw->tm.duty = next.n_seg > 0u ? next.dur[0] : 0;
     fw->tm.psi_amp = fw->estimate.now.psi_amp;
     fw->tm.torque = fw->estimate.now.torque;
     fw->tm.omega_e = fw->estimate.omega_e;
     fw->tm.torque_ref = fw->refs.torque;
+}
+
+/* A running period: measurements, protections, control. */
+static inline void fw_period_running(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
+                                     const hal_encoder_raw_t *enc)
+{
+    /* The measurements go straight into the telemetry sample. */
+    ctrl_meas_t *const m = &fw->tm.meas;
+    const q24_t i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
+    const q24_t i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
+    m->i_a = i_a;
+    m->i_b = i_b;
+    uint32_t f = fw_protect_fast(fw, hal, i_a, i_b);
+    fw_measure_rest(fw, raw, enc, m);
+    if (f == FW_FAULT_NONE) {
+        f = fw_protect_slow(fw, m->vdc, enc->count);
+        if (f != FW_FAULT_NONE) {
+            fw_fault_now(fw, f);
+        }
+    }
+    if (f == FW_FAULT_NONE) {
+        fw_control(fw, hal, m);
+    } else {
+        fw->tm.vec = 0u;
+        fw->tm.duty = 0;
+        fw_pwm_off(fw);
+    }
+}
+
+/* Every other state (boot, calibration, ready, fault): gates off. */
+static void fw_period_idle(fw_t *fw, const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc)
+{
+    fw->tm.vec = 0u;
+    fw->tm.duty = 0;
+    if (fw->sm.state == FW_STATE_BOOT) {
+        (void)fw_state_event(&fw->sm, FW_EV_START, 0u);
+    }
+    if (fw->sm.state == FW_STATE_CALIB) {
+        fw_pwm_off(fw);
+        fw_calibrate(fw, raw);
+        return;
+    }
+    ctrl_meas_t *const m = &fw->tm.meas;
+    m->i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
+    m->i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
+    if (fw->sm.state != FW_STATE_FAULT) {
+        (void)fw_protect_fast(fw, fw->hal, m->i_a, m->i_b);
+    }
+    fw_measure_rest(fw, raw, enc, m);
+    if (fw->sm.state != FW_STATE_FAULT) {
+        const uint32_t f = fw_protect_slow(fw, m->vdc, enc->count);
+        if (f != FW_FAULT_NONE) {
+            fw_fault_now(fw, f);
+        }
+    }
+    fw_pwm_off(fw);
 }
 
 void fw_isr(fw_t *fw)
@@ -224,7 +362,9 @@ void fw_isr(fw_t *fw)
     if (fw == NULL || fw->hal == NULL || fw->ctrl == NULL) {
         return;
     }
-    const uint32_t t0 = hal_cycles(fw->hal);
+    /* The handle is fixed from fw_init on: kept in a register. */
+    hal_t *const hal = fw->hal;
+    const uint32_t t0 = hal_cycles(hal);
     if (fw->busy) {
         /* Entered while the previous period's ISR was still running. */
         fw_fault_now(fw, FW_FAULT_DEADLINE);
@@ -235,46 +375,21 @@ void fw_isr(fw_t *fw)
 
     hal_adc_raw_t raw;
     hal_encoder_raw_t enc;
-    hal_adc_read(fw->hal, &raw);
-    hal_encoder_read(fw->hal, &enc);
+    hal_adc_read(hal, &raw);
+    hal_encoder_read(hal, &enc);
 
-    fw_apply_commands(fw);
-
-    fw->tm.vec = 0u;
-    fw->tm.duty = 0;
-    if (fw->sm.state == FW_STATE_BOOT) {
-        (void)fw_state_event(&fw->sm, FW_EV_START, 0u);
+    if ((fw->req_clear | fw->req_disarm | fw->req_arm) != 0) {
+        fw_apply_commands(fw);
     }
-    if (fw->sm.state == FW_STATE_CALIB) {
-        fw_pwm_off(fw);
-        fw_calibrate(fw, &raw);
+    /* Running: one predictable branch to the straight path; boot,
+     * calibration, ready and fault take the general one. */
+    if (fw->sm.state == FW_STATE_RUNNING) {
+        fw_period_running(fw, hal, &raw, &enc);
     } else {
-        ctrl_meas_t m;
-        m.i_a = fw_current_pu(raw.i_a, fw->off_q8[0], fw->gain_q30[0]);
-        m.i_b = fw_current_pu(raw.i_b, fw->off_q8[1], fw->gain_q30[1]);
-        if (fw->sm.state != FW_STATE_FAULT) {
-            fw_protect_fast(fw, m.i_a, m.i_b);
-        }
-        m.vdc = fx_sat32(fx_rshift64_round((int64_t)raw.vdc * fw->vdc_gain_q30, 6u));
-        m.theta_e = fw_encoder_angle(fw, &enc);
-        fw->tm.i_a = m.i_a;
-        fw->tm.i_b = m.i_b;
-        fw->tm.vdc = m.vdc;
-        fw->tm.theta_e = m.theta_e;
-        if (fw->sm.state != FW_STATE_FAULT) {
-            const uint32_t f = fw_protect_slow(fw, m.vdc, enc.count);
-            if (f != FW_FAULT_NONE) {
-                fw_fault_now(fw, f);
-            }
-        }
-        if (fw->sm.state == FW_STATE_RUNNING) {
-            fw_control(fw, &m);
-        } else {
-            fw_pwm_off(fw);
-        }
+        fw_period_idle(fw, &raw, &enc);
     }
 
-    const uint32_t wf = fw_protect_watchdog_tick(&fw->prot);
+    const uint32_t wf = fw_protect_watchdog_tick_fast(&fw->prot);
     if (wf != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, wf);
     }
@@ -282,12 +397,12 @@ void fw_isr(fw_t *fw)
     fw->tm.period = fw->period;
     fw->tm.state = (uint8_t)fw->sm.state;
     fw->tm.fault = (uint8_t)fw->sm.fault_code;
-    fw->tm.gates = fw_state_gates_allowed(&fw->sm) ? 1u : 0u;
+    fw->tm.gates = fw_state_gates_on(&fw->sm) ? 1u : 0u;
 
     /* Deadline: duration of this ISR against the period's cycle budget. */
-    const uint32_t elapsed = hal_cycles(fw->hal) - t0;
+    const uint32_t elapsed = hal_cycles(hal) - t0;
     fw->tm.cycles = elapsed;
-    const uint32_t df = fw_protect_deadline(&fw->prot, elapsed);
+    const uint32_t df = fw_protect_deadline_fast(&fw->prot, elapsed);
     if (df != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, df);
         fw->tm.state = (uint8_t)fw->sm.state;
@@ -329,6 +444,7 @@ void fw_set_torque_ref(fw_t *fw, q24_t torque_pu)
 {
     if (fw != NULL) {
         fw->torque_ref = torque_pu;
+        fw->torque_ref_lim = fx_clamp(torque_pu, fw->torque_ref_min, fw->torque_ref_max);
         fw->ref_mode = FW_REF_TORQUE;
     }
 }

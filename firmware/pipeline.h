@@ -12,7 +12,8 @@
  *                                           the plan acting in [k, k+1)
  *   speed PI (speed mode) -> torque reference
  *   desc->step                              plan for [k+1, k+2)
- *   ctrl_plan_to_legs -> compare values -> hal_pwm_write (effective at k+1)
+ *   plan -> leg duties (legs_fast.h: one or two segments; else
+ *   ctrl_plan_to_legs) -> compare values -> hal_pwm_write (effective at k+1)
  *   telemetry sample
  *   deadline check (hal_cycles against the period budget)
  *
@@ -20,13 +21,19 @@
  *   ADC offsets: Q8 counts (average of calib_samples samples, 8 fractional bits)
  *   current gain: Q30 pu per count (nominal A/count from hal_info / i_base,
  *                 times the optional per-channel correction)
- *   i_pu (Q24) = ((raw << 8) - off_q8) * gain_q30 / 2^14 (rounded)
+ *   i_pu (Q24) = ((raw << 8) - off_q8) * gain_q30 / 2^14 (rounded, saturated;
+ *                the difference fits 32 bits: one 32x32 -> 64 multiply)
  *   DC-link gain: Q30 pu per count; vdc_pu (Q24) = raw * gain_q30 / 2^6
+ *   compare value = round(duty_q24 * period_counts / 2^24), ties up, in
+ *                [0, period_counts]
  *   encoder: position pos in [0, cpr); theta_e = pos * p * 2^32 / cpr (64-bit,
  *            exact modulo one electrical turn) + enc_offset (fx_angle_t); the
  *            counter is taken as aligned (0 at the d axis); every new index
  *            pulse (at position 0) re-synchronises pos = count - index_count,
  *            which removes counts gained or lost by glitches
+ *
+ * The running state takes its own straight path (fw_period_running), with
+ * the protections inlined from protect.h; every other state the general one.
  *
  * All state lives in fw_t (no globals); the controller's state is a static,
  * aligned block of CTRL_STATE_MAX bytes inside it.
@@ -56,21 +63,28 @@
 
 /* One period's signals for telemetry, tests and the simulator. */
 typedef struct {
-    uint32_t period;    /* ISR count (modulo 2^32) */
-    uint8_t state;      /* fw_state_id_t */
-    uint8_t fault;      /* latched fault code (protect.h) */
-    uint8_t vec;        /* selected vector (plan segment 0) for [k+1, k+2) */
-    uint8_t gates;      /* 1 when the gates are requested on */
-    q24_t i_a, i_b;     /* measured phase currents, Q24 pu */
-    q24_t vdc;          /* measured DC link, Q24 pu */
-    q24_t psi_amp;      /* |psi_s| estimate at k, Q24 pu */
-    q24_t torque;       /* torque estimate at k, Q24 pu */
-    q24_t omega_e;      /* electrical speed estimate, Q24 pu */
-    q24_t torque_ref;   /* torque reference used at k, Q24 pu */
-    q24_t duty;         /* on-time of segment 0, Q24 fraction */
-    q24_t legs[3];      /* leg duties written at k, Q24 fraction */
-    fx_angle_t theta_e; /* electrical angle from the encoder */
-    uint32_t cycles;    /* ISR duration measured with hal_cycles */
+    uint32_t period; /* ISR count (modulo 2^32) */
+    uint8_t state;   /* fw_state_id_t */
+    uint8_t fault;   /* latched fault code (protect.h) */
+    uint8_t vec;     /* selected vector (plan segment 0) for [k+1, k+2) */
+    uint8_t gates;   /* 1 when the gates are requested on */
+    union {
+        /* The measurements as handed to the estimator (the same four
+         * values: a common initial sequence of the two structs). */
+        ctrl_meas_t meas;
+        struct {
+            q24_t i_a, i_b;     /* measured phase currents, Q24 pu */
+            q24_t vdc;          /* measured DC link, Q24 pu */
+            fx_angle_t theta_e; /* electrical angle from the encoder */
+        };
+    };
+    q24_t psi_amp;    /* |psi_s| estimate at k, Q24 pu */
+    q24_t torque;     /* torque estimate at k, Q24 pu */
+    q24_t omega_e;    /* electrical speed estimate, Q24 pu */
+    q24_t torque_ref; /* torque reference used at k, Q24 pu */
+    q24_t duty;       /* on-time of segment 0, Q24 fraction */
+    q24_t legs[3];    /* leg duties written at k, Q24 fraction */
+    uint32_t cycles;  /* ISR duration measured with hal_cycles */
 } fw_telemetry_t;
 
 typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
@@ -114,8 +128,10 @@ typedef struct {
     ctrl_speed_pi_t speed_pi;
     fw_ref_mode_t ref_mode;
     q24_t torque_ref;     /* Q24 pu (torque mode) */
+    q24_t torque_ref_lim; /* torque_ref clamped to +-torque_ref_max (fw_set_torque_ref) */
     q24_t speed_ref;      /* Q24 pu electrical (speed mode) */
     q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
+    q24_t torque_ref_min; /* Q24 pu, fx_neg(torque_ref_max) (set with it) */
     q24_t speed_tref;     /* last speed-PI output, Q24 pu (held between updates) */
     uint32_t speed_div;   /* periods per speed-PI update (>= 1) */
     uint32_t speed_cnt;   /* periods since the last update */
@@ -128,6 +144,7 @@ typedef struct {
     int32_t gain_q30[3];  /* Q30 pu per count */
     int32_t vdc_gain_q30; /* Q30 pu per count */
     uint16_t adc_mid;     /* 2^(bits-1) */
+    uint32_t pwm_n8;      /* period_counts * 2^8 if period_counts < 2^24, else 0 */
     /* encoder */
     uint32_t enc_cpr;
     uint32_t enc_q32; /* floor(p 2^32 / cpr) mod 2^32 (angle per count, integer part) */

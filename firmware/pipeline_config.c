@@ -111,6 +111,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         return FW_ERANGE;
     }
     fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
+    fw->pwm_n8 = in->period_counts < (1u << 24) ? in->period_counts << 8 : 0u;
     fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
     fw->calib_samples = cfg->calib_samples;
     fw->enc_cpr = in->encoder_counts_per_rev;
@@ -140,6 +141,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         return FW_ERANGE;
     }
     fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
+    fw->torque_ref_min = fx_neg(fw->torque_ref_max);
     fw->ref_mode = FW_REF_TORQUE;
     ctrl_plan_single(&fw->applied, 0u);
     fw_state_init(&fw->sm);

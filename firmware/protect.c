@@ -18,6 +18,15 @@ void fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg)
         return;
     }
     p->cfg = *cfg;
+    /* Constants of the unsigned compares (fw_protect_t). */
+    const q24_t lim = cfg->i_max;
+    p->i_fast = lim >= 0 && lim <= ((q24_t)1 << 30) ? 1u : 0u;
+    p->i_off = p->i_fast != 0u ? (uint32_t)lim : (lim < 0 ? 1u : 0u);
+    p->i_span = p->i_fast != 0u ? 2u * (uint32_t)lim : 0u;
+    p->j_off = cfg->enc_jump_max >= 0 ? (uint32_t)cfg->enc_jump_max : 0u;
+    p->j_span = 2u * p->j_off;
+    p->deadline_lim = cfg->deadline_cycles != 0u ? cfg->deadline_cycles : UINT32_MAX;
+    p->wdg_lim = cfg->wdg_periods != 0u ? cfg->wdg_periods : UINT32_MAX;
     fw_protect_reset(p);
 }
 
@@ -29,7 +38,8 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_last = 0u;
     p->enc_last_delta = 0;
     p->enc_still = 0u;
-    p->enc_rate_q16 = 0;
+    p->enc_move_delta = 0;
+    p->enc_move_still = 0u;
     p->enc_primed = 0u;
     p->wdg_count = 0u;
 }
@@ -47,79 +57,41 @@ uint32_t fw_protect_current(const fw_protect_t *p, q24_t i_a, q24_t i_b)
 
 uint32_t fw_protect_vdc(const fw_protect_t *p, q24_t vdc)
 {
-    if (vdc > p->cfg.vdc_max) {
-        return FW_FAULT_DC_OVERVOLT;
-    }
-    if (vdc < p->cfg.vdc_min) {
-        return FW_FAULT_DC_UNDERVOLT;
-    }
-    return FW_FAULT_NONE;
+    return fw_protect_vdc_fast(p, vdc);
 }
 
-uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count)
+uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
 {
     if (p->enc_primed == 0u) {
         p->enc_last = count;
         p->enc_primed = 1u;
         return FW_FAULT_NONE;
     }
-    /* Modulo-2^32 difference read as signed: well defined via the unsigned
-     * subtraction, then a range-checked conversion. */
-    const uint32_t du = count - p->enc_last;
-    const int32_t delta = du <= (uint32_t)INT32_MAX ? (int32_t)du : -(int32_t)(UINT32_MAX - du) - 1;
-    p->enc_last = count;
-
-    uint32_t fault = FW_FAULT_NONE;
     if (p->enc_primed == 1u) {
-        /* First difference: nothing to compare the rate with yet. */
-        p->enc_primed = 2u;
-        p->enc_last_delta = delta;
-        p->enc_rate_q16 = 0;
+        /* First difference: nothing to compare the rate with yet (rate 0). */
+        p->enc_last_delta = fx_u2i(count - p->enc_last);
+        p->enc_last = count;
+        p->enc_primed = p->cfg.enc_jump_max >= 0 ? 2u : 3u;
+        p->enc_move_delta = 0;
+        p->enc_move_still = 0u;
         return FW_FAULT_NONE;
     }
-    if (delta != 0) {
-        const int64_t dd = (int64_t)delta - p->enc_last_delta;
-        if (dd > p->cfg.enc_jump_max || dd < -(int64_t)p->cfg.enc_jump_max) {
-            fault = FW_FAULT_ENC_JUMP;
-        }
-        /* Rate at this move: counts over the periods it took (Q16.16). */
-        const int64_t mag = delta < 0 ? -(int64_t)delta : (int64_t)delta;
-        /* mag < 2^15: the Q16.16 rate fits 32 bits, a 32-bit UDIV (no
-         * 64-bit division, __aeabi_ldivmod, in the interrupt). */
-        const int64_t rate = mag < 32768 ? (int64_t)(((uint32_t)mag << 16) / (p->enc_still + 1u))
-                                         : mag * 65536 / (int64_t)(p->enc_still + 1u);
-        p->enc_rate_q16 = rate > INT32_MAX ? INT32_MAX : (int32_t)rate;
-        p->enc_still = 0u;
-    } else {
-        if (p->enc_still < UINT32_MAX) {
-            p->enc_still++;
-        }
-        if (p->enc_still >= p->cfg.enc_stuck_periods &&
-            p->enc_rate_q16 >= p->cfg.enc_rate_min_q16) {
-            fault = FW_FAULT_ENC_STUCK;
-        }
-    }
-    p->enc_last_delta = delta;
-    return fault;
+    return fw_protect_encoder_check(p, count);
+}
+
+uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count)
+{
+    return fw_protect_encoder_fast(p, count);
 }
 
 uint32_t fw_protect_deadline(const fw_protect_t *p, uint32_t elapsed_cycles)
 {
-    if (p->cfg.deadline_cycles != 0u && elapsed_cycles > p->cfg.deadline_cycles) {
-        return FW_FAULT_DEADLINE;
-    }
-    return FW_FAULT_NONE;
+    return fw_protect_deadline_fast(p, elapsed_cycles);
 }
 
 uint32_t fw_protect_watchdog_tick(fw_protect_t *p)
 {
-    if (p->wdg_count < UINT32_MAX) {
-        p->wdg_count++;
-    }
-    if (p->cfg.wdg_periods != 0u && p->wdg_count > p->cfg.wdg_periods) {
-        return FW_FAULT_WATCHDOG;
-    }
-    return FW_FAULT_NONE;
+    return fw_protect_watchdog_tick_fast(p);
 }
 
 void fw_protect_watchdog_kick(fw_protect_t *p)

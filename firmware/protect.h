@@ -66,12 +66,28 @@ typedef struct {
 
 typedef struct {
     fw_protect_cfg_t cfg;
+    /* |x| > lim as one unsigned compare, (uint32_t)x + off > span (mod 2^32)
+     * with off = lim, span = 2 lim (constants from fw_protect_init): for
+     * 0 <= lim <= INT32_MAX, x + lim lies in [0, 2 lim] exactly when |x| <= lim,
+     * in (2 lim, 2^32) when x > lim and, wrapped, in [2^31 + lim, 2^32) when
+     * x < -lim. */
+    uint32_t i_off, i_span; /* i_max (i_fast: 0 <= i_max <= 2^30), see below */
+    uint8_t i_fast;
+    uint32_t j_off, j_span; /* enc_jump_max (enc_primed 2 only when it is >= 0) */
     uint32_t enc_last;      /* counter at the previous period */
     int32_t enc_last_delta; /* counts moved in the previous period */
     uint32_t enc_still;     /* periods since the counter last moved */
-    int32_t enc_rate_q16;   /* |rate| at the last move, counts/period Q16.16 */
-    uint8_t enc_primed;     /* 0: nothing, 1: enc_last valid, 2: enc_last_delta valid */
-    uint32_t wdg_count;     /* periods since the last kick */
+    /* Rate at the last move, kept as the move and the periods it took - 1:
+     * rate (Q16.16) = floor(|move_delta| 2^16 / (move_still + 1)). */
+    int32_t enc_move_delta;
+    uint32_t enc_move_still;
+    /* 0: nothing, 1: enc_last valid, 2: enc_last_delta valid (fast form),
+     * 3: the same with a negative enc_jump_max (every move is a jump). */
+    uint8_t enc_primed;
+    uint32_t wdg_count; /* periods since the last kick */
+    /* deadline_cycles and wdg_periods with 0 ("off") as UINT32_MAX, which no
+     * uint32_t exceeds: one compare each. */
+    uint32_t deadline_lim, wdg_lim;
 } fw_protect_t;
 
 /*
@@ -83,6 +99,8 @@ typedef struct {
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
                       uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz);
 
+/* Copies cfg and derives the constants of the checks from it: change the
+ * configuration only through fw_protect_init. */
 void fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg);
 /* Forget the encoder history (on arm) and the watchdog count. */
 void fw_protect_reset(fw_protect_t *p);
@@ -94,5 +112,136 @@ uint32_t fw_protect_deadline(const fw_protect_t *p, uint32_t elapsed_cycles);
 /* Called once per period; returns FW_FAULT_WATCHDOG when the kick is overdue. */
 uint32_t fw_protect_watchdog_tick(fw_protect_t *p);
 void fw_protect_watchdog_kick(fw_protect_t *p);
+
+/* ---- The same checks inlined into the interrupt, with identical results for
+ * every input (tests/loop/test_fw_fast.c): the functions above call them,
+ * except fw_protect_current, the saturating form they are checked against. */
+
+/* fw_protect_encoder while the counter history is incomplete, or with a
+ * negative enc_jump_max (enc_primed != 2; protect.c). */
+uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count);
+
+/*
+ * fw_protect_current with the unsigned compare of fw_protect_t, exact for
+ * 0 <= i_max <= 2^30. i_c = -(i_a + i_b) is tested only when |i_a|, |i_b| <=
+ * i_max: then |i_a + i_b| <= 2^31 and the compare is exact for it too
+ * (3 i_max < 2^32); fx_add's saturation at 2^31 gives the same verdict. For
+ * any other i_max the constants make (nearly) every input a candidate that the
+ * saturating form decides: off = span = 0 (i_max > 2^30: all but
+ * i_a = i_b = 0, which does not trip) or off = 1, span = 0 (i_max < 0: all).
+ */
+static inline uint32_t fw_protect_current_fast(const fw_protect_t *p, q24_t i_a, q24_t i_b)
+{
+    const uint32_t off = p->i_off;
+    const uint32_t span = p->i_span;
+    const uint32_t a = (uint32_t)i_a;
+    const uint32_t b = (uint32_t)i_b;
+    if (a + off > span || b + off > span || a + b + off > span) {
+        return p->i_fast != 0u ? FW_FAULT_OVERCURRENT : fw_protect_current(p, i_a, i_b);
+    }
+    return FW_FAULT_NONE;
+}
+
+static inline uint32_t fw_protect_vdc_fast(const fw_protect_t *p, q24_t vdc)
+{
+    if (vdc > p->cfg.vdc_max) {
+        return FW_FAULT_DC_OVERVOLT;
+    }
+    if (vdc < p->cfg.vdc_min) {
+        return FW_FAULT_DC_UNDERVOLT;
+    }
+    return FW_FAULT_NONE;
+}
+
+/* *d = a - b; true (and *d = 0) when the difference does not fit an int32_t
+ * (gcc/clang: their overflow builtin, SUBS + a branch on V). */
+static inline bool fw_protect_sub_overflow(int32_t a, int32_t b, int32_t *d)
+{
+#if defined(__GNUC__)
+    if (__builtin_sub_overflow(a, b, d)) {
+        *d = 0;
+        return true;
+    }
+    return false;
+#else
+    const int64_t w = (int64_t)a - b;
+    const bool ovf = w < INT32_MIN || w > INT32_MAX;
+    *d = ovf ? 0 : (int32_t)w;
+    return ovf;
+#endif
+}
+
+/* Whether the rate at the last move, floor(mag 2^16 / (still + 1)) (the
+ * Q16.16 counts per period), is >= rate_min: for integers, floor(a / b) >= r
+ * <=> a >= r b (b >= 1), so no division; a <= 2^47, r b < 2^63. */
+static inline bool fw_protect_rate_armed(const fw_protect_t *p)
+{
+    const int32_t r = p->cfg.enc_rate_min_q16;
+    if (r <= 0) {
+        return true;
+    }
+    const int32_t d = p->enc_move_delta;
+    const uint64_t a = (uint64_t)(d < 0 ? 0u - (uint32_t)d : (uint32_t)d) << 16;
+    return a >= (uint64_t)(uint32_t)r * ((uint64_t)p->enc_move_still + 1u);
+}
+
+/*
+ * fw_protect_encoder once the history is complete (enc_primed 2 or 3): the
+ * signed modulo-2^32 difference; at a move the jump test on its second
+ * difference (a difference of two int32_t that overflows is above any limit)
+ * and the move's size and duration; without a move the stuck test.
+ */
+static inline uint32_t fw_protect_encoder_check(fw_protect_t *p, uint32_t count)
+{
+    const int32_t delta = fx_u2i(count - p->enc_last);
+    p->enc_last = count;
+    uint32_t fault = FW_FAULT_NONE;
+    if (delta != 0) {
+        int32_t dd;
+        const bool ovf = fw_protect_sub_overflow(delta, p->enc_last_delta, &dd);
+        if (p->enc_primed != 2u || ovf || (uint32_t)dd + p->j_off > p->j_span) {
+            fault = FW_FAULT_ENC_JUMP;
+        }
+        p->enc_move_delta = delta;
+        p->enc_move_still = p->enc_still;
+        p->enc_still = 0u;
+    } else {
+        if (p->enc_still < UINT32_MAX) {
+            p->enc_still++;
+        }
+        if (p->enc_still >= p->cfg.enc_stuck_periods && fw_protect_rate_armed(p)) {
+            fault = FW_FAULT_ENC_STUCK;
+        }
+    }
+    p->enc_last_delta = delta;
+    return fault;
+}
+
+static inline uint32_t fw_protect_encoder_fast(fw_protect_t *p, uint32_t count)
+{
+    if (p->enc_primed != 2u) {
+        return fw_protect_encoder_prime(p, count); /* 0, 1, or 3 */
+    }
+    return fw_protect_encoder_check(p, count);
+}
+
+static inline uint32_t fw_protect_deadline_fast(const fw_protect_t *p, uint32_t elapsed_cycles)
+{
+    if (elapsed_cycles > p->deadline_lim) {
+        return FW_FAULT_DEADLINE;
+    }
+    return FW_FAULT_NONE;
+}
+
+static inline uint32_t fw_protect_watchdog_tick_fast(fw_protect_t *p)
+{
+    if (p->wdg_count < UINT32_MAX) {
+        p->wdg_count++;
+    }
+    if (p->wdg_count > p->wdg_lim) {
+        return FW_FAULT_WATCHDOG;
+    }
+    return FW_FAULT_NONE;
+}
 
 #endif /* FIRMWARE_PROTECT_H */

@@ -1,0 +1,348 @@
+/*
+ * The interrupt's fast forms against the forms they replace (no plant, runs
+ * on the host and in QEMU):
+ *  - fw_legs_fast / fw_legs_from_plan (firmware/legs_fast.h) against
+ *    ctrl_plan_to_legs for every vector pair (and bad indices), every n_seg
+ *    and random, edge and out-of-range durations;
+ *  - fw_pwm_compare8 (one UMULL) against the 64-bit rounding of compare values;
+ *  - fw_protect_current_fast against the saturating |i_a|, |i_b|,
+ *    |-(i_a + i_b)| > i_max test, for limits inside and outside its fast range;
+ *  - fw_protect_encoder (jump test without 64-bit arithmetic, rate without a
+ *    division) against the original per-move Q16.16 rate and 64-bit jump test,
+ *    on random count sequences (steady, stops, jumps, the 2^32 wrap).
+ * The references below are the pre-optimisation code, kept verbatim in logic.
+ */
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "legs_fast.h"
+#include "plan.h"
+#include "protect.h"
+#include "unity.h"
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+/* xorshift32: deterministic pseudo-random inputs. */
+static uint32_t rng = 0x9E3779B9u;
+static uint32_t rnd(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 17;
+    rng ^= rng << 5;
+    return rng;
+}
+
+static int32_t rnd_i32(void)
+{
+    return fx_u2i(rnd());
+}
+
+/* A duration: in range, at the edges or far outside. */
+static q24_t rnd_dur(void)
+{
+    static const q24_t edge[] = {0,  1,         FX_ONE - 1, FX_ONE,    FX_ONE + 1,
+                                 -1, INT32_MIN, INT32_MAX,  FX_ONE / 2};
+    const uint32_t k = rnd() % 4u;
+    if (k == 0u) {
+        return edge[rnd() % (sizeof edge / sizeof edge[0])];
+    }
+    if (k == 1u) {
+        return rnd_i32();
+    }
+    return (q24_t)(rnd() % ((uint32_t)FX_ONE + 1u));
+}
+
+static void legs_check(const ctrl_plan_t *p)
+{
+    ctrl_legs_t want;
+    ctrl_legs_t got;
+    ctrl_plan_to_legs(p, &want);
+    memset(&got, 0x5A, sizeof got);
+    fw_legs_from_plan(p, &got);
+    for (int x = 0; x < 3; x++) {
+        if (want.duty[x] != got.duty[x]) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "n_seg %u vec %u,%u dur %ld,%ld leg %d", (unsigned)p->n_seg,
+                     (unsigned)p->vec[0], (unsigned)p->vec[1], (long)p->dur[0], (long)p->dur[1], x);
+            TEST_ASSERT_EQUAL_INT32_MESSAGE(want.duty[x], got.duty[x], msg);
+        }
+    }
+    /* The fast form takes every plan of one to four segments with on-times
+     * in [0, FX_ONE] (those used), and nothing else. */
+    ctrl_legs_t tmp;
+    const bool fast = fw_legs_fast(p, &tmp);
+    bool in = p->n_seg >= 1u && p->n_seg <= 4u;
+    for (unsigned i = 0; in && i < p->n_seg; i++) {
+        in = p->dur[i] >= 0 && p->dur[i] <= FX_ONE;
+    }
+    TEST_ASSERT_EQUAL_INT(in, fast);
+}
+
+static void test_legs_every_pair(void)
+{
+    static const uint8_t vecs[] = {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u, 200u, 255u};
+    const size_t nv = sizeof vecs / sizeof vecs[0];
+    for (size_t a = 0; a < nv; a++) {
+        for (size_t b = 0; b < nv; b++) {
+            for (uint8_t n = 0u; n <= 5u; n++) {
+                for (int r = 0; r < 40; r++) {
+                    ctrl_plan_t p;
+                    p.n_seg = n;
+                    p.vec[0] = vecs[a];
+                    p.vec[1] = vecs[b];
+                    p.vec[2] = (uint8_t)(rnd() % 9u);
+                    p.vec[3] = (uint8_t)(rnd() % 9u);
+                    for (int s = 0; s < 4; s++) {
+                        /* Half the plans with every on-time in range (fast form). */
+                        p.dur[s] =
+                            (r & 1) != 0 ? (q24_t)(rnd() % ((uint32_t)FX_ONE + 1u)) : rnd_dur();
+                    }
+                    legs_check(&p);
+                }
+            }
+        }
+    }
+}
+
+/* Plans as the helpers build them: exact complements, every active vector. */
+static void test_legs_helper_plans(void)
+{
+    for (uint8_t v = 0u; v <= 7u; v++) {
+        for (int r = 0; r < 2000; r++) {
+            ctrl_plan_t p;
+            const q24_t d = r < 3 ? (q24_t)(r * (FX_ONE / 2)) : (q24_t)(rnd() % (FX_ONE + 1u));
+            ctrl_plan_active_zero(&p, v, d);
+            legs_check(&p);
+            ctrl_plan_single(&p, v);
+            legs_check(&p);
+            /* Two active vectors and a zero vector (SVM-like). */
+            const q24_t d2 = (q24_t)(rnd() % (FX_ONE + 1u));
+            ctrl_plan_two_active(&p, v, d, (uint8_t)(1u + rnd() % 6u), d2);
+            legs_check(&p);
+        }
+    }
+}
+
+/* ---- compare values: the 2^8-scaled form against the 64-bit rounding ---- */
+static void test_pwm_compare(void)
+{
+    static const uint32_t ns[] = {1u,    2u,     3u,     255u,     4200u,
+                                  8399u, 65535u, 65536u, 1000003u, (1u << 24) - 1u};
+    for (size_t i = 0; i < sizeof ns / sizeof ns[0]; i++) {
+        const uint32_t n = ns[i];
+        for (uint32_t k = 0; k < 60000u; k++) {
+            /* Edges, ties (d n = (2j + 1) 2^23 when possible) and random. */
+            uint32_t d;
+            if (k < 3u) {
+                d = k == 0u ? 0u : (k == 1u ? 1u : (uint32_t)FX_ONE);
+            } else if (k % 3u == 0u) {
+                d = rnd() % ((uint32_t)FX_ONE + 1u);
+            } else {
+                d = (k * 2797u) % ((uint32_t)FX_ONE + 1u);
+            }
+            const uint64_t exact = ((uint64_t)d * n + (1u << 23)) >> 24;
+            TEST_ASSERT_EQUAL_UINT32((uint32_t)exact, fw_pwm_compare(d, n));
+            TEST_ASSERT_EQUAL_UINT32((uint32_t)exact, fw_pwm_compare8(d, n << 8));
+            TEST_ASSERT_TRUE(exact <= n);
+        }
+        /* Exact ties: d n = 2^23 (mod 2^24) rounds up. */
+        if (n % 2u == 1u) {
+            const uint32_t d = 1u << 23;
+            TEST_ASSERT_EQUAL_UINT32((n + 1u) / 2u, fw_pwm_compare8(d, n << 8));
+        }
+    }
+}
+
+/* ---- over-current ---- */
+static uint32_t ref_current(q24_t lim, q24_t i_a, q24_t i_b)
+{
+    const q24_t i_c = fx_neg(fx_add(i_a, i_b));
+    return fx_abs(i_a) > lim || fx_abs(i_b) > lim || fx_abs(i_c) > lim ? FW_FAULT_OVERCURRENT
+                                                                       : FW_FAULT_NONE;
+}
+
+static q24_t near(q24_t lim)
+{
+    /* Values around +-lim, +-2 lim and the int32_t ends. */
+    const int64_t base[] = {lim,       -(int64_t)lim, 2 * (int64_t)lim, -2 * (int64_t)lim, 0,
+                            INT32_MAX, INT32_MIN,     (int64_t)lim / 2, -(int64_t)lim / 2};
+    const int64_t v = base[rnd() % (sizeof base / sizeof base[0])] + (int64_t)(rnd() % 5u) - 2;
+    return v > INT32_MAX ? INT32_MAX : (v < INT32_MIN ? INT32_MIN : (q24_t)v);
+}
+
+static void test_current_fast(void)
+{
+    static const q24_t lims[] = {
+        0,         1,  FX_ONE / 2, FX_ONE * 3, 1 << 30, (1 << 30) + 1, INT32_MAX - 1,
+        INT32_MAX, -1, INT32_MIN,  123456789};
+    for (size_t l = 0; l < sizeof lims / sizeof lims[0]; l++) {
+        fw_protect_cfg_t cfg = {lims[l], FX_ONE, 0, 5, 8, 65536, 0u, 0u};
+        fw_protect_t p;
+        fw_protect_init(&p, &cfg);
+        for (int r = 0; r < 20000; r++) {
+            const q24_t a = (r & 1) != 0 ? near(lims[l]) : rnd_i32();
+            const q24_t b = (r & 2) != 0 ? near(lims[l]) : rnd_i32();
+            const uint32_t want = ref_current(lims[l], a, b);
+            if (fw_protect_current_fast(&p, a, b) != want || fw_protect_current(&p, a, b) != want) {
+                char msg[120];
+                snprintf(msg, sizeof msg, "lim %ld i_a %ld i_b %ld", (long)lims[l], (long)a,
+                         (long)b);
+                TEST_FAIL_MESSAGE(msg);
+            }
+        }
+    }
+}
+
+/* ---- encoder: the original check (per-move Q16.16 rate, 64-bit jump) ---- */
+typedef struct {
+    uint32_t last;
+    int32_t last_delta;
+    uint32_t still;
+    int32_t rate_q16;
+    uint8_t primed;
+} ref_enc_t;
+
+static uint32_t ref_encoder(ref_enc_t *p, const fw_protect_cfg_t *cfg, uint32_t count)
+{
+    if (p->primed == 0u) {
+        p->last = count;
+        p->primed = 1u;
+        return FW_FAULT_NONE;
+    }
+    const uint32_t du = count - p->last;
+    const int32_t delta = du <= (uint32_t)INT32_MAX ? (int32_t)du : -(int32_t)(UINT32_MAX - du) - 1;
+    p->last = count;
+    uint32_t fault = FW_FAULT_NONE;
+    if (p->primed == 1u) {
+        p->primed = 2u;
+        p->last_delta = delta;
+        p->rate_q16 = 0;
+        return FW_FAULT_NONE;
+    }
+    if (delta != 0) {
+        const int64_t dd = (int64_t)delta - p->last_delta;
+        if (dd > cfg->enc_jump_max || dd < -(int64_t)cfg->enc_jump_max) {
+            fault = FW_FAULT_ENC_JUMP;
+        }
+        const int64_t mag = delta < 0 ? -(int64_t)delta : (int64_t)delta;
+        const int64_t rate = mag * 65536 / (int64_t)(p->still + 1u);
+        p->rate_q16 = rate > INT32_MAX ? INT32_MAX : (int32_t)rate;
+        p->still = 0u;
+    } else {
+        if (p->still < UINT32_MAX) {
+            p->still++;
+        }
+        if (p->still >= cfg->enc_stuck_periods && p->rate_q16 >= cfg->enc_rate_min_q16) {
+            fault = FW_FAULT_ENC_STUCK;
+        }
+    }
+    p->last_delta = delta;
+    return fault;
+}
+
+/* Next counter value: mostly a steady rate with noise, sometimes a stop,
+ * a glitch or a huge step. */
+static uint32_t next_count(uint32_t c, int32_t *rate)
+{
+    const uint32_t k = rnd() % 100u;
+    if (k < 3u) {
+        *rate = (int32_t)(rnd() % 7u) - 3;
+    } else if (k < 5u) {
+        *rate = 0;
+    } else if (k < 6u) {
+        return c + rnd(); /* anything, incl. |delta| >= 2^15 and 2^31 */
+    } else if (k < 8u) {
+        return c + (uint32_t)(int32_t)((int32_t)(rnd() % 41u) - 20);
+    } else if (k < 9u) {
+        *rate = fx_u2i(rnd()) / 65536 * 2; /* |rate| up to 2^16 */
+    }
+    const int32_t noise = (rnd() % 4u == 0u) ? (int32_t)(rnd() % 3u) - 1 : 0;
+    return c + (uint32_t)(*rate + noise);
+}
+
+static void test_encoder_fast(void)
+{
+    static const int32_t jumps[] = {5, 0, 1, 40, -3, INT32_MAX, 100000};
+    static const int32_t rmins[] = {65536, 1, 0, -5, 3 * 65536 + 7, INT32_MAX, 20000};
+    static const uint32_t stucks[] = {8u, 1u, 0u, 3u, 50u};
+    for (size_t j = 0; j < sizeof jumps / sizeof jumps[0]; j++) {
+        for (size_t r = 0; r < sizeof rmins / sizeof rmins[0]; r++) {
+            for (size_t s = 0; s < sizeof stucks / sizeof stucks[0]; s++) {
+                fw_protect_cfg_t cfg = {FX_ONE, FX_ONE, 0, jumps[j], stucks[s], rmins[r], 0u, 0u};
+                fw_protect_t p;
+                fw_protect_init(&p, &cfg);
+                ref_enc_t ref;
+                memset(&ref, 0, sizeof ref);
+                uint32_t c = rnd();
+                int32_t rate = 3;
+                for (int k = 0; k < 3000; k++) {
+                    if (k % 1000 == 999) {
+                        fw_protect_reset(&p);
+                        memset(&ref, 0, sizeof ref);
+                    }
+                    const uint32_t want = ref_encoder(&ref, &cfg, c);
+                    const uint32_t got = fw_protect_encoder(&p, c);
+                    if (want != got) {
+                        char msg[160];
+                        snprintf(msg, sizeof msg,
+                                 "jump %ld rate_min %ld stuck %lu k %d: %lu vs %lu", (long)jumps[j],
+                                 (long)rmins[r], (unsigned long)stucks[s], k, (unsigned long)want,
+                                 (unsigned long)got);
+                        TEST_FAIL_MESSAGE(msg);
+                    }
+                    c = next_count(c, &rate);
+                }
+            }
+        }
+    }
+}
+
+/* Deadline and watchdog: 0 disables the check; otherwise the fault is above
+ * the limit, up to the largest values. */
+static void test_deadline_watchdog_limits(void)
+{
+    static const uint32_t lims[] = {0u, 1u, 1000u, UINT32_MAX - 1u, UINT32_MAX};
+    for (size_t l = 0; l < sizeof lims / sizeof lims[0]; l++) {
+        fw_protect_cfg_t cfg = {FX_ONE, FX_ONE, 0, 5, 8, 65536, lims[l], lims[l]};
+        fw_protect_t p;
+        fw_protect_init(&p, &cfg);
+        static const uint32_t el[] = {0u, 1u, 2u, 999u, 1000u, 1001u, UINT32_MAX - 1u, UINT32_MAX};
+        for (size_t e = 0; e < sizeof el / sizeof el[0]; e++) {
+            const uint32_t want =
+                lims[l] != 0u && el[e] > lims[l] ? FW_FAULT_DEADLINE : FW_FAULT_NONE;
+            TEST_ASSERT_EQUAL_UINT32(want, fw_protect_deadline(&p, el[e]));
+            /* Watchdog count set directly (a kick clears it, ticks add one). */
+            p.wdg_count = el[e] == 0u ? 0u : el[e] - 1u;
+            const uint32_t wd = fw_protect_watchdog_tick(&p);
+            TEST_ASSERT_EQUAL_UINT32(el[e] == 0u ? 1u : el[e], p.wdg_count);
+            const uint32_t n = p.wdg_count;
+            TEST_ASSERT_EQUAL_UINT32(
+                lims[l] != 0u && n > lims[l] ? FW_FAULT_WATCHDOG : FW_FAULT_NONE, wd);
+        }
+        /* Saturation at UINT32_MAX periods without a kick. */
+        p.wdg_count = UINT32_MAX;
+        const uint32_t wd = fw_protect_watchdog_tick(&p);
+        TEST_ASSERT_EQUAL_UINT32(UINT32_MAX, p.wdg_count);
+        TEST_ASSERT_EQUAL_UINT32(
+            lims[l] != 0u && lims[l] < UINT32_MAX ? FW_FAULT_WATCHDOG : FW_FAULT_NONE, wd);
+    }
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_legs_every_pair);
+    RUN_TEST(test_legs_helper_plans);
+    RUN_TEST(test_pwm_compare);
+    RUN_TEST(test_current_fast);
+    RUN_TEST(test_encoder_fast);
+    RUN_TEST(test_deadline_watchdog_limits);
+    return UNITY_END();
+}
