@@ -1,6 +1,8 @@
 # Build-wide settings. PMSM_TARGET: host | cm4 | cm0 (set by the presets).
 set(PMSM_TARGET "host" CACHE STRING "host, cm4 or cm0")
+set_property(CACHE PMSM_TARGET PROPERTY STRINGS host cm4 cm0)
 option(PMSM_SANITIZE "Build host code with ASan and UBSan" OFF)
+set(UNITY_ROOT "" CACHE PATH "Upstream Unity checkout to build the tests against (empty: tests/unity)")
 
 # Strict warnings for the product folders (control/, hal/, firmware/).
 set(PMSM_STRICT_WARNINGS -Wall -Wextra -Wconversion -Wsign-conversion -Wshadow
@@ -13,3 +15,20 @@ if(PMSM_SANITIZE AND PMSM_TARGET STREQUAL "host")
   add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
   add_link_options(-fsanitize=address,undefined)
 endif()
+
+# pmsm_qemu_firmware(<executable target>)
+#   Makes a cm4 executable a QEMU mps2-an386 image: links the board support
+#   (startup, linker script, syscalls, UART, timers), names it <target>.elf, writes
+#   <target>.map beside it and prints arm-none-eabi-size after the link.
+#   Run it with tools/qemu-run <target>.elf.
+function(pmsm_qemu_firmware target)
+  if(NOT PMSM_TARGET STREQUAL "cm4")
+    message(FATAL_ERROR "pmsm_qemu_firmware(${target}) needs the cm4 preset")
+  endif()
+  set_target_properties(${target} PROPERTIES SUFFIX ".elf")
+  target_link_libraries(${target} PRIVATE pmsm_qemu_mps2)
+  target_link_options(${target} PRIVATE "-Wl,-Map=$<TARGET_FILE_DIR:${target}>/${target}.map")
+  add_custom_command(TARGET ${target} POST_BUILD
+    COMMAND ${CMAKE_SIZE} $<TARGET_FILE:${target}>
+    VERBATIM)
+endfunction()

@@ -1,0 +1,183 @@
+/*
+ * mps2-an386 peripherals used by the project: CMSDK UART0, CMSDK Timer0/Timer1,
+ * the NVIC, and ARM semihosting. Addresses and bit fields: QEMU.md.
+ */
+#include <stddef.h>
+#include <stdint.h>
+
+#include "qemu_mps2.h"
+
+#define REG32(addr) (*(volatile uint32_t *)(addr))
+
+/* CMSDK APB UART0 */
+#define UART0_BASE 0x40004000u
+#define UART_DATA REG32(UART0_BASE + 0x0u)
+#define UART_STATE REG32(UART0_BASE + 0x4u)
+#define UART_CTRL REG32(UART0_BASE + 0x8u)
+#define UART_BAUDDIV REG32(UART0_BASE + 0x10u)
+#define UART_STATE_TX_FULL 0x1u
+#define UART_CTRL_TX_EN 0x1u
+
+/* CMSDK APB timers (down-counters at the 25 MHz system clock) */
+#define TIMER0_BASE 0x40000000u
+#define TIMER1_BASE 0x40001000u
+#define TIMER_CTRL(b) REG32((b) + 0x0u)
+#define TIMER_VALUE(b) REG32((b) + 0x4u)
+#define TIMER_RELOAD(b) REG32((b) + 0x8u)
+#define TIMER_INTCLEAR(b) REG32((b) + 0xCu)
+#define TIMER_CTRL_EN 0x1u
+#define TIMER_CTRL_IRQ_EN 0x8u
+#define TIMER0_IRQ 8u
+
+/* NVIC */
+#define NVIC_ISER0 REG32(0xE000E100u)
+#define NVIC_ICER0 REG32(0xE000E180u)
+#define NVIC_ICPR0 REG32(0xE000E280u)
+
+/* Semihosting operations */
+#define SYS_WRITE0 0x04
+#define SYS_EXIT 0x18
+#define SYS_EXIT_EXTENDED 0x20
+#define ADP_STOPPED_APPLICATION_EXIT 0x20026
+
+void TIMER0_Handler(void);
+
+static timer0_callback_t timer0_callback;
+static uint32_t timer0_period;
+
+void board_init(void)
+{
+    UART_BAUDDIV = 16u; /* minimum legal divider; QEMU does not model the baud rate */
+    UART_CTRL = UART_CTRL_TX_EN;
+
+    /* Timer1: free-running from 0xFFFFFFFF, no interrupt. */
+    TIMER_CTRL(TIMER1_BASE) = 0u;
+    TIMER_RELOAD(TIMER1_BASE) = 0xFFFFFFFFu;
+    TIMER_VALUE(TIMER1_BASE) = 0xFFFFFFFFu;
+    TIMER_CTRL(TIMER1_BASE) = TIMER_CTRL_EN;
+}
+
+void uart_putc(char c)
+{
+    while ((UART_STATE & UART_STATE_TX_FULL) != 0u) {
+    }
+    UART_DATA = (uint32_t)(unsigned char)c;
+}
+
+void uart_puts(const char *s)
+{
+    if (s == NULL) {
+        return;
+    }
+    while (*s != '\0') {
+        uart_putc(*s++);
+    }
+}
+
+void uart_put_u32(uint32_t v)
+{
+    char buf[10];
+    unsigned n = 0u;
+    do {
+        buf[n++] = (char)('0' + (char)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0u) {
+        uart_putc(buf[--n]);
+    }
+}
+
+void uart_put_i32(int32_t v)
+{
+    if (v < 0) {
+        uart_putc('-');
+        uart_put_u32(0u - (uint32_t)v); /* modulo 2^32: also right for INT32_MIN */
+    } else {
+        uart_put_u32((uint32_t)v);
+    }
+}
+
+static int semihost_call(int op, const void *arg)
+{
+    register int r0 __asm__("r0") = op;
+    register const void *r1 __asm__("r1") = arg;
+    __asm__ volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");
+    return r0;
+}
+
+void semihost_write0(const char *s)
+{
+    if (s != NULL) {
+        (void)semihost_call(SYS_WRITE0, s);
+    }
+}
+
+void semihost_exit(int code)
+{
+    /* SYS_EXIT_EXTENDED: QEMU exits with code & 0xFF (QEMU.md). */
+    const uint32_t block[2] = {ADP_STOPPED_APPLICATION_EXIT, (uint32_t)code};
+    (void)semihost_call(SYS_EXIT_EXTENDED, block);
+    /* Not reached under QEMU; a debugger without the extension gets SYS_EXIT. */
+    (void)semihost_call(SYS_EXIT, (const void *)(uintptr_t)ADP_STOPPED_APPLICATION_EXIT);
+    for (;;) {
+    }
+}
+
+int timer0_start(uint32_t hz, timer0_callback_t callback)
+{
+    if (hz == 0u || hz > 1000000u || callback == NULL) {
+        return -1;
+    }
+    timer0_stop();
+    timer0_callback = callback;
+    timer0_period = QEMU_MPS2_SYSCLK_HZ / hz;
+    TIMER_RELOAD(TIMER0_BASE) = timer0_period - 1u;
+    TIMER_VALUE(TIMER0_BASE) = timer0_period - 1u;
+    TIMER_INTCLEAR(TIMER0_BASE) = 1u;
+    NVIC_ICPR0 = 1u << TIMER0_IRQ;
+    NVIC_ISER0 = 1u << TIMER0_IRQ;
+    TIMER_CTRL(TIMER0_BASE) = TIMER_CTRL_EN | TIMER_CTRL_IRQ_EN;
+    return 0;
+}
+
+void timer0_stop(void)
+{
+    TIMER_CTRL(TIMER0_BASE) = 0u;
+    NVIC_ICER0 = 1u << TIMER0_IRQ;
+    TIMER_INTCLEAR(TIMER0_BASE) = 1u;
+    NVIC_ICPR0 = 1u << TIMER0_IRQ;
+    timer0_period = 0u;
+}
+
+uint32_t timer0_period_ticks(void)
+{
+    return timer0_period;
+}
+
+void TIMER0_Handler(void)
+{
+    TIMER_INTCLEAR(TIMER0_BASE) = 1u;
+    if (timer0_callback != NULL) {
+        timer0_callback();
+    }
+}
+
+uint32_t timer1_read(void)
+{
+    return 0xFFFFFFFFu - TIMER_VALUE(TIMER1_BASE);
+}
+
+void board_irq_disable(void)
+{
+    __asm__ volatile("cpsid i" ::: "memory");
+}
+
+void board_irq_enable(void)
+{
+    __asm__ volatile("cpsie i" ::: "memory");
+}
+
+void board_idle(void)
+{
+    __asm__ volatile("nop" ::: "memory");
+}

@@ -1,0 +1,25 @@
+# Runs a test binary that is meant to fail and checks how the failure is reported.
+#   cmake -DCMD="<program;args>" -DEXPECT_RC_NONZERO=ON -DPATTERNS="<regex;regex;...>"
+#         -P pmsm_expect_fail.cmake
+# Passes when the program exits non-zero and its output matches every pattern.
+if(NOT CMD)
+  message(FATAL_ERROR "pmsm_expect_fail: CMD not given")
+endif()
+execute_process(COMMAND ${CMD} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+set(all "${out}${err}")
+message("---- output of the deliberately failing test (exit status ${rc}) ----\n${all}----")
+set(bad 0)
+if(rc EQUAL 0)
+  message("ERROR: exit status is 0, expected non-zero")
+  set(bad 1)
+endif()
+foreach(p IN LISTS PATTERNS)
+  if(NOT all MATCHES "${p}")
+    message("ERROR: output does not match: ${p}")
+    set(bad 1)
+  endif()
+endforeach()
+if(bad)
+  message(FATAL_ERROR "pmsm_expect_fail: failure was not reported as expected")
+endif()
+message("pmsm_expect_fail: failure reported correctly")
