@@ -56,6 +56,9 @@ typedef struct ctrl_desc {
     void (*reset)(void *state);
     /* One control period: choose the plan for [k+1, k+2). Integer-only. */
     void (*step)(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+    /* Optional estimator outputs (CTRL_EST_* of estimator.h) this controller never
+     * reads, so the pipeline can skip computing them; 0 = it may read all. */
+    uint8_t est_unused;
 } ctrl_desc_t;
 
 /* Largest state_size / cfg_size of any registered controller, for static buffers. */

@@ -242,6 +242,7 @@ const ctrl_desc_t ctrl_desc_drr = {
     drr_init,
     ctrl_drr_reset,
     ctrl_drr_step,
+    0, /* reads |psi| at k+1 */
 };
 
 /* ---------------- baselines ---------------- */
@@ -379,6 +380,7 @@ static int df_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         ctrl_drr_base_reset,                                                                       \
         ctrl_drr_base_step,                                                                        \
+        0,                                                                                         \
     }
 
 DRR_BASE_DESC(drr_d1, "DRR baseline D1: D = |T_err/C_T| + |psi_err/C_psi| (thesis (5.19))",

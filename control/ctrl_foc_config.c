@@ -9,6 +9,7 @@
 
 #include "ctrl_foc.h"
 #include "ctrl_params.h"
+#include "estimator.h"
 
 #define FOC_FS_HZ 10000u   /* S1 §2: Ts = 100 us */
 #define FOC_WC_PER_FS 20.0 /* default wc = 2 pi fs / 20 */
@@ -202,6 +203,7 @@ const ctrl_desc_t ctrl_desc_foc = {
     foc_init,
     ctrl_foc_reset,
     ctrl_foc_step,
+    CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* FOC reads currents, not |psi| or sectors */
 };
 
 const ctrl_desc_t ctrl_desc_foc_hyst = {
@@ -216,4 +218,5 @@ const ctrl_desc_t ctrl_desc_foc_hyst = {
     foc_hyst_init,
     ctrl_foc_reset,
     ctrl_foc_step,
+    CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* FOC reads currents, not |psi| or sectors */
 };

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "ctrl_m2.h"
+#include "estimator.h"
 
 static const ctrl_tunable_t m2_tunables[] = {
     {"eps_psi", "Wb",
@@ -67,4 +68,5 @@ const ctrl_desc_t ctrl_desc_m2 = {
     .init = m2_init,
     .reset = ctrl_m2_reset,
     .step = ctrl_m2_step,
+    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW,
 };

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "ctrl_m2ptfc.h"
+#include "estimator.h"
 
 static const ctrl_tunable_t m2ptfc_tunables[] = {
     {"lambda", "1", "EMA coefficient of sigma_T (6.8); Table 6.2: 0.03 (750 and 2250 r/min)",
@@ -61,4 +62,5 @@ const ctrl_desc_t ctrl_desc_m2ptfc = {
     .init = m2ptfc_init,
     .reset = ctrl_m2ptfc_reset,
     .step = ctrl_m2ptfc_step,
+    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW,
 };

@@ -2,6 +2,7 @@
 #include <stddef.h>
 
 #include "ctrl_mptfc.h"
+#include "estimator.h"
 
 static const ctrl_tunable_t mptfc_tunables[] = {
     {"zeta", "N*m/Wb",
@@ -23,4 +24,5 @@ const ctrl_desc_t ctrl_desc_mptfc = {
     .init = ctrl_mpc_winit,
     .reset = ctrl_mpc_wreset,
     .step = ctrl_mptfc_step,
+    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW,
 };

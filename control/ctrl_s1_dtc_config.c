@@ -290,6 +290,7 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         resetfn,                                                                                   \
         stepfn,                                                                                    \
+        0,                                                                                         \
     }
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 §3, Table 3)",

@@ -192,6 +192,7 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         st_hyst_reset,                                                                             \
         st_hyst_step,                                                                              \
+        0,                                                                                         \
     }
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init);
@@ -212,4 +213,5 @@ const ctrl_desc_t ctrl_desc_fst = {
     st_fst_init,
     st_fst_reset,
     st_fst_step,
+    0,
 };

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "controller.h"
+#include "vectors.h"
 
 #define FW_LINK_PI 3.14159265358979323846
 
@@ -232,7 +233,8 @@ void fw_link_isr(fw_link_t *l)
     s->duty = tm->duty;
     s->vdc = tm->vdc;
     s->theta = (int32_t)(tm->theta_e >> 8);
-    s->sector = (int32_t)fw->estimate.now.sector;
+    /* now.sector may be switched off in the estimator (controller.h est_unused). */
+    s->sector = (int32_t)ctrl_sector(fw->estimate.now.psi_alpha, fw->estimate.now.psi_beta);
     s->state = (int32_t)tm->state;
     s->fault = (int32_t)tm->fault;
     s->cycles = (int32_t)(tm->cycles > (uint32_t)INT32_MAX ? (uint32_t)INT32_MAX : tm->cycles);

@@ -163,6 +163,9 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     memcpy(fw->ctrl_state.bytes, st.bytes, sizeof st.bytes);
     memcpy(fw->ctrl_cfg.bytes, cfg, CTRL_CFG_MAX);
     fw->ctrl = d;
+    /* Skip the estimates the controller never reads; |psi_s| at k stays on for
+     * telemetry (the status command derives the sector itself). */
+    fw->est.outputs = (uint8_t)((CTRL_EST_ALL & ~(unsigned)d->est_unused) | CTRL_EST_AMP_NOW);
     return FW_OK;
 }
 

@@ -62,7 +62,7 @@ static const ctrl_desc_t ol_desc = {"test_ol", "open-loop test sequence",
                                     8u,        NULL,
                                     0u,        ol_cfg_default,
                                     ol_init,   ol_reset,
-                                    ol_step};
+                                    ol_step,   0u};
 
 static void plans_equal(const ctrl_plan_t *a, const ctrl_plan_t *b)
 {
