@@ -89,11 +89,12 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     }
 
     fw->machine = cfg->machine;
+    /* Before the controller: installing it narrows the estimator's outputs. */
+    ctrl_estimator_init(&fw->est, &fw->params);
     const int sel = fw_select_controller(fw, cfg->ctrl, cfg->ctrl_cfg);
     if (sel != FW_OK) {
         return sel;
     }
-    ctrl_estimator_init(&fw->est, &fw->params);
 
     /* Conversion gains (formats in pipeline.h). */
     for (int x = 0; x < 3; x++) {
