@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "chapter_machines.h"
+#include "chapter_rig.h"
 #include "controller.h"
 #include "ctrl_foc.h"
 #include "ctrl_params.h"
@@ -41,38 +42,11 @@ static double q(q24_t x)
     return (double)x / 16777216.0;
 }
 
-typedef struct {
-    ctrl_params_t params;
-    ctrl_bases_t bases;
-    ctrl_estimate_t est;
-    ctrl_refs_t ref;
-    ctrl_ctx_t ctx;
-    _Alignas(8) unsigned char state[CTRL_STATE_MAX];
-    _Alignas(8) unsigned char cfg[CTRL_CFG_MAX];
-    const ctrl_desc_t *d;
-} rig_t;
-
-static rig_t rig;
-
-static void rig_init(const char *name, const ctrl_machine_t *m)
-{
-    memset(&rig, 0, sizeof rig);
-    rig.d = ctrl_find(name);
-    TEST_ASSERT_NOT_NULL(rig.d);
-    TEST_ASSERT_TRUE(rig.d->state_size <= CTRL_STATE_MAX);
-    TEST_ASSERT_TRUE(rig.d->cfg_size <= CTRL_CFG_MAX);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&rig.params, &rig.bases, m, 10000u));
-    rig.d->cfg_default(rig.cfg, m);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
-    rig.ctx.params = &rig.params;
-    rig.ctx.est = &rig.est;
-    rig.ctx.ref = &rig.ref;
-    rig.est.vdc = rig.params.vdc_nom;
-}
+static chapter_rig_t rig;
 
 static void test_iref(void)
 {
-    rig_init("foc", &ini_thesis_spmsm);
+    chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     for (int k = -50; k <= 50; k++) {
         const q24_t t = ctrl_q24_from_double(0.01 * k);
@@ -82,7 +56,7 @@ static void test_iref(void)
         TEST_ASSERT_INT32_WITHIN(2, 0, id); /* SPMSM: i_d = 0 */
         TEST_ASSERT_INT32_WITHIN(4, t, iq); /* T = psi_pm i_q, psi_pm = 1 pu */
     }
-    rig_init("foc", &ini_chapter_ipmsm);
+    chapter_rig_init(&rig, "foc", &ini_chapter_ipmsm);
     s = (const ctrl_foc_state_t *)rig.state;
     const double ld = q(rig.params.ld);
     const double lq = q(rig.params.lq);
@@ -228,7 +202,7 @@ static void check_step(const char *label, double omega_pu, double torque_pu)
 
 static void test_current_step_spmsm(void)
 {
-    rig_init("foc", &ini_thesis_spmsm);
+    chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     check_step("SPMSM standstill", 0.0, 0.1);
     check_step("SPMSM 750 r/min", 4.0 * 750.0 * 2.0 * PI / 60.0 / rig.bases.w_rad_s, 0.1);
     check_step("SPMSM -750 r/min, negative torque",
@@ -239,7 +213,7 @@ static void test_current_step_ipmsm_mtpa(void)
 {
     /* Chapter IPMSM: Kp_q = Lq wc = 14.5 pu, so the linear region is a small
      * step (the voltage stays inside the hexagon): 0.015 pu torque at 0.1 pu speed. */
-    rig_init("foc", &ini_chapter_ipmsm);
+    chapter_rig_init(&rig, "foc", &ini_chapter_ipmsm);
     check_step("IPMSM MTPA", 0.1, 0.015);
 }
 
@@ -247,7 +221,7 @@ static void test_saturation_recovery(void)
 {
     /* A step that saturates the voltage (Kp e = 1.35 pu > Vdc/sqrt 3): the
      * conditional integration must prevent a wind-up overshoot. */
-    rig_init("foc", &ini_thesis_spmsm);
+    chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     run_loop(0.0, 0.5);
     double rise;
@@ -260,7 +234,7 @@ static void test_saturation_recovery(void)
 
 static void test_foc_hyst_decisions(void)
 {
-    rig_init("foc_hyst", &ini_thesis_spmsm);
+    chapter_rig_init(&rig, "foc_hyst", &ini_thesis_spmsm);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     const double h = q(s->h_i);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.05 * 4.2 / rig.bases.i_a, h);
@@ -286,7 +260,7 @@ static void test_foc_hyst_decisions(void)
 
 static void test_config_errors(void)
 {
-    rig_init("foc", &ini_thesis_spmsm);
+    chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "wc", 1.0e5));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL,
                           rig.d->init(rig.state, rig.cfg, &rig.params)); /* wc Ts > 1.5 */

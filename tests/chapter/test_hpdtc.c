@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "chapter_machines.h"
+#include "chapter_rig.h"
 #include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
@@ -135,35 +136,12 @@ static void test_timing_table_synthesis(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_hpdtc_timing_table(NAN, pts));
 }
 
-typedef struct {
-    ctrl_params_t params;
-    ctrl_bases_t bases;
-    ctrl_estimate_t est;
-    ctrl_refs_t ref;
-    ctrl_ctx_t ctx;
-    _Alignas(8) unsigned char state[CTRL_STATE_MAX];
-    _Alignas(8) unsigned char cfg[CTRL_CFG_MAX];
-    const ctrl_desc_t *d;
-} rig_t;
-
-static rig_t rig;
+static chapter_rig_t rig;
 
 static void rig_init(void)
 {
-    memset(&rig, 0, sizeof rig);
-    rig.d = ctrl_find("hpdtc");
-    TEST_ASSERT_NOT_NULL(rig.d);
-    TEST_ASSERT_TRUE(rig.d->state_size <= CTRL_STATE_MAX);
-    TEST_ASSERT_TRUE(rig.d->cfg_size <= CTRL_CFG_MAX);
+    chapter_rig_init(&rig, "hpdtc", &ini_chapter_ipmsm);
     TEST_ASSERT_EQUAL_UINT32(10000u, rig.d->fs_default_hz);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK,
-                          ctrl_params_init(&rig.params, &rig.bases, &ini_chapter_ipmsm, 10000u));
-    rig.d->cfg_default(rig.cfg, &ini_chapter_ipmsm);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
-    rig.ctx.params = &rig.params;
-    rig.ctx.est = &rig.est;
-    rig.ctx.ref = &rig.ref;
-    rig.est.vdc = rig.params.vdc_nom;
 }
 
 /* Flux at angle lam (rad), amplitude 1 pu, torque t (pu) in est->next. */

@@ -345,11 +345,11 @@ void run_machine(const ctrl_machine_t &mach, uint32_t fs, int n, std::mt19937_64
 void test_reference_all_machines()
 {
     std::mt19937_64 gen(20240601u);
-    const ctrl_machine_t *machines[] = {&machine_thesis_spmsm, &machine_thesis_ipmsm80,
-                                        &machine_chapter_ipmsm};
-    for (const ctrl_machine_t *m : machines) {
-        run_machine(*m, 10000u, 10000, gen);
-        run_machine(*m, 20000u, 10000, gen);
+    const ctrl_machine_t machines[] = {machine_thesis_spmsm(), machine_thesis_ipmsm80(),
+                                       machine_chapter_ipmsm()};
+    for (const ctrl_machine_t &m : machines) {
+        run_machine(m, 10000u, 10000, gen);
+        run_machine(m, 20000u, 10000, gen);
     }
     // the random drive covered all four quadrants of Fig. 3.9
     for (long c : quadrant_count)
@@ -370,7 +370,8 @@ void test_estimator_matches_components()
 {
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_ipmsm80, 20000u));
+    const ctrl_machine_t ipm = machine_thesis_ipmsm80();
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &ipm, 20000u));
     ctrl_estimator_t e;
     ctrl_estimator_init(&e, &p);
     ctrl_meas_t m{q(0.3), q(-0.7), q(1.02), 0x87654321u};

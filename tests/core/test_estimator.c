@@ -353,7 +353,8 @@ static void test_estimator_voltage_model_source(void)
 
 int main(void)
 {
-    if (ctrl_params_init(&P, &B, &machine_thesis_spmsm, 10000u) != CTRL_OK) {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
+    if (ctrl_params_init(&P, &B, &spm, 10000u) != CTRL_OK) {
         return 1;
     }
     UNITY_BEGIN();

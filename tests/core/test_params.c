@@ -43,9 +43,10 @@ static int all_zero(const void *p, size_t n)
 
 static void test_bases_spmsm(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
     const double wb = 220.0 / 0.09427;
     const double ib = 0.09427 / 6.552e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * wb, wb, b.w_rad_s);
@@ -80,14 +81,16 @@ static void test_bases_spmsm(void)
 
 static void test_bases_ipmsm(void)
 {
+    const ctrl_machine_t ipm = machine_thesis_ipmsm80();
+    const ctrl_machine_t chap = machine_chapter_ipmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_ipmsm80, 20000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &ipm, 20000u));
     TEST_ASSERT_EQUAL_UINT8(1u, p.salient);
     TEST_ASSERT_TRUE(fabs(d(p.lq) - 1.33 / 0.6) <= 0.5 * LSB);
     TEST_ASSERT_TRUE(fabs(d(p.inv_lq) - 0.6 / 1.33) <= 0.5 * LSB);
     TEST_ASSERT_TRUE(fabs(d(p.psi_ref) - 0.1837 / 0.1875) <= 0.5 * LSB);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_chapter_ipmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &chap, 10000u));
     TEST_ASSERT_EQUAL_UINT8(1u, p.salient);
 }
 
@@ -104,18 +107,19 @@ static void expect_reject(const ctrl_machine_t *m, uint32_t fs, int code)
 
 static void test_reject_bad_machines(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_init(NULL, &b, &machine_thesis_spmsm, 10000u));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_init(&p, NULL, &machine_thesis_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_init(NULL, &b, &spm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_init(&p, NULL, &spm, 10000u));
     expect_reject(NULL, 10000u, CTRL_EINVAL);
-    expect_reject(&machine_thesis_spmsm, 0u, CTRL_EINVAL);
+    expect_reject(&spm, 0u, CTRL_EINVAL);
     const double nan = NAN;
     const double inf = INFINITY;
     ctrl_machine_t m;
 #define BAD(field, value, code)                                                                    \
     do {                                                                                           \
-        m = machine_thesis_spmsm;                                                                  \
+        m = spm;                                                                                   \
         m.field = (value);                                                                         \
         expect_reject(&m, 10000u, (code));                                                         \
     } while (0)
@@ -146,10 +150,10 @@ static void test_reject_bad_machines(void)
     BAD(rs_ohm, 1e-7, CTRL_ERANGE); /* 6.5e-9 pu: no resolution */
 #undef BAD
     /* 100 Hz sampling: 23 rad per period at 1 pu speed */
-    expect_reject(&machine_thesis_spmsm, 100u, CTRL_ERANGE);
-    expect_reject(&machine_thesis_spmsm, 100000000u, CTRL_EINVAL);
+    expect_reject(&spm, 100u, CTRL_ERANGE);
+    expect_reject(&spm, 100000000u, CTRL_EINVAL);
     /* an ideal lossless machine is accepted */
-    m = machine_thesis_spmsm;
+    m = spm;
     m.rs_ohm = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &m, 10000u));
     TEST_ASSERT_EQUAL_INT32(0, p.rs);
@@ -178,9 +182,10 @@ static void test_q24_conversion(void)
  * 5e-5 rad) plus the fixed-point error (< 1e-6 pu, README). */
 static void test_mtpa_oracle_spmsm(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
     const q24_t t = ctrl_q24_from_double(1.8 / b.torque_nm);
     const q24_t psi = ctrl_mtpa_psi(&p, t);
     TEST_ASSERT_DOUBLE_WITHIN(5e-6 + 1e-6 * b.psi_wb, 0.09655, d(psi) * b.psi_wb);
@@ -226,9 +231,10 @@ static void mtpa_search(double lq, double i, double *t_out, double *psi_out)
 
 static void test_mtpa_ipmsm_table(void)
 {
+    const ctrl_machine_t ipm = machine_thesis_ipmsm80();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_ipmsm80, 20000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &ipm, 20000u));
     const double lq = d(p.lq);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, ctrl_mtpa_psi(&p, 0));
     q24_t prev = 0;
@@ -262,9 +268,10 @@ static void test_mtpa_ipmsm_table(void)
 
 static void test_speed_lpf_setter(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_spmsm, 20000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 20000u));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_set_speed_lpf(&p, 100.0));
     TEST_ASSERT_TRUE(fabs(d(p.speed_lpf_k) - (1.0 - exp(-2 * PI * 100.0 / 20000.0))) <= 0.5 * LSB);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_set_speed_lpf(&p, 0.0));
@@ -275,9 +282,10 @@ static void test_speed_lpf_setter(void)
 
 static void test_speed_pi(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
     ctrl_params_t p;
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &machine_thesis_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
     ctrl_speed_pi_t pi;
     /* thesis gains, speed in mechanical rad/s, 2.4 N*m limit, loop at 10 kHz */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_speed_pi_config(&pi, &b, 4, 0.006843, 0.78046,

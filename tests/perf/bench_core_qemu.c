@@ -75,11 +75,13 @@ static double urand(void)
 
 static void make_inputs(void)
 {
+    const ctrl_machine_t spm = machine_thesis_spmsm();
+    const ctrl_machine_t ipm = machine_thesis_ipmsm80();
     ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &b, &machine_thesis_spmsm, 10000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &b, &spm, 10000u));
     ctrl_bases_t b2;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P_ipm, &b2, &machine_thesis_ipmsm80, 10000u));
-    const double imax = machine_thesis_spmsm.current_max_a / b.i_a;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P_ipm, &b2, &ipm, 10000u));
+    const double imax = spm.current_max_a / b.i_a;
     for (int k = 0; k < N_IN; k++) {
         input_t *t = &in[k];
         const double amp = imax * urand();

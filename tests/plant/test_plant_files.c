@@ -292,41 +292,60 @@ static void expect_replay_error(const char *text, const char *must_contain)
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(err, must_contain), err);
 }
 
+/* The replay header, then rows: the replay must fail with must_contain. */
+static void expect_replay_rows_error(const char *rows, const char *must_contain)
+{
+    char buf[512];
+    snprintf(buf, sizeof buf, "t_start_s,duration_s,S1,S2,S3\n%s", rows);
+    expect_replay_error(buf, must_contain);
+}
+
 static void test_replay_malformed_rows(void)
 {
-    const char *h = "t_start_s,duration_s,S1,S2,S3\n";
-    char buf[512];
     expect_replay_error("t,d,S1,S2,S3\n0,1e-6,1,0,0\n", "bad.csv:1: expected header");
     expect_replay_error("", "empty file");
-    snprintf(buf, sizeof buf, "%s0,1e-6,1,0,0\n1e-6,abc,1,0,0\n", h);
-    expect_replay_error(buf, "bad.csv:3: expected 5 numeric fields");
-    snprintf(buf, sizeof buf, "%s0,1e-6,1,0\n", h);
-    expect_replay_error(buf, "bad.csv:2: expected 5 numeric fields");
-    snprintf(buf, sizeof buf, "%s0,1e-6,1,0,0,7\n", h);
-    expect_replay_error(buf, "bad.csv:2: expected 5 numeric fields");
-    snprintf(buf, sizeof buf, "%s0,1e-6,1,2,0\n", h);
-    expect_replay_error(buf, "bad.csv:2: S2 = 2 must be 0 or 1");
-    snprintf(buf, sizeof buf, "%s0,-1e-6,1,0,0\n", h);
-    expect_replay_error(buf, "bad.csv:2: duration_s = -1e-06 must be in");
-    snprintf(buf, sizeof buf, "%s0,1.5e-9,1,0,0\n", h);
-    expect_replay_error(buf, "bad.csv:2: duration_s = 1.5e-09 is not a whole number of ns");
-    snprintf(buf, sizeof buf, "%s0,1e-6,1,0,0\n2e-6,1e-6,1,0,0\n", h);
-    expect_replay_error(buf, "bad.csv:3: t_start_s = 2e-06, expected 1e-06");
-    snprintf(buf, sizeof buf, "%s0,nan,1,0,0\n", h);
-    expect_replay_error(buf, "bad.csv:2:");
+    expect_replay_rows_error("0,1e-6,1,0,0\n1e-6,abc,1,0,0\n",
+                             "bad.csv:3: expected 5 numeric fields");
+    expect_replay_rows_error("0,1e-6,1,0\n", "bad.csv:2: expected 5 numeric fields");
+    expect_replay_rows_error("0,1e-6,1,0,0,7\n", "bad.csv:2: expected 5 numeric fields");
+    expect_replay_rows_error("0,1e-6,1,2,0\n", "bad.csv:2: S2 = 2 must be 0 or 1");
+    expect_replay_rows_error("0,-1e-6,1,0,0\n", "bad.csv:2: duration_s = -1e-06 must be in");
+    expect_replay_rows_error("0,1.5e-9,1,0,0\n",
+                             "bad.csv:2: duration_s = 1.5e-09 is not a whole number of ns");
+    expect_replay_rows_error("0,1e-6,1,0,0\n2e-6,1e-6,1,0,0\n",
+                             "bad.csv:3: t_start_s = 2e-06, expected 1e-06");
+    expect_replay_rows_error("0,nan,1,0,0\n", "bad.csv:2:");
 }
 
 /* ------------------------------------------------------------ flux maps */
 
-static void test_fluxmap_shipped_and_inverse(void)
+/* The shipped synthetic flux map of the 80 kW IPMSM (gen_fluxmap_ipmsm80.py). */
+static void load_fluxmap_ipmsm80(plant_fluxmap_t *m)
 {
-    plant_fluxmap_t m;
     char err[256] = "";
     TEST_ASSERT_EQUAL_INT_MESSAGE(
         PLANT_OK,
-        plant_fluxmap_load(&m, PLANT_MACHINES_DIR "/ipmsm_80kw_fluxmap_synthetic.csv", err,
+        plant_fluxmap_load(m, PLANT_MACHINES_DIR "/ipmsm_80kw_fluxmap_synthetic.csv", err,
                            sizeof err),
         err);
+}
+
+/* The plant of the shipped saturated 80 kW IPMSM file (its linear data; the
+ * caller binds the flux map). */
+static void load_plant_ipmsm80_sat(plant_config_t *c)
+{
+    char err[256] = "";
+    sim_machine_t mm;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        0, sim_machine_load(PLANT_MACHINES_DIR "/thesis_ipmsm_80kw_sat.ini", &mm, err, sizeof err),
+        err);
+    sim_machine_to_plant(&mm, c);
+}
+
+static void test_fluxmap_shipped_and_inverse(void)
+{
+    plant_fluxmap_t m;
+    load_fluxmap_ipmsm80(&m);
     TEST_ASSERT_EQUAL_UINT32(31u, (uint32_t)m.n_d);
     TEST_ASSERT_EQUAL_UINT32(31u, (uint32_t)m.n_q);
     /* the generating law at grid points (gen_fluxmap_ipmsm80.py) */
@@ -362,12 +381,8 @@ static void test_fluxmap_shipped_and_inverse(void)
 
     /* Saturated 80 kW IPMSM at 1500 r/min: the simulation runs; at small
      * current its torque matches the linear model (the map is linear at 0). */
-    sim_machine_t mm;
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, sim_machine_load(PLANT_MACHINES_DIR "/thesis_ipmsm_80kw_sat.ini", &mm, err, sizeof err),
-        err);
     plant_config_t c;
-    sim_machine_to_plant(&mm, &c);
+    load_plant_ipmsm80_sat(&c);
     c.speed0_rpm = 1500.0;
     c.id0_a = -2.0;
     c.iq0_a = 3.0;
@@ -401,18 +416,9 @@ static void test_fluxmap_shipped_and_inverse(void)
 static void test_fluxmap_rk4_accuracy(void)
 {
     plant_fluxmap_t m;
-    char err[256] = "";
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        PLANT_OK,
-        plant_fluxmap_load(&m, PLANT_MACHINES_DIR "/ipmsm_80kw_fluxmap_synthetic.csv", err,
-                           sizeof err),
-        err);
-    sim_machine_t mm;
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, sim_machine_load(PLANT_MACHINES_DIR "/thesis_ipmsm_80kw_sat.ini", &mm, err, sizeof err),
-        err);
+    load_fluxmap_ipmsm80(&m);
     plant_config_t c;
-    sim_machine_to_plant(&mm, &c);
+    load_plant_ipmsm80_sat(&c);
     c.fluxmap = &m;
     c.speed0_rpm = 2000.0;
     c.id0_a = -150.0;

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ini_machines.h"
 #include "plant.h"
 #include "unity.h"
 
@@ -20,34 +21,32 @@ void tearDown(void)
 {
 }
 
-/* Thesis SPMSM, Table 3.2. */
-static plant_config_t cfg_spmsm(void)
+/* The electrical and mechanical data of a shipped machine file
+ * (ini_machines.h), everything else of the plant zero (ideal inverter). */
+static plant_config_t cfg_from_machine(const ctrl_machine_t *m)
 {
     plant_config_t c;
     memset(&c, 0, sizeof c);
-    c.pole_pairs = 4;
-    c.rs_ohm = 0.901;
-    c.ld_h = 6.552e-3;
-    c.lq_h = 6.552e-3;
-    c.psi_pm_wb = 0.09427;
-    c.vdc_v = 220.0;
-    c.inertia_kgm2 = 1.2e-4;
+    c.pole_pairs = m->pole_pairs;
+    c.rs_ohm = m->rs_ohm;
+    c.ld_h = m->ld_h;
+    c.lq_h = m->lq_h;
+    c.psi_pm_wb = m->psi_pm_wb;
+    c.vdc_v = m->vdc_v;
+    c.inertia_kgm2 = m->inertia_kgm2;
     return c;
+}
+
+/* Thesis SPMSM, Table 3.2. */
+static plant_config_t cfg_spmsm(void)
+{
+    return cfg_from_machine(&ini_thesis_spmsm);
 }
 
 /* Book-chapter IPMSM, S1 Table 2 (Ld < Lq per REFERENCE.md). */
 static plant_config_t cfg_chapter(void)
 {
-    plant_config_t c;
-    memset(&c, 0, sizeof c);
-    c.pole_pairs = 2;
-    c.rs_ohm = 5.8;
-    c.ld_h = 44.8e-3;
-    c.lq_h = 102.7e-3;
-    c.psi_pm_wb = 0.533;
-    c.vdc_v = 264.0;
-    c.inertia_kgm2 = 3.29e-4;
-    return c;
+    return cfg_from_machine(&ini_chapter_ipmsm);
 }
 
 static double rel_err(double a, double b, double scale)

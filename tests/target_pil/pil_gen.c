@@ -23,6 +23,7 @@
 #include "pil_data.h"
 #include "pipeline.h"
 #include "plant.h"
+#include "rec_loop.h"
 #include "sim_machine.h"
 #include "sim_run.h"
 
@@ -59,31 +60,13 @@ static uint32_t fs_of(const ctrl_desc_t *d, const sim_machine_t *m)
 static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t *sm,
                   uint32_t periods, uint32_t *n_out, int32_t *tref_out, hal_info_t *info_out)
 {
-    static plant_t plant;
-    static hal_t hal;
-    static fw_t fw;
-    ctrl_machine_t cm;
-    sim_ctrl_machine_from(sm, &cm);
-    const uint32_t fs = fs_of(d, sm);
-    plant_config_t pc;
-    sim_machine_to_plant(sm, &pc);
-    pc.mech = PLANT_MECH_IMPOSED;
-    pc.speed0_rpm = GEN_SPEED_RPM;
-    if (plant_init(&plant, &pc) != PLANT_OK) {
-        return die("plant_init failed for ", d->name);
+    static rec_loop_t loop;
+    const char *fail = rec_loop_init(&loop, d, sm, fs_of(d, sm), GEN_SPEED_RPM, GEN_CALIB);
+    if (fail != NULL) {
+        return die(fail, d->name);
     }
-    hal_sim_config_t hc;
-    hal_sim_config_default(&hc, fs, sm->current_max_a, sm->vdc_v);
-    if (hal_sim_init(&hal, &hc, &plant) != HAL_SIM_OK) {
-        return die("hal_sim_init failed for ", d->name);
-    }
-    fw_config_t fc;
-    fw_config_default(&fc, &cm, d);
-    fc.calib_samples = GEN_CALIB;
-    if (fw_init(&fw, &hal, &fc) != FW_OK) {
-        return die("fw_init failed for ", d->name);
-    }
-    hal_info_get(&hal, info_out);
+    *info_out = loop.info;
+    const hal_t *hal = &loop.hal;
     const uint32_t max = GEN_CALIB + 32u + periods;
     pil_in_t *in = calloc(max, sizeof *in);
     pil_out_t *out = calloc(max, sizeof *out);
@@ -93,35 +76,15 @@ static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t
         return die("out of memory", NULL);
     }
     uint32_t n = 0u, after_arm = 0u;
-    int armed = 0;
     while (n < max && after_arm < periods) {
-        uint8_t cmd = 0u;
-        if (!armed && fw_state(&fw) == FW_STATE_READY) {
-            fw_set_torque_ref_nm(&fw, GEN_TORQUE_NM);
-            fw_cmd_arm(&fw);
-            cmd = PIL_CMD_TORQUE | PIL_CMD_ARM;
-            armed = 1;
-            *tref_out = fw.torque_ref;
-        }
-        hal_sim_period_begin(&hal);
-        in[n].adc[0] = hal.adc.i_a;
-        in[n].adc[1] = hal.adc.i_b;
-        in[n].adc[2] = hal.adc.i_c;
-        in[n].adc[3] = hal.adc.vdc;
-        in[n].cmd = cmd;
-        in[n].index_seen = hal.enc.index_seen ? 1u : 0u;
-        in[n].trip = hal.trip ? 1u : 0u;
-        in[n].enc_count = hal.enc.count;
-        in[n].index_count = hal.enc.index_count;
-        fw_isr(&fw);
-        fw_watchdog_kick(&fw);
-        const fw_telemetry_t *tm = fw_telemetry(&fw);
+        rec_loop_isr(&loop, GEN_TORQUE_NM, &in[n]);
+        const fw_telemetry_t *tm = fw_telemetry(&loop.fw);
         pil_out_t *o = &out[n];
         for (int x = 0; x < 3; x++) {
-            o->cmp[x] = hal.shadow.cmp[x];
+            o->cmp[x] = hal->shadow.cmp[x];
             o->legs[x] = tm->legs[x];
         }
-        o->gates = (hal.gates_on || hal.gate_enable_pending) ? 1u : 0u;
+        o->gates = (hal->gates_on || hal->gate_enable_pending) ? 1u : 0u;
         o->state = tm->state;
         o->fault = tm->fault;
         o->vec = tm->vec;
@@ -136,28 +99,28 @@ static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t
         o->theta_e = tm->theta_e;
         o->period = tm->period;
         o->cycles = tm->cycles;
-        if (hal_sim_period_end(&hal) != PLANT_OK) {
+        if (rec_loop_end(&loop) != PLANT_OK) {
             free(in);
             free(out);
             return die("plant failed for ", d->name);
         }
         n++;
-        if (armed) {
+        if (loop.armed) {
             after_arm++;
         }
     }
-    if (!armed) {
+    if (!loop.armed) {
         fprintf(stderr, "pil_gen: %s: never became ready (state %s, fault %s)\n", d->name,
-                fw_state_name(fw_state(&fw)), fw_fault_name(fw_fault(&fw)));
+                fw_state_name(fw_state(&loop.fw)), fw_fault_name(fw_fault(&loop.fw)));
         free(in);
         free(out);
         return 1;
     }
-    if (fw_state(&fw) != FW_STATE_RUNNING) {
+    if (fw_state(&loop.fw) != FW_STATE_RUNNING) {
         /* Still a valid recording (the replay compares whatever happened), but
          * the controller did not hold the operating point: say so. */
         fprintf(stderr, "pil_gen: warning: %s: state %s, fault %s at the end of the recording\n",
-                d->name, fw_state_name(fw_state(&fw)), fw_fault_name(fw_fault(&fw)));
+                d->name, fw_state_name(fw_state(&loop.fw)), fw_fault_name(fw_fault(&loop.fw)));
     }
     fprintf(f, "static const pil_in_t rec%zu_in[%u] = {\n", idx, n);
     for (uint32_t k = 0; k < n; k++) {
@@ -180,6 +143,7 @@ static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t
     free(in);
     free(out);
     *n_out = n;
+    *tref_out = loop.torque_ref_armed;
     return 0;
 }
 

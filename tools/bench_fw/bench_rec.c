@@ -22,8 +22,12 @@
 #include "hal_sim.h"
 #include "pipeline.h"
 #include "plant.h"
+#include "rec_loop.h"
 #include "sim_machine.h"
 #include "sim_run.h"
+
+_Static_assert(BENCH_CMD_TORQUE == PIL_CMD_TORQUE && BENCH_CMD_ARM == PIL_CMD_ARM,
+               "the recorded command bits are the PIL ones");
 
 static int die(const char *msg, const char *arg)
 {
@@ -42,33 +46,16 @@ static void put_name(char *dst, size_t n, const char *src)
 static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double speed_rpm,
                       double torque_nm, uint32_t periods, const char *outdir)
 {
-    static plant_t plant;
-    static hal_t hal;
-    static fw_t fw;
+    static rec_loop_t loop;
     const uint32_t calib = 256u;
     ctrl_machine_t cm;
     sim_ctrl_machine_from(sm, &cm);
     const uint32_t fs = d->fs_default_hz != 0u ? d->fs_default_hz : (uint32_t)sm->fs_hz;
-    plant_config_t pc;
-    sim_machine_to_plant(sm, &pc);
-    pc.mech = PLANT_MECH_IMPOSED;
-    pc.speed0_rpm = speed_rpm;
-    if (plant_init(&plant, &pc) != PLANT_OK) {
-        return die("plant_init failed for ", d->name);
+    const char *fail = rec_loop_init(&loop, d, sm, fs, speed_rpm, calib);
+    if (fail != NULL) {
+        return die(fail, d->name);
     }
-    hal_sim_config_t hc;
-    hal_sim_config_default(&hc, fs, sm->current_max_a, sm->vdc_v);
-    if (hal_sim_init(&hal, &hc, &plant) != HAL_SIM_OK) {
-        return die("hal_sim_init failed for ", d->name);
-    }
-    fw_config_t fc;
-    fw_config_default(&fc, &cm, d);
-    fc.calib_samples = calib;
-    if (fw_init(&fw, &hal, &fc) != FW_OK) {
-        return die("fw_init failed for ", d->name);
-    }
-    hal_info_t info;
-    hal_info_get(&hal, &info);
+    const hal_info_t info = loop.info;
     const uint32_t max = calib + 32u + periods;
     const size_t bytes = sizeof(bench_hdr_t) + (size_t)max * sizeof(bench_rec_t);
     if (bytes > BENCH_BLOB_MAX) {
@@ -81,59 +68,50 @@ static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double spee
     bench_hdr_t *h = (bench_hdr_t *)(void *)blob;
     bench_rec_t *rec = (bench_rec_t *)(void *)(h + 1);
     uint32_t n = 0u, after_arm = 0u;
-    int armed = 0;
     while (n < max && after_arm < periods) {
-        uint8_t cmd = 0u;
-        if (!armed && fw_state(&fw) == FW_STATE_READY) {
-            fw_set_torque_ref_nm(&fw, torque_nm);
-            fw_cmd_arm(&fw);
-            cmd = BENCH_CMD_TORQUE | BENCH_CMD_ARM;
-            armed = 1;
+        pil_in_t in;
+        rec_loop_isr(&loop, torque_nm, &in);
+        if (in.cmd != 0u) {
             h->arm_index = n;
-            h->torque_ref_q24 = fw.torque_ref;
         }
-        hal_sim_period_begin(&hal);
         bench_rec_t *r = &rec[n];
-        r->adc[0] = hal.adc.i_a;
-        r->adc[1] = hal.adc.i_b;
-        r->adc[2] = hal.adc.i_c;
-        r->adc[3] = hal.adc.vdc;
-        r->cmd = cmd;
-        r->index_seen = hal.enc.index_seen ? 1u : 0u;
-        r->trip = hal.trip ? 1u : 0u;
-        r->enc_count = hal.enc.count;
-        r->index_count = hal.enc.index_count;
-        fw_isr(&fw);
-        fw_watchdog_kick(&fw);
-        r->state_after = (uint8_t)fw_state(&fw);
+        memcpy(r->adc, in.adc, sizeof r->adc);
+        r->cmd = in.cmd; /* BENCH_CMD_* == PIL_CMD_* (asserted above) */
+        r->index_seen = in.index_seen;
+        r->trip = in.trip;
+        r->enc_count = in.enc_count;
+        r->index_count = in.index_count;
+        r->state_after = (uint8_t)fw_state(&loop.fw);
         for (int x = 0; x < 3; x++) {
-            r->cmp[x] = hal.shadow.cmp[x];
+            r->cmp[x] = loop.hal.shadow.cmp[x];
         }
-        if (hal_sim_period_end(&hal) != PLANT_OK) {
+        if (rec_loop_end(&loop) != PLANT_OK) {
             free(blob);
             return die("plant failed for ", d->name);
         }
         n++;
-        after_arm += armed ? 1u : 0u;
+        after_arm += loop.armed ? 1u : 0u;
     }
-    if (!armed) {
+    if (!loop.armed) {
         fprintf(stderr, "bench_rec: %s: never armed (state %s, fault %s)\n", d->name,
-                fw_state_name(fw_state(&fw)), fw_fault_name(fw_fault(&fw)));
+                fw_state_name(fw_state(&loop.fw)), fw_fault_name(fw_fault(&loop.fw)));
         free(blob);
         return 1;
     }
-    if (fw_state(&fw) != FW_STATE_RUNNING) {
+    if (fw_state(&loop.fw) != FW_STATE_RUNNING) {
         /* Kept: the benchmark counts the running periods before the fault
          * and reports the fault (a property of the controller, not of the bench). */
         fprintf(stderr,
                 "bench_rec: warning: %s at %.0f r/min: not running at the end (state %s, "
                 "fault %s)\n",
-                d->name, speed_rpm, fw_state_name(fw_state(&fw)), fw_fault_name(fw_fault(&fw)));
+                d->name, speed_rpm, fw_state_name(fw_state(&loop.fw)),
+                fw_fault_name(fw_fault(&loop.fw)));
     }
     h->magic = BENCH_MAGIC;
     h->version = BENCH_VERSION;
     h->n = n;
     h->calib_samples = calib;
+    h->torque_ref_q24 = loop.torque_ref_armed;
     h->speed_rpm = (uint32_t)(speed_rpm + 0.5);
     h->torque_mnm = (uint32_t)(torque_nm * 1000.0 + 0.5);
     put_name(h->ctrl_name, sizeof h->ctrl_name, d->name);

@@ -65,13 +65,22 @@
 #define PIL_OBS_PER_PERIOD 10u
 #define PIL_OVERRUN_AT_S 0.02
 
+/* Everything the image keeps between interrupts, in one instance (pil below):
+ * the Timer0 interrupt (pil_isr) and the wrapped controller step
+ * (pil_slow_step) are called without an argument that could carry it, so on
+ * bare metal it has to be reachable at file scope. Everything else takes it by
+ * pointer. */
 typedef struct {
+    plant_t plant;
+    hal_t hal;
+    fw_t fw;
+    fw_link_t link;
     /* closed loop */
     const pil_cl_t *sc;
     double ts, obs_dt, t_arm, speed_sum_rpm;
     uint64_t speed_n, tr_win_start;
     double t_win_start;
-    volatile bool arm_cmd; /* set by the main loop with the arm command */
+    volatile bool arm_cmd;     /* set by the main loop with the arm command */
     volatile bool armed, done; /* written by the interrupt, read by the main loop */
     bool win_started, win_done, obs_on;
     metrics_acc_t m_plant, m_ctrl;
@@ -86,17 +95,13 @@ typedef struct {
     uint32_t fault_period; /* ISR count at the fault */
     bool gates_at_fault;   /* plant gates still on in the faulted period */
     uint32_t overrun_start_period;
+    const ctrl_desc_t *inner; /* the selected controller, wrapped by slow_desc */
+    ctrl_desc_t slow_desc;
 } pil_t;
 
-static plant_t pil_plant;
-static hal_t pil_hal;
-static fw_t pil_fw;
-static fw_link_t pil_link;
 static pil_t pil;
 
 /* ---- deadline test: a controller that wraps the selected one ---- */
-static const ctrl_desc_t *pil_inner;
-static ctrl_desc_t pil_slow_desc;
 
 __attribute__((noinline)) static void pil_busy(uint32_t n)
 {
@@ -107,7 +112,7 @@ __attribute__((noinline)) static void pil_busy(uint32_t n)
 
 static void pil_slow_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
-    pil_inner->step(state, ctx, out);
+    pil.inner->step(state, ctx, out);
     if (pil.overrun_on) {
         pil_busy(pil.overrun_nops);
     }
@@ -122,9 +127,9 @@ static void pil_write(void *ctx, const uint8_t *bytes, size_t len)
     }
 }
 
-static double pil_torque_ref_nm(void)
+static double pil_torque_ref_nm(const pil_t *s)
 {
-    return ctrl_q24_to_double(pil_fw.refs.torque) * pil_fw.bases.torque_nm;
+    return ctrl_q24_to_double(s->fw.refs.torque) * s->fw.bases.torque_nm;
 }
 
 /* Plant observer on the Ts/10 grid (sim_run.c's, without the trace). */
@@ -138,7 +143,7 @@ static void pil_observer(void *ctx, const plant_t *p)
     if (t >= s->sc->win_start_s && t <= s->sc->win_end_s) {
         double i_abc[3];
         plant_i_abc(p, i_abc);
-        metrics_add(&s->m_plant, t, plant_torque(p), pil_torque_ref_nm(), plant_psi_amp(p),
+        metrics_add(&s->m_plant, t, plant_torque(p), pil_torque_ref_nm(s), plant_psi_amp(p),
                     i_abc[0]);
         s->speed_sum_rpm += plant_omega_m(p) * 60.0 / (2.0 * PIL_PI);
         s->speed_n++;
@@ -147,7 +152,7 @@ static void pil_observer(void *ctx, const plant_t *p)
 
 static void pil_count_transitions(pil_t *s, double t)
 {
-    const uint64_t n = plant_transitions(&pil_plant) - s->tr_win_start;
+    const uint64_t n = plant_transitions(&s->plant) - s->tr_win_start;
     metrics_set_transitions(&s->m_plant, n, t - s->t_win_start);
     metrics_set_transitions(&s->m_ctrl, n, t - s->t_win_start);
 }
@@ -157,12 +162,12 @@ static void pil_bookkeeping(pil_t *s, double t)
 {
     const bool in_win = PIL_PLANT_GRID && t + s->ts >= s->sc->win_start_s && t <= s->sc->win_end_s;
     if (in_win != s->obs_on) {
-        plant_set_observer(&pil_plant, in_win ? pil_observer : NULL, s, in_win ? s->obs_dt : 0.0);
+        plant_set_observer(&s->plant, in_win ? pil_observer : NULL, s, in_win ? s->obs_dt : 0.0);
         s->obs_on = in_win;
     }
     if (t >= s->sc->win_start_s && !s->win_started) {
         s->win_started = true;
-        s->tr_win_start = plant_transitions(&pil_plant);
+        s->tr_win_start = plant_transitions(&s->plant);
         s->t_win_start = t;
     }
     if (t >= s->sc->win_end_s && s->win_started && !s->win_done) {
@@ -171,9 +176,9 @@ static void pil_bookkeeping(pil_t *s, double t)
     }
     if (t >= s->sc->win_start_s && t <= s->sc->win_end_s) {
         double i_abc[3];
-        plant_i_abc(&pil_plant, i_abc);
-        metrics_add(&s->m_ctrl, t, plant_torque(&pil_plant), pil_torque_ref_nm(),
-                    plant_psi_amp(&pil_plant), i_abc[0]);
+        plant_i_abc(&s->plant, i_abc);
+        metrics_add(&s->m_ctrl, t, plant_torque(&s->plant), pil_torque_ref_nm(s),
+                    plant_psi_amp(&s->plant), i_abc[0]);
     }
 }
 
@@ -205,7 +210,7 @@ static void pil_isr(void)
         return;
     }
     const uint32_t t_enter = timer1_read();
-    if (hal_qemu_period_end(&pil_hal) != PLANT_OK) {
+    if (hal_qemu_period_end(&s->hal) != PLANT_OK) {
         s->done = true;
         timer0_stop();
         return;
@@ -213,10 +218,10 @@ static void pil_isr(void)
     if (s->arm_cmd && !s->armed) {
         /* The arm command was given after the previous period (as in sim_run_init). */
         s->armed = true;
-        s->t_arm = plant_time(&pil_plant);
+        s->t_arm = plant_time(&s->plant);
     }
     if (s->armed) {
-        const double t = plant_time(&pil_plant) - s->t_arm;
+        const double t = plant_time(&s->plant) - s->t_arm;
         if (!(t + 0.5 * s->ts < s->sc->duration_s)) {
             s->done = true;
             timer0_stop();
@@ -225,16 +230,16 @@ static void pil_isr(void)
         pil_bookkeeping(s, t);
         if (PIL_OVERRUN && !s->overrun_on && t >= PIL_OVERRUN_AT_S) {
             s->overrun_on = true;
-            s->overrun_start_period = pil_fw.period + 1u;
+            s->overrun_start_period = s->fw.period + 1u;
         }
     }
-    hal_qemu_period_begin(&pil_hal);
+    hal_qemu_period_begin(&s->hal);
 
-    const uint8_t state_before = (uint8_t)fw_state(&pil_fw);
-    fw_isr(&pil_fw);
-    fw_link_isr(&pil_link);
+    const uint8_t state_before = (uint8_t)fw_state(&s->fw);
+    fw_isr(&s->fw);
+    fw_link_isr(&s->link);
 
-    const fw_telemetry_t *tm = fw_telemetry(&pil_fw);
+    const fw_telemetry_t *tm = fw_telemetry(&s->fw);
     const uint32_t pipe = tm->cycles;
     if (pipe > s->pipe_max) {
         s->pipe_max = pipe;
@@ -247,10 +252,10 @@ static void pil_isr(void)
         s->pipe_n++;
     }
     if (tm->state == FW_STATE_FAULT && s->fault_period == 0u) {
-        s->fault_period = pil_fw.period;
+        s->fault_period = s->fw.period;
         /* hal_gate_enable(false) acts at once: the plant period that starts
          * now is integrated with all switches open. */
-        s->gates_at_fault = hal_qemu_plant_gates_on(hal_qemu_plant_models(&pil_hal));
+        s->gates_at_fault = hal_qemu_plant_gates_on(hal_qemu_plant_models(&s->hal));
         /* The deadline test ends at the fault; elsewhere a fault fails the run
          * (and with the gates open the plant's RK4 path is slow). */
         s->done = true;
@@ -271,19 +276,19 @@ static void pil_isr(void)
 /* Feeds a command line to the interpreter with the interrupt masked, so that
  * it acts between two periods exactly (as the host simulator's calls do);
  * *mark (if not NULL) is set in the same masked section. */
-static void pil_command(const char *line, volatile bool *mark)
+static void pil_command(pil_t *s, const char *line, volatile bool *mark)
 {
     uart_puts("> ");
     uart_puts(line);
     board_irq_disable();
     for (const char *c = line; *c != '\0'; c++) {
-        fw_link_rx(&pil_link, (uint8_t)*c);
+        fw_link_rx(&s->link, (uint8_t)*c);
     }
     if (mark != NULL) {
         *mark = true;
     }
     board_irq_enable();
-    fw_link_poll(&pil_link);
+    fw_link_poll(&s->link);
 }
 
 static void pil_print_num(const char *key, double host, double target, double tol)
@@ -340,7 +345,7 @@ int main(void)
     pc.inertia_kgm2 = sc->inertia_kgm2;
     pc.friction_nms = sc->friction_nms;
     pc.speed0_rpm = sc->speed_rpm;
-    if (plant_init(&pil_plant, &pc) != PLANT_OK) {
+    if (plant_init(&s->plant, &pc) != PLANT_OK) {
         printf("pil: plant_init failed\n");
         return 2;
     }
@@ -359,35 +364,35 @@ int main(void)
     hc.enc_index = sc->enc_index != 0u;
     hc.trip_level_a = sc->trip_level_a;
     hc.seed = 1u;
-    hal_qemu_plant_t *models = hal_qemu_plant_init(&hc, &pil_plant);
-    if (models == NULL || hal_qemu_init(&pil_hal, models, PIL_CPU_HZ) != HAL_QEMU_OK) {
+    hal_qemu_plant_t *models = hal_qemu_plant_init(&hc, &s->plant);
+    if (models == NULL || hal_qemu_init(&s->hal, models, PIL_CPU_HZ) != HAL_QEMU_OK) {
         printf("pil: HAL init failed\n");
         return 2;
     }
     if (PIL_OVERRUN) {
-        pil_inner = desc;
-        pil_slow_desc = *desc;
-        pil_slow_desc.step = pil_slow_step;
-        desc = &pil_slow_desc;
+        s->inner = desc;
+        s->slow_desc = *desc;
+        s->slow_desc.step = pil_slow_step;
+        desc = &s->slow_desc;
     }
     fw_config_t fc;
     fw_config_default(&fc, &sc->machine, desc);
     fc.calib_samples = sc->calib_samples;
-    const int frc = fw_init(&pil_fw, &pil_hal, &fc);
+    const int frc = fw_init(&s->fw, &s->hal, &fc);
     if (frc != FW_OK) {
         printf("pil: fw_init: %s\n", fw_strerror(frc));
         return 2;
     }
     hal_info_t info;
-    hal_info_get(&pil_hal, &info);
+    hal_info_get(&s->hal, &info);
     /* Busy-wait of twice the budget (the loop costs >= 3 instructions per nop). */
     s->overrun_nops = 2u * (uint32_t)((uint64_t)PIL_CPU_HZ / info.pwm_freq_hz);
     printf("pil: %s on %s, fs %u Hz, %.0f r/min, %.2f N*m, %.2f s; Timer1 %u ticks/1000 instr; "
            "deadline budget %u instr (CPU %u Hz)\n",
            desc->name, sc->machine.name, (unsigned)sc->fs_hz, sc->speed_rpm, sc->torque_ref_nm,
-           sc->duration_s, (unsigned)hal_qemu_ticks_per_kinstr(&pil_hal),
+           sc->duration_s, (unsigned)hal_qemu_ticks_per_kinstr(&s->hal),
            (unsigned)(PIL_CPU_HZ / info.pwm_freq_hz), (unsigned)PIL_CPU_HZ);
-    fw_link_init(&pil_link, &pil_fw, pil_write, NULL);
+    fw_link_init(&s->link, &s->fw, pil_write, NULL);
     hal_qemu_uart_rx_enable();
     /* No THD on the target: its Fourier sums over the Ts/10 samples cost ~10^10
      * soft-float instructions (see README-pil.md). */
@@ -404,62 +409,61 @@ int main(void)
         const int c = hal_qemu_uart_getc();
         if (c >= 0) {
             board_irq_disable();
-            fw_link_rx(&pil_link, (uint8_t)c);
+            fw_link_rx(&s->link, (uint8_t)c);
             board_irq_enable();
         }
-        if (!sent && fw_state(&pil_fw) == FW_STATE_READY) {
-            pil_command(script, NULL);
-            pil_command("arm\n", &s->arm_cmd);
+        if (!sent && fw_state(&s->fw) == FW_STATE_READY) {
+            pil_command(s, script, NULL);
+            pil_command(s, "arm\n", &s->arm_cmd);
             sent = true;
         }
-        if (sent && !s->armed && fw_state(&pil_fw) == FW_STATE_FAULT) {
+        if (sent && !s->armed && fw_state(&s->fw) == FW_STATE_FAULT) {
             break;
         }
-        fw_link_poll(&pil_link);
-        fw_watchdog_kick(&pil_fw);
+        fw_link_poll(&s->link);
+        fw_watchdog_kick(&s->fw);
         board_idle();
     }
     timer0_stop();
     const uint32_t virt_ticks = timer1_read() - t_start;
-    pil_command("status\n", NULL);
+    pil_command(s, "status\n", NULL);
 
-    const uint32_t pipe_max_i = hal_qemu_ticks_to_instr(&pil_hal, s->pipe_max_running);
+    const uint32_t pipe_max_i = hal_qemu_ticks_to_instr(&s->hal, s->pipe_max_running);
     const uint32_t pipe_mean_i =
-        s->pipe_n > 0u ? hal_qemu_ticks_to_instr(&pil_hal, (uint32_t)(s->pipe_sum / s->pipe_n))
-                       : 0u;
+        s->pipe_n > 0u ? hal_qemu_ticks_to_instr(&s->hal, (uint32_t)(s->pipe_sum / s->pipe_n)) : 0u;
     printf("pil: %lu interrupts; pipeline (fw_isr, running) mean %u max %u instructions "
            "(budget %u); interrupt incl. plant mean %u max %u instructions; %.2f s virtual\n",
            (unsigned long)s->isr_n, (unsigned)pipe_mean_i, (unsigned)pipe_max_i,
            (unsigned)(PIL_CPU_HZ / info.pwm_freq_hz),
-           (unsigned)hal_qemu_ticks_to_instr(&pil_hal,
+           (unsigned)hal_qemu_ticks_to_instr(&s->hal,
                                              s->isr_n ? (uint32_t)(s->isr_sum / s->isr_n) : 0u),
-           (unsigned)hal_qemu_ticks_to_instr(&pil_hal, s->isr_max),
+           (unsigned)hal_qemu_ticks_to_instr(&s->hal, s->isr_max),
            (double)virt_ticks / (double)QEMU_MPS2_SYSCLK_HZ);
 
     if (PIL_OVERRUN) {
-        const fw_telemetry_t *tm = fw_telemetry(&pil_fw);
+        const fw_telemetry_t *tm = fw_telemetry(&s->fw);
         printf("pil: busy-wait (%u nop loop passes) in the controller step from ISR %u; fault "
                "%s at ISR %u after %u pipeline instructions (budget %u); state %s; plant "
                "gates %s\n",
                (unsigned)s->overrun_nops, (unsigned)s->overrun_start_period,
-               fw_fault_name(fw_fault(&pil_fw)), (unsigned)s->fault_period,
-               (unsigned)hal_qemu_ticks_to_instr(&pil_hal, tm->cycles),
-               (unsigned)(PIL_CPU_HZ / info.pwm_freq_hz), fw_state_name(fw_state(&pil_fw)),
+               fw_fault_name(fw_fault(&s->fw)), (unsigned)s->fault_period,
+               (unsigned)hal_qemu_ticks_to_instr(&s->hal, tm->cycles),
+               (unsigned)(PIL_CPU_HZ / info.pwm_freq_hz), fw_state_name(fw_state(&s->fw)),
                s->gates_at_fault ? "ON" : "off");
-        const bool ok = s->overrun_on && fw_fault(&pil_fw) == FW_FAULT_DEADLINE &&
-                        fw_state(&pil_fw) == FW_STATE_FAULT && !s->gates_at_fault &&
+        const bool ok = s->overrun_on && fw_fault(&s->fw) == FW_FAULT_DEADLINE &&
+                        fw_state(&s->fw) == FW_STATE_FAULT && !s->gates_at_fault &&
                         tm->gates == 0u && s->fault_period == s->overrun_start_period;
         printf("%s: deadline overrun -> fault %u, gates off in the same period\n",
                ok ? "PASS" : "FAIL", (unsigned)FW_FAULT_DEADLINE);
         return ok ? 0 : 4;
     }
-    if (fw_state(&pil_fw) != FW_STATE_RUNNING || pil_hal.plant_rc != PLANT_OK || !s->armed) {
-        printf("FAIL: state %s, fault %s, plant %d\n", fw_state_name(fw_state(&pil_fw)),
-               fw_fault_name(fw_fault(&pil_fw)), pil_hal.plant_rc);
+    if (fw_state(&s->fw) != FW_STATE_RUNNING || s->hal.plant_rc != PLANT_OK || !s->armed) {
+        printf("FAIL: state %s, fault %s, plant %d\n", fw_state_name(fw_state(&s->fw)),
+               fw_fault_name(fw_fault(&s->fw)), s->hal.plant_rc);
         return 3;
     }
     if (!s->win_done && s->win_started) {
-        pil_count_transitions(s, plant_time(&pil_plant) - s->t_arm);
+        pil_count_transitions(s, plant_time(&s->plant) - s->t_arm);
     }
     metrics_result_t mp, mc;
     memset(&mp, 0, sizeof mp);
