@@ -32,7 +32,7 @@ static const ctrl_tunable_t foc_tunables[] = {
 };
 
 static const ctrl_tunable_t foc_hyst_tunables[] = {
-    {"h_i", "A", "phase-current hysteresis half band (S1 §2 current-controlled inverter)",
+    {"h_i", "A", "phase-current hysteresis half band (S1 sec. 2 current-controlled inverter)",
      offsetof(ctrl_foc_cfg_t, h_i), 0.0, 1.0e4},
     {"mtpa", "-", "1: i_d from the MTPA locus (IPMSM); 0: i_d = 0 (S1 Algorithm 1)",
      offsetof(ctrl_foc_cfg_t, mtpa), 0.0, 1.0},
@@ -193,7 +193,7 @@ static int foc_hyst_init(void *state, const void *cfg, const ctrl_params_t *p)
 
 const ctrl_desc_t ctrl_desc_foc = {
     "foc",
-    "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 §2, Algorithm 1)",
+    "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
     FOC_FS_HZ,
     sizeof(ctrl_foc_state_t),
     sizeof(ctrl_foc_cfg_t),
@@ -208,7 +208,7 @@ const ctrl_desc_t ctrl_desc_foc = {
 
 const ctrl_desc_t ctrl_desc_foc_hyst = {
     "foc_hyst",
-    "FOC with per-phase hysteresis current control, one vector per period (S1 §2)",
+    "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
     FOC_FS_HZ,
     sizeof(ctrl_foc_state_t),
     sizeof(ctrl_foc_cfg_t),

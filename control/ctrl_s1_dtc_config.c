@@ -18,23 +18,23 @@
 #define S1_TILT_DEFAULT (S1_PI / 30.0) /* 6 deg: half a section */
 
 static const ctrl_tunable_t hdtc_tunables[] = {
-    {"h_T", "N*m", "torque hysteresis half band (S1 §3.3: +-0.01)", offsetof(ctrl_s1_cfg_t, h_t),
-     0.0, 1000.0},
-    {"h_psi", "Wb", "flux hysteresis half band (S1 §3.3: +-0.01)", offsetof(ctrl_s1_cfg_t, h_psi),
-     0.0, 10.0},
-    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 §4, §6.1.4)",
+    {"h_T", "N*m", "torque hysteresis half band (S1 sec. 3.3: +-0.01)",
+     offsetof(ctrl_s1_cfg_t, h_t), 0.0, 1000.0},
+    {"h_psi", "Wb", "flux hysteresis half band (S1 sec. 3.3: +-0.01)",
+     offsetof(ctrl_s1_cfg_t, h_psi), 0.0, 10.0},
+    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 sec. 4, sec. 6.1.4)",
      offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
 };
 
 static const ctrl_tunable_t svm_tunables[] = {
-    {"Kp", "rad/pu", "predictive-controller PI, Delta delta per pu torque error (S1 §4.1: 1)",
+    {"Kp", "rad/pu", "predictive-controller PI, Delta delta per pu torque error (S1 sec. 4.1: 1)",
      offsetof(ctrl_s1_cfg_t, kp), 0.0, 100.0},
-    {"Ki", "rad/(pu*sample)", "integral gain per sample (S1 §4.1: 0.03)",
+    {"Ki", "rad/(pu*sample)", "integral gain per sample (S1 sec. 4.1: 0.03)",
      offsetof(ctrl_s1_cfg_t, ki), 0.0, 10.0},
     {"omega_ff", "-", "1: add the rotor advance omega_e Ts to Delta delta",
      offsetof(ctrl_s1_cfg_t, omega_ff), 0.0, 1.0},
-    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 §4)", offsetof(ctrl_s1_cfg_t, psi_ref), 0.0,
-     100.0},
+    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 sec. 4)", offsetof(ctrl_s1_cfg_t, psi_ref),
+     0.0, 100.0},
 };
 
 static const ctrl_tunable_t hpdtc_tunables[] = {
@@ -293,9 +293,9 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
         0,                                                                                         \
     }
 
-S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 §3, Table 3)",
+S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",
         ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step);
-S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 §4, S1(17)-(20))",
+S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 sec. 4, S1(17)-(20))",
         ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step);
-S1_DESC(hpdtc, "HP-DTC, two adjacent vectors + 20-point timing table (S1 §5, Table 4)",
+S1_DESC(hpdtc, "HP-DTC, two adjacent vectors + 20-point timing table (S1 sec. 5, Table 4)",
         ctrl_hpdtc_state_t, hpdtc_tunables, hpdtc_init, ctrl_hpdtc_reset, ctrl_hpdtc_step);

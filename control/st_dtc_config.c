@@ -25,7 +25,7 @@ static const ctrl_tunable_t fst_tunables[] = {
     {"sigma", "rad", "subsector width of the voltage replacement (4.19), 0 = off",
      offsetof(st_fst_cfg_t, sigma), 0.0, ST_SIGMA_MAX},
     {"dT_step", "N*m",
-     "reference-step detection |dT_ref| > dT_step (§4.5.3; 0 = any change, as the thesis)",
+     "reference-step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)",
      offsetof(st_fst_cfg_t, dt_step), 0.0, 1000.0},
 };
 
@@ -203,7 +203,7 @@ ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (T
 
 const ctrl_desc_t ctrl_desc_fst = {
     "fst",
-    "ST-DTC, flexible switching table + voltage replacement (thesis §4.5, Table 4.6)",
+    "ST-DTC, flexible switching table + voltage replacement (thesis sec. 4.5, Table 4.6)",
     ST_FS_HZ,
     sizeof(st_fst_state_t),
     sizeof(st_fst_cfg_t),
