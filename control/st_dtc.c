@@ -69,6 +69,33 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
                           ctrl_hyst3_update(&s->torque3, t_err));
         break;
     case ST_KIND_MBST:
+        /*
+         * MBST has a voltage (speed) limit that BST does not share; it is a
+         * property of Table 4.3 with sectors (4.18), not a bug. To raise the
+         * torque only V_{x+1} and V_{x+3} are available, 120 deg apart. With
+         * |psi_s| held in its band their mix lies on the chord between them,
+         * whose part along the flux's direction of motion at flux angle u
+         * into the sector is |V| / (2 cos(30 deg - u)), |V| = 2/3 Vdc: from
+         * Vdc/3 (mid-sector) to 2 Vdc / (3 sqrt 3) (edges), time average
+         * pi Vdc / 9. BST (V_{x+1}, V_{x+2}, 60 deg apart) gets sqrt(3)
+         * times more. So the flux can turn at most at
+         * omega_e |psi_s| = pi Vdc / 9 - R_s i. Thesis SPMSM, Vdc 220 V,
+         * 1.8 N*m with MTPA flux 0.0966 Wb: 76.8 V - 2.9 V, i.e. about
+         * 1830 r/min (BST: 133 V, about 3200 r/min). At 2250 r/min the flux
+         * must turn at 942 rad/s * 0.0966 Wb = 91 V, more than the 84.7 V at
+         * the best sector position: it falls behind the rotor at any band,
+         * sample rate or sensor resolution, the load angle walks negative
+         * while the table keeps asking for more torque, and the current
+         * |psi_s - psi_pm| / L reaches the 10.5 A trip (after 6.7 ms in
+         * ./tools/sim, load angle -41 deg). Measured: the simulator holds
+         * 1.68 N*m at 750 r/min, 1.30 at 1800, 0.57 at 1900, slips at 2000;
+         * at 2250 r/min it stays in motoring with Vdc 270 V, slips at 250 V (limit
+         * 9 (91 + 3) / pi = 269 V). The thesis predicts this (§4.4.2: V_{x+1}
+         * and V_{x+3} fail to raise the torque at high speed; Fig. 4.10(b):
+         * MBST unstable at 3000 r/min); its 2250 r/min MBST experiment
+         * (Fig. 4.13) cannot be met at the stated 220 V. Test:
+         * tables_closed_loop, test_mbst_voltage_limit.
+         */
         n = st_lookup_mbst(ctrl_sector_mbst(nx->psi_alpha, nx->psi_beta), e_psi,
                            ctrl_hyst3_update(&s->torque3, t_err));
         break;

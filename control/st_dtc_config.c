@@ -196,6 +196,8 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_params_t *p)
     }
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init);
+/* MBST cannot hold the thesis SPMSM above about 1830 r/min at 220 V (an
+ * average-voltage limit of Table 4.3 with (4.18)): see ST_KIND_MBST in st_dtc.c. */
 ST_HYST_DESC(mbst, "ST-DTC, modified basic table, sectors (4.18) (thesis Table 4.3)", st_mbst_init);
 ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4.4)", st_ast_init);
 ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (Table 4.5)",
