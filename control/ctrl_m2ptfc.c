@@ -1,6 +1,8 @@
 /* Two-candidate M2PTFC, thesis §6.3 (see ctrl_m2ptfc.h). Integer only. */
 #include "ctrl_m2ptfc.h"
 
+#include <stddef.h>
+
 #include "plan.h"
 
 /* V_{x+1}, V_{x+2}, V_{x+4}, V_{x+5} for x = 1..6 (index arithmetic of (4.14)
@@ -49,16 +51,35 @@ void ctrl_m2ptfc_reset(void *state)
     }
     s->sigma = 0;
     s->trace.n = 0u;
+    s->psi2_params = NULL; /* no valid psi_ref^2 cached */
+}
+
+/* psi_ref^2 of (6.9) (MTPA (4.15) squared, ctrl_mpc_psi_ref2), from the cache
+ * when params and the references are those it was computed for. */
+static int32_t m2ptfc_psi2(ctrl_m2ptfc_t *s, const ctrl_params_t *p, const ctrl_refs_t *ref)
+{
+    if (s->psi2_params != p || s->psi2_torque != ref->torque || s->psi2_psi != ref->psi) {
+        s->psi2 = ctrl_mpc_psi_ref2(p, ref);
+        s->psi2_params = p;
+        s->psi2_torque = ref->torque;
+        s->psi2_psi = ref->psi;
+    }
+    return s->psi2;
 }
 
 void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
 {
     ctrl_m2ptfc_t *s = state;
-    ctrl_mpc_basis_t b;
-    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
+    if (out == NULL) {
         return;
     }
-    const ctrl_params_t *p = ctx->params;
+    if (s == NULL || !ctrl_ctx_ok(ctx)) {
+        ctrl_plan_single(out, 0u); /* no voltage (as ctrl_mpc_step_begin) */
+        return;
+    }
+    /* Only V1..V3 are rotated: the two candidates are any V_i (ctrl_mpc_vec3_dq). */
+    ctrl_mpc_basis3_t b;
+    ctrl_mpc_basis3(&s->model, ctx->params, ctx->est, &b);
     const ctrl_estimate_t *est = ctx->est;
     const q24_t t_ref = ctx->ref->torque;
     const q24_t t1 = est->next.torque;
@@ -66,8 +87,10 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     /* Te of (6.5), (6.7), (6.8): Te(k+1), or Te_c for centre-aligned PWM (header). */
     const q24_t te = ctrl_m2ptfc_t_eval(s, t1, b.t0);
 
-    /* (6.8) sigma_T = lambda (T_ref - Te) + (1 - lambda) sigma_T(k-1). */
-    s->sigma = fx_add(s->sigma, fx_mul(s->lambda, fx_sub(fx_sub(t_ref, te), s->sigma)));
+    /* (6.8) sigma_T = lambda (T_ref - Te) + (1 - lambda) sigma_T(k-1). With
+     * 0 < lambda <= FX_ONE (init) the product is at most 2^24 * 2^31 = 2^55
+     * in magnitude and its rounded Q24 value fits an int32_t: no saturation. */
+    s->sigma = fx_add(s->sigma, fx_mul_nosat(s->lambda, fx_sub(fx_sub(t_ref, te), s->sigma)));
     const q24_t t_upper = fx_add(t_ref, s->sigma);
     const q24_t num = fx_sub(t_upper, te); /* numerator of (6.5) */
     const q24_t two_sigma = fx_add(s->sigma, s->sigma);
@@ -75,22 +98,24 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     uint8_t cand[2];
     ctrl_m2ptfc_candidates(est->next.sector, t_upper, te, cand);
 
-    /* psi_ref^2 of (6.9), compared on squares: no square root (MTPA (4.15) squared). */
-    const int32_t r2 = ctrl_mpc_ref2_amp2(&b, ctrl_mpc_psi_ref2(p, ctx->ref));
+    /* psi_ref^2 of (6.9), compared on squares: no square root (MTPA (4.15)
+     * squared), scaled by mag2 as ctrl_mpc_ref2_amp2: psi2 <= 2^30 (amp2
+     * clamp) and mag2 < 2^24 (1 + 2.5e-6), product < 2^55 - 2^23: no saturation. */
+    const int32_t r2 = fx_mul_nosat(m2ptfc_psi2(s, ctx->params, ctx->ref), b.mag2);
 
     q24_t duty[2];
     int32_t a2[2];
     for (unsigned k = 0; k < 2u; k++) {
         q24_t vd;
         q24_t vq;
-        ctrl_mpc_vec_dq(&b, cand[k], &vd, &vq);
+        ctrl_mpc_vec3_dq(&b, cand[k], &vd, &vq);
         /* Te(k+2) with the vector for the whole period -> dTe[x+n] (6.10)-(6.11). */
         const q24_t t_full = ctrl_mpc_torque(&s->model, b.d0 + vd, b.q0 + vq);
         const q24_t den = fx_add(fx_sub(t_full, t1), two_sigma);
         duty[k] = ctrl_m2ptfc_duty(num, den); /* (6.5)-(6.6) */
-        q24_t pd;
-        q24_t pq;
-        ctrl_mpc_flux(&b, vd, vq, duty[k], &pd, &pq); /* psi(k+2) for D Ts */
+        /* psi(k+2) for D Ts (ctrl_mpc_flux: components <= 12.4 pu, no overflow). */
+        const q24_t pd = b.d0 + fx_mul_nosat(duty[k], vd);
+        const q24_t pq = b.q0 + fx_mul_nosat(duty[k], vq);
         a2[k] = ctrl_mpc_amp2(pd, pq);
     }
     /* (6.9): keep the first candidate unless the second is strictly closer. */

@@ -12,8 +12,21 @@
 #define MPC_SQRT3_2 ((q24_t)14529495)
 #define MPC_HALF ((q24_t)(FX_ONE / 2))
 
-void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                    ctrl_mpc_basis_t *b)
+/* Forced inlining of the shared basis core: an out-of-line call costs each
+ * step more than it saves in code (measured, tools/bench). */
+#if defined(__GNUC__)
+#define MPC_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define MPC_ALWAYS_INLINE
+#endif
+
+/* The part of the basis common to ctrl_mpc_basis and ctrl_mpc_basis3:
+ * d0, q0, t0, mag2 and Ts V1 = (w[0], w[1]), Ts V2 = (w[2], w[3]) in the
+ * rotor frame at k+2 (inlined into both, one set of arithmetic). */
+static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
+                                                    const ctrl_params_t *p,
+                                                    const ctrl_estimate_t *est, q24_t *d0,
+                                                    q24_t *q0, q24_t *t0, q24_t *mag2, q24_t w[4])
 {
     const ctrl_mstate_t *n = &est->next;
     /* (6.10) with a zero vector, alpha/beta: psi(k+1) - Ts Rs i(k+1). The
@@ -34,20 +47,33 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
     q24_t c;
     fx_sincos(th2, &s, &c);
     /* Park (3.7): d = c a + s b, q = c b - s a. */
-    b->d0 = fx_dot_nosat(c, s, pa, pb);
-    b->q0 = fx_dot_nosat(c, -s, pb, pa);
-    b->t0 = ctrl_mpc_torque(m, b->d0, b->q0);
-    b->mag2 = fx_dot_nosat(s, c, s, c);
+    const q24_t d = fx_dot_nosat(c, s, pa, pb);
+    const q24_t q = fx_dot_nosat(c, -s, pb, pa);
+    *d0 = d;
+    *q0 = q;
+    *t0 = ctrl_mpc_torque(m, d, q);
+    *mag2 = fx_dot_nosat(s, c, s, c);
     /* Ts V1 = Ts 2/3 Vdc on alpha; in the rotor frame Ts|V| e^{-j th2}:
      * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
      * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
     const q24_t mv = fx_mul_nosat(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
     const q24_t c1 = fx_dot_nosat(c, s, MPC_HALF, MPC_SQRT3_2);
     const q24_t s1 = fx_dot_nosat(s, -c, MPC_HALF, MPC_SQRT3_2);
-    const q24_t w0d = fx_mul_nosat(mv, c);
-    const q24_t w0q = -fx_mul_nosat(mv, s);
-    const q24_t w1d = fx_mul_nosat(mv, c1);
-    const q24_t w1q = -fx_mul_nosat(mv, s1);
+    w[0] = fx_mul_nosat(mv, c);
+    w[1] = -fx_mul_nosat(mv, s);
+    w[2] = fx_mul_nosat(mv, c1);
+    w[3] = -fx_mul_nosat(mv, s1);
+}
+
+void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                    ctrl_mpc_basis_t *b)
+{
+    q24_t w[4];
+    mpc_basis_core(m, p, est, &b->d0, &b->q0, &b->t0, &b->mag2, w);
+    const q24_t w0d = w[0];
+    const q24_t w0q = w[1];
+    const q24_t w1d = w[2];
+    const q24_t w1q = w[3];
     /* V3 = V1 e^{j 2pi/3} = V2 - V1; V_{i+3} = -V_i. */
     const q24_t w2d = w1d - w0d;
     const q24_t w2q = w1q - w0q;
@@ -63,6 +89,19 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
     b->wq[4] = -w1q;
     b->wd[5] = -w2d;
     b->wq[5] = -w2q;
+}
+
+void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                     ctrl_mpc_basis3_t *b)
+{
+    q24_t w[4];
+    mpc_basis_core(m, p, est, &b->d0, &b->q0, &b->t0, &b->mag2, w);
+    b->wd[0] = w[0];
+    b->wq[0] = w[1];
+    b->wd[1] = w[2];
+    b->wq[1] = w[3];
+    b->wd[2] = w[2] - w[0]; /* V3 = V2 - V1 */
+    b->wq[2] = w[3] - w[1];
 }
 
 int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_plan_t *out,

@@ -60,6 +60,16 @@ typedef struct {
                          * so amplitude comparisons do not see it */
 } ctrl_mpc_basis_t;
 
+/* The same basis with only V1..V3 (V_{i+3} = -V_i): for controllers that use
+ * two candidates (m2ptfc), ctrl_mpc_vec3_dq() gives any V_i. Same ranges and
+ * the same values as ctrl_mpc_basis_t (bit-identical arithmetic). */
+typedef struct {
+    q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
+    q24_t wd[3], wq[3]; /* Ts V_1 .. Ts V_3, rotor frame (index i - 1), Q24 pu */
+    q24_t t0;           /* Te(k+2) with a zero vector, Q24 pu */
+    q24_t mag2;         /* as in ctrl_mpc_basis_t, Q24 */
+} ctrl_mpc_basis3_t;
+
 /* Model limits checked by ctrl_mpc_model_init (CTRL_ERANGE outside). */
 #define CTRL_MPC_AB_MAX (2 * FX_ONE)    /* |a|, |b| <= 2 pu */
 #define CTRL_MPC_TS_V_MAX (FX_ONE / 2)  /* Ts 2/3 <= 0.5 pu */
@@ -151,6 +161,11 @@ int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_p
 void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
                     ctrl_mpc_basis_t *b);
 
+/* ctrl_mpc_basis() with V1..V3 only (no V4..V6): the same d0, q0, t0, mag2
+ * and wd/wq[0..2] bit for bit. */
+void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                     ctrl_mpc_basis3_t *b);
+
 /* Stator-flux amplitude reference: ref->psi if > 0, else the machine's fixed
  * reference p->psi_ref if > 0, else MTPA of the torque reference (4.15). */
 q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref);
@@ -199,6 +214,19 @@ static inline void ctrl_mpc_vec_dq(const ctrl_mpc_basis_t *b, uint8_t i, q24_t *
 {
     *vd = b->wd[i - 1u];
     *vq = b->wq[i - 1u];
+}
+
+/* Ts V_i (i = 1..6) from a ctrl_mpc_basis3_t: V_i for i <= 3, else -V_{i-3}
+ * (equal to ctrl_mpc_vec_dq of the full basis; |w| <= 1 pu, no overflow). */
+static inline void ctrl_mpc_vec3_dq(const ctrl_mpc_basis3_t *b, uint8_t i, q24_t *vd, q24_t *vq)
+{
+    if (i > 3u) {
+        *vd = -b->wd[i - 4u];
+        *vq = -b->wq[i - 4u];
+    } else {
+        *vd = b->wd[i - 1u];
+        *vq = b->wq[i - 1u];
+    }
 }
 
 /* Te = psi_q (a + b psi_d), (3.6)/(6.11) with (6.12) in the rotor frame, for a

@@ -644,6 +644,107 @@ static void test_psi_ref2(void)
     }
 }
 
+/* ctrl_mpc_basis3 (m2ptfc: V1..V3 only) gives the same basis as
+ * ctrl_mpc_basis bit for bit, every V_i through ctrl_mpc_vec3_dq, also for
+ * states far outside any machine's range (the clamps of the basis). */
+static void test_basis3_equals_basis(void)
+{
+    const ctrl_machine_t *ms[3] = {&ini_thesis_spmsm, &ini_thesis_ipmsm80, &ini_chapter_ipmsm};
+    for (int k = 0; k < 3; k++) {
+        ctrl_params_t p;
+        params_for(ms[k], 10000u, &p);
+        ctrl_m2ptfc_cfg_t c;
+        ctrl_m2ptfc_t s;
+        ctrl_desc_m2ptfc.cfg_default(&c, ms[k]);
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
+        for (int i = 0; i < N_RANDOM; i++) {
+            ctrl_estimate_t est;
+            ctrl_refs_t ref;
+            ctrl_plan_t applied;
+            random_point(&p, &est, &ref, &applied);
+            if (i % 8 == 7) { /* any int32_t: beyond the clamps */
+                est.next.i_alpha = fx_u2i(rng_u32());
+                est.next.i_beta = fx_u2i(rng_u32());
+                est.next.psi_alpha = fx_u2i(rng_u32());
+                est.next.psi_beta = fx_u2i(rng_u32());
+                est.vdc = fx_u2i(rng_u32());
+            }
+            ctrl_mpc_basis_t b6;
+            ctrl_mpc_basis3_t b3;
+            ctrl_mpc_basis(&s.model, &p, &est, &b6);
+            ctrl_mpc_basis3(&s.model, &p, &est, &b3);
+            TEST_ASSERT_EQUAL_INT32(b6.d0, b3.d0);
+            TEST_ASSERT_EQUAL_INT32(b6.q0, b3.q0);
+            TEST_ASSERT_EQUAL_INT32(b6.t0, b3.t0);
+            TEST_ASSERT_EQUAL_INT32(b6.mag2, b3.mag2);
+            for (uint8_t v = 1u; v <= 6u; v++) {
+                q24_t d6;
+                q24_t q6;
+                q24_t d3;
+                q24_t q3;
+                ctrl_mpc_vec_dq(&b6, v, &d6, &q6);
+                ctrl_mpc_vec3_dq(&b3, v, &d3, &q3);
+                TEST_ASSERT_EQUAL_INT32(d6, d3);
+                TEST_ASSERT_EQUAL_INT32(q6, q3);
+            }
+        }
+    }
+}
+
+/* The cached psi_ref^2 of m2ptfc follows every change of ref->torque,
+ * ref->psi and params: each step decides exactly as a step whose cache was
+ * just invalidated (same sigma), and the cache holds ctrl_mpc_psi_ref2 of the
+ * inputs of the last step. */
+static void test_m2ptfc_psi2_cache(void)
+{
+    ctrl_params_t pa;
+    ctrl_params_t pb;
+    params_for(&ini_thesis_spmsm, 10000u, &pa);
+    params_for(&ini_thesis_spmsm, 10000u, &pb);
+    pb.psi_ref = q24(1.05 * d24(pa.psi_pm)); /* fixed reference instead of MTPA */
+    ctrl_m2ptfc_cfg_t c;
+    ctrl_m2ptfc_t s;
+    ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &pa));
+    TEST_ASSERT_NULL(s.psi2_params);
+    ctrl_estimate_t est;
+    ctrl_refs_t ref;
+    ctrl_plan_t applied;
+    random_point(&pa, &est, &ref, &applied);
+    int recomputed = 0;
+    for (int i = 0; i < 300; i++) {
+        /* references held for a few steps, then changed (torque, psi or params) */
+        const ctrl_params_t *p = (i / 50) % 2 ? &pb : &pa;
+        if (i % 7 == 0) {
+            ref.torque = q24(rng_uniform(-1.2, 1.2) * d24(pa.torque_rated));
+        }
+        if (i % 11 == 0) {
+            ref.psi = (rng_u32() & 1u) ? 0 : q24(rng_uniform(0.8, 1.2) * d24(pa.psi_pm));
+        }
+        est.next.theta_e += 0x01000000u; /* the machine moves on */
+        ctrl_m2ptfc_t fresh = s;
+        fresh.psi2_params = NULL;
+        const ctrl_params_t *cached = s.psi2_params;
+        const q24_t cached_t = s.psi2_torque;
+        const q24_t cached_psi = s.psi2_psi;
+        const ctrl_ctx_t ctx = {p, &est, &ref, &applied};
+        ctrl_plan_t o1;
+        ctrl_plan_t o2;
+        ctrl_desc_m2ptfc.step(&s, &ctx, &o1);
+        ctrl_desc_m2ptfc.step(&fresh, &ctx, &o2);
+        TEST_ASSERT_EQUAL_UINT8(o2.n_seg, o1.n_seg);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(o2.vec, o1.vec, o1.n_seg);
+        TEST_ASSERT_EQUAL_INT32_ARRAY(o2.dur, o1.dur, o1.n_seg);
+        TEST_ASSERT_EQUAL_INT32(fresh.sigma, s.sigma);
+        TEST_ASSERT_EQUAL_INT32(ctrl_mpc_psi_ref2(p, &ref), s.psi2);
+        TEST_ASSERT_TRUE(s.psi2_params == p);
+        recomputed += cached != p || cached_t != ref.torque || cached_psi != ref.psi;
+    }
+    TEST_ASSERT_TRUE(recomputed > 20 && recomputed < 200); /* held and changed */
+    ctrl_desc_m2ptfc.reset(&s);
+    TEST_ASSERT_NULL(s.psi2_params);
+}
+
 static void test_sigma_ema(void)
 {
     /* (6.8): a constant error e drives sigma to e with rate lambda:
@@ -692,5 +793,7 @@ int main(void)
     RUN_TEST(test_sigma_ema);
     RUN_TEST(test_t_eval);
     RUN_TEST(test_psi_ref2);
+    RUN_TEST(test_basis3_equals_basis);
+    RUN_TEST(test_m2ptfc_psi2_cache);
     return UNITY_END();
 }
