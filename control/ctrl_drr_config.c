@@ -8,6 +8,7 @@
 
 #include "ctrl_drr.h"
 #include "ctrl_params.h"
+#include "estimator.h"
 #include "vreplace.h"
 
 #define DRR_PI 3.14159265358979323846
@@ -242,7 +243,7 @@ const ctrl_desc_t ctrl_desc_drr = {
     drr_init,
     ctrl_drr_reset,
     ctrl_drr_step,
-    0, /* reads |psi| at k+1 */
+    CTRL_EST_SECTOR_NOW, /* reads |psi| and the sector at k+1 only */
 };
 
 /* ---------------- baselines ---------------- */
@@ -380,7 +381,7 @@ static int df_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         ctrl_drr_base_reset,                                                                       \
         ctrl_drr_base_step,                                                                        \
-        0,                                                                                         \
+        CTRL_EST_SECTOR_NOW,                                                                       \
     }
 
 DRR_BASE_DESC(drr_d1, "DRR baseline D1: D = |T_err/C_T| + |psi_err/C_psi| (thesis (5.19))",

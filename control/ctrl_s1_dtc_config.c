@@ -9,6 +9,7 @@
 
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
+#include "estimator.h"
 
 #define S1_FS_HZ 10000u /* S1: Ts = 100 us */
 #define S1_BAND 0.01    /* S1 §3.3, §6.1.4: +-0.01 (N*m and Wb) */
@@ -290,7 +291,7 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         resetfn,                                                                                   \
         stepfn,                                                                                    \
-        0,                                                                                         \
+        CTRL_EST_SECTOR_NOW,                                                                       \
     }
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",

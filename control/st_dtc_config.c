@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "ctrl_params.h"
+#include "estimator.h"
 #include "st_dtc.h"
 
 #define ST_FS_HZ 20000u  /* Table 4.7 */
@@ -192,7 +193,7 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_params_t *p)
         initfn,                                                                                    \
         st_hyst_reset,                                                                             \
         st_hyst_step,                                                                              \
-        0,                                                                                         \
+        CTRL_EST_SECTOR_NOW,                                                                       \
     }
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init);
@@ -215,5 +216,5 @@ const ctrl_desc_t ctrl_desc_fst = {
     st_fst_init,
     st_fst_reset,
     st_fst_step,
-    0,
+    CTRL_EST_SECTOR_NOW,
 };
