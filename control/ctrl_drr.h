@@ -54,21 +54,6 @@
 #define CTRL_DRR_FS_HZ 10000u /* thesis §5.6: DRR methods at 10 kHz */
 #define CTRL_DRR_C_MAX 64     /* |C| of (5.13) is clamped to this (see ctrl_drr.c) */
 
-/* ---------------- drr: SI configuration (tunables are the doubles) ---------------- */
-typedef struct {
-    double a_nm;            /* A (5.9), N*m; 0 = from the machine at init */
-    double b_nm;            /* B (5.10), N*m; 0 = from the machine at init */
-    double c;               /* C (5.13), dimensionless, < 0; 0 = speed-dependent (5.13) */
-    double lambda;          /* EMA smoothing factor (5.4), thesis 0.03 */
-    double sigma;           /* subsector width (4.19) of the replacement, rad; 0 = off */
-    double dpsi_max_wb;     /* Delta psi_max of §5.3.5, Wb; 0 = sqrt(3) Vdc Ts / 3 */
-    double pred_516;        /* 0: model prediction of T(k+1) (default); 1: (5.16) */
-    double gamma_max_nm;    /* |gamma| limit, N*m; 0 = none (thesis) */
-    double centre;          /* 1: plans realised centre-aligned (plan.h, default): T_e is
-                               shifted to the active-vector start; 0: active vector first */
-    ctrl_machine_t machine; /* copied by cfg_default (not a tunable) */
-} ctrl_drr_cfg_t;
-
 /* ---------------- drr: runtime state ---------------- */
 typedef struct {
     /* configuration, fixed point */
@@ -96,18 +81,7 @@ typedef struct {
     uint8_t last_vec_51;          /* vector by (5.1) before replacement */
 } ctrl_drr_state_t;
 
-/* ---------------- baselines: one SI configuration, each descriptor exposes its part ------ */
-typedef struct {
-    double c_t_nm;     /* D1 (5.19) C_T, N*m (thesis 1.2) */
-    double c_psi_wb;   /* D1 (5.19) C_psi, Wb (thesis 0.09427) */
-    double k_a_nm;     /* D2 (5.21) K_a, N*m (thesis 2) */
-    double k_b_nm_rpm; /* D2 (5.21) K_b, N*m/(r/min) (thesis 6e-4) */
-    double kp;         /* D_PI (5.20) K_P, 1/(N*m) */
-    double ki;         /* D_PI (5.20) K_I, 1/(N*m*s) */
-    double rms;        /* D_f: 0 = D_f (5.18), 1 = D_RMS (5.17) */
-    ctrl_machine_t machine;
-} ctrl_drr_base_cfg_t;
-
+/* ---------------- baselines: runtime state (SI configuration in ctrl_drr_config.h) ------ */
 typedef enum {
     CTRL_DRR_BASE_D1 = 0,
     CTRL_DRR_BASE_D2,
@@ -195,17 +169,6 @@ q24_t ctrl_drr_duty_df(const ctrl_drr_base_state_t *s, const ctrl_params_t *p,
 
 /* Flux reference: ref->psi, else p->psi_ref, else MTPA (4.15) of torque. */
 q24_t ctrl_drr_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t torque);
-
-/* ---------------- configuration helpers (ctrl_drr_config.c, double) ---------------- */
-
-/* (5.9) A = p Vdc psi_pm Ts / Ls and (5.10) B = 3 p w_rn psi_pm^2 Ts / (2 Ls),
- * w_rn = 2 pi n_rated / 60 * p (electrical), Ls = Ld, in N*m. CTRL_OK or
- * CTRL_EINVAL (NULL, non-finite or non-positive data). */
-int ctrl_drr_ab_si(const ctrl_machine_t *m, double ts_s, double *a_nm, double *b_nm);
-
-/* (5.5): cut-off frequency of the EMA (5.4) with factor lambda at fs, Hz
- * (NaN for lambda outside (0, 1) or fs <= 0). */
-double ctrl_drr_ema_cutoff_hz(double lambda, double fs_hz);
 
 /* The descriptors. */
 extern const ctrl_desc_t ctrl_desc_drr;

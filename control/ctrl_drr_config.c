@@ -7,9 +7,11 @@
 #include <string.h>
 
 #include "ctrl_drr.h"
+#include "ctrl_drr_config.h"
 #include "ctrl_params.h"
 #include "estimator.h"
 #include "vreplace.h"
+#include "vreplace_config.h"
 
 #define DRR_PI 3.14159265358979323846
 #define DRR_SQRT3 1.73205080756887729353

@@ -39,17 +39,6 @@
 
 #define CTRL_FOC_MTPA_N 32 /* segments of the current-reference table */
 
-/* SI configuration (tunables are the double fields listed in the descriptor). */
-typedef struct {
-    double wc;         /* current-loop bandwidth, rad/s; 0 = 2 pi fs / 20 */
-    double kp_d, kp_q; /* V/A; 0 = Ld wc, Lq wc */
-    double ki_d, ki_q; /* V/(A s); 0 = Rs wc */
-    double mtpa;       /* 1 = MTPA i_d (IPMSM), 0 = i_d = 0 */
-    double h_i;        /* foc_hyst current band half width, A */
-    /* Set by cfg_default from the machine (not tunables). */
-    double r_base_ohm, i_base_a, rs_ohm;
-} ctrl_foc_cfg_t;
-
 /* One current PI (Q formats at the fields). */
 typedef struct {
     q24_t kp;      /* V pu per A pu, Q24 */

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "ctrl_foc.h"
+#include "ctrl_foc_config.h"
 #include "ctrl_params.h"
 #include "estimator.h"
 

@@ -44,9 +44,8 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-/* SI configuration and state: the layout shared by m1, m3 and mptfc
+/* State: the layout shared by m1, m3 and mptfc
  * (ctrl_m2ptfc_model.h); trace the six active vectors with D_f (5.18). */
-typedef ctrl_mpc_wcfg_t ctrl_m1_cfg_t;
 typedef ctrl_mpc_wstate_t ctrl_m1_t;
 
 extern const ctrl_desc_t ctrl_desc_m1;

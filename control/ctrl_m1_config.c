@@ -2,6 +2,8 @@
 #include <stddef.h>
 
 #include "ctrl_m1.h"
+#include "ctrl_m1_config.h"
+#include "ctrl_m2ptfc_model_config.h"
 #include "estimator.h"
 
 static const ctrl_tunable_t m1_tunables[] = {

@@ -27,12 +27,6 @@
 #define CTRL_M2_Y_MAX 16
 
 typedef struct {
-    double eps_psi; /* "eps_psi", Wb, (6.17) */
-    double y;       /* "y", number of duty levels (6.15), integer 1..16 */
-    ctrl_mpc_model_cfg_t model;
-} ctrl_m2_cfg_t;
-
-typedef struct {
     ctrl_mpc_model_t model;
     q24_t eps_psi; /* Q24 pu */
     uint8_t y;

@@ -4,6 +4,8 @@
 #include <string.h>
 
 #include "ctrl_m2.h"
+#include "ctrl_m2_config.h"
+#include "ctrl_m2ptfc_model_config.h"
 #include "estimator.h"
 
 static const ctrl_tunable_t m2_tunables[] = {

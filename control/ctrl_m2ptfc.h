@@ -67,14 +67,6 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-/* SI configuration (tunables by name). */
-typedef struct {
-    double lambda;              /* "lambda": EMA coefficient of (6.8), 0 < lambda <= 1 */
-    double centre;              /* "centre": 1 = Te_c (**) for centre-aligned PWM (default),
-                                   0 = the thesis' literal (6.5)-(6.8) */
-    ctrl_mpc_model_cfg_t model; /* "rs_model", "ld_model", "lq_model", "psi_pm_model" */
-} ctrl_m2ptfc_cfg_t;
-
 typedef struct {
     ctrl_mpc_model_t model;
     q24_t lambda;   /* Q24 */

@@ -38,15 +38,6 @@ typedef struct {
     q24_t ts_v;  /* Ts * 2/3: |V_i| Ts per pu of DC link, Q24 pu */
 } ctrl_mpc_model_t;
 
-/* SI overrides of the prediction model (0 = the machine's value) and the
- * machine data needed to convert SI tunables to per unit. Part of each MPC
- * controller's configuration struct; filled by ctrl_mpc_model_cfg_default(). */
-typedef struct {
-    double rs_ohm, ld_h, lq_h, psi_pm_wb; /* tunables "rs_model" ... (0 = machine) */
-    /* Copied from the machine (not tunables): */
-    double m_rs_ohm, m_ld_h, m_lq_h, m_psi_pm_wb, m_torque_rated_nm;
-} ctrl_mpc_model_cfg_t;
-
 /* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
  * bounds the fast arithmetic below relies on): |d0|, |q0| <= 8 sqrt(2) pu
  * (psi0 clamped to +-8 pu per alpha/beta component), |wd|, |wq| <= 1 pu. */
@@ -86,64 +77,14 @@ typedef struct {
     q24_t duty[CTRL_MPC_TRACE_MAX];  /* its duty, Q24 fraction of the period */
 } ctrl_mpc_trace_t;
 
-/* Configuration and state shared by the weighted-cost controllers m1, m3 and
- * mptfc (cost (6.13) with one weight zeta and the k+2 model): one
- * cfg_default / init / reset serves the three descriptors. */
-typedef struct {
-    double zeta;                /* "zeta", N*m/Wb, (6.13); 0 = T_rated/psi_pm (6.5) */
-    ctrl_mpc_model_cfg_t model; /* model overrides, see ctrl_mpc_model_cfg_t */
-} ctrl_mpc_wcfg_t;
-
+/* State shared by the weighted-cost controllers m1, m3 and mptfc (cost
+ * (6.13) with one weight zeta and the k+2 model); their SI configuration,
+ * ctrl_mpc_wcfg_t, is in ctrl_m2ptfc_model_config.h. */
 typedef struct {
     ctrl_mpc_model_t model;
     q24_t zeta;             /* Q24 pu (T_base / psi_base) */
     ctrl_mpc_trace_t trace; /* candidates of the last step (see each controller) */
 } ctrl_mpc_wstate_t;
-
-/* ---- configuration (ctrl_m2ptfc_model_config.c, may use double) ---- */
-
-/* ctrl_desc_t.cfg_default of m1, m3, mptfc: zeta 0 (T_rated/psi_pm), model
- * overrides off. cfg is a ctrl_mpc_wcfg_t. */
-void ctrl_mpc_wcfg_default(void *cfg, const ctrl_machine_t *machine);
-
-/* ctrl_desc_t.init of m1, m3, mptfc: model constants and zeta in pu; state
- * is a ctrl_mpc_wstate_t, cfg a ctrl_mpc_wcfg_t. CTRL_OK, CTRL_EINVAL (NULL,
- * zeta < 0 or not finite, bad model) or CTRL_ERANGE. */
-int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_params_t *params);
-
-/* Tunable-table entries of the model overrides, for a cfg struct T with a
- * member "model" (expanded only in *_config.c files). */
-#define CTRL_MPC_RS_MODEL_MAX 1000.0 /* ohm, upper bound of "rs_model" */
-#define CTRL_MPC_LPSI_MODEL_MAX 10.0 /* H or Wb, upper bound of "ld/lq/psi_pm_model" */
-/* clang-format off */
-#define CTRL_MPC_MODEL_TUNABLES(T)                                                  \
-    {"rs_model", "ohm", "Rs of the k+2 prediction (6.10); 0 = machine",            \
-     offsetof(T, model.rs_ohm), 0.0, CTRL_MPC_RS_MODEL_MAX},                       \
-    {"ld_model", "H", "Ld of the k+2 prediction (6.12); 0 = machine",              \
-     offsetof(T, model.ld_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
-    {"lq_model", "H", "Lq of the k+2 prediction (6.12); 0 = machine",              \
-     offsetof(T, model.lq_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
-    {"psi_pm_model", "Wb", "psi_pm of the k+2 prediction (6.12); 0 = machine",     \
-     offsetof(T, model.psi_pm_wb), 0.0, CTRL_MPC_LPSI_MODEL_MAX}
-/* clang-format on */
-
-/* Copy the machine data into c, overrides off. */
-void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *machine);
-
-/* Model constants for params (with the overrides of c). CTRL_OK, CTRL_EINVAL
- * (NULL, an override negative, not finite or above its tunable's maximum) or
- * CTRL_ERANGE (model outside the limits below). */
-int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
-                        const ctrl_params_t *params);
-
-/* A torque per flux weight zeta (N*m/Wb) of (6.13) in pu (Q24); zeta == 0 gives
- * the equal-importance value T_rated / psi_pm (§6.5). CTRL_OK or CTRL_EINVAL. */
-int ctrl_mpc_zeta_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double zeta,
-                     q24_t *out);
-
-/* A flux (Wb) in pu (Q24). CTRL_OK or CTRL_EINVAL. */
-int ctrl_mpc_flux_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double wb,
-                     q24_t *out);
 
 /* ---- per sample (ctrl_m2ptfc_model.c, integer only) ---- */
 

@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "ctrl_m2ptfc_model.h"
+#include "ctrl_m2ptfc_model_config.h"
 
 void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *machine)
 {

@@ -1,7 +1,9 @@
 /* M3 configuration and descriptor (SI -> Q24; floating point allowed here). */
 #include <stddef.h>
 
+#include "ctrl_m2ptfc_model_config.h"
 #include "ctrl_m3.h"
+#include "ctrl_m3_config.h"
 #include "estimator.h"
 
 static const ctrl_tunable_t m3_tunables[] = {

@@ -19,9 +19,8 @@
 #include "controller.h"
 #include "ctrl_m2ptfc_model.h"
 
-/* SI configuration and state: the layout shared by m1, m3 and mptfc
+/* State: the layout shared by m1, m3 and mptfc
  * (ctrl_m2ptfc_model.h); trace vec 0 (zero vector, duty 0), then V1..V6 (duty 1). */
-typedef ctrl_mpc_wcfg_t ctrl_mptfc_cfg_t;
 typedef ctrl_mpc_wstate_t ctrl_mptfc_t;
 
 extern const ctrl_desc_t ctrl_desc_mptfc;

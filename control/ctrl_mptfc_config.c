@@ -1,7 +1,9 @@
 /* FS-MPTFC configuration and descriptor (SI -> Q24; floating point allowed here). */
 #include <stddef.h>
 
+#include "ctrl_m2ptfc_model_config.h"
 #include "ctrl_mptfc.h"
+#include "ctrl_mptfc_config.h"
 #include "estimator.h"
 
 static const ctrl_tunable_t mptfc_tunables[] = {

@@ -62,20 +62,6 @@
 #define HPDTC_LEVELS 5   /* voltage levels */
 #define HPDTC_SECTIONS 5 /* reflected-position sections of 12 deg */
 
-/* SI configuration shared by the three (each lists its own tunables). */
-typedef struct {
-    double h_t;      /* torque hysteresis half band, N*m (hdtc, hpdtc) */
-    double h_psi;    /* flux hysteresis half band, Wb (hdtc, hpdtc) */
-    double psi_ref;  /* flux reference, Wb; 0 = psi_pm (see above) */
-    double kp;       /* svm_dtc: rad per pu torque */
-    double ki;       /* svm_dtc: rad per (pu torque * sample) */
-    double omega_ff; /* svm_dtc: 1 = add omega_e Ts to Delta delta */
-    double e_fs;     /* hpdtc: |T_err| of the full voltage level, N*m; 0 = computed */
-    double tilt;     /* hpdtc: reference direction tilted towards V_k1, rad */
-    /* Set by cfg_default from the machine (not tunables). */
-    double torque_base_nm, psi_base_wb, psi_pm_wb;
-} ctrl_s1_cfg_t;
-
 typedef struct {
     q24_t psi_ref; /* Q24 pu, > 0 */
     ctrl_hyst2_t flux;
@@ -114,12 +100,6 @@ int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2);
  * (psi_alpha, psi_beta) from the centre of its sector n (4.5), in [-30, 30) deg:
  * S1(40) with lambda_s measured from the start of the sector. */
 int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n);
-
-/* Generate the timing table (configuration; hpdtc_config): for level l
- * (m = l / 5 of the inscribed-circle voltage Vdc/sqrt(3)) and reflected
- * section j, the on-times of V_k1, V_k2 in points of Ts/20. tilt in rad.
- * Returns CTRL_OK or CTRL_EINVAL. */
-int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTIONS][2]);
 
 extern const ctrl_desc_t ctrl_desc_hdtc;
 extern const ctrl_desc_t ctrl_desc_svm_dtc;

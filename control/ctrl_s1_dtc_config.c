@@ -9,6 +9,7 @@
 
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
+#include "ctrl_s1_dtc_config.h"
 #include "estimator.h"
 
 #define S1_FS_HZ 10000u /* S1: Ts = 100 us */

@@ -39,10 +39,6 @@ typedef struct {
 /* Set mode and gain; the state is cleared (not primed). */
 void ctrl_flux_vm_init(ctrl_flux_vm_t *vm, uint8_t mode, q24_t k_corr);
 
-/* Gain k_corr = w_c Ts (Q24) for corner frequency fc_hz, in flux_vm_config.c.
- * Returns CTRL_OK or CTRL_EINVAL (fc not finite, <= 0, or k >= 0.5). */
-int ctrl_flux_vm_gain(const ctrl_params_t *p, double fc_hz, q24_t *k_corr);
-
 /* Start from a known flux and current (e.g. the current model at standstill). */
 void ctrl_flux_vm_reset(ctrl_flux_vm_t *vm, q24_t psi_alpha, q24_t psi_beta, q24_t i_alpha,
                         q24_t i_beta);

@@ -3,6 +3,7 @@
 #include <stddef.h>
 
 #include "flux_vm.h"
+#include "flux_vm_config.h"
 
 #define PI_CONST 3.14159265358979323846
 

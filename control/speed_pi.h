@@ -15,13 +15,6 @@
 #include "ctrl_params.h"
 #include "fx.h"
 
-/* Unit of the speed in which the SI gains are given. */
-typedef enum {
-    CTRL_SPEED_UNIT_RAD_S_MECH = 0, /* N*m per (mechanical rad/s), N*m per rad */
-    CTRL_SPEED_UNIT_RPM = 1,        /* N*m per (r/min), N*m per (r/min * s) */
-    CTRL_SPEED_UNIT_RAD_S_ELEC = 2  /* N*m per (electrical rad/s) */
-} ctrl_speed_unit_t;
-
 typedef struct {
     int32_t kp;    /* proportional gain, Q(kp_shift): torque pu per speed pu */
     int32_t ki_ts; /* Ki * Ts of the loop, Q(ki_shift): torque pu per (speed pu * period) */
@@ -29,13 +22,6 @@ typedef struct {
     q24_t out_max;              /* output limit, Q24 pu torque (> 0) */
     int64_t integ;              /* integrator, Q(24 + ki_shift) pu torque */
 } ctrl_speed_pi_t;
-
-/* SI gains -> fixed point (speed_pi_config.c). kp in N*m per speed unit, ki in
- * N*m per (speed unit * s), out_limit_nm > 0, loop_hz = rate at which
- * ctrl_speed_pi_step is called. Clears the integrator. Returns CTRL_OK,
- * CTRL_EINVAL (NULL, non-finite, negative) or CTRL_ERANGE (does not fit). */
-int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs, double kp,
-                         double ki, ctrl_speed_unit_t unit, double out_limit_nm, uint32_t loop_hz);
 
 /* Set the integrator so that the output starts at out (bumpless start). */
 void ctrl_speed_pi_reset(ctrl_speed_pi_t *pi, q24_t out);

@@ -11,6 +11,7 @@
 #include <stddef.h>
 
 #include "speed_pi.h"
+#include "speed_pi_config.h"
 
 #define PI_CONST 3.14159265358979323846
 

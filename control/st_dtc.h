@@ -31,23 +31,6 @@
 /* Which table a hysteresis-based controller uses. */
 typedef enum { ST_KIND_BST = 0, ST_KIND_MBST, ST_KIND_AST, ST_KIND_ZST } st_kind_t;
 
-/* SI configuration of BST/MBST/AST/ZST (tunables are the double fields). */
-typedef struct {
-    double h_t;   /* torque band half width h_T, N*m (Table 4.7: 2 % of T_rated) */
-    double h_psi; /* flux band half width h_psi, Wb (Table 4.7: 2 % of psi_pm) */
-    /* Set by cfg_default from the machine (not tunables): SI value of 1 pu
-     * (ctrl_bases_t) and the rated torque, to convert and cross-check at init. */
-    double torque_base_nm, psi_base_wb, torque_rated_nm;
-} st_hyst_cfg_t;
-
-/* SI configuration of FST. */
-typedef struct {
-    double sigma;   /* subsector width of (4.19), rad, [0, pi/12]; 0 = no replacement */
-    double dt_step; /* |Delta T_ref| above which a reference step is detected, N*m;
-                       0 = any change (thesis §4.5.3: Delta T_ref != 0) */
-    double torque_base_nm, psi_base_wb, torque_rated_nm; /* as in st_hyst_cfg_t */
-} st_fst_cfg_t;
-
 /* Runtime state of BST/MBST/AST/ZST. */
 typedef struct {
     uint8_t kind;         /* st_kind_t */

@@ -9,6 +9,8 @@
 #include "ctrl_params.h"
 #include "estimator.h"
 #include "st_dtc.h"
+#include "st_dtc_config.h"
+#include "vreplace_config.h"
 
 #define ST_FS_HZ 20000u  /* Table 4.7 */
 #define ST_BAND_REL 0.02 /* h_T = 2 % T_rated, h_psi = 2 % psi_pm (Table 4.7) */

@@ -40,12 +40,4 @@ typedef struct {
 uint8_t ctrl_vreplace(const ctrl_vreplace_t *c, uint8_t vec, uint8_t sector, q24_t psi_alpha,
                       q24_t psi_beta);
 
-/*
- * Configuration (vreplace_config.c, uses double): sigma_rad in [0, pi/12]
- * (4.19); sigma == 0 disables the replacement. Returns CTRL_OK, or
- * CTRL_EINVAL for NULL, a non-finite or out-of-range sigma (c is then left
- * disabled when not NULL).
- */
-int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad);
-
 #endif /* CONTROL_VREPLACE_H */

@@ -4,6 +4,7 @@
 
 #include "ctrl_params.h"
 #include "vreplace.h"
+#include "vreplace_config.h"
 
 int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad)
 {

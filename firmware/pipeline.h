@@ -53,6 +53,7 @@
 #include "hal.h"
 #include "protect.h"
 #include "speed_pi.h"
+#include "speed_pi_config.h"
 
 #define FW_OK 0
 #define FW_EINVAL (-1) /* NULL, bad machine or configuration */

@@ -7,6 +7,7 @@
 
 #include "pipeline.h"
 #include "plan.h"
+#include "speed_pi_config.h"
 
 #define FW_PI 3.14159265358979323846
 #define FW_CALIB_DEFAULT 256u

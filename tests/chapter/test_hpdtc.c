@@ -15,6 +15,7 @@
 #include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
+#include "ctrl_s1_dtc_config.h"
 #include "plan.h"
 #include "unity.h"
 #include "vectors.h"

@@ -8,6 +8,7 @@
 
 #include "estimator.h"
 #include "flux_vm.h"
+#include "flux_vm_config.h"
 #include "machines.h"
 #include "plan.h"
 #include "predict.h"

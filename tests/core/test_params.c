@@ -13,6 +13,7 @@
 #include "machines.h"
 #include "mtpa.h"
 #include "speed_pi.h"
+#include "speed_pi_config.h"
 #include "unity.h"
 
 void setUp(void)

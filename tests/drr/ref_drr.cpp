@@ -23,6 +23,7 @@
 extern "C" {
 #include "controller.h"
 #include "ctrl_drr.h"
+#include "ctrl_drr_config.h"
 #include "ctrl_params.h"
 #include "mtpa.h"
 #include "predict.h"

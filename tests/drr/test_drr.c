@@ -8,6 +8,7 @@
 
 #include "controller.h"
 #include "ctrl_drr.h"
+#include "ctrl_drr_config.h"
 #include "ctrl_params.h"
 #include "drr_machines.h"
 #include "plan.h"

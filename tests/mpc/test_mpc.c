@@ -25,6 +25,7 @@
 #include "ctrl_m1.h"
 #include "ctrl_m2.h"
 #include "ctrl_m2ptfc.h"
+#include "ctrl_m2ptfc_config.h"
 #include "ctrl_m3.h"
 #include "ctrl_mptfc.h"
 #include "mpc_machines.h"

@@ -36,8 +36,10 @@ extern "C" {
 #include "controller.h"
 #include "ctrl_params.h"
 #include "st_dtc.h"
+#include "st_dtc_config.h"
 #include "vectors.h"
 #include "vreplace.h"
+#include "vreplace_config.h"
 }
 #include "thesis_tables.h"
 #include "unity.h"

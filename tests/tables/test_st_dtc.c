@@ -14,6 +14,7 @@
 #include "ctrl_params.h"
 #include "mtpa.h"
 #include "st_dtc.h"
+#include "st_dtc_config.h"
 #include "thesis_tables.h"
 #include "unity.h"
 

@@ -17,6 +17,7 @@
 #include "unity.h"
 #include "vectors.h"
 #include "vreplace.h"
+#include "vreplace_config.h"
 
 void setUp(void)
 {
