@@ -24,6 +24,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -159,84 +160,26 @@ static void test_baselines_run(void)
 /* Speed reversal of thesis Fig. 5.12. */
 static void test_reversal(void)
 {
-    static sim_scenario_t scn;
-    const char *text = "at 0 torque_ref=0 load=1.6\n"
-                       "at 0.002 torque_ref=2\n"
-                       "when speed>=2250 torque_ref=-2\n"
-                       "when speed<=0 load=-1.6\n";
-    FILE *f = tmpfile();
-    TEST_ASSERT_NOT_NULL(f);
-    fputs(text, f);
-    rewind(f);
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "reversal", err, sizeof err), err);
-    fclose(f);
     sim_run_cfg_t c;
     drr_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
-    c.free_mech = true;
-    c.load_nm = 0.0;
-    c.scenario = &scn;
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    const double ts = 1.0 / (double)c.fs_hz;
-    double t_rev = -1.0;
-    double t_end = c.duration_s;
-    double t_fall = NAN;
-    double t_rise = NAN;
-    double min_rpm = 1e9;
-    double acc = 0.0;
-    double acc2 = 0.0;
-    int n = 0;
-    int reached = 0;
-    for (;;) {
-        const double t = sim_run_time(&run);
-        if (t >= t_end || fw_state(&run.fw) == FW_STATE_FAULT) {
-            break;
-        }
-        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-        const double tq = plant_torque(&run.plant);
-        const double rpm = plant_omega_m(&run.plant) * 60.0 / (2.0 * 3.14159265358979);
-        if (isnan(t_rise) && t > 0.002 && tq >= 0.9 * 2.0) {
-            t_rise = (t + ts - 0.002) * 1e3;
-        }
-        if (!reached && run.scn.next >= 3u) {
-            reached = 1;
-            t_rev = t;
-        }
-        if (reached) {
-            if (isnan(t_fall) && tq <= -1.6) {
-                t_fall = (t + ts - t_rev) * 1e3;
-            }
-            min_rpm = fmin(min_rpm, rpm);
-            if (rpm <= -1000.0 && t_end > t + 0.020) {
-                t_end = t + 0.020; /* 20 ms of backward motoring, then stop */
-            }
-            if (rpm <= -1000.0 && t > t_end - 0.010) {
-                acc += tq;
-                acc2 += tq * tq;
-                n++;
-            }
-        }
-    }
-    const uint32_t fault = fw_fault(&run.fw);
-    sim_run_free(&run);
-    const double mean = n > 0 ? acc / n : NAN;
-    const double rip = n > 0 ? sqrt(fmax(0.0, acc2 / n - mean * mean)) : NAN;
-    printf("  drr reversal: rise %.3f ms, fall %.3f ms, min speed %.0f r/min, "
-           "backward T_mean %.4f T_rip %.4f, fault %s\n",
-           t_rise, t_fall, min_rpm, mean, rip, fw_fault_name(fault));
-    TEST_ASSERT_EQUAL_UINT32_MESSAGE(FW_FAULT_NONE, fault, fw_fault_name(fault));
-    TEST_ASSERT_TRUE_MESSAGE(reached, "speed never reached 2250 r/min");
-    TEST_ASSERT_TRUE_MESSAGE(min_rpm <= -1000.0, "speed did not reverse");
-    TEST_ASSERT_TRUE_MESSAGE(t_fall < 1.0, "torque fall time >= 1 ms");
+    /* 20 ms of backward motoring: gamma is still settling after the 4 N*m step. */
+    const loop_reversal_t r = loop_reversal(&run, &c,
+                                            "at 0 torque_ref=0 load=1.6\n"
+                                            "at 0.002 torque_ref=2\n"
+                                            "when speed>=2250 torque_ref=-2\n"
+                                            "when speed<=0 load=-1.6\n",
+                                            -1.6, 0.020, "drr");
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE(FW_FAULT_NONE, r.fault, fw_fault_name(r.fault));
+    TEST_ASSERT_TRUE_MESSAGE(r.reached, "speed never reached 2250 r/min");
+    TEST_ASSERT_TRUE_MESSAGE(r.min_rpm_after <= -1000.0, "speed did not reverse");
+    TEST_ASSERT_TRUE_MESSAGE(r.t_fall_ms < 1.0, "torque fall time >= 1 ms");
     /* Stable after the reversal: over the last 10 ms (speed below -1000 r/min)
      * the mean torque is within 2 % of T_rated of -2 N*m (gamma is still
      * settling: the EMA time constant is 3.3 ms and the reference stepped by
      * 4 N*m) and the ripple stays below 5 % of T_rated (the steady-state DRR
      * ripple scale: a sawtooth of +-gamma, gamma ~ B |w| / w_rn / |C|). */
-    TEST_ASSERT_DOUBLE_WITHIN(0.02 * T_RATED, -2.0, mean);
-    TEST_ASSERT_TRUE(rip < 0.05 * T_RATED);
+    TEST_ASSERT_DOUBLE_WITHIN(0.02 * T_RATED, -2.0, r.tq_back_mean);
+    TEST_ASSERT_TRUE(r.tq_back_rip < 0.05 * T_RATED);
 }
 
 int main(void)

@@ -1,7 +1,10 @@
 #include "loop_util.h"
 
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
+#include "fw_state.h"
 #include "unity.h"
 
 const sim_machine_t *loop_spmsm(void)
@@ -40,4 +43,74 @@ void loop_start(sim_run_t *r, const sim_run_cfg_t *c)
     if (sim_run_init(r, c, err, sizeof err) != 0) {
         TEST_FAIL_MESSAGE(err);
     }
+}
+
+loop_reversal_t loop_reversal(sim_run_t *run, const sim_run_cfg_t *base, const char *scenario,
+                              double fall_nm, double back_s, const char *label)
+{
+    static sim_scenario_t scn;
+    FILE *f = tmpfile();
+    TEST_ASSERT_NOT_NULL(f);
+    fputs(scenario, f);
+    rewind(f);
+    char err[256];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "reversal", err, sizeof err), err);
+    fclose(f);
+    sim_run_cfg_t c = *base;
+    c.free_mech = true;
+    c.load_nm = 0.0;
+    c.scenario = &scn;
+    loop_start(run, &c);
+
+    loop_reversal_t r = {false, 1e9, NAN, NAN, NAN, NAN, 0u};
+    const double ts = 1.0 / (double)c.fs_hz;
+    double t_rev = -1.0;
+    double t_end = c.duration_s;
+    double t_stats = INFINITY; /* start of the backward statistics window */
+    double acc = 0.0;
+    double acc2 = 0.0;
+    int n = 0;
+    for (;;) {
+        const double t = sim_run_time(run);
+        if (t >= t_end || fw_state(&run->fw) == FW_STATE_FAULT) {
+            break;
+        }
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(run));
+        const double tq = plant_torque(&run->plant);
+        const double rpm = plant_omega_m(&run->plant) * 60.0 / (2.0 * 3.14159265358979);
+        if (isnan(r.t_rise_ms) && t > 0.002 && tq >= 0.9 * 2.0) {
+            r.t_rise_ms = (t + ts - 0.002) * 1e3;
+        }
+        if (!r.reached && run->scn.next >= 3u) {
+            r.reached = true;
+            t_rev = t;
+        }
+        if (!r.reached) {
+            continue;
+        }
+        if (isnan(r.t_fall_ms) && tq <= fall_nm) {
+            r.t_fall_ms = (t + ts - t_rev) * 1e3;
+        }
+        r.min_rpm_after = fmin(r.min_rpm_after, rpm);
+        if (rpm <= -1000.0 && isinf(t_stats)) {
+            t_end = fmin(t_end, t + back_s);
+            t_stats = t + back_s - 0.010 - 0.5 * ts; /* half a period: no rounding edge */
+        }
+        if (rpm <= -1000.0 && t >= t_stats) {
+            acc += tq;
+            acc2 += tq * tq;
+            n++;
+        }
+    }
+    r.fault = fw_fault(&run->fw);
+    if (n > 0) {
+        r.tq_back_mean = acc / n;
+        r.tq_back_rip = sqrt(fmax(0.0, acc2 / n - r.tq_back_mean * r.tq_back_mean));
+    }
+    printf("  %s reversal: reached %d, rise %.3f ms, fall %.3f ms, min speed %.0f r/min, "
+           "backward T_mean %.4f T_rip %.4f, fault %s\n",
+           label, (int)r.reached, r.t_rise_ms, r.t_fall_ms, r.min_rpm_after, r.tq_back_mean,
+           r.tq_back_rip, fw_fault_name(r.fault));
+    sim_run_free(run);
+    return r;
 }

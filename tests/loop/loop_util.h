@@ -2,6 +2,9 @@
 #ifndef TESTS_LOOP_LOOP_UTIL_H
 #define TESTS_LOOP_LOOP_UTIL_H
 
+#include <stdbool.h>
+#include <stdint.h>
+
 #include "sim_run.h"
 
 /* Thesis SPMSM (sim_host/machines/thesis_spmsm.ini); aborts the test on error. */
@@ -14,5 +17,26 @@ void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torqu
 
 /* Initialise the run; fails the test with the message on error. */
 void loop_start(sim_run_t *r, const sim_run_cfg_t *c);
+
+/* Result of a speed-reversal run (thesis Figs. 4.14, 5.12, 6.17). */
+typedef struct {
+    bool reached;         /* the reversal command (the scenario's third line) fired */
+    double min_rpm_after; /* lowest speed after the reversal command */
+    double t_rise_ms;     /* T >= 90 % of 2 N*m after the step at 2 ms */
+    double t_fall_ms;     /* T <= fall_nm after the reversal command */
+    double tq_back_mean;  /* mean torque over the last 10 ms of backward motoring */
+    double tq_back_rip;   /* its standard deviation */
+    uint32_t fault;
+} loop_reversal_t;
+
+/*
+ * Run `base` with free mechanics under `scenario` (text in the sim_scenario.h
+ * format; its third line must be the reversal command). The run stops at the
+ * configured duration, at a fault, or back_s after the speed first reaches
+ * -1000 r/min; the backward torque statistics cover the last 10 ms of that
+ * span. Prints one line under `label`.
+ */
+loop_reversal_t loop_reversal(sim_run_t *run, const sim_run_cfg_t *base, const char *scenario,
+                              double fall_nm, double back_s, const char *label);
 
 #endif /* TESTS_LOOP_LOOP_UTIL_H */

@@ -86,94 +86,21 @@ static void test_bst_fst_hold_torque(void)
     }
 }
 
-typedef struct {
-    bool reached_1500;
-    double min_rpm_after; /* lowest speed after the reversal command */
-    double t_rise_ms;     /* 0 -> 90 % of 2 N*m after the step */
-    double t_fall_ms;     /* 2 -> -1.8 N*m after the step to -2 */
-    double tq_back_mean;  /* mean torque over the last 10 ms */
-    double tq_back_rip;   /* its standard deviation */
-    uint32_t fault;
-} reversal_t;
-
 /* Thesis Fig. 4.14: free mechanics, load 1.6 N*m, T_ref 0 -> 2 N*m, then -2 N*m
  * once the speed reaches 1500 r/min. The load is passive (it opposes the
  * rotation, like the thesis' loading machine): it starts with the torque step
  * and changes sign at zero speed ("when speed<=0 load=-1.6"). Runs until
  * -1000 r/min (or 0.3 s). */
-static reversal_t reversal(const char *name)
+static loop_reversal_t reversal(const char *name)
 {
-    static sim_scenario_t scn;
-    const char *text = "at 0 torque_ref=0 load=0\n"
-                       "at 0.002 torque_ref=2 load=1.6\n"
-                       "when speed>=1500 torque_ref=-2\n"
-                       "when speed<=0 load=-1.6\n";
-    FILE *f = tmpfile();
-    TEST_ASSERT_NOT_NULL(f);
-    fputs(text, f);
-    rewind(f);
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "reversal", err, sizeof err), err);
-    fclose(f);
-
     sim_run_cfg_t c;
     loop_cfg(&c, name, 0.0, 0.0, 0.3, 0.0);
-    c.free_mech = true;
-    c.load_nm = 0.0;
-    c.scenario = &scn;
-    loop_start(&run, &c);
-
-    reversal_t r = {false, 1e9, NAN, NAN, NAN, NAN, 0u};
-    const double ts = 1.0 / (double)c.fs_hz;
-    double t_rev = -1.0, t_end = c.duration_s;
-    double acc = 0.0, acc2 = 0.0;
-    int n = 0;
-    for (;;) {
-        const double t = sim_run_time(&run);
-        if (t >= t_end) {
-            break;
-        }
-        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-        const double tq = plant_torque(&run.plant);
-        const double rpm = plant_omega_m(&run.plant) * 60.0 / (2.0 * 3.14159265358979);
-        if (isnan(r.t_rise_ms) && t > 0.002 && tq >= 0.9 * 2.0) {
-            r.t_rise_ms = (t + ts - 0.002) * 1e3;
-        }
-        if (!r.reached_1500 && run.scn.next >= 3u) {
-            r.reached_1500 = true;
-            t_rev = t;
-        }
-        if (r.reached_1500) {
-            if (isnan(r.t_fall_ms) && tq <= -1.8) {
-                r.t_fall_ms = (t + ts - t_rev) * 1e3;
-            }
-            if (rpm < r.min_rpm_after) {
-                r.min_rpm_after = rpm;
-            }
-            if (rpm <= -1000.0 && t_end > t + 0.010) {
-                t_end = t + 0.010; /* 10 ms of backward motoring, then stop */
-            }
-            if (rpm <= -1000.0) {
-                acc += tq;
-                acc2 += tq * tq;
-                n++;
-            }
-        }
-        if (fw_state(&run.fw) == FW_STATE_FAULT) {
-            break;
-        }
-    }
-    r.fault = fw_fault(&run.fw);
-    if (n > 0) {
-        r.tq_back_mean = acc / n;
-        r.tq_back_rip = sqrt(fmax(0.0, acc2 / n - r.tq_back_mean * r.tq_back_mean));
-    }
-    printf("  %s reversal: reached 1500 %d, rise %.3f ms, fall %.3f ms, min speed %.0f r/min, "
-           "backward T_mean %.3f T_rip %.3f, fault %s\n",
-           name, (int)r.reached_1500, r.t_rise_ms, r.t_fall_ms, r.min_rpm_after, r.tq_back_mean,
-           r.tq_back_rip, fw_fault_name(r.fault));
-    sim_run_free(&run);
-    return r;
+    return loop_reversal(&run, &c,
+                         "at 0 torque_ref=0 load=0\n"
+                         "at 0.002 torque_ref=2 load=1.6\n"
+                         "when speed>=1500 torque_ref=-2\n"
+                         "when speed<=0 load=-1.6\n",
+                         -1.8, 0.010, name);
 }
 
 /* Rise/fall bound: at standstill the fastest torque slope is
@@ -182,9 +109,9 @@ static reversal_t reversal(const char *name)
  * one-period computation delay. */
 static void test_fst_speed_reversal(void)
 {
-    const reversal_t r = reversal("fst");
+    const loop_reversal_t r = reversal("fst");
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(FW_FAULT_NONE, r.fault, fw_fault_name(r.fault));
-    TEST_ASSERT_TRUE_MESSAGE(r.reached_1500, "speed never reached 1500 r/min");
+    TEST_ASSERT_TRUE_MESSAGE(r.reached, "speed never reached 1500 r/min");
     TEST_ASSERT_TRUE_MESSAGE(r.min_rpm_after <= -1000.0, "speed did not reverse");
     TEST_ASSERT_TRUE(r.t_rise_ms <= 2.0 * 0.2 + 0.05);
     TEST_ASSERT_TRUE(r.t_fall_ms <= 2.0 * 0.27 + 0.05);
@@ -195,9 +122,9 @@ static void test_fst_speed_reversal(void)
 /* BST goes through the same reversal (thesis Fig. 4.14(a)). */
 static void test_bst_speed_reversal(void)
 {
-    const reversal_t r = reversal("bst");
+    const loop_reversal_t r = reversal("bst");
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(FW_FAULT_NONE, r.fault, fw_fault_name(r.fault));
-    TEST_ASSERT_TRUE(r.reached_1500);
+    TEST_ASSERT_TRUE(r.reached);
     TEST_ASSERT_TRUE(r.min_rpm_after <= -1000.0);
     TEST_ASSERT_DOUBLE_WITHIN(T_SSE_MAX, -2.0, r.tq_back_mean);
 }
@@ -209,8 +136,8 @@ static void test_bst_speed_reversal(void)
  * within the bound); observed (printed): the speed stalls near zero. */
 static void test_zst_speed_reversal_unstable(void)
 {
-    const reversal_t r = reversal("zst");
-    TEST_ASSERT_TRUE(r.reached_1500);
+    const loop_reversal_t r = reversal("zst");
+    TEST_ASSERT_TRUE(r.reached);
     const bool stable_reversal =
         r.min_rpm_after <= -1000.0 && fabs(r.tq_back_mean + 2.0) <= T_SSE_MAX;
     TEST_ASSERT_FALSE_MESSAGE(stable_reversal, "ZST reversed stably, unlike thesis Fig. 4.14(d)");

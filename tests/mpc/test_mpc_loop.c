@@ -282,83 +282,21 @@ static void test_table62_weights_report(void)
 
 #elif MPC_LOOP_GROUP == 2
 
-typedef struct {
-    int reached;
-    double min_rpm_after, t_fall_ms, tq_back_mean, tq_back_rip;
-    uint32_t fault;
-} rev_t;
-
 /* Thesis Fig. 6.17: torque mode 2 N*m with a passive load, step to -2 N*m once
  * the speed reaches 0.5 pu (1500 r/min); continue to -1000 r/min. Load 1.6 N*m
  * as the loop owner's Fig. 4.14 scenario and tools/compare.py (the thesis:
  * "around 1.8"). Fall time: from the step command until Te <= -1.6 N*m
  * (90 % of the 4 N*m swing). */
-static rev_t reversal(const mpc_ctrl_t *k)
+static loop_reversal_t reversal(const mpc_ctrl_t *k)
 {
-    static sim_scenario_t scn;
-    const char *text = "at 0 torque_ref=0 load=1.6\n"
-                       "at 0.002 torque_ref=2\n"
-                       "when speed>=1500 torque_ref=-2\n"
-                       "when speed<=0 load=-1.6\n";
-    FILE *f = tmpfile();
-    TEST_ASSERT_NOT_NULL(f);
-    fputs(text, f);
-    rewind(f);
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "reversal", err, sizeof err), err);
-    fclose(f);
     sim_run_cfg_t c;
     mpc_cfg(&c, machine(SPMSM), k, 0.0, 0.0, 0.4, 0.0, -1.0);
-    c.free_mech = true;
-    c.load_nm = 0.0;
-    c.scenario = &scn;
-    loop_start(&run, &c);
-
-    rev_t r = {0, 1e9, NAN, NAN, NAN, 0u};
-    const double ts = 1.0 / (double)c.fs_hz;
-    double t_rev = -1.0;
-    double t_end = c.duration_s;
-    double acc = 0.0;
-    double acc2 = 0.0;
-    int n = 0;
-    for (;;) {
-        const double t = sim_run_time(&run);
-        if (t >= t_end || fw_state(&run.fw) == FW_STATE_FAULT) {
-            break;
-        }
-        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-        const double tq = plant_torque(&run.plant);
-        const double rpm = plant_omega_m(&run.plant) * 60.0 / (2.0 * 3.14159265358979);
-        if (!r.reached && run.scn.next >= 3u) {
-            r.reached = 1;
-            t_rev = t;
-        }
-        if (r.reached) {
-            if (isnan(r.t_fall_ms) && tq <= -1.6) {
-                r.t_fall_ms = (t + ts - t_rev) * 1e3;
-            }
-            r.min_rpm_after = fmin(r.min_rpm_after, rpm);
-            if (rpm <= -1000.0) {
-                if (t_end > t + 0.010) {
-                    t_end = t + 0.010; /* 10 ms of backward motoring, then stop */
-                }
-                acc += tq;
-                acc2 += tq * tq;
-                n++;
-            }
-        }
-    }
-    r.fault = fw_fault(&run.fw);
-    if (n > 0) {
-        r.tq_back_mean = acc / n;
-        r.tq_back_rip = sqrt(fmax(0.0, acc2 / n - r.tq_back_mean * r.tq_back_mean));
-    }
-    printf("  %-6s reversal: reached 1500 %d, fall %.3f ms, min speed %.0f r/min, backward "
-           "T_mean %.3f T_rip %.3f, fault %s\n",
-           k->name, r.reached, r.t_fall_ms, r.min_rpm_after, r.tq_back_mean, r.tq_back_rip,
-           fw_fault_name(r.fault));
-    sim_run_free(&run);
-    return r;
+    return loop_reversal(&run, &c,
+                         "at 0 torque_ref=0 load=1.6\n"
+                         "at 0.002 torque_ref=2\n"
+                         "when speed>=1500 torque_ref=-2\n"
+                         "when speed<=0 load=-1.6\n",
+                         -1.6, 0.010, k->name);
 }
 
 /* Bounds: no fault; the speed reverses to -1000 r/min; fall time < 1 ms (thesis
@@ -367,7 +305,7 @@ static rev_t reversal(const mpc_ctrl_t *k)
  * within 25 % (no instability). */
 static void check_reversal(const mpc_ctrl_t *k)
 {
-    const rev_t r = reversal(k);
+    const loop_reversal_t r = reversal(k);
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, r.fault, fw_fault_name(r.fault));
     TEST_ASSERT_TRUE_MESSAGE(r.reached, "speed never reached 1500 r/min");
     TEST_ASSERT_TRUE_MESSAGE(r.min_rpm_after <= -1000.0, "speed did not reverse");
