@@ -20,16 +20,12 @@ void ctrl_plan_single(ctrl_plan_t *p, uint8_t vec)
     p->dur[3] = 0;
 }
 
-/* ctrl_zero_after() as a table (V0 after V0, V1, V3, V5; V7 after V7, V2, V4,
- * V6; indices > 7 give V0): the plan helpers run every period. */
-static const uint8_t plan_zero_after[8] = {0u, 0u, 7u, 0u, 7u, 0u, 7u, 7u};
-
 void ctrl_plan_active_zero(ctrl_plan_t *p, uint8_t vec, q24_t duty)
 {
     const q24_t d = fx_clamp(duty, 0, FX_ONE);
     p->n_seg = 2u;
     p->vec[0] = vec;
-    p->vec[1] = vec <= 7u ? plan_zero_after[vec] : 0u;
+    p->vec[1] = vec <= 7u ? ctrl_vec_zero_after[vec] : 0u;
     p->vec[2] = 0u;
     p->vec[3] = 0u;
     p->dur[0] = d;
@@ -51,10 +47,6 @@ void ctrl_plan_two_active(ctrl_plan_t *p, uint8_t v1, q24_t d1, uint8_t v2, q24_
     p->dur[2] = FX_ONE - a - b;
 }
 
-/* Leg states per vector (Table 4.2), bit 0 = leg a, bit 1 = b, bit 2 = c; a
- * local copy of vectors.c's table so the per-sample loop needs no calls. */
-static const uint8_t plan_leg_mask[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
-
 void ctrl_plan_to_legs(const ctrl_plan_t *p, ctrl_legs_t *legs)
 {
     /* Leg duty = total on-time of the segments with that leg high: the same
@@ -66,7 +58,7 @@ void ctrl_plan_to_legs(const ctrl_plan_t *p, ctrl_legs_t *legs)
     const unsigned n = p->n_seg < CTRL_PLAN_MAX_SEG ? p->n_seg : CTRL_PLAN_MAX_SEG;
     for (unsigned i = 0u; i < n; i++) {
         const q24_t dur = fx_clamp(p->dur[i], 0, FX_ONE);
-        const unsigned m = p->vec[i] <= 7u ? plan_leg_mask[p->vec[i]] : 0u;
+        const unsigned m = p->vec[i] <= 7u ? ctrl_vec_legs[p->vec[i]] : 0u;
         acc_a += (m & 1u) != 0u ? dur : 0;
         acc_b += (m & 2u) != 0u ? dur : 0;
         acc_c += (m & 4u) != 0u ? dur : 0;

@@ -5,7 +5,10 @@
 
 /* Leg states per vector: bit 0 = leg a (S1), bit 1 = leg b (S2), bit 2 = leg c (S3).
  * V0=000, V1=100, V2=110, V3=010, V4=011, V5=001, V6=101, V7=111 (Table 4.2). */
-static const uint8_t vec_legs[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+const uint8_t ctrl_vec_legs[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+
+/* One leg switches: V1, V3, V5 have one leg high -> V0; V2, V4, V6 two -> V7. */
+const uint8_t ctrl_vec_zero_after[8] = {0u, 0u, 7u, 0u, 7u, 0u, 7u, 7u};
 
 /* V_i / Vdc, Q30: alpha = 2/3 cos((i-1) pi/3), beta = 2/3 sin((i-1) pi/3). */
 #define K_2_3 715827883
@@ -19,7 +22,7 @@ uint8_t ctrl_vector_leg(uint8_t idx, unsigned leg)
     if (idx > 7u || leg > 2u) {
         return 0u;
     }
-    return (uint8_t)((vec_legs[idx] >> leg) & 1u);
+    return (uint8_t)((ctrl_vec_legs[idx] >> leg) & 1u);
 }
 
 void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
@@ -43,11 +46,7 @@ uint8_t ctrl_vec_wrap(int x)
 
 uint8_t ctrl_zero_after(uint8_t vec)
 {
-    /* One leg switches: V1, V3, V5 have one leg high -> V0; V2, V4, V6 two -> V7. */
-    if (vec == 7u || vec == 2u || vec == 4u || vec == 6u) {
-        return 7u;
-    }
-    return 0u;
+    return vec <= 7u ? ctrl_vec_zero_after[vec] : 0u;
 }
 
 /* 3 a^2 < b^2 exactly (|a|, |b| <= 2^31: 3 a^2 < 2^64). */

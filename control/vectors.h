@@ -15,6 +15,13 @@
 
 #include "fx.h"
 
+/* Leg states per vector index 0..7 (Table 4.2): bit 0 = leg a (S1), bit 1 = leg b
+ * (S2), bit 2 = leg c (S3). One table for every module that maps vectors to legs. */
+extern const uint8_t ctrl_vec_legs[8];
+
+/* ctrl_zero_after() as a table, for per-sample code that indexes it directly. */
+extern const uint8_t ctrl_vec_zero_after[8];
+
 /* Switching state of leg 0..2 (a, b, c) for vector idx 0..7 (1 = upper switch on).
  * idx > 7 gives 0 (treated as V0). */
 uint8_t ctrl_vector_leg(uint8_t idx, unsigned leg);
