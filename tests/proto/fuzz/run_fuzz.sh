@@ -10,10 +10,12 @@ SECS=${3:-15}
 shift 3 2>/dev/null || shift $#
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/../../.." && pwd)
-FW=$ROOT/firmware
+FW=$ROOT/firmware/protocol
+# The core's include path: every folder of control/.
+CTRL_INC=$(for d in "$ROOT"/control/*/; do printf -- ' -I%s' "${d%/}"; done)
 mkdir -p "$OUT"
 CFLAGS="-std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
-        -Wall -Wextra -Werror -I$FW -I$ROOT/control -I$HERE/.."
+        -Wall -Wextra -Werror -I$FW $CTRL_INC -I$HERE/.."
 SRC="$FW/cmd.c $FW/cmd_num.c $FW/telemetry.c $FW/telemetry_frame.c"
 # shellcheck disable=SC2086
 $CLANG $CFLAGS -o "$OUT/fuzz_cmd" "$HERE/fuzz_cmd.c" "$HERE/../cmd_mock.c" $SRC
@@ -28,7 +30,7 @@ while IFS= read -r line; do
   printf '\000%s\r\n' "$line" > "$OUT/corpus_cmd/seed$i"
 done < "$HERE/cmd_seeds.txt"
 # shellcheck disable=SC2086
-$CLANG -std=c11 -O1 -I$FW -I$ROOT/control -o "$OUT/stream_gen" "$HERE/../stream_gen.c" \
+$CLANG -std=c11 -O1 -I$FW $CTRL_INC -o "$OUT/stream_gen" "$HERE/../stream_gen.c" \
   $FW/telemetry.c $FW/telemetry_frame.c
 "$OUT/stream_gen" "$OUT/corpus_tel/stream.bin" "$OUT/stream_expect.txt"
 head -c 600 "$OUT/corpus_tel/stream.bin" > "$OUT/corpus_tel/stream_head.bin"
