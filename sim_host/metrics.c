@@ -207,6 +207,9 @@ int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
     if (m->f1_hz > 0.0) {
         r->thd_i_pct = metrics_thd_pct(m->ia_t, m->ia_v, m->ia_n, m->f1_hz, m->thd_fmax_hz,
                                        &r->thd_harmonics, &r->thd_window_s, &r->i1_amp_a);
+        if (!(r->i1_amp_a >= m->thd_i1_min_a)) {
+            r->thd_i_pct = NAN; /* no fundamental to refer to (metrics.h) */
+        }
     }
     return 0;
 }

@@ -12,6 +12,11 @@
  * integration of the uniformly sampled i_a over the largest integer number of
  * fundamental periods that fits in the window (the end is linearly
  * interpolated), harmonics 2..N with N f1 <= min(10 kHz, f_sample/2).
+ * THD is undefined (NaN, "null" in JSON) without a fundamental to refer to:
+ * f1 = 0 (standstill), less than one fundamental period in the window, or a
+ * fundamental amplitude below thd_i1_min_a (set by the caller; the simulator
+ * uses 5 % of the rated current: below it the ratio measures the switching
+ * ripple, not distortion, and ran to ~1000 % at zero torque).
  * Samples are assumed uniformly spaced (the ripple figures are plain sample
  * statistics; THD uses the sample times).
  */
@@ -30,8 +35,9 @@ typedef enum { METRICS_SAMPLING_PLANT = 0, METRICS_SAMPLING_CONTROL = 1 } metric
 
 typedef struct {
     metrics_sampling_t sampling;
-    double f1_hz;       /* fundamental for THD (0 = no THD) */
-    double thd_fmax_hz; /* highest harmonic frequency, default 10 kHz */
+    double f1_hz;        /* fundamental for THD (0 = no THD) */
+    double thd_fmax_hz;  /* highest harmonic frequency, default 10 kHz */
+    double thd_i1_min_a; /* least fundamental amplitude for a THD, default 0 */
     /* Welford accumulators */
     uint64_t n;
     double t_first, t_last;
@@ -53,7 +59,7 @@ typedef struct {
     double flux_mean_wb, flux_ripple_wb;
     double torque_sse_nm;
     double f_av_hz;      /* NaN if no transition count was given */
-    double thd_i_pct;    /* NaN if f1 == 0 or under one fundamental period */
+    double thd_i_pct;    /* NaN if f1 == 0, under one fundamental period, or i1 < thd_i1_min_a */
     double thd_window_s; /* the integer-period window used for THD */
     int thd_harmonics;   /* N */
     double i1_amp_a;     /* fundamental amplitude of i_a */

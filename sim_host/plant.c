@@ -469,10 +469,20 @@ static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, dou
     int rc;
     if (p->cfg.mech == PLANT_MECH_FREE) {
         /* omega held at the midpoint prediction; Te averaged by Simpson. */
-        const double J = p->cfg.inertia_kgm2, B = p->cfg.friction_nms, tl = p->load_torque_nm;
+        const double J = p->cfg.inertia_kgm2, B = p->cfg.friction_nms;
         const double te0 = plant_torque(p);
         const double wm0 = p->omega_m;
-        const double wm_mid = wm0 + 0.5 * dt * (te0 - tl - B * wm0) / J;
+        /* Passive load: its sign follows the motion at the piece start (at
+         * rest: the direction the net torque would start it, none when the
+         * load can hold it). */
+        const double tp = p->load_passive_nm;
+        double dir = (wm0 > 0.0) - (wm0 < 0.0);
+        if (dir == 0.0 && fabs(te0 - p->load_torque_nm) > tp) {
+            dir = te0 - p->load_torque_nm > 0.0 ? 1.0 : -1.0;
+        }
+        const double tl = p->load_torque_nm + tp * dir;
+        const int held = tp > 0.0 && dir == 0.0;
+        const double wm_mid = held ? 0.0 : wm0 + 0.5 * dt * (te0 - tl - B * wm0) / J;
         const double th0 = p->theta_e;
         rc = electrical_piece(p, l, sine, wm_mid * pp, 0.0, 0.5 * dt);
         if (rc != PLANT_OK) {
@@ -488,11 +498,19 @@ static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, dou
         const double te1 = plant_torque(p);
         const double te_av = (te0 + 4.0 * te_mid + te1) / 6.0;
         const double f = te_av - tl;
-        if (B > 0.0) {
+        if (held) {
+            p->omega_m = 0.0;
+        } else if (B > 0.0) {
             const double a = exp(-B * dt / J);
             p->omega_m = wm0 * a + f / B * (1.0 - a);
         } else {
             p->omega_m = wm0 + f * dt / J;
+        }
+        if (tp > 0.0 && dir != 0.0 && p->omega_m * dir < 0.0) {
+            /* A passive load stops the rotor, it cannot reverse it: the
+             * speed crossed zero inside the piece; the next piece starts at
+             * rest and decides from the torque then (error: one piece). */
+            p->omega_m = 0.0;
         }
         p->theta_m += wm_mid * dt;
     } else {
@@ -524,8 +542,9 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
              finite_pos(c->ld_h) && finite_pos(c->lq_h) && finite_nonneg(c->psi_pm_wb) &&
              finite_pos(c->vdc_v) && finite_nonneg(c->dc_cap_f) && finite_nonneg(c->dead_time_s) &&
              finite_nonneg(c->v_fwd_v) && finite_nonneg(c->friction_nms) &&
-             isfinite(c->load_torque_nm) && isfinite(c->theta0_e_rad) && isfinite(c->id0_a) &&
-             isfinite(c->iq0_a) && isfinite(c->speed0_rpm) && finite_nonneg(c->rk4_step_s) &&
+             isfinite(c->load_torque_nm) && finite_nonneg(c->load_passive_nm) &&
+             isfinite(c->theta0_e_rad) && isfinite(c->id0_a) && isfinite(c->iq0_a) &&
+             isfinite(c->speed0_rpm) && finite_nonneg(c->rk4_step_s) &&
              (c->mech == PLANT_MECH_IMPOSED || c->mech == PLANT_MECH_FREE);
     if (ok && c->dc_cap_f > 0.0) {
         ok = finite_pos(c->dc_src_r_ohm);
@@ -550,6 +569,7 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
     p->omega_m = c->speed0_rpm * 2.0 * PLANT_PI / 60.0;
     p->vdc = c->vdc_v;
     p->load_torque_nm = c->load_torque_nm;
+    p->load_passive_nm = c->load_passive_nm;
     p->id = c->id0_a;
     p->iq = c->iq0_a;
     flux_from_current(p, p->id, p->iq, &p->psi_d, &p->psi_q);
@@ -581,6 +601,27 @@ void plant_set_load_torque(plant_t *p, double t_load_nm)
     if (p != NULL && isfinite(t_load_nm)) {
         p->load_torque_nm = t_load_nm;
     }
+}
+
+void plant_set_load_passive(plant_t *p, double t_passive_nm)
+{
+    if (p != NULL && isfinite(t_passive_nm) && t_passive_nm >= 0.0) {
+        p->load_passive_nm = t_passive_nm;
+    }
+}
+
+double plant_load_torque(const plant_t *p)
+{
+    if (p == NULL) {
+        return NAN;
+    }
+    const double tp = p->load_passive_nm;
+    if (p->omega_m != 0.0) {
+        return p->load_torque_nm + (p->omega_m > 0.0 ? tp : -tp);
+    }
+    /* At rest the passive load holds up to tp of the net torque. */
+    const double net = plant_torque(p) - p->load_torque_nm;
+    return p->load_torque_nm + (net > tp ? tp : (net < -tp ? -tp : net));
 }
 
 void plant_set_speed_rpm(plant_t *p, double rpm)

@@ -86,9 +86,12 @@ typedef struct {
 
     /* Mechanics (3.15), mechanical units. */
     plant_mech_mode_t mech;
-    double inertia_kgm2;   /* J > 0 (needed when mech == PLANT_MECH_FREE) */
-    double friction_nms;   /* B >= 0, N*m*s/rad (mechanical) */
-    double load_torque_nm; /* initial T_L */
+    double inertia_kgm2;    /* J > 0 (needed when mech == PLANT_MECH_FREE) */
+    double friction_nms;    /* B >= 0, N*m*s/rad (mechanical) */
+    double load_torque_nm;  /* initial T_L (active: acts whatever the motion) */
+    double load_passive_nm; /* >= 0: passive load T_p sign(w_m) (Coulomb friction of a
+                               load): opposes the rotation, holds the rotor at rest
+                               while |Te - T_L| <= T_p, never drives it */
 
     /* Initial state. */
     double theta0_e_rad; /* electrical rotor angle */
@@ -111,15 +114,16 @@ typedef void (*plant_observer_fn)(void *ctx, const plant_t *p);
 struct plant {
     plant_config_t cfg;
     /* electrical state, rotor frame */
-    double id, iq;         /* A */
-    double psi_d, psi_q;   /* Wb */
-    double theta_e;        /* electrical angle, wrapped to [-pi, pi) */
-    double theta_m;        /* mechanical angle, unwrapped (rad) */
-    double omega_m;        /* mechanical speed, rad/s */
-    double vdc;            /* V */
-    double t;              /* simulated time, s */
-    double load_torque_nm; /* T_L */
-    uint8_t s[3];          /* last applied leg states (for transitions) */
+    double id, iq;          /* A */
+    double psi_d, psi_q;    /* Wb */
+    double theta_e;         /* electrical angle, wrapped to [-pi, pi) */
+    double theta_m;         /* mechanical angle, unwrapped (rad) */
+    double omega_m;         /* mechanical speed, rad/s */
+    double vdc;             /* V */
+    double t;               /* simulated time, s */
+    double load_torque_nm;  /* T_L */
+    double load_passive_nm; /* T_p */
+    uint8_t s[3];           /* last applied leg states (for transitions) */
     uint8_t s_valid;
     uint64_t transitions[3]; /* leg transitions since init (on and off) */
     double dead_end[3];      /* leg x is off (dead time) until this time */
@@ -165,6 +169,10 @@ void plant_set_observer(plant_t *p, plant_observer_fn fn, void *ctx, double obs_
 
 /* Time-varying inputs: call between advances (piecewise-constant profiles). */
 void plant_set_load_torque(plant_t *p, double t_load_nm);
+void plant_set_load_passive(plant_t *p, double t_passive_nm); /* magnitude >= 0 */
+/* Load torque on the shaft now (free mechanics): T_L + the passive load's
+ * present value (T_p sign(w_m); at rest the part of Te - T_L it holds). */
+double plant_load_torque(const plant_t *p);
 void plant_set_speed_rpm(plant_t *p, double rpm); /* imposed speed (and free: sets the state) */
 
 /* True state getters. */

@@ -118,10 +118,42 @@ static int handler(void *user, const char *section, const char *name, const char
         }
         return 1;
     }
-    if (!section_known) {
+    if (section[0] == '\0') {
+        snprintf(c->msg, sizeof c->msg, "key %s before any [section] header", name);
+    } else if (!section_known) {
         snprintf(c->msg, sizeof c->msg, "unknown section [%s] (key %s)", section, name);
     } else {
         snprintf(c->msg, sizeof c->msg, "unknown key %s in [%s]", name, section);
+    }
+    return 0;
+}
+
+/* Section headers libinih would skip silently (it reports the line but then
+ * files the keys under the previous section): "[name]" with nothing but a
+ * comment after it. Returns the first bad line (0: none) and its text. */
+static int header_check(FILE *f, char *bad, size_t badlen)
+{
+    char line[512];
+    int n = 0;
+    while (fgets(line, sizeof line, f) != NULL) {
+        n++;
+        const char *p = line;
+        while (*p == ' ' || *p == '\t') {
+            p++;
+        }
+        if (*p != '[') {
+            continue;
+        }
+        const char *close = strchr(p, ']');
+        const char *q = close != NULL ? close + 1 : NULL;
+        while (q != NULL && (*q == ' ' || *q == '\t' || *q == '\r' || *q == '\n')) {
+            q++;
+        }
+        if (close == NULL || close == p + 1 || (*q != '\0' && *q != ';' && *q != '#')) {
+            size_t k = strcspn(p, "\r\n");
+            snprintf(bad, badlen, "%.*s", (int)(k < 60 ? k : 60), p);
+            return n;
+        }
     }
     return 0;
 }
@@ -154,6 +186,16 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
+    char hdr[64];
+    const int hdr_line = header_check(f, hdr, sizeof hdr);
+    if (hdr_line != 0) {
+        fclose(f);
+        snprintf(err, errlen, "%s:%d: malformed section header '%s' (expected [name])", path,
+                 hdr_line, hdr);
+        memset(out, 0, sizeof(*out));
+        return -1;
+    }
+    rewind(f);
     const int line = ini_parse_file(f, handler, &c);
     fclose(f);
     if (line != 0) {
@@ -174,15 +216,21 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
         }
     }
     /* Cross-field rules. */
-    const char *bad = NULL;
+    char bad[200] = "";
     if (!(out->current_max_a > out->current_rated_a)) {
-        bad = "[rated] current_max_a must exceed current_a";
+        snprintf(bad, sizeof bad,
+                 "[rated] current_max_a must exceed current_a (current_max_a = %g A, current_a = "
+                 "%g A)",
+                 out->current_max_a, out->current_rated_a);
     } else if (out->dc_cap_f > 0.0 && !(out->dc_src_r_ohm > 0.0)) {
-        bad = "[inverter] dc_src_r_ohm is required (> 0) when dc_cap_uf > 0";
+        snprintf(bad, sizeof bad, "[inverter] dc_src_r_ohm is required (> 0) when dc_cap_uf > 0");
     } else if (out->dead_time_s * out->fs_hz > 0.1) {
-        bad = "[inverter] dead_time_ns exceeds 10 % of the PWM period";
+        snprintf(bad, sizeof bad,
+                 "[inverter] dead_time_ns = %g exceeds 10 %% of the PWM period (<= %g ns at "
+                 "fs_hz = %g)",
+                 out->dead_time_s * 1e9, 0.1e9 / out->fs_hz, out->fs_hz);
     }
-    if (bad != NULL) {
+    if (bad[0] != '\0') {
         snprintf(err, errlen, "%s: %s", path, bad);
         memset(out, 0, sizeof(*out));
         return -1;

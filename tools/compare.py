@@ -176,8 +176,9 @@ def main():
             rc, out, err, dt = fut.result()
             label = f"{name} {'dynamic' if kind == 'dynamic' else str(rpm) + ' r/min'}"
             print(f"  [{k:2d}/{len(jobs)}] {label:<22s} {dt:5.1f} s  "
-                  f"{'ok' if rc == 0 else 'FAILED'}", flush=True)
-            if rc != 0:
+                  f"{ {0: 'ok', 3: 'tripped'}.get(rc, 'FAILED')}", flush=True)
+            # Exit status 3: the drive tripped; the metrics (up to the trip) are written.
+            if rc not in (0, 3) or not os.path.exists(base + ".json"):
                 failed.append((label, err.strip()))
                 continue
             with open(base + ".json") as f:

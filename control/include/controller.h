@@ -34,7 +34,7 @@ typedef struct {
  */
 typedef struct {
     const char *name; /* e.g. "h_T" */
-    const char *unit; /* e.g. "N*m" */
+    const char *unit; /* e.g. "N*m"; "0/1" marks a switch (only 0 and 1 accepted) */
     const char *help; /* one line, cites the seed */
     size_t offset;    /* offsetof(cfg struct, field), field is a double */
     double min, max;  /* accepted range (inclusive) */

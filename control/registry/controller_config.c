@@ -38,6 +38,9 @@ int ctrl_tunable_set(const ctrl_desc_t *d, void *cfg, const char *name, double v
     if (!tunable_in_cfg(d, t) || !isfinite(value) || value < t->min || value > t->max) {
         return CTRL_EINVAL;
     }
+    if (strcmp(t->unit, "0/1") == 0 && value != 0.0 && value != 1.0) {
+        return CTRL_EINVAL; /* a switch: 0 or 1 only (controller.h) */
+    }
     memcpy((char *)cfg + t->offset, &value, sizeof value);
     return CTRL_OK;
 }

@@ -47,16 +47,44 @@ expect_fail "duration out of range" "--duration -1 is out of range" --machine "$
 expect_fail "option without value" "needs a value" --machine "$m" --controller bst --duration
 expect_fail "bad window" "--window" --machine "$m" --controller bst --duration 0.1 --window 0.2:0.1
 expect_fail "window beyond duration" "--window" --machine "$m" --controller bst --duration 0.1 --window 0:0.5
-expect_fail "seed not integer" "--seed expects an integer" --machine "$m" --controller bst --seed 1.5
+expect_fail "seed not integer" "--seed 1.5: must be a whole number" --machine "$m" --controller bst --seed 1.5
 expect_fail "both references" "either --torque-ref or --speed-ref-rpm" --machine "$m" --controller bst --torque-ref 1 --speed-ref-rpm 100
 expect_fail "load without free" "--load-nm needs --free" --machine "$m" --controller bst --load-nm 1
 expect_fail "unknown tunable" "no tunable 'nope'" --machine "$m" --controller bst --set nope=1
-expect_fail "tunable out of range" "out of range: 'h_T=-5'" --machine "$m" --controller bst --set h_T=-5
+expect_fail "tunable out of range" "bst tunable h_T = -5 N\*m is out of range \[0, " --machine "$m" --controller bst --set h_T=-5
 expect_fail "tunable malformed" "--set expects NAME=VALUE" --machine "$m" --controller bst --set h_T
 expect_fail "scenario missing" "cannot open scenario" --machine "$m" --controller bst --scenario "$tmp/none.scn"
 expect_fail "scenario unknown key" "bad_key.scn:2: unknown key" --machine "$m" --controller bst --scenario "$tmp/bad_key.scn"
 expect_fail "scenario time order" "bad_order.scn:2: times must not decrease" --machine "$m" --controller bst --scenario "$tmp/bad_order.scn"
 expect_fail "scenario bad trigger" "bad_trig.scn:1: expected 'at' or 'when'" --machine "$m" --controller bst --scenario "$tmp/bad_trig.scn"
+# Issue 13: every input is validated before the run; errors name quantity, value, range.
+printf '[machine\nname = x\n' >"$tmp/bad_hdr.ini"
+printf 'at 0 load=1\n' >"$tmp/load_dyn.scn"
+printf 'at 0 speed=100\n' >"$tmp/speed_free.scn"
+printf 'at 0.01 speed_ref=100\n' >"$tmp/mode.scn"
+printf 'at 0 torque_ref=1 torque_ref=2\n' >"$tmp/dup.scn"
+printf 'at 0.01 load_passive=-1\n' >"$tmp/neg_passive.scn"
+sed 's/^lq_mh = .*/lq_mh = 0.3/' "$m" >"$tmp/lq_small.ini"
+expect_fail "fs not whole" "--fs 10000.7: must be a whole number of Hz \(allowed range \[1000, 200000\]\)" --machine "$m" --controller bst --fs 10000.7
+expect_fail "0/1 tunable" "m2ptfc tunable centre = 0.5: a 0/1 switch, allowed values 0 or 1" --machine "$m" --controller m2ptfc --set centre=0.5
+expect_fail "malformed section header" "bad_hdr.ini:1: malformed section header '\[machine'" --machine "$tmp/bad_hdr.ini" --controller bst
+expect_fail "scenario load on dynamometer" "load_dyn.scn|line 1 \(at 0\): load= and load_passive= act on free mechanics only" --machine "$m" --controller bst --scenario "$tmp/load_dyn.scn"
+expect_fail "scenario speed on free" "line 1 \(at 0\): speed= imposes the dynamometer speed" --machine "$m" --controller bst --free --scenario "$tmp/speed_free.scn"
+expect_fail "scenario mode switch" "speed_ref= in a torque-mode run" --machine "$m" --controller bst --free --scenario "$tmp/mode.scn"
+expect_fail "scenario duplicate key" "dup.scn:1: key given twice in one event: 'torque_ref'" --machine "$m" --controller bst --scenario "$tmp/dup.scn"
+expect_fail "scenario negative passive load" "neg_passive.scn:1: load_passive is a magnitude" --machine "$m" --controller bst --free --scenario "$tmp/neg_passive.scn"
+expect_fail "speed loop on a dynamometer" "--speed-ref-rpm needs --free" --machine "$m" --controller bst --speed-ref-rpm 100
+expect_fail "fixed-point range named" "Lq = 0.3 mH is outside the accepted range \(>= [0-9.]+ mH\)" --machine "$tmp/lq_small.ini" --controller m2ptfc
+expect_fail "fs below the Q format" "fs = 1000 Hz is outside the accepted range \(>= [0-9]+ Hz\)" --machine "$m" --controller bst --fs 1000
+# An unwritable metrics path fails before the run: no trace row is written.
+out="$("$sim" --machine "$m" --controller bst --duration 0.01 --trace "$tmp/early.csv" \
+       --metrics "$tmp/no/dir/m.json" 2>&1)"; rc=$?
+if [ "$rc" -ne 2 ] || ! grep -q "cannot write metrics file" <<<"$out" || [ -s "$tmp/early.csv" ]; then
+  echo "FAIL: metrics path checked before the run: status $rc, trace $(wc -c <"$tmp/early.csv" 2>/dev/null) bytes: $out"
+  fails=$((fails + 1))
+else
+  echo "ok: metrics path checked before the run"
+fi
 expect_fail "trace not writable" "cannot write trace file" --machine "$m" --controller bst --trace "$tmp/no/dir/t.csv"
 expect_fail "replay without speed" "--replay needs --speed-rpm" --machine "$m" --replay "$tmp/none.csv" --trace "$tmp/t.csv"
 expect_fail "replay file missing" "replay" --machine "$m" --replay "$tmp/none.csv" --speed-rpm 100 --trace "$tmp/t.csv"
@@ -70,13 +98,65 @@ if [ "$rc" -ne 0 ] || ! grep -q "T_rip" <<<"$out"; then
   echo "FAIL: good run: status $rc: $out"; fails=$((fails + 1))
 else
   for k in torque_mean_nm torque_ripple_nm flux_mean_wb flux_ripple_wb torque_sse_nm f_av_hz \
-           thd_i_pct fs_hz controller window torque_ripple_ctrl_nm flux_ripple_ctrl_wb; do
+           thd_i_pct fs_hz controller window torque_ripple_ctrl_nm flux_ripple_ctrl_wb \
+           torque_ref_requested_nm torque_ref_applied_nm warnings mode mechanics fault_time_s; do
     grep -q "\"$k\"" "$tmp/m.json" || { echo "FAIL: metrics key $k missing"; fails=$((fails + 1)); }
   done
-  head -n1 "$tmp/t.csv" | grep -q "^t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty" ||
+  head -n1 "$tmp/t.csv" | grep -q "^t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,speed_ref_rpm,load_nm$" ||
     { echo "FAIL: trace header"; fails=$((fails + 1)); }
   echo "ok: good run"
 fi
+# --torque-ref 50 on the 2.4 N*m machine: a warning on stderr and in the JSON,
+# with the requested and the applied reference.
+err="$("$sim" --machine "$m" --controller bst --speed-rpm 750 --torque-ref 50 --duration 0.01 \
+       --metrics "$tmp/clamp.json" 2>&1 >/dev/null)"; rc=$?
+if [ "$rc" -eq 0 ] && grep -q "warning: torque reference 50 N\*m is outside the drive's torque limit \[-2.4, 2.4\] N\*m" <<<"$err" &&
+   grep -q '"torque_ref_requested_nm": 50,' "$tmp/clamp.json" &&
+   grep -Eq '"torque_ref_applied_nm": 2\.4[0-9]*,' "$tmp/clamp.json" &&
+   grep -q '"warnings": \["torque reference 50 N\*m is outside' "$tmp/clamp.json"; then
+  echo "ok: --torque-ref 50 warns and records requested/applied"
+else
+  echo "FAIL: --torque-ref 50: status $rc: $err"; fails=$((fails + 1))
+fi
+# THD at zero torque has no fundamental: null in JSON, n/a in text (was 984 %).
+out="$("$sim" --machine "$m" --controller bst --speed-rpm 750 --torque-ref 0 --duration 0.05 \
+       --metrics "$tmp/zero.json" 2>&1)"
+if grep -q "THD_I n/a" <<<"$out" && grep -q '"thd_i_pct": null,' "$tmp/zero.json"; then
+  echo "ok: THD undefined at zero torque"
+else
+  echo "FAIL: THD at zero torque: $out"; fails=$((fails + 1))
+fi
+# A drive that trips exits 3 (mbst at 2250 r/min, 1.8 N*m: overcurrent), JSON still written.
+out="$("$sim" --machine "$m" --controller mbst --speed-rpm 2250 --torque-ref 1.8 --duration 0.1 \
+       --metrics "$tmp/trip.json" 2>&1)"; rc=$?
+if [ "$rc" -eq 3 ] && grep -q "the drive faulted at t = " <<<"$out" &&
+   grep -q '"fault": "overcurrent"' "$tmp/trip.json" && grep -Eq '"fault_time_s": [0-9]' "$tmp/trip.json"; then
+  echo "ok: mbst at 2250 r/min exits 3"
+else
+  echo "FAIL: mbst at 2250 r/min: status $rc: $out"; fails=$((fails + 1))
+fi
+# Scenario events after the end or never reached are warnings, also in the JSON.
+printf 'at 0.5 torque_ref=1\nwhen speed>=1000 torque_ref=1\n' >"$tmp/late.scn"
+err="$("$sim" --machine "$m" --controller bst --free --duration 0.01 --scenario "$tmp/late.scn" \
+       --metrics "$tmp/late.json" 2>&1 >/dev/null)"
+if grep -q "line 1 (at 0.5): after the end of the run" <<<"$err" &&
+   grep -q "line 2 (when speed>=1000) never fired" <<<"$err" &&
+   grep -q '"scenario_fired_s": \[null, null\]' "$tmp/late.json" && grep -q "never fired" "$tmp/late.json"; then
+  echo "ok: scenario events that never fire warn"
+else
+  echo "FAIL: late scenario events: $err"; fails=$((fails + 1))
+fi
+# --list-tunables: unit, range, default of each tunable (m2ptfc lists the switch centre).
+out="$("$sim" --list-tunables m2ptfc)"
+if grep -Eq "^centre +0/1 +\{0, 1\} +1 " <<<"$out" && grep -Eq "^lambda +1 +\[0.0001, 1\] +0.03 " <<<"$out"; then
+  echo "ok: --list-tunables m2ptfc"
+else
+  echo "FAIL: --list-tunables m2ptfc: $out"; fails=$((fails + 1))
+fi
+# --help states the default metrics window the run uses, and the exit codes.
+"$sim" --help | grep -q -- "--window START:END.*default duration/3 : duration" &&
+  "$sim" --help | grep -q "3 the drive" || { echo "FAIL: --help"; fails=$((fails + 1)); }
+
 # Open-loop replay of two intervals: exit 0, the plant owner's trace header.
 printf 't_start_s,duration_s,S1,S2,S3\n0,0.0001,1,0,0\n0.0001,0.0001,0,0,0\n' >"$tmp/rp.csv"
 if "$sim" --machine "$m" --replay "$tmp/rp.csv" --speed-rpm 100 --trace "$tmp/rp_out.csv" >/dev/null 2>&1 &&

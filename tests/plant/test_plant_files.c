@@ -197,6 +197,8 @@ static void test_ini_bad_input(void)
     expect_ini_error("vdc_v = 220", "vdc_v = 220\nvdc_v = 230", "vdc_v given twice");
     /* cross-field rule */
     expect_ini_error("current_max_a = 10", "current_max_a = 4", "current_max_a must exceed");
+    /* A header libinih would skip, filing the keys under no section. */
+    expect_ini_error("[rated]", "[rated", ":8: malformed section header '[rated'");
     /* empty value */
     expect_ini_error("vdc_v = 220", "vdc_v =", "vdc_v = '' is not a number");
     /* missing file */

@@ -391,6 +391,44 @@ static void test_free_mechanics_friction_load(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 100.0 / 60.0 * 2.0 * PI, plant_omega_m(&p));
 }
 
+/* Passive load T_p (no electromagnetic torque: psi_pm = 0, no current):
+ * J dw/dt = -T_L - T_p sign(w). From w0 > 0 with T_L = 0 the rotor decelerates
+ * at T_p/J, stops at t_s = J w0 / T_p and stays at rest (the load cannot drive
+ * it backwards). An active load below T_p is then held; one above it turns
+ * the rotor backwards at (T_L - T_p)/J. */
+static void test_free_mechanics_passive_load(void)
+{
+    plant_config_t c = cfg_spmsm();
+    c.psi_pm_wb = 0.0;
+    c.mech = PLANT_MECH_FREE;
+    c.load_passive_nm = 0.5;
+    c.speed0_rpm = 500.0;
+    plant_t p;
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
+    const uint8_t v0[3] = {0, 0, 0};
+    const double w0 = 500.0 / 60.0 * 2.0 * PI, J = c.inertia_kgm2, tp = c.load_passive_nm;
+    const double t_stop = J * w0 / tp; /* 12.6 ms */
+    const double h = 1e-4;
+    for (int k = 1; k * h < 2.0 * t_stop; ++k) {
+        TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, h, v0));
+        const double t = k * h;
+        const double w = t < t_stop ? w0 - tp / J * t : 0.0;
+        /* exact per piece except the piece that contains the stop (one piece) */
+        TEST_ASSERT_DOUBLE_WITHIN(tp / J * h + 1e-9, w, plant_omega_m(&p));
+        TEST_ASSERT_TRUE(plant_omega_m(&p) >= 0.0);
+    }
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, plant_omega_m(&p));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, plant_load_torque(&p));
+    plant_set_load_torque(&p, 0.3); /* below T_p: held */
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, 0.01, v0));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, plant_omega_m(&p));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.0, plant_load_torque(&p)); /* T_L held by T_p */
+    plant_set_load_torque(&p, 0.8); /* above T_p: backwards at (0.8 - 0.5)/J */
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, 0.01, v0));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, -(0.8 - tp) / J * 0.01, plant_omega_m(&p));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.8 - tp, plant_load_torque(&p));
+}
+
 /* Dead time at locked rotor: leg a PWM at duty d, legs b, c low; i_a > 0, so
  * during each dead time after the turn-off command the lower diode conducts
  * (no change) and after the turn-on command the leg stays at 0 V: the leg
@@ -607,6 +645,7 @@ int main(void)
     RUN_TEST(test_rk4_path_matches_exact);
     RUN_TEST(test_free_mechanics_energy);
     RUN_TEST(test_free_mechanics_friction_load);
+    RUN_TEST(test_free_mechanics_passive_load);
     RUN_TEST(test_dead_time_volt_seconds);
     RUN_TEST(test_gates_off_current_decays);
     RUN_TEST(test_observer_grid);

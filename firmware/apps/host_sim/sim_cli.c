@@ -1,89 +1,344 @@
 /*
  * Host simulator CLI (./tools/sim): closed loop of plant + HAL sim + firmware,
  * or open-loop replay of a switching sequence. `sim --help` lists the options.
+ *
+ * Adding an option: one row of k_opts (name, kind, allowed range and unit,
+ * mode, needs/excludes, help with its default) and, when it needs more than
+ * its row says, one rule in cli_check. Every value is validated before the
+ * run starts; an error names the option, the value and the allowed range and
+ * exits with SIM_EXIT_USAGE. Clamps and inputs that do not act as written are
+ * warnings (stderr and the metrics JSON).
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "controller.h"
+#include "sim_diag.h"
 #include "sim_replay.h"
 #include "sim_run.h"
 
-#define SIM_MAX_SETS 32
+/* Exit status (documented in --help and README.md). */
+enum {
+    SIM_EXIT_OK = 0,    /* the run completed, the drive did not fault */
+    SIM_EXIT_RUN = 1,   /* the run could not complete (plant failure, I/O error) */
+    SIM_EXIT_USAGE = 2, /* invalid input: nothing was simulated */
+    SIM_EXIT_FAULT = 3  /* the drive faulted (tripped); metrics and trace up to the fault */
+};
 
-static const char *const usage =
-    "usage: sim --machine FILE [options]\n"
-    "closed loop:\n"
-    "  --controller NAME        controller from the registry (see --list-controllers)\n"
-    "  --fs HZ                  sampling/PWM frequency (default: the controller's)\n"
-    "  --control-machine FILE   configure the controller with another machine file\n"
-    "  --speed-rpm R            dynamometer: imposed speed (default 0)\n"
-    "  --free                   free mechanics (3.15), initial speed --speed-rpm\n"
-    "  --load-nm T              load torque (free mechanics)\n"
-    "  --torque-ref NM | --speed-ref-rpm R   reference (default torque 0)\n"
-    "  --duration S             simulated time after arm (default 0.3)\n"
-    "  --window START:END       metrics window in s (default 0.1:duration)\n"
-    "  --scenario FILE          time/speed-triggered steps (firmware/host/sim_scenario.h)\n"
-    "  --seed N                 ADC noise seed (default 1)\n"
-    "  --trace FILE.csv         true signals on a Ts/10 grid\n"
-    "  --trace-decimation N     keep every N-th trace row (default 1)\n"
-    "  --trace-window START:END write trace rows only in this time span (s)\n"
-    "  --metrics FILE.json      performance indices (also printed to stdout)\n"
-    "  --set NAME=VALUE         controller tunable (repeatable)\n"
-    "  --list-controllers       print name, fs_default_hz and title of each controller\n"
-    "open-loop replay:\n"
-    "  --replay FILE.csv --speed-rpm R [--theta0-elec RAD] [--id0 A] [--iq0 A] --trace FILE\n";
+typedef enum { K_FLAG, K_REAL, K_UINT, K_TEXT, K_SPAN, K_SET } cli_kind_t;
+/* Which kind of run an option belongs to. */
+typedef enum { M_ANY, M_LOOP, M_REPLAY, M_INFO } cli_mode_t;
 
-static int die(const char *fmt, const char *a, const char *b)
+typedef struct {
+    double start, end;
+} cli_span_t;
+
+/* Parsed values (one field per option, kind by k_opts). */
+typedef struct {
+    const char *machine, *control_machine, *controller, *scenario, *trace, *metrics, *replay;
+    const char *list_tunables;
+    double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
+    double decim, theta0, id0, iq0;
+    cli_span_t window, trace_window;
+    int free_mech, help, list_controllers, continue_on_fault;
+    sim_set_t sets[SIM_MAX_SETS];
+    size_t n_sets;
+} cli_t;
+
+typedef struct {
+    const char *name, *metavar;
+    cli_kind_t kind;
+    double lo, hi;    /* K_REAL, K_UINT: allowed range (inclusive) */
+    const char *unit; /* in messages */
+    cli_mode_t mode;
+    const char *needs;    /* another option that must be given with it, or NULL */
+    const char *excludes; /* an option that must not be given with it, or NULL */
+    size_t off;           /* field in cli_t */
+    const char *help;     /* one line, with the default */
+} cli_opt_t;
+
+#define F(x) offsetof(cli_t, x)
+static const cli_opt_t k_opts[] = {
+    {"--machine", "FILE", K_TEXT, 0, 0, "", M_ANY, NULL, NULL, F(machine),
+     "machine file (sim_host/machines/*.ini); required except for --list-*"},
+    {"--controller", "NAME", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(controller),
+     "controller from the registry (see --list-controllers); required"},
+    {"--fs", "HZ", K_UINT, 1000, 200000, "Hz", M_LOOP, NULL, NULL, F(fs),
+     "sampling/PWM frequency, whole Hz (default: the controller's)"},
+    {"--control-machine", "FILE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(control_machine),
+     "configure the controller with another machine file (parameter mismatch)"},
+    {"--speed-rpm", "R", K_REAL, -1e5, 1e5, "r/min", M_ANY, NULL, NULL, F(speed_rpm),
+     "dynamometer: imposed speed; --free: initial speed; --replay: speed (default 0)"},
+    {"--free", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(free_mech),
+     "free mechanics (3.15) instead of the dynamometer"},
+    {"--load-nm", "T", K_REAL, -1e5, 1e5, "N*m", M_LOOP, "--free", NULL, F(load_nm),
+     "constant (active) load torque from arm on (default 0)"},
+    {"--load-passive-nm", "T", K_REAL, 0, 1e5, "N*m", M_LOOP, "--free", NULL, F(load_passive_nm),
+     "passive load of this magnitude: opposes the rotation, never drives it (default 0)"},
+    {"--torque-ref", "NM", K_REAL, -1e5, 1e5, "N*m", M_LOOP, NULL, "--speed-ref-rpm", F(torque_ref),
+     "torque reference, torque mode (default 0)"},
+    {"--speed-ref-rpm", "R", K_REAL, -1e5, 1e5, "r/min", M_LOOP, "--free", "--torque-ref",
+     F(speed_ref), "speed reference: speed mode (outer PI), needs --free"},
+    {"--duration", "S", K_REAL, 1e-4, 100, "s", M_LOOP, NULL, NULL, F(duration),
+     "simulated time after arm (default 0.3)"},
+    {"--window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, NULL, NULL, F(window),
+     "metrics window (default duration/3 : duration)"},
+    {"--scenario", "FILE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(scenario),
+     "time/speed-triggered steps (format: README.md, sim_scenario.h)"},
+    {"--seed", "N", K_UINT, 0, 9007199254740992.0, "", M_LOOP, NULL, NULL, F(seed),
+     "ADC noise seed, integer (default 1)"},
+    {"--trace", "FILE.csv", K_TEXT, 0, 0, "", M_ANY, NULL, NULL, F(trace),
+     "closed loop: true signals on a Ts/10 grid; replay: the output trace"},
+    {"--trace-decimation", "N", K_UINT, 1, 1e6, "", M_LOOP, "--trace", NULL, F(decim),
+     "keep every N-th trace row (default 1)"},
+    {"--trace-window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, "--trace", NULL, F(trace_window),
+     "write trace rows only in this time span (default: the whole run)"},
+    {"--metrics", "FILE.json", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(metrics),
+     "performance indices, settings and warnings (also printed to stdout)"},
+    {"--set", "NAME=VALUE", K_SET, 0, 0, "", M_LOOP, NULL, NULL, F(sets),
+     "controller tunable (repeatable; see --list-tunables NAME)"},
+    {"--continue-on-fault", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(continue_on_fault),
+     "keep simulating after a fault (gates off) to the end; the exit status stays 3"},
+    {"--list-controllers", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(list_controllers),
+     "print name, default fs and title of each controller"},
+    {"--list-tunables", "NAME", K_TEXT, 0, 0, "", M_INFO, NULL, NULL, F(list_tunables),
+     "print each tunable of a controller: unit, range, default (for --machine)"},
+    {"--replay", "FILE.csv", K_TEXT, 0, 0, "", M_REPLAY, "--trace", NULL, F(replay),
+     "open loop: replay a switching sequence (needs --speed-rpm and --trace)"},
+    {"--theta0-elec", "RAD", K_REAL, -1000, 1000, "rad", M_REPLAY, "--replay", NULL, F(theta0),
+     "replay: initial electrical angle (default 0)"},
+    {"--id0", "A", K_REAL, -1e5, 1e5, "A", M_REPLAY, "--replay", NULL, F(id0),
+     "replay: initial d current (default 0)"},
+    {"--iq0", "A", K_REAL, -1e5, 1e5, "A", M_REPLAY, "--replay", NULL, F(iq0),
+     "replay: initial q current (default 0)"},
+    {"--help", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(help), "this text"},
+};
+#undef F
+#define N_OPTS (sizeof k_opts / sizeof k_opts[0])
+
+static const char *const k_help_tail =
+    "exit status: 0 the run completed without a fault; 1 the run could not complete\n"
+    "  (plant failure, I/O error); 2 invalid input, nothing simulated; 3 the drive\n"
+    "  faulted (the run stops there unless --continue-on-fault; metrics and trace\n"
+    "  are written up to it).\n"
+    "Warnings (clamped references, events that never fire, ...) go to stderr and\n"
+    "to the \"warnings\" list of the metrics JSON. Undefined indices print n/a\n"
+    "(null in JSON).\n";
+
+static int die(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static int die(const char *fmt, ...)
 {
+    va_list ap;
+    va_start(ap, fmt);
     fprintf(stderr, "sim: error: ");
-    fprintf(stderr, fmt, a != NULL ? a : "", b != NULL ? b : "");
+    vfprintf(stderr, fmt, ap);
     fprintf(stderr, "\n");
-    return 2;
+    va_end(ap);
+    return SIM_EXIT_USAGE;
 }
 
-/* Strict number: whole string, finite, within [lo, hi]. */
-static int num_arg(const char *opt, const char *s, double lo, double hi, double *out)
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: sim --machine FILE --controller NAME [options]     closed loop\n"
+               "       sim --machine FILE --replay FILE.csv --speed-rpm R --trace FILE   "
+               "open loop\n"
+               "       sim --list-controllers | --list-tunables NAME [--machine FILE]\n"
+               "options:\n");
+    for (size_t i = 0; i < N_OPTS; i++) {
+        const cli_opt_t *o = &k_opts[i];
+        char lhs[48];
+        (void)snprintf(lhs, sizeof lhs, "%s%s%s", o->name, o->metavar ? " " : "",
+                       o->metavar ? o->metavar : "");
+        fprintf(f, "  %-26s %s", lhs, o->help);
+        if (o->kind == K_REAL || o->kind == K_UINT) {
+            if (o->hi < 1e15) {
+                fprintf(f, " [%g, %g]%s%s", o->lo, o->hi, o->unit[0] ? " " : "", o->unit);
+            }
+        }
+        fprintf(f, "\n");
+    }
+    fputs(k_help_tail, f);
+}
+
+static const cli_opt_t *opt_find(const char *name)
+{
+    for (size_t i = 0; i < N_OPTS; i++) {
+        if (strcmp(k_opts[i].name, name) == 0) {
+            return &k_opts[i];
+        }
+    }
+    return NULL;
+}
+
+/* A whole-string finite number. */
+static int parse_number(const char *s, double *out)
 {
     char *end = NULL;
     errno = 0;
-    const double v = s != NULL ? strtod(s, &end) : 0.0;
-    if (s == NULL || end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
-        fprintf(stderr, "sim: error: %s expects a number, got '%s'\n", opt, s ? s : "");
-        return -1;
-    }
-    if (v < lo || v > hi) {
-        fprintf(stderr, "sim: error: %s %s is out of range [%g, %g]\n", opt, s, lo, hi);
+    const double v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
         return -1;
     }
     *out = v;
     return 0;
 }
 
-/* START:END with 0 <= START < END <= duration. */
-static int parse_span(const char *opt, const char *arg, double duration, double *start,
-                      double *end_out)
+static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
 {
-    char *end = NULL;
-    errno = 0;
-    const double ws = strtod(arg, &end);
-    if (end == arg || *end != ':' || errno != 0) {
-        fprintf(stderr, "sim: error: %s expects START:END in seconds, got '%s'\n", opt, arg);
-        return -1;
+    void *dst = (char *)c + o->off;
+    switch (o->kind) {
+    case K_TEXT:
+        if (v[0] == '\0') {
+            return die("%s expects %s, got an empty string", o->name, o->metavar);
+        }
+        *(const char **)dst = v;
+        return 0;
+    case K_REAL:
+    case K_UINT: {
+        double x;
+        if (parse_number(v, &x) != 0) {
+            return die("%s expects a number%s%s, got '%s'", o->name, o->unit[0] ? " in " : "",
+                       o->unit, v);
+        }
+        if (o->kind == K_UINT && x != floor(x)) {
+            return die("%s %s: must be a whole number%s%s (allowed range [%g, %g])", o->name, v,
+                       o->unit[0] ? " of " : "", o->unit, o->lo, o->hi);
+        }
+        if (x < o->lo || x > o->hi) {
+            return die("%s %s is out of range: allowed [%g, %g]%s%s", o->name, v, o->lo, o->hi,
+                       o->unit[0] ? " " : "", o->unit);
+        }
+        *(double *)dst = x;
+        return 0;
     }
-    const char *s2 = end + 1;
-    const double we = strtod(s2, &end);
-    if (end == s2 || *end != '\0' || errno != 0 || !isfinite(ws) || !isfinite(we) || ws < 0.0 ||
-        we <= ws || we > duration + 1e-12) {
-        fprintf(stderr, "sim: error: %s '%s' must satisfy 0 <= START < END <= duration\n", opt,
-                arg);
-        return -1;
+    case K_SPAN: {
+        cli_span_t *sp = dst;
+        const char *colon = strchr(v, ':');
+        char a[64];
+        if (colon == NULL || (size_t)(colon - v) >= sizeof a) {
+            return die("%s expects START:END in seconds, got '%s'", o->name, v);
+        }
+        memcpy(a, v, (size_t)(colon - v));
+        a[colon - v] = '\0';
+        if (parse_number(a, &sp->start) != 0 || parse_number(colon + 1, &sp->end) != 0) {
+            return die("%s expects START:END in seconds, got '%s'", o->name, v);
+        }
+        return 0;
     }
-    *start = ws;
-    *end_out = we;
+    case K_SET: {
+        const char *eq = strchr(v, '=');
+        if (eq == NULL || eq == v || (size_t)(eq - v) >= SIM_SET_NAME_MAX) {
+            return die("--set expects NAME=VALUE, got '%s'", v);
+        }
+        if (c->n_sets >= SIM_MAX_SETS) {
+            return die("--set given more than %u times", (unsigned)SIM_MAX_SETS);
+        }
+        sim_set_t *st = &c->sets[c->n_sets];
+        memcpy(st->name, v, (size_t)(eq - v));
+        st->name[eq - v] = '\0';
+        for (size_t k = 0; k < c->n_sets; k++) {
+            if (strcmp(c->sets[k].name, st->name) == 0) {
+                return die("--set %s given twice", st->name);
+            }
+        }
+        if (parse_number(eq + 1, &st->value) != 0) {
+            return die("--set %s expects a number, got '%s'", st->name, eq + 1);
+        }
+        c->n_sets++;
+        return 0;
+    }
+    case K_FLAG:
+    default:
+        *(int *)dst = 1;
+        return 0;
+    }
+}
+
+/* Parse argv into c and given[] (option index -> given). */
+static int cli_parse(int argc, char **argv, cli_t *c, int *given)
+{
+    for (int i = 1; i < argc; i++) {
+        const cli_opt_t *o = opt_find(argv[i]);
+        if (o == NULL) {
+            return die("unknown option '%s' (see --help)", argv[i]);
+        }
+        const size_t idx = (size_t)(o - k_opts);
+        if (given[idx] && o->kind != K_SET) {
+            return die("%s given twice", o->name);
+        }
+        given[idx] = 1;
+        if (o->kind == K_FLAG) {
+            (void)parse_value(o, NULL, c);
+            continue;
+        }
+        if (i + 1 >= argc) {
+            return die("option %s needs a value (%s)", o->name, o->metavar);
+        }
+        const int rc = parse_value(o, argv[++i], c);
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    return 0;
+}
+
+static int is_given(const int *given, const char *name)
+{
+    const cli_opt_t *o = opt_find(name);
+    return o != NULL && given[o - k_opts];
+}
+
+/* Rules between options (the table's needs/excludes/mode, then the rest). */
+static int cli_check(cli_t *c, const int *given)
+{
+    const int replay = is_given(given, "--replay");
+    for (size_t i = 0; i < N_OPTS; i++) {
+        const cli_opt_t *o = &k_opts[i];
+        if (!given[i]) {
+            continue;
+        }
+        if (o->needs != NULL && !is_given(given, o->needs)) {
+            return die("%s needs %s%s", o->name, o->needs,
+                       strcmp(o->needs, "--free") == 0
+                           ? " (a dynamometer imposes the speed: no load, no speed loop)"
+                           : "");
+        }
+        if (o->excludes != NULL && is_given(given, o->excludes)) {
+            return die("give either %s or %s, not both", o->name, o->excludes);
+        }
+        if (replay && o->mode == M_LOOP) {
+            return die("--replay is open loop: %s does not apply to it", o->name);
+        }
+        if (!replay && o->mode == M_REPLAY) {
+            return die("%s belongs to --replay", o->name);
+        }
+    }
+    if (replay) {
+        if (!is_given(given, "--speed-rpm")) {
+            return die("--replay needs --speed-rpm");
+        }
+        return 0;
+    }
+    if (!is_given(given, "--window")) {
+        c->window.start = c->duration / 3.0;
+        c->window.end = c->duration;
+    }
+    if (!(c->window.start >= 0.0 && c->window.start < c->window.end &&
+          c->window.end <= c->duration * (1.0 + 1e-12))) {
+        return die("--window %g:%g must satisfy 0 <= START < END <= duration (%g s)",
+                   c->window.start, c->window.end, c->duration);
+    }
+    if (is_given(given, "--trace-window") &&
+        !(c->trace_window.start >= 0.0 && c->trace_window.start < c->trace_window.end &&
+          c->trace_window.end <= c->duration * (1.0 + 1e-12))) {
+        return die("--trace-window %g:%g must satisfy 0 <= START < END <= duration (%g s)",
+                   c->trace_window.start, c->trace_window.end, c->duration);
+    }
     return 0;
 }
 
@@ -95,301 +350,269 @@ static void list_controllers(void)
     }
 }
 
+static int list_tunables(const char *name, const sim_machine_t *m)
+{
+    const ctrl_desc_t *d = ctrl_find(name);
+    if (d == NULL) {
+        return die("unknown controller '%s' (see --list-controllers)", name);
+    }
+    static union {
+        max_align_t a;
+        unsigned char b[CTRL_CFG_MAX];
+    } cfg;
+    ctrl_machine_t cm;
+    sim_ctrl_machine_from(m, &cm);
+    memset(cfg.b, 0, sizeof cfg.b);
+    if (d->cfg_default != NULL && d->cfg_size <= CTRL_CFG_MAX) {
+        d->cfg_default(cfg.b, &cm);
+    }
+    printf("# %s: %s\n# defaults for machine %s; a computed parameter shows 0 "
+           "(computed from the machine at init)\n",
+           d->name, d->title, m->name);
+    int w = 4;
+    for (size_t i = 0; i < d->n_tunables; i++) {
+        const int n = (int)strlen(d->tunables[i].name);
+        w = n > w ? n : w;
+    }
+    printf("%-*s %-16s %-24s %-12s %s\n", w, "name", "unit", "range", "default", "help");
+    for (size_t i = 0; i < d->n_tunables; i++) {
+        const ctrl_tunable_t *t = &d->tunables[i];
+        double v = NAN;
+        (void)ctrl_tunable_get(d, cfg.b, t->name, &v);
+        char range[48];
+        if (strcmp(t->unit, "0/1") == 0) {
+            (void)snprintf(range, sizeof range, "{0, 1}");
+        } else {
+            (void)snprintf(range, sizeof range, "[%g, %g]", t->min, t->max);
+        }
+        printf("%-*s %-16s %-24s %-12g %s\n", w, t->name, t->unit, range, v, t->help);
+    }
+    return SIM_EXIT_OK;
+}
+
+/* One value with its unit, "n/a" when undefined. */
+static const char *fmt_num(char *buf, size_t len, const char *f, double v)
+{
+    if (isfinite(v)) {
+        (void)snprintf(buf, len, f, v);
+    } else {
+        (void)snprintf(buf, len, "n/a");
+    }
+    return buf;
+}
+
 static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
                           const metrics_result_t *mc)
 {
-    fprintf(f,
-            "controller %s  fs %u Hz  window %.3f:%.3f s  state %s  fault %s\n"
-            "  plant grid (Ts/10): T_mean %.4f N*m  T_rip %.4f N*m  psi_mean %.5f Wb  "
-            "psi_rip %.5f Wb  T_sse %.4f N*m  f_av %.0f Hz  THD_I %.2f %%\n"
-            "  control instants:   T_mean %.4f N*m  T_rip %.4f N*m  psi_rip %.5f Wb\n",
+    char b[12][32];
+    fprintf(f, "controller %s  fs %u Hz  window %.3f:%.3f s  state %s  fault %s\n",
             r->cfg.ctrl->name, (unsigned)r->cfg.fs_hz, r->cfg.win_start_s, r->cfg.win_end_s,
-            fw_state_name(fw_state(&r->fw)), fw_fault_name(fw_fault(&r->fw)), mp->torque_mean_nm,
-            mp->torque_ripple_nm, mp->flux_mean_wb, mp->flux_ripple_wb, mp->torque_sse_nm,
-            mp->f_av_hz, mp->thd_i_pct, mc->torque_mean_nm, mc->torque_ripple_nm,
-            mc->flux_ripple_wb);
+            fw_state_name(fw_state(&r->fw)), fw_fault_name(fw_fault(&r->fw)));
+    fprintf(f,
+            "  plant grid (Ts/10): T_mean %s  T_rip %s  psi_mean %s  psi_rip %s  T_sse %s  "
+            "f_av %s  THD_I %s\n",
+            fmt_num(b[0], 32, "%.4f N*m", mp->torque_mean_nm),
+            fmt_num(b[1], 32, "%.4f N*m", mp->torque_ripple_nm),
+            fmt_num(b[2], 32, "%.5f Wb", mp->flux_mean_wb),
+            fmt_num(b[3], 32, "%.5f Wb", mp->flux_ripple_wb),
+            fmt_num(b[4], 32, "%.4f N*m", mp->torque_sse_nm),
+            fmt_num(b[5], 32, "%.0f Hz", mp->f_av_hz), fmt_num(b[6], 32, "%.2f %%", mp->thd_i_pct));
+    fprintf(f, "  control instants:   T_mean %s  T_rip %s  psi_rip %s\n",
+            fmt_num(b[7], 32, "%.4f N*m", mc->torque_mean_nm),
+            fmt_num(b[8], 32, "%.4f N*m", mc->torque_ripple_nm),
+            fmt_num(b[9], 32, "%.5f Wb", mc->flux_ripple_wb));
+    const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : NAN;
+    if (r->cfg.speed_mode) {
+        fprintf(f, "  speed mode: reference %.1f r/min, window mean %s, at the end %s\n",
+                r->cfg.speed_ref_rpm, fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
+                fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
+    } else if (r->cfg.free_mech) {
+        fprintf(f, "  free mechanics: speed window mean %s, at the end %s\n",
+                fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
+                fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
+    }
+    if (!isnan(r->fault_time_s)) {
+        fprintf(f, "  fault %s at t = %.6f s\n", fw_fault_name(fw_fault(&r->fw)), r->fault_time_s);
+    }
+}
+
+static int replay_main(const cli_t *c, const sim_machine_t *pm)
+{
+    char err[512];
+    plant_config_t base;
+    sim_machine_to_plant(pm, &base);
+    sim_replay_opts_t o = {c->speed_rpm, c->theta0, c->id0, c->iq0};
+    if (sim_replay_files(&base, &o, c->replay, c->trace, err, sizeof err) != 0) {
+        fprintf(stderr, "sim: error: replay: %s\n", err);
+        return SIM_EXIT_RUN;
+    }
+    printf("replay: %s -> %s\n", c->replay, c->trace);
+    return SIM_EXIT_OK;
 }
 
 int main(int argc, char **argv)
 {
-    const char *machine_path = NULL, *ctrl_machine_path = NULL, *ctrl_name = NULL;
-    const char *scenario_path = NULL, *trace_path = NULL, *metrics_path = NULL;
-    const char *replay_path = NULL, *window = NULL, *trace_window = NULL;
-    const char *sets[SIM_MAX_SETS];
-    size_t n_sets = 0;
-    double fs = 0.0, speed_rpm = 0.0, load_nm = 0.0, torque_ref = 0.0, speed_ref = 0.0;
-    double duration = 0.3, seed = 1.0, decim = 1.0, theta0 = 0.0, id0 = 0.0, iq0 = 0.0;
-    int free_mech = 0, have_tref = 0, have_sref = 0, have_load = 0, have_theta0 = 0;
-    int have_id0 = 0, have_iq0 = 0, have_speed = 0;
-
+    static cli_t c;
+    static int given[N_OPTS];
+    memset(&c, 0, sizeof c);
+    c.duration = 0.3;
+    c.seed = 1.0;
+    c.decim = 1.0;
     if (argc < 2) {
-        fputs(usage, stderr);
-        return 2;
+        usage(stderr);
+        return SIM_EXIT_USAGE;
     }
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = (i + 1 < argc) ? argv[i + 1] : NULL;
-#define NEED_VALUE()                                                                               \
-    do {                                                                                           \
-        if (v == NULL) {                                                                           \
-            return die("option %s needs a value%s", a, NULL);                                      \
-        }                                                                                          \
-        i++;                                                                                       \
-    } while (0)
-#define NUM(dst, lo, hi)                                                                           \
-    do {                                                                                           \
-        NEED_VALUE();                                                                              \
-        if (num_arg(a, v, (lo), (hi), &(dst)) != 0) {                                              \
-            return 2;                                                                              \
-        }                                                                                          \
-    } while (0)
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            fputs(usage, stdout);
-            return 0;
-        } else if (strcmp(a, "--list-controllers") == 0) {
-            list_controllers();
-            return 0;
-        } else if (strcmp(a, "--machine") == 0) {
-            NEED_VALUE();
-            machine_path = v;
-        } else if (strcmp(a, "--control-machine") == 0) {
-            NEED_VALUE();
-            ctrl_machine_path = v;
-        } else if (strcmp(a, "--controller") == 0) {
-            NEED_VALUE();
-            ctrl_name = v;
-        } else if (strcmp(a, "--fs") == 0) {
-            NUM(fs, 1000.0, 200000.0);
-        } else if (strcmp(a, "--speed-rpm") == 0) {
-            NUM(speed_rpm, -100000.0, 100000.0);
-            have_speed = 1;
-        } else if (strcmp(a, "--free") == 0) {
-            free_mech = 1;
-        } else if (strcmp(a, "--load-nm") == 0) {
-            NUM(load_nm, -1.0e5, 1.0e5);
-            have_load = 1;
-        } else if (strcmp(a, "--torque-ref") == 0) {
-            NUM(torque_ref, -1.0e5, 1.0e5);
-            have_tref = 1;
-        } else if (strcmp(a, "--speed-ref-rpm") == 0) {
-            NUM(speed_ref, -100000.0, 100000.0);
-            have_sref = 1;
-        } else if (strcmp(a, "--duration") == 0) {
-            NUM(duration, 1.0e-4, 100.0);
-        } else if (strcmp(a, "--window") == 0) {
-            NEED_VALUE();
-            window = v;
-        } else if (strcmp(a, "--trace-window") == 0) {
-            NEED_VALUE();
-            trace_window = v;
-        } else if (strcmp(a, "--scenario") == 0) {
-            NEED_VALUE();
-            scenario_path = v;
-        } else if (strcmp(a, "--seed") == 0) {
-            NUM(seed, 0.0, 9007199254740992.0);
-            if (seed != floor(seed)) {
-                return die("--seed expects an integer, got '%s'%s", v, NULL);
-            }
-        } else if (strcmp(a, "--trace") == 0) {
-            NEED_VALUE();
-            trace_path = v;
-        } else if (strcmp(a, "--trace-decimation") == 0) {
-            NUM(decim, 1.0, 1.0e6);
-            if (decim != floor(decim)) {
-                return die("--trace-decimation expects an integer, got '%s'%s", v, NULL);
-            }
-        } else if (strcmp(a, "--metrics") == 0) {
-            NEED_VALUE();
-            metrics_path = v;
-        } else if (strcmp(a, "--set") == 0) {
-            NEED_VALUE();
-            if (n_sets >= SIM_MAX_SETS) {
-                return die("too many --set options%s%s", NULL, NULL);
-            }
-            sets[n_sets++] = v;
-        } else if (strcmp(a, "--replay") == 0) {
-            NEED_VALUE();
-            replay_path = v;
-        } else if (strcmp(a, "--theta0-elec") == 0) {
-            NUM(theta0, -1000.0, 1000.0);
-            have_theta0 = 1;
-        } else if (strcmp(a, "--id0") == 0) {
-            NUM(id0, -1.0e5, 1.0e5);
-            have_id0 = 1;
-        } else if (strcmp(a, "--iq0") == 0) {
-            NUM(iq0, -1.0e5, 1.0e5);
-            have_iq0 = 1;
-        } else {
-            return die("unknown option '%s'%s (see --help)", a, NULL);
-        }
-#undef NUM
-#undef NEED_VALUE
+    int rc = cli_parse(argc, argv, &c, given);
+    if (rc != 0) {
+        return rc;
     }
-
-    if (machine_path == NULL) {
-        return die("--machine FILE is required%s%s", NULL, NULL);
+    if (c.help) {
+        usage(stdout);
+        return SIM_EXIT_OK;
     }
-    char err[512];
+    if (c.list_controllers) {
+        list_controllers();
+        return SIM_EXIT_OK;
+    }
+    char err[2048];
     static sim_machine_t pm;
-    if (sim_machine_load(machine_path, &pm, err, sizeof err) != 0) {
-        return die("machine file: %s%s", err, NULL);
+    const char *mpath = c.machine;
+    if (c.list_tunables != NULL && mpath == NULL) {
+        mpath = PMSM_MACHINES_DIR "/thesis_spmsm.ini";
+    }
+    if (mpath == NULL) {
+        return die("--machine FILE is required");
+    }
+    if (sim_machine_load(mpath, &pm, err, sizeof err) != 0) {
+        return die("machine file: %s", err);
+    }
+    if (c.list_tunables != NULL) {
+        return list_tunables(c.list_tunables, &pm);
+    }
+    rc = cli_check(&c, given);
+    if (rc != 0) {
+        return rc;
+    }
+    if (c.replay != NULL) {
+        return replay_main(&c, &pm);
     }
 
-    /* ---- open-loop replay ---- */
-    if (replay_path != NULL) {
-        if (ctrl_name != NULL || have_tref || have_sref || free_mech || scenario_path != NULL) {
-            return die("--replay is open loop: no --controller, references, --free or "
-                       "--scenario%s%s",
-                       NULL, NULL);
-        }
-        if (!have_speed) {
-            return die("--replay needs --speed-rpm%s%s", NULL, NULL);
-        }
-        if (trace_path == NULL) {
-            return die("--replay needs --trace FILE%s%s", NULL, NULL);
-        }
-        plant_config_t base;
-        sim_machine_to_plant(&pm, &base);
-        sim_replay_opts_t o = {speed_rpm, have_theta0 ? theta0 : 0.0, have_id0 ? id0 : 0.0,
-                               have_iq0 ? iq0 : 0.0};
-        if (sim_replay_files(&base, &o, replay_path, trace_path, err, sizeof err) != 0) {
-            return die("replay: %s%s", err, NULL);
-        }
-        printf("replay: %s -> %s\n", replay_path, trace_path);
-        return 0;
+    /* ---- closed loop: everything is checked before the run starts ---- */
+    if (c.controller == NULL) {
+        return die("--controller NAME is required (see --list-controllers)");
     }
-    if (have_theta0 || have_id0 || have_iq0) {
-        return die("--theta0-elec, --id0 and --iq0 belong to --replay%s%s", NULL, NULL);
-    }
-
-    /* ---- closed loop ---- */
-    if (ctrl_name == NULL) {
-        return die("--controller NAME is required (see --list-controllers)%s%s", NULL, NULL);
-    }
-    const ctrl_desc_t *d = ctrl_find(ctrl_name);
+    const ctrl_desc_t *d = ctrl_find(c.controller);
     if (d == NULL) {
-        return die("unknown controller '%s'%s (see --list-controllers)", ctrl_name, NULL);
+        return die("unknown controller '%s' (see --list-controllers)", c.controller);
     }
-    if (have_tref && have_sref) {
-        return die("give either --torque-ref or --speed-ref-rpm, not both%s%s", NULL, NULL);
-    }
-    if (have_load && !free_mech) {
-        return die("--load-nm needs --free (a dynamometer imposes the speed)%s%s", NULL, NULL);
-    }
-
+    static sim_warnings_t warnings;
     static sim_run_cfg_t cfg;
     sim_run_config_default(&cfg, &pm, d);
     static sim_machine_t cm;
-    if (ctrl_machine_path != NULL) {
-        if (sim_machine_load(ctrl_machine_path, &cm, err, sizeof err) != 0) {
-            return die("control machine file: %s%s", err, NULL);
+    if (c.control_machine != NULL) {
+        if (sim_machine_load(c.control_machine, &cm, err, sizeof err) != 0) {
+            return die("control machine file: %s", err);
         }
         sim_ctrl_machine_from(&cm, &cfg.ctrl_machine);
     }
-    cfg.fs_hz = fs > 0.0 ? (uint32_t)fs : d->fs_default_hz;
-    cfg.free_mech = free_mech != 0;
-    cfg.speed_rpm = speed_rpm;
-    cfg.load_nm = load_nm;
-    cfg.speed_mode = have_sref != 0;
-    cfg.torque_ref_nm = torque_ref;
-    cfg.speed_ref_rpm = speed_ref;
-    cfg.duration_s = duration;
-    cfg.win_start_s = duration > 0.1 ? duration / 3.0 : 0.0;
-    cfg.win_end_s = duration;
-    cfg.seed = (uint64_t)seed;
-    cfg.trace_decimation = (uint32_t)decim;
-    if (window != NULL &&
-        parse_span("--window", window, duration, &cfg.win_start_s, &cfg.win_end_s) != 0) {
-        return 2;
+    cfg.fs_hz = is_given(given, "--fs") ? (uint32_t)c.fs : d->fs_default_hz;
+    cfg.free_mech = c.free_mech != 0;
+    cfg.speed_rpm = c.speed_rpm;
+    cfg.load_nm = c.load_nm;
+    cfg.load_passive_nm = c.load_passive_nm;
+    cfg.speed_mode = is_given(given, "--speed-ref-rpm");
+    cfg.torque_ref_nm = c.torque_ref;
+    cfg.speed_ref_rpm = c.speed_ref;
+    cfg.duration_s = c.duration;
+    cfg.win_start_s = c.window.start;
+    cfg.win_end_s = c.window.end;
+    cfg.seed = (uint64_t)c.seed;
+    cfg.trace_decimation = (uint32_t)c.decim;
+    if (is_given(given, "--trace-window")) {
+        cfg.trace_start_s = c.trace_window.start;
+        cfg.trace_end_s = c.trace_window.end;
     }
-    if (trace_window != NULL && parse_span("--trace-window", trace_window, duration,
-                                           &cfg.trace_start_s, &cfg.trace_end_s) != 0) {
-        return 2;
-    }
-
-    /* Controller configuration and tunables. */
-    static union {
-        max_align_t a;
-        unsigned char b[CTRL_CFG_MAX];
-    } ccfg;
-    if (d->cfg_size > CTRL_CFG_MAX) {
-        return die("controller '%s' configuration too large%s", d->name, NULL);
-    }
-    if (d->cfg_default != NULL) {
-        d->cfg_default(ccfg.b, &cfg.ctrl_machine);
-    }
-    for (size_t k = 0; k < n_sets; k++) {
-        char name[96];
-        const char *eq = strchr(sets[k], '=');
-        if (eq == NULL || eq == sets[k] || (size_t)(eq - sets[k]) >= sizeof name) {
-            return die("--set expects NAME=VALUE, got '%s'%s", sets[k], NULL);
-        }
-        memcpy(name, sets[k], (size_t)(eq - sets[k]));
-        name[eq - sets[k]] = '\0';
-        double val = 0.0;
-        if (num_arg("--set", eq + 1, -INFINITY, INFINITY, &val) != 0) {
-            return 2;
-        }
-        const int rc = ctrl_tunable_set(d, ccfg.b, name, val);
-        if (rc == CTRL_ENOENT) {
-            return die("controller has no tunable '%s'%s", name, NULL);
-        }
-        if (rc != CTRL_OK) {
-            return die("tunable value out of range: '%s'%s", sets[k], NULL);
-        }
-    }
-    cfg.ctrl_cfg = ccfg.b;
+    memcpy(cfg.sets, c.sets, sizeof c.sets);
+    cfg.n_sets = c.n_sets;
+    cfg.stop_on_fault = !c.continue_on_fault;
+    cfg.warnings = &warnings;
 
     static sim_scenario_t scn;
-    if (scenario_path != NULL) {
-        if (sim_scenario_load(&scn, scenario_path, err, sizeof err) != 0) {
-            return die("scenario: %s%s", err, NULL);
+    if (c.scenario != NULL) {
+        if (sim_scenario_load(&scn, c.scenario, err, sizeof err) != 0) {
+            return die("scenario: %s", err);
         }
         cfg.scenario = &scn;
     }
+    /* Output files are opened before the run: a path that cannot be written
+     * fails now, not after the simulation. */
     FILE *trace = NULL;
-    if (trace_path != NULL) {
-        trace = fopen(trace_path, "w");
+    FILE *mf = NULL;
+    if (c.trace != NULL) {
+        trace = fopen(c.trace, "w");
         if (trace == NULL) {
-            return die("cannot write trace file '%s': %s", trace_path, strerror(errno));
+            return die("cannot write trace file '%s': %s", c.trace, strerror(errno));
         }
         cfg.trace = trace;
     }
+    if (c.metrics != NULL) {
+        mf = fopen(c.metrics, "w");
+        if (mf == NULL) {
+            const int e = errno;
+            if (trace != NULL) {
+                fclose(trace);
+            }
+            return die("cannot write metrics file '%s': %s", c.metrics, strerror(e));
+        }
+    }
 
     static sim_run_t run;
-    int status = 0;
-    if (sim_run_init(&run, &cfg, err, sizeof err) != 0 || sim_run_all(&run, err, sizeof err) != 0) {
+    int status = SIM_EXIT_OK;
+    if (sim_run_init(&run, &cfg, err, sizeof err) != 0) {
         fprintf(stderr, "sim: error: %s\n", err);
-        status = 1;
+        status = SIM_EXIT_USAGE;
+    } else if (sim_run_all(&run, err, sizeof err) != 0) {
+        fprintf(stderr, "sim: error: %s\n", err);
+        status = SIM_EXIT_RUN;
     }
-    if (status == 0) {
+    if (status == SIM_EXIT_OK) {
         metrics_result_t mp, mc;
-        if (sim_run_metrics(&run, &mp, &mc) != 0) {
+        const int have = sim_run_metrics(&run, &mp, &mc) == 0;
+        if (!have && !sim_run_faulted(&run)) {
             fprintf(stderr, "sim: error: no samples in the metrics window\n");
-            status = 1;
+            status = SIM_EXIT_RUN;
         } else {
-            print_metrics(stdout, &run, &mp, &mc);
-            if (metrics_path != NULL) {
-                FILE *mf = fopen(metrics_path, "w");
-                if (mf == NULL) {
-                    fprintf(stderr, "sim: error: cannot write metrics file '%s': %s\n",
-                            metrics_path, strerror(errno));
-                    status = 1;
-                } else {
-                    sim_run_write_metrics_json(mf, &run, &mp, &mc);
-                    fclose(mf);
-                }
+            if (!have) {
+                sim_warn(&warnings,
+                         "the drive faulted before the metrics window (%g s): no "
+                         "indices",
+                         cfg.win_start_s);
             }
-            if (fw_state(&run.fw) == FW_STATE_FAULT) {
-                fprintf(stderr, "sim: warning: the firmware tripped: %s\n",
-                        fw_fault_name(fw_fault(&run.fw)));
+            print_metrics(stdout, &run, &mp, &mc);
+            if (mf != NULL) {
+                sim_run_write_metrics_json(mf, &run, &mp, &mc);
+            }
+            if (sim_run_faulted(&run)) {
+                fprintf(stderr,
+                        "sim: error: the drive faulted at t = %.6f s: %s (exit status %d)\n",
+                        run.fault_time_s, fw_fault_name(fw_fault(&run.fw)), SIM_EXIT_FAULT);
+                status = SIM_EXIT_FAULT;
             }
         }
     }
     sim_run_free(&run);
+    if (mf != NULL) {
+        if (fclose(mf) != 0) {
+            fprintf(stderr, "sim: error: writing the metrics file failed\n");
+            status = SIM_EXIT_RUN;
+        }
+        if (status == SIM_EXIT_RUN || status == SIM_EXIT_USAGE) {
+            (void)remove(c.metrics); /* no stale or empty result file */
+        }
+    }
     if (trace != NULL && fclose(trace) != 0) {
         fprintf(stderr, "sim: error: writing the trace failed\n");
-        status = 1;
+        status = SIM_EXIT_RUN;
     }
     return status;
 }

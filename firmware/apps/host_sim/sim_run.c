@@ -2,6 +2,8 @@
 #include "sim_run.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #define SIM_PI 3.14159265358979323846
@@ -48,12 +50,23 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->trace_start_s = 0.0;
     c->trace_end_s = 1.0e9;
     c->calib_samples = 256u;
+    c->stop_on_fault = false;
     hal_sim_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
 }
 
 static double sim_torque_ref_nm(const sim_run_t *r)
 {
     return ctrl_q24_to_double(r->fw.refs.torque) * r->fw.bases.torque_nm;
+}
+
+/* The speed reference in force (r/min), NaN in torque mode. */
+static double sim_run_speed_ref_now(const sim_run_t *r)
+{
+    if (r->fw.ref_mode != FW_REF_SPEED) {
+        return NAN;
+    }
+    return ctrl_q24_to_double(r->fw.speed_ref) * r->fw.bases.w_rad_s /
+           (double)r->fw.params.pole_pairs * 60.0 / (2.0 * SIM_PI);
 }
 
 static void sim_observer(void *ctx, const plant_t *p)
@@ -78,10 +91,12 @@ static void sim_observer(void *ctx, const plant_t *p)
         double id, iq;
         plant_i_dq(p, &id, &iq);
         const fw_telemetry_t *tm = fw_telemetry(&r->fw);
-        fprintf(r->cfg.trace, "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%u\n", t,
+        const double load = r->cfg.free_mech ? plant_load_torque(p) : NAN;
+        fprintf(r->cfg.trace,
+                "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%u,%.6g,%.6g\n", t,
                 i_abc[0], i_abc[1], i_abc[2], id, iq, psi, tq,
                 plant_omega_m(p) * 60.0 / (2.0 * SIM_PI), tref, (unsigned)r->vec_now, r->duty_now,
-                (unsigned)tm->state);
+                (unsigned)tm->state, sim_run_speed_ref_now(r), load);
     }
     r->obs_count++;
 }
@@ -90,12 +105,16 @@ static void sim_apply_event(sim_run_t *r, const sim_event_t *e)
 {
     if (e->set & SIM_SET_TORQUE_REF) {
         fw_set_torque_ref_nm(&r->fw, e->torque_ref_nm);
+        r->torque_ref_requested_nm = e->torque_ref_nm;
     }
     if (e->set & SIM_SET_SPEED_REF) {
         fw_set_speed_ref_rpm(&r->fw, e->speed_ref_rpm);
     }
     if (e->set & SIM_SET_LOAD) {
         plant_set_load_torque(&r->plant, e->load_nm);
+    }
+    if (e->set & SIM_SET_LOAD_PASSIVE) {
+        plant_set_load_passive(&r->plant, e->load_passive_nm);
     }
     if (e->set & SIM_SET_SPEED) {
         plant_set_speed_rpm(&r->plant, e->speed_rpm);
@@ -130,6 +149,7 @@ static void sim_scenario_step(sim_run_t *r, double t)
             break;
         }
         sim_apply_event(r, e);
+        r->scn_fired_s[s->next] = t;
         s->next++;
     }
 }
@@ -203,7 +223,264 @@ int sim_run_period(sim_run_t *r)
         metrics_add(&r->m_ctrl, t, plant_torque(&r->plant), sim_torque_ref_nm(r),
                     plant_psi_amp(&r->plant), i_abc[0]);
     }
-    return sim_period_raw(r);
+    const int rc = sim_period_raw(r);
+    if (isnan(r->fault_time_s) && fw_state(&r->fw) == FW_STATE_FAULT) {
+        r->fault_time_s = t;
+    }
+    return rc;
+}
+
+/* The controller's SI configuration: cfg_default for the controller's machine,
+ * then the tunables set by name. Returns 0, or -1 with the tunable named. */
+static int sim_ctrl_cfg_build(const sim_run_cfg_t *c, const ctrl_machine_t *m, unsigned char *buf,
+                              char *err, size_t errlen)
+{
+    const ctrl_desc_t *d = c->ctrl;
+    memset(buf, 0, CTRL_CFG_MAX);
+    if (d->cfg_size > CTRL_CFG_MAX) {
+        (void)snprintf(err, errlen, "controller %s: configuration of %zu bytes, at most %u",
+                       d->name, d->cfg_size, (unsigned)CTRL_CFG_MAX);
+        return -1;
+    }
+    if (d->cfg_default != NULL) {
+        d->cfg_default(buf, m);
+    }
+    for (size_t k = 0; k < c->n_sets; k++) {
+        const sim_set_t *st = &c->sets[k];
+        const int rc = ctrl_tunable_set(d, buf, st->name, st->value);
+        if (rc == CTRL_ENOENT) {
+            (void)snprintf(err, errlen,
+                           "controller %s has no tunable '%s' (see --list-tunables %s)", d->name,
+                           st->name, d->name);
+            return -1;
+        }
+        if (rc != CTRL_OK) {
+            const ctrl_tunable_t *t = NULL;
+            for (size_t i = 0; i < d->n_tunables; i++) {
+                if (strcmp(d->tunables[i].name, st->name) == 0) {
+                    t = &d->tunables[i];
+                }
+            }
+            if (t != NULL && strcmp(t->unit, "0/1") == 0) {
+                (void)snprintf(err, errlen,
+                               "%s tunable %s = %g: a 0/1 switch, allowed values 0 or 1", d->name,
+                               st->name, st->value);
+            } else if (t != NULL) {
+                /* Dimensionless units ("1", "-") are not repeated after numbers. */
+                const char *u =
+                    (strcmp(t->unit, "1") == 0 || strcmp(t->unit, "-") == 0) ? "" : t->unit;
+                (void)snprintf(err, errlen, "%s tunable %s = %g%s%s is out of range [%g, %g]%s%s",
+                               d->name, st->name, st->value, u[0] ? " " : "", u, t->min, t->max,
+                               u[0] ? " " : "", u);
+            } else {
+                (void)snprintf(err, errlen, "%s tunable %s = %g rejected", d->name, st->name,
+                               st->value);
+            }
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* fw_init on a scratch pipeline for (machine, fs): the same steps as the run,
+ * plant not touched. Returns FW_OK or the fw_init code. */
+static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_t fs_hz)
+{
+    static unsigned char buf[CTRL_CFG_MAX] __attribute__((aligned(16)));
+    static fw_t fw;
+    static hal_t hal;
+    static plant_t dummy;
+    char err[SIM_WARN_LEN];
+    if (c->ctrl_cfg == NULL && sim_ctrl_cfg_build(c, m, buf, err, sizeof err) != 0) {
+        return FW_EINVAL;
+    }
+    hal_sim_config_t hc = c->hal;
+    hc.pwm_freq_hz = fs_hz;
+    if (hal_sim_init(&hal, &hc, &dummy) != HAL_SIM_OK) {
+        return FW_EINVAL;
+    }
+    fw_config_t fc;
+    fw_config_default(&fc, m, c->ctrl);
+    fc.ctrl_cfg = c->ctrl_cfg != NULL ? c->ctrl_cfg : buf;
+    fc.calib_samples = c->calib_samples;
+    return fw_init(&fw, &hal, &fc);
+}
+
+/* The quantities the explanation varies, one at a time. */
+typedef struct {
+    const char *name, *unit;
+    size_t offset; /* double in ctrl_machine_t; SIZE_MAX: fs */
+    double scale;  /* shown = stored * scale */
+} sim_qty_t;
+
+#define SIM_QTY(f, n, u, k)                                                                        \
+    {                                                                                              \
+        n, u, offsetof(ctrl_machine_t, f), k                                                       \
+    }
+static const sim_qty_t sim_qtys[] = {
+    SIM_QTY(rs_ohm, "rs", "ohm", 1.0),
+    SIM_QTY(ld_h, "Ld", "mH", 1e3),
+    SIM_QTY(lq_h, "Lq", "mH", 1e3),
+    SIM_QTY(psi_pm_wb, "psi_pm", "Wb", 1.0),
+    SIM_QTY(vdc_v, "Vdc", "V", 1.0),
+    SIM_QTY(inertia_kgm2, "inertia", "kg*m^2", 1.0),
+    SIM_QTY(torque_rated_nm, "rated torque", "N*m", 1.0),
+    SIM_QTY(speed_rated_rpm, "rated speed", "r/min", 1.0),
+    SIM_QTY(current_rated_a, "rated current", "A", 1.0),
+    SIM_QTY(current_max_a, "current_max", "A", 1.0),
+    SIM_QTY(psi_ref_wb, "psi_ref", "Wb", 1.0),
+    {"fs", "Hz", SIZE_MAX, 1.0},
+};
+
+static int sim_trial_scaled(const sim_run_cfg_t *c, const sim_qty_t *q, double v)
+{
+    ctrl_machine_t m = c->ctrl_machine;
+    uint32_t fs = c->fs_hz;
+    if (q->offset == SIZE_MAX) {
+        if (!(v >= 1.0 && v <= 4.0e9)) {
+            return FW_EINVAL;
+        }
+        fs = (uint32_t)floor(v + 0.5);
+    } else {
+        memcpy((char *)&m + q->offset, &v, sizeof v);
+    }
+    return sim_fw_trial(c, &m, fs);
+}
+
+/*
+ * Why fw_init refused: for each quantity, the accepted values with every other
+ * one unchanged (log-scale search over factors 2^+-16, then bisection to 0.1 %
+ * of the boundary). Names the quantity, its value and the accepted range.
+ */
+static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, size_t errlen)
+{
+    (void)snprintf(err, errlen,
+                   "the firmware refuses this drive: %s (controller %s, machine %s, fs %u Hz)",
+                   fw_strerror(fw_rc), c->ctrl->name, c->ctrl_machine.name, (unsigned)c->fs_hz);
+    int found = 0;
+    for (size_t k = 0; k < sizeof sim_qtys / sizeof sim_qtys[0]; k++) {
+        const sim_qty_t *q = &sim_qtys[k];
+        double v0;
+        if (q->offset == SIZE_MAX) {
+            v0 = (double)c->fs_hz;
+        } else {
+            memcpy(&v0, (const char *)&c->ctrl_machine + q->offset, sizeof v0);
+        }
+        if (!(v0 > 0.0) || !isfinite(v0)) {
+            continue;
+        }
+        /* Nearest accepted factor 2^(+-j). */
+        double ok_v = NAN;
+        for (int j = 1; j <= 16 && isnan(ok_v); j++) {
+            const double up = v0 * ldexp(1.0, j);
+            const double dn = v0 * ldexp(1.0, -j);
+            if (sim_trial_scaled(c, q, dn) == FW_OK) {
+                ok_v = dn;
+            } else if (sim_trial_scaled(c, q, up) == FW_OK) {
+                ok_v = up;
+            }
+        }
+        if (isnan(ok_v)) {
+            continue;
+        }
+        double bad = v0;
+        double good = ok_v;
+        for (int it = 0; it < 40 && fabs(good / bad - 1.0) > 1e-3; it++) {
+            const double mid = sqrt(bad * good);
+            if (sim_trial_scaled(c, q, mid) == FW_OK) {
+                good = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        sim_appendf(err, errlen, "%s %s = %.4g %s is outside the accepted range (%s %.4g %s)",
+                    found ? ";" : ". With every other value unchanged:", q->name, v0 * q->scale,
+                    q->unit, good > v0 ? ">=" : "<=", good * q->scale, q->unit);
+        found = 1;
+    }
+    /* A tunable whose default would be accepted. */
+    static sim_run_cfg_t alt;
+    for (size_t k = 0; c->ctrl_cfg == NULL && k < c->n_sets; k++) {
+        alt = *c;
+        alt.sets[k] = alt.sets[alt.n_sets - 1u];
+        alt.n_sets--;
+        if (sim_fw_trial(&alt, &alt.ctrl_machine, alt.fs_hz) == FW_OK) {
+            sim_appendf(err, errlen,
+                        "%s tunable %s = %g is refused with this drive (its default "
+                        "is accepted)",
+                        found ? ";" : ".", c->sets[k].name, c->sets[k].value);
+            found = 1;
+        }
+    }
+    if (!found) {
+        sim_appendf(err, errlen,
+                    ". No single machine value, fs or tunable changed alone makes it acceptable");
+    }
+}
+
+static const char *sim_trig_text(const sim_event_t *e, char *buf, size_t len)
+{
+    if (e->trig == SIM_TRIG_AT) {
+        (void)snprintf(buf, len, "at %g", e->level);
+    } else {
+        (void)snprintf(buf, len, "when speed%s%g",
+                       e->trig == SIM_TRIG_SPEED_GE ? ">=" : "<=", e->level);
+    }
+    return buf;
+}
+
+/* The scenario against the run: an assignment that cannot act as written is
+ * an error; one the firmware clamps, or that never fires, a warning. */
+static int sim_scenario_check(sim_run_t *r, char *err, size_t errlen)
+{
+    const sim_run_cfg_t *c = &r->cfg;
+    for (size_t i = 0; i < r->scn.n; i++) {
+        const sim_event_t *e = &r->scn.ev[i];
+        char trig[48];
+        (void)sim_trig_text(e, trig, sizeof trig);
+        if (!c->free_mech && (e->set & (SIM_SET_LOAD | SIM_SET_LOAD_PASSIVE))) {
+            (void)snprintf(err, errlen,
+                           "scenario line %d (%s): load= and load_passive= act on free mechanics "
+                           "only; this run has a dynamometer (give --free)",
+                           e->line, trig);
+            return -1;
+        }
+        if (c->free_mech && (e->set & SIM_SET_SPEED)) {
+            (void)snprintf(err, errlen,
+                           "scenario line %d (%s): speed= imposes the dynamometer speed; this run "
+                           "has free mechanics (drop --free)",
+                           e->line, trig);
+            return -1;
+        }
+        if (!c->speed_mode && (e->set & SIM_SET_SPEED_REF)) {
+            (void)snprintf(err, errlen,
+                           "scenario line %d (%s): speed_ref= in a torque-mode run (start the "
+                           "run in speed mode with --speed-ref-rpm)",
+                           e->line, trig);
+            return -1;
+        }
+        if (c->speed_mode && (e->set & SIM_SET_TORQUE_REF)) {
+            (void)snprintf(err, errlen,
+                           "scenario line %d (%s): torque_ref= in a speed-mode run (the speed "
+                           "loop sets the torque reference; start in torque mode with "
+                           "--torque-ref)",
+                           e->line, trig);
+            return -1;
+        }
+        if ((e->set & SIM_SET_TORQUE_REF) && fabs(e->torque_ref_nm) > r->torque_limit_nm) {
+            sim_warn(c->warnings,
+                     "scenario line %d (%s): torque_ref=%g N*m is outside the drive's torque "
+                     "limit [-%g, %g] N*m: the firmware clamps it to %g N*m",
+                     e->line, trig, e->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm,
+                     copysign(r->torque_limit_nm, e->torque_ref_nm));
+        }
+        if (e->trig == SIM_TRIG_AT && e->level >= c->duration_s) {
+            sim_warn(c->warnings,
+                     "scenario line %d (%s): after the end of the run (duration %g s), never fires",
+                     e->line, trig, c->duration_s);
+        }
+    }
+    return 0;
 }
 
 int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errlen)
@@ -211,6 +488,10 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     memset(r, 0, sizeof *r);
     r->cfg = *cfg;
     sim_run_cfg_t *c = &r->cfg;
+    r->fault_time_s = NAN;
+    for (size_t i = 0; i < SIM_SCN_MAX_EVENTS; i++) {
+        r->scn_fired_s[i] = NAN;
+    }
     /* The controller's machine name points into the copied plant machine. */
     if (cfg->ctrl_machine.name == cfg->plant_machine.name) {
         c->ctrl_machine.name = c->plant_machine.name;
@@ -219,16 +500,30 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         return sim_err(err, errlen, "no controller");
     }
     if (c->fs_hz < 1000u || c->fs_hz > 200000u) {
-        return sim_err(err, errlen, "sampling frequency out of range (1 kHz .. 200 kHz)");
+        char msg[120];
+        (void)snprintf(msg, sizeof msg, "fs = %u Hz is out of range [1000, 200000] Hz",
+                       (unsigned)c->fs_hz);
+        return sim_err(err, errlen, msg);
     }
     if (!(c->duration_s > 0.0) || c->duration_s > 100.0) {
-        return sim_err(err, errlen, "duration out of range (0 .. 100 s)");
+        return sim_err(err, errlen, "duration out of range (0, 100] s");
     }
     if (!(c->win_start_s >= 0.0) || !(c->win_end_s > c->win_start_s)) {
         return sim_err(err, errlen, "metrics window must satisfy 0 <= start < end");
     }
     if (c->trace_decimation == 0u) {
         return sim_err(err, errlen, "trace decimation must be >= 1");
+    }
+    if (!(c->load_passive_nm >= 0.0) || !isfinite(c->load_passive_nm)) {
+        return sim_err(err, errlen, "passive load must be a finite magnitude >= 0 N*m");
+    }
+    if (!c->free_mech && (c->load_nm != 0.0 || c->load_passive_nm != 0.0)) {
+        return sim_err(err, errlen,
+                       "a load torque needs free mechanics (a dynamometer imposes "
+                       "the speed)");
+    }
+    if (c->n_sets > SIM_MAX_SETS) {
+        return sim_err(err, errlen, "too many tunables set");
     }
     if (cfg->scenario != NULL) {
         r->scn = *cfg->scenario;
@@ -253,13 +548,30 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     fw_config_t fc;
     fw_config_default(&fc, &c->ctrl_machine, c->ctrl);
-    fc.ctrl_cfg = c->ctrl_cfg;
+    if (c->ctrl_cfg == NULL) {
+        if (sim_ctrl_cfg_build(c, &c->ctrl_machine, r->ctrl_cfg_buf, err, errlen) != 0) {
+            return -1;
+        }
+        fc.ctrl_cfg = r->ctrl_cfg_buf;
+    } else {
+        fc.ctrl_cfg = c->ctrl_cfg;
+    }
     fc.calib_samples = c->calib_samples;
     const int frc = fw_init(&r->fw, &r->hal, &fc);
     if (frc != FW_OK) {
-        char msg[200];
-        (void)snprintf(msg, sizeof msg, "firmware init failed: %s", fw_strerror(frc));
-        return sim_err(err, errlen, msg);
+        sim_explain_reject(c, frc, err, errlen);
+        return -1;
+    }
+    r->torque_limit_nm = ctrl_q24_to_double(r->fw.torque_ref_max) * r->fw.bases.torque_nm;
+    if (r->has_scn && sim_scenario_check(r, err, errlen) != 0) {
+        return -1;
+    }
+    if (!c->speed_mode && fabs(c->torque_ref_nm) > r->torque_limit_nm) {
+        sim_warn(c->warnings,
+                 "torque reference %g N*m is outside the drive's torque limit [-%g, %g] N*m "
+                 "(rated torque of %s): the firmware clamps it to %g N*m",
+                 c->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm, c->ctrl_machine.name,
+                 copysign(r->torque_limit_nm, c->torque_ref_nm));
     }
 
     const double ts = 1.0 / (double)c->fs_hz;
@@ -270,6 +582,10 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     metrics_init(&r->m_plant, METRICS_SAMPLING_PLANT, f1);
     metrics_init(&r->m_ctrl, METRICS_SAMPLING_CONTROL, 0.0);
+    /* THD is a distortion ratio only where there is a fundamental to refer
+     * to: below 5 % of the rated current it measures the ripple (at zero
+     * torque it reached ~1000 %), so it is reported as undefined. */
+    r->m_plant.thd_i1_min_a = 0.05 * c->plant_machine.current_rated_a;
 
     /* Boot and offset calibration with the gates off. */
     const uint32_t max_boot = c->calib_samples + 16u;
@@ -289,21 +605,29 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     if (c->speed_mode) {
         fw_set_speed_ref_rpm(&r->fw, c->speed_ref_rpm);
+        r->torque_ref_requested_nm = NAN;
     } else {
         fw_set_torque_ref_nm(&r->fw, c->torque_ref_nm);
+        r->torque_ref_requested_nm = c->torque_ref_nm;
     }
     fw_cmd_arm(&r->fw);
     if (c->free_mech) {
         plant_set_load_torque(&r->plant, c->load_nm);
+        plant_set_load_passive(&r->plant, c->load_passive_nm);
     }
     r->t_arm = plant_time(&r->plant);
     r->t_end = c->duration_s;
     r->obs_on = false;
     if (c->trace != NULL) {
-        fprintf(c->trace,
-                "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state\n");
+        fprintf(c->trace, "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,"
+                          "speed_ref_rpm,load_nm\n");
     }
     return 0;
+}
+
+bool sim_run_faulted(const sim_run_t *r)
+{
+    return !isnan(r->fault_time_s) || fw_state(&r->fw) == FW_STATE_FAULT;
 }
 
 int sim_run_all(sim_run_t *r, char *err, size_t errlen)
@@ -315,6 +639,19 @@ int sim_run_all(sim_run_t *r, char *err, size_t errlen)
             (void)snprintf(msg, sizeof msg, "plant integration failed at t = %.6f s (code %d)",
                            sim_run_time(r), r->plant_rc);
             return sim_err(err, errlen, msg);
+        }
+        if (r->cfg.stop_on_fault && !isnan(r->fault_time_s)) {
+            break;
+        }
+    }
+    if (r->has_scn) {
+        for (size_t i = 0; i < r->scn.n; i++) {
+            const sim_event_t *e = &r->scn.ev[i];
+            if (isnan(r->scn_fired_s[i]) && !(e->trig == SIM_TRIG_AT && e->level >= r->t_end)) {
+                char trig[48];
+                sim_warn(r->cfg.warnings, "scenario line %d (%s) never fired", e->line,
+                         sim_trig_text(e, trig, sizeof trig));
+            }
         }
     }
     return 0;
@@ -334,12 +671,17 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
     return (a == 0 && b == 0) ? 0 : -1;
 }
 
-static void sim_json_num(FILE *f, const char *key, double v, bool comma)
+double sim_run_speed_rpm(const sim_run_t *r)
+{
+    return plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI);
+}
+
+static void sim_json_num(FILE *f, const char *key, double v)
 {
     if (isfinite(v)) {
-        fprintf(f, "  \"%s\": %.9g%s\n", key, v, comma ? "," : "");
+        fprintf(f, "  \"%s\": %.9g,\n", key, v);
     } else {
-        fprintf(f, "  \"%s\": null%s\n", key, comma ? "," : "");
+        fprintf(f, "  \"%s\": null,\n", key);
     }
 }
 
@@ -353,22 +695,47 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     fprintf(f, "  \"window\": [%.9g, %.9g],\n", c->win_start_s, c->win_end_s);
     fprintf(f, "  \"sampling\": \"plant grid Ts/%u (true signals); *_ctrl: control instants\",\n",
             SIM_OBS_PER_PERIOD);
-    sim_json_num(f, "fs_hz", (double)c->fs_hz, true);
-    sim_json_num(f, "torque_mean_nm", mp->torque_mean_nm, true);
-    sim_json_num(f, "torque_ripple_nm", mp->torque_ripple_nm, true);
-    sim_json_num(f, "flux_mean_wb", mp->flux_mean_wb, true);
-    sim_json_num(f, "flux_ripple_wb", mp->flux_ripple_wb, true);
-    sim_json_num(f, "torque_sse_nm", mp->torque_sse_nm, true);
-    sim_json_num(f, "f_av_hz", mp->f_av_hz, true);
-    sim_json_num(f, "thd_i_pct", mp->thd_i_pct, true);
-    sim_json_num(f, "torque_mean_ctrl_nm", mc->torque_mean_nm, true);
-    sim_json_num(f, "torque_ripple_ctrl_nm", mc->torque_ripple_nm, true);
-    sim_json_num(f, "flux_mean_ctrl_wb", mc->flux_mean_wb, true);
-    sim_json_num(f, "flux_ripple_ctrl_wb", mc->flux_ripple_wb, true);
-    sim_json_num(f, "torque_sse_ctrl_nm", mc->torque_sse_nm, true);
+    fprintf(f, "  \"mode\": \"%s\",\n", c->speed_mode ? "speed" : "torque");
+    fprintf(f, "  \"mechanics\": \"%s\",\n", c->free_mech ? "free" : "dynamometer");
+    sim_json_num(f, "fs_hz", (double)c->fs_hz);
+    sim_json_num(f, "torque_ref_requested_nm", c->speed_mode ? NAN : r->torque_ref_requested_nm);
+    sim_json_num(f, "torque_ref_applied_nm",
+                 c->speed_mode ? NAN
+                               : ctrl_q24_to_double(r->fw.torque_ref_lim) * r->fw.bases.torque_nm);
+    sim_json_num(f, "torque_limit_nm", r->torque_limit_nm);
+    sim_json_num(f, "speed_ref_rpm", sim_run_speed_ref_now(r));
+    sim_json_num(f, "speed_imposed_rpm", c->free_mech ? NAN : sim_run_speed_rpm(r));
+    sim_json_num(f, "load_nm", c->free_mech ? r->plant.load_torque_nm : NAN);
+    sim_json_num(f, "load_passive_nm", c->free_mech ? r->plant.load_passive_nm : NAN);
+    sim_json_num(f, "torque_mean_nm", mp->torque_mean_nm);
+    sim_json_num(f, "torque_ripple_nm", mp->torque_ripple_nm);
+    sim_json_num(f, "flux_mean_wb", mp->flux_mean_wb);
+    sim_json_num(f, "flux_ripple_wb", mp->flux_ripple_wb);
+    sim_json_num(f, "torque_sse_nm", mp->torque_sse_nm);
+    sim_json_num(f, "f_av_hz", mp->f_av_hz);
+    sim_json_num(f, "thd_i_pct", mp->thd_i_pct);
+    sim_json_num(f, "i1_amp_a", mp->i1_amp_a);
+    sim_json_num(f, "torque_mean_ctrl_nm", mc->torque_mean_nm);
+    sim_json_num(f, "torque_ripple_ctrl_nm", mc->torque_ripple_nm);
+    sim_json_num(f, "flux_mean_ctrl_wb", mc->flux_mean_wb);
+    sim_json_num(f, "flux_ripple_ctrl_wb", mc->flux_ripple_wb);
+    sim_json_num(f, "torque_sse_ctrl_nm", mc->torque_sse_nm);
     const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : NAN;
-    sim_json_num(f, "speed_mean_rpm", mean_rpm, true);
-    sim_json_num(f, "speed_end_rpm", plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI), true);
+    sim_json_num(f, "speed_mean_rpm", mean_rpm);
+    sim_json_num(f, "speed_end_rpm", sim_run_speed_rpm(r));
+    sim_json_num(f, "fault_time_s", r->fault_time_s);
+    fprintf(f, "  \"scenario_fired_s\": [");
+    for (size_t i = 0; r->has_scn && i < r->scn.n; i++) {
+        if (isnan(r->scn_fired_s[i])) {
+            fprintf(f, "%snull", i ? ", " : "");
+        } else {
+            fprintf(f, "%s%.9g", i ? ", " : "", r->scn_fired_s[i]);
+        }
+    }
+    fprintf(f, "],\n");
+    fprintf(f, "  \"warnings\": ");
+    sim_warnings_json(f, c->warnings);
+    fprintf(f, ",\n");
     fprintf(f, "  \"state\": \"%s\",\n", fw_state_name(fw_state(&r->fw)));
     fprintf(f, "  \"fault\": \"%s\"\n", fw_fault_name(fw_fault(&r->fw)));
     fprintf(f, "}\n");

@@ -11,7 +11,19 @@
  * Metrics (sim_host/metrics.h): true plant signals on a grid of Ts/10 over the
  * window (plant sampling), and the true signals at the control instants
  * (control sampling, the *_ctrl keys). The torque reference of T_sse is the
- * reference the firmware used (output of the speed PI in speed mode).
+ * reference the firmware used (output of the speed PI in speed mode); the
+ * reference asked for is kept beside it (torque_ref_requested_nm in the JSON)
+ * and a reference outside the drive's torque limit raises a warning.
+ *
+ * Validation before the run (sim_run_init): the scenario against the run
+ * (load steps need free mechanics, speed steps a dynamometer, a reference
+ * must match the run's mode: errors; events after the end and references the
+ * firmware clamps: warnings). A configuration the firmware refuses is
+ * explained by the single values (machine data, fs) that would make it
+ * acceptable. Warnings go to stderr and to cfg.warnings (the JSON).
+ *
+ * Faults: with stop_on_fault the run ends in the period the firmware latched
+ * a fault (fault_time_s, metrics over the samples before it).
  */
 #ifndef FIRMWARE_HOST_SIM_RUN_H
 #define FIRMWARE_HOST_SIM_RUN_H
@@ -24,19 +36,32 @@
 #include "metrics.h"
 #include "pipeline.h"
 #include "plant.h"
+#include "sim_diag.h"
 #include "sim_machine.h"
 #include "sim_scenario.h"
+
+#define SIM_MAX_SETS 32u
+#define SIM_SET_NAME_MAX 48u
+
+/* A controller tunable set by name (--set NAME=VALUE). */
+typedef struct {
+    char name[SIM_SET_NAME_MAX];
+    double value;
+} sim_set_t;
 
 typedef struct {
     sim_machine_t plant_machine; /* the simulated drive */
     ctrl_machine_t ctrl_machine; /* what the controller is configured with */
     const ctrl_desc_t *ctrl;
-    const void *ctrl_cfg; /* NULL = desc->cfg_default */
+    const void *ctrl_cfg; /* NULL = desc->cfg_default(ctrl_machine) + sets */
+    sim_set_t sets[SIM_MAX_SETS];
+    size_t n_sets;
     uint32_t fs_hz;
-    bool free_mech;   /* false: dynamometer at speed_rpm */
-    double speed_rpm; /* imposed speed, or initial speed (free) */
-    double load_nm;   /* free mechanics */
-    bool speed_mode;  /* speed reference (outer PI) instead of torque */
+    bool free_mech;         /* false: dynamometer at speed_rpm */
+    double speed_rpm;       /* imposed speed, or initial speed (free) */
+    double load_nm;         /* free mechanics: constant (active) load torque */
+    double load_passive_nm; /* free mechanics: passive load magnitude (opposes motion) */
+    bool speed_mode;        /* speed reference (outer PI) instead of torque */
     double torque_ref_nm, speed_ref_rpm;
     double duration_s;             /* after arm */
     double win_start_s, win_end_s; /* metrics window (scenario time) */
@@ -47,6 +72,8 @@ typedef struct {
     double trace_start_s, trace_end_s; /* rows written in [start, end] (scenario time) */
     hal_sim_config_t hal;              /* filled by sim_run_config_default, adjustable */
     uint32_t calib_samples;
+    bool stop_on_fault;       /* end the run at a fault (default false) */
+    sim_warnings_t *warnings; /* may be NULL (warnings printed only) */
 } sim_run_cfg_t;
 
 typedef struct {
@@ -68,8 +95,13 @@ typedef struct {
     double speed_sum_rpm; /* mean speed in the window (free-mode THD) */
     uint64_t speed_n;
     int plant_rc;
-    uint8_t vec_now; /* vector acting in the present period (chosen at k-1) */
-    double duty_now; /* its on-time fraction */
+    uint8_t vec_now;                /* vector acting in the present period (chosen at k-1) */
+    double duty_now;                /* its on-time fraction */
+    double torque_limit_nm;         /* the firmware's torque-reference clamp */
+    double torque_ref_requested_nm; /* last torque reference asked for (torque mode) */
+    double fault_time_s;            /* scenario time of the first fault, NaN if none */
+    double scn_fired_s[SIM_SCN_MAX_EVENTS]; /* scenario time each event fired, NaN if not */
+    unsigned char ctrl_cfg_buf[CTRL_CFG_MAX] __attribute__((aligned(16)));
 } sim_run_t;
 
 /* Convert a machine file into the controller's machine description. */
@@ -85,7 +117,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
 int sim_run_period(sim_run_t *r);
 /* Scenario time of the next period start (seconds since arm). */
 double sim_run_time(const sim_run_t *r);
-/* Run until the end of the duration. */
+/* Run until the end of the duration (or the fault, with stop_on_fault). */
 int sim_run_all(sim_run_t *r, char *err, size_t errlen);
 /* Metrics of the window (plant and control sampling). */
 int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctrl);
@@ -93,5 +125,11 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
 void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
                                 const metrics_result_t *mc);
 void sim_run_free(sim_run_t *r);
+
+/* True when the run ended at a fault or the firmware is in the fault state. */
+bool sim_run_faulted(const sim_run_t *r);
+
+/* The speed reference, N*m limit and mode in SI for reports. */
+double sim_run_speed_rpm(const sim_run_t *r);
 
 #endif /* FIRMWARE_HOST_SIM_RUN_H */

@@ -90,22 +90,36 @@ int sim_scenario_parse(sim_scenario_t *s, FILE *f, const char *name, char *err, 
                 return sim_fail(err, errlen, name, line, "expected KEY=NUMBER, got", tok);
             }
             *eq = '\0';
+            unsigned bit;
             if (strcmp(tok, "torque_ref") == 0) {
-                e->set |= SIM_SET_TORQUE_REF;
+                bit = SIM_SET_TORQUE_REF;
                 e->torque_ref_nm = v;
             } else if (strcmp(tok, "speed_ref") == 0) {
-                e->set |= SIM_SET_SPEED_REF;
+                bit = SIM_SET_SPEED_REF;
                 e->speed_ref_rpm = v;
             } else if (strcmp(tok, "load") == 0) {
-                e->set |= SIM_SET_LOAD;
+                bit = SIM_SET_LOAD;
                 e->load_nm = v;
+            } else if (strcmp(tok, "load_passive") == 0) {
+                if (v < 0.0) {
+                    return sim_fail(err, errlen, name, line,
+                                    "load_passive is a magnitude, allowed range [0, inf) N*m, got",
+                                    eq + 1);
+                }
+                bit = SIM_SET_LOAD_PASSIVE;
+                e->load_passive_nm = v;
             } else if (strcmp(tok, "speed") == 0) {
-                e->set |= SIM_SET_SPEED;
+                bit = SIM_SET_SPEED;
                 e->speed_rpm = v;
             } else {
-                return sim_fail(err, errlen, name, line,
-                                "unknown key (torque_ref, speed_ref, load, speed):", tok);
+                return sim_fail(
+                    err, errlen, name, line,
+                    "unknown key (torque_ref, speed_ref, load, load_passive, speed):", tok);
             }
+            if (e->set & bit) {
+                return sim_fail(err, errlen, name, line, "key given twice in one event:", tok);
+            }
+            e->set |= bit;
         }
         if (e->set == 0u) {
             return sim_fail(err, errlen, name, line, "event without an assignment", NULL);

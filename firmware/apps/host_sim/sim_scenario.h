@@ -9,15 +9,20 @@
  * Events fire in FILE ORDER: an event is armed only after the one before it
  * has fired (so "at 0.01 torque_ref=2" then "when speed>=1500 torque_ref=-2"
  * means: step to 2 N*m at 10 ms, then to -2 N*m once 1500 r/min is reached).
- * Assignments (any number, at least one):
- *   torque_ref=<N*m>    torque reference (torque mode)
- *   speed_ref=<rpm>     speed reference (speed mode, outer PI)
- *   load=<N*m>          load torque (free mechanics)
- *   speed=<rpm>         imposed speed (dynamometer mode)
+ * Assignments (at least one, each key at most once per event):
+ *   torque_ref=<N*m>    torque reference (a torque-mode run: --torque-ref)
+ *   speed_ref=<rpm>     speed reference (a speed-mode run: --speed-ref-rpm)
+ *   load=<N*m>          constant (active) load torque, free mechanics
+ *   load_passive=<N*m>  passive load of this magnitude (>= 0), free mechanics:
+ *                       it opposes the rotation, holds the rotor at rest while
+ *                       the motor torque is smaller, never drives it
+ *   speed=<rpm>         imposed speed (a dynamometer run)
+ * sim_run_init checks the assignments against the run (an error when a key
+ * does not apply to it; a warning for an event after the end).
  * Example:
- *   # dynamic test of thesis Fig. 4.14
- *   at 0      torque_ref=0 load=1.6
- *   at 0.005  torque_ref=2
+ *   # dynamic test of thesis Fig. 4.14 (free mechanics, torque mode)
+ *   at 0      torque_ref=0
+ *   at 0.002  torque_ref=2 load_passive=1.6
  *   when speed>=1500 torque_ref=-2
  */
 #ifndef FIRMWARE_HOST_SIM_SCENARIO_H
@@ -34,14 +39,15 @@ enum {
     SIM_SET_TORQUE_REF = 1u << 0,
     SIM_SET_SPEED_REF = 1u << 1,
     SIM_SET_LOAD = 1u << 2,
-    SIM_SET_SPEED = 1u << 3
+    SIM_SET_SPEED = 1u << 3,
+    SIM_SET_LOAD_PASSIVE = 1u << 4
 };
 
 typedef struct {
     sim_trig_t trig;
     double level; /* seconds (AT) or r/min (SPEED_*) */
     unsigned set; /* SIM_SET_* mask */
-    double torque_ref_nm, speed_ref_rpm, load_nm, speed_rpm;
+    double torque_ref_nm, speed_ref_rpm, load_nm, speed_rpm, load_passive_nm;
     int line;
 } sim_event_t;
 
