@@ -46,6 +46,11 @@ static const key_t_ k_keys[] = {
     {"mechanics", "inertia_kgm2", K_REAL, 1, 0, 1e6, 1, 1.0, OFF(inertia_kgm2)},
     {"mechanics", "friction_nms", K_REAL, 0, 0, 1e6, 0, 1.0, OFF(friction_nms)},
     {"fluxmap", "file", K_PATH, 0, 0, 0, 0, 1.0, OFF(fluxmap_path)},
+    {"rated", "overspeed_rpm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(overspeed_rpm)},
+    {"speed_loop", "bandwidth_hz", K_REAL, 0, 0, 1e4, 1, 1.0, OFF(speed_bw_hz)},
+    {"speed_loop", "phase_margin_deg", K_REAL, 0, 20, 80, 0, 1.0, OFF(speed_pm_deg)},
+    {"speed_loop", "kp_nm_s_per_rad", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(speed_kp)},
+    {"speed_loop", "ki_nm_per_rad", K_REAL, 0, 0, 1e8, 0, 1.0, OFF(speed_ki)},
 };
 #define N_KEYS (sizeof(k_keys) / sizeof(k_keys[0]))
 
@@ -224,6 +229,16 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
                  out->current_max_a, out->current_rated_a);
     } else if (out->dc_cap_f > 0.0 && !(out->dc_src_r_ohm > 0.0)) {
         snprintf(bad, sizeof bad, "[inverter] dc_src_r_ohm is required (> 0) when dc_cap_uf > 0");
+    } else if (out->overspeed_rpm > 0.0 && !(out->overspeed_rpm > out->speed_rated_rpm)) {
+        snprintf(bad, sizeof bad,
+                 "[rated] overspeed_rpm must exceed speed_rpm (overspeed_rpm = %g, speed_rpm = %g)",
+                 out->overspeed_rpm, out->speed_rated_rpm);
+    } else if (out->speed_ki > 0.0 && !(out->speed_kp > 0.0)) {
+        snprintf(bad, sizeof bad, "[speed_loop] ki_nm_per_rad needs kp_nm_s_per_rad");
+    } else if (out->speed_kp > 0.0 && (out->speed_bw_hz > 0.0 || out->speed_pm_deg > 0.0)) {
+        snprintf(bad, sizeof bad,
+                 "[speed_loop] give either the gains (kp_nm_s_per_rad, ki_nm_per_rad) or the "
+                 "design (bandwidth_hz, phase_margin_deg), not both");
     } else if (out->dead_time_s * out->fs_hz > 0.1) {
         snprintf(bad, sizeof bad,
                  "[inverter] dead_time_ns = %g exceeds 10 %% of the PWM period (<= %g ns at "

@@ -9,8 +9,13 @@
  *   [inverter]  vdc_v, fs_hz (default control/PWM frequency),
  *               dead_time_ns (optional, 0), v_fwd_v (optional, 0),
  *               dc_cap_uf (optional, 0 = stiff), dc_src_r_ohm (optional, needed if dc_cap_uf > 0)
+ *   [rated]     ... overspeed_rpm (optional, 0 = 1.05 x speed_rpm: the
+ *               firmware's overspeed trip level)
  *   [mechanics] inertia_kgm2, friction_nms (optional, 0)
  *   [fluxmap]   file (optional, CSV path relative to the INI file's folder)
+ *   [speed_loop] (optional, firmware/isr/speed_loop.h) bandwidth_hz,
+ *               phase_margin_deg (the sizing from the inertia; 0 = defaults),
+ *               or explicit gains kp_nm_s_per_rad, ki_nm_per_rad (mechanical)
  * Unknown sections and unknown keys are REJECTED (a typo must not silently
  * fall back to a default). Values must be finite numbers in range.
  */
@@ -38,6 +43,9 @@ typedef struct {
     double dead_time_s, v_fwd_v, dc_cap_f, dc_src_r_ohm;
     double inertia_kgm2, friction_nms;
     char fluxmap_path[SIM_MACHINE_PATH_MAX]; /* "" = none; resolved path */
+    double overspeed_rpm;                    /* 0 = firmware default */
+    double speed_bw_hz, speed_pm_deg;        /* 0 = firmware defaults */
+    double speed_kp, speed_ki;               /* explicit gains; 0 = sized */
 } sim_machine_t;
 
 /* Returns 0 on success; otherwise -1 and a message naming the key (and the
@@ -45,7 +53,8 @@ typedef struct {
 int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen);
 
 /* Fill a plant configuration from a machine (mechanics imposed, zero initial
- * state, no flux map: the caller loads cfg.fluxmap if it wants saturation). */
+ * state, no flux map: the caller loads m->fluxmap_path into cfg.fluxmap with
+ * plant_fluxmap_load; sim_run and the CLI's replay do). */
 void sim_machine_to_plant(const sim_machine_t *m, plant_config_t *cfg);
 
 #ifdef __cplusplus

@@ -256,6 +256,14 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, const ctrl_legs_t *legs)
 static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
 {
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, &fw->estimate);
+    if (fw_protect_overspeed_fast(&fw->prot, fw->estimate.omega_e) != FW_FAULT_NONE) {
+        fw_fault_now(fw, FW_FAULT_OVERSPEED);
+        fw->tm.vec = 0u;
+        fw->tm.duty = 0;
+        fw_pwm_off(fw);
+        fw->tm.omega_e = fw->estimate.omega_e;
+        return;
+    }
 
     q24_t tref;
     if (fw->ref_mode == FW_REF_SPEED) {

@@ -99,13 +99,26 @@ typedef struct {
     uint32_t calib_samples;        /* ADC offset averaging (>= 1), default 256 */
     double adc_gain_corr[3];       /* per-channel current gain correction (~1.0) */
     fx_angle_t enc_offset;         /* electrical angle at encoder count 0 */
-    /* Outer speed loop (thesis §4.6.2.1: Kp = 0.006843, Ki = 0.78046). */
+    /* Outer speed loop: sized from the machine (speed_loop.h) with this
+     * bandwidth and phase margin (0 = the defaults there), unless explicit
+     * gains are given (speed_kp or speed_ki > 0, in speed_unit). */
+    double speed_bw_hz, speed_pm_deg;
     double speed_kp, speed_ki;
     ctrl_speed_unit_t speed_unit;
-    double speed_out_max_nm; /* torque-reference limit (> 0) */
+    double speed_out_max_nm; /* torque-reference limit (> 0), default
+                                fw_torque_limit_nm (speed_loop.h) */
     uint32_t speed_loop_hz;  /* speed PI update rate (divides fs), default 1000;
                                 0 = every period */
+    double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x rated speed */
 } fw_config_t;
+
+/* The speed loop and speed limits in force (SI, for reports; set by fw_init). */
+typedef struct {
+    double kp_nm_s_rad, ki_nm_rad;                  /* per mechanical rad/s, rad */
+    double bandwidth_hz, phase_margin_deg, zero_hz; /* of the design; 0 for explicit gains */
+    double overspeed_rpm;                           /* trip level */
+    double speed_ref_max_rpm;                       /* |speed reference| limit: overspeed / 1.05 */
+} fw_speed_info_t;
 
 typedef struct {
     hal_t *hal;
@@ -136,6 +149,7 @@ typedef struct {
     q24_t speed_tref;     /* last speed-PI output, Q24 pu (held between updates) */
     uint32_t speed_div;   /* periods per speed-PI update (>= 1) */
     uint32_t speed_cnt;   /* periods since the last update */
+    fw_speed_info_t speed_info;
     fw_state_t sm;
     fw_protect_t prot;
     /* calibration */
@@ -163,8 +177,9 @@ typedef struct {
     fw_telemetry_t tm;
 } fw_t;
 
-/* Configuration defaults: thesis speed gains (r/min units of the thesis'
- * experiments, see pipeline_config.c), limit = rated torque, 256 samples. */
+/* Configuration defaults: speed loop sized from the machine (speed_loop.h),
+ * torque limit from the ratings (the rated torque, or less at a fixed flux
+ * reference: fw_torque_limit_nm), overspeed at 1.05 x rated speed, 256 samples. */
 void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl);
 
 /* Bind the HAL, compute the fixed-point conversion, initialise the controller

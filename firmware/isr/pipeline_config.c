@@ -7,6 +7,7 @@
 
 #include "pipeline.h"
 #include "plan.h"
+#include "speed_loop.h"
 #include "speed_pi_config.h"
 
 #define FW_PI 3.14159265358979323846
@@ -24,15 +25,15 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->calib_samples = FW_CALIB_DEFAULT;
     c->adc_gain_corr[0] = c->adc_gain_corr[1] = c->adc_gain_corr[2] = 1.0;
     c->enc_offset = 0u;
-    /* Thesis §4.6.2.1. The gains are read as N*m per (r/min) and N*m per
-     * (r/min s): with J = 1.2e-4 kg m^2 this gives a crossover near
-     * Kp/J = 545 rad/s with the PI zero at Ki/Kp = 114 rad/s (78 deg phase
-     * margin); read per rad/s the zero would lie above the crossover (27 deg). */
-    c->speed_kp = 0.006843;
-    c->speed_ki = 0.78046;
-    c->speed_unit = CTRL_SPEED_UNIT_RPM;
-    c->speed_out_max_nm = machine != NULL ? machine->torque_rated_nm : 0.0;
+    /* Speed PI sized at fw_init from the machine's inertia (speed_loop.h). */
+    c->speed_bw_hz = 0.0;
+    c->speed_pm_deg = 0.0;
+    c->speed_kp = 0.0;
+    c->speed_ki = 0.0;
+    c->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
+    c->speed_out_max_nm = fw_torque_limit_nm(machine, NULL);
     c->speed_loop_hz = 1000u;
+    c->overspeed_rpm = 0.0;
 }
 
 const char *fw_strerror(int code)
@@ -125,8 +126,15 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     fw->enc_offset = cfg->enc_offset;
 
     fw_protect_cfg_t pc;
+    /* Overspeed: FW_OVERSPEED_REL above the rated speed unless configured;
+     * the speed reference is limited to the trip level / FW_OVERSPEED_REL. */
+    fw->speed_info.overspeed_rpm = cfg->overspeed_rpm > 0.0
+                                       ? cfg->overspeed_rpm
+                                       : FW_OVERSPEED_REL * cfg->machine->speed_rated_rpm;
+    fw->speed_info.speed_ref_max_rpm = fw->speed_info.overspeed_rpm / FW_OVERSPEED_REL;
     if (fw_protect_config(&pc, cfg->machine, &fw->bases, in->pwm_freq_hz,
-                          in->encoder_counts_per_rev, in->cycle_clock_hz) != CTRL_OK) {
+                          in->encoder_counts_per_rev, in->cycle_clock_hz,
+                          fw->speed_info.overspeed_rpm) != CTRL_OK) {
         return FW_EINVAL;
     }
     fw_protect_init(&fw->prot, &pc);
@@ -136,12 +144,38 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
                                  ? in->pwm_freq_hz
                                  : cfg->speed_loop_hz;
     fw->speed_div = (in->pwm_freq_hz + loop_hz / 2u) / loop_hz;
+    fw_speed_info_t *si = &fw->speed_info;
+    double kp = cfg->speed_kp;
+    double ki = cfg->speed_ki;
+    ctrl_speed_unit_t unit = cfg->speed_unit;
+    if (!(kp > 0.0) && !(ki > 0.0)) {
+        fw_speed_design_t d = {cfg->speed_bw_hz, cfg->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
+        const double loop_rate = (double)in->pwm_freq_hz / (double)fw->speed_div;
+        const double lpf_hz = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)in->pwm_freq_hz
+                                  ? CTRL_SPEED_LPF_HZ_DEFAULT
+                                  : 0.45 * (double)in->pwm_freq_hz;
+        if (fw_speed_loop_design(&d, cfg->machine, loop_rate, lpf_hz, NULL, 0u) != CTRL_OK) {
+            return FW_EINVAL;
+        }
+        kp = d.kp_nm_s_rad;
+        ki = d.ki_nm_rad;
+        unit = CTRL_SPEED_UNIT_RAD_S_MECH;
+        si->bandwidth_hz = d.bandwidth_hz;
+        si->phase_margin_deg = d.phase_margin_deg;
+        si->zero_hz = d.zero_hz;
+    }
+    /* The gains in SI per mechanical rad/s for reports. */
+    const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / (2.0 * FW_PI)
+                           : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)cfg->machine->pole_pairs
+                                                                : 1.0;
+    si->kp_nm_s_rad = kp * per_rad;
+    si->ki_nm_rad = ki * per_rad;
     if (!(cfg->speed_out_max_nm > 0.0) ||
-        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, cfg->machine->pole_pairs, cfg->speed_kp,
-                             cfg->speed_ki, cfg->speed_unit, cfg->speed_out_max_nm,
-                             in->pwm_freq_hz / fw->speed_div) != CTRL_OK) {
+        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, cfg->machine->pole_pairs, kp, ki, unit,
+                             cfg->speed_out_max_nm, in->pwm_freq_hz / fw->speed_div) != CTRL_OK) {
         return FW_ERANGE;
     }
+
     fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
     fw->torque_ref_min = fx_neg(fw->torque_ref_max);
     fw->ref_mode = FW_REF_TORQUE;

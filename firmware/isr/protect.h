@@ -27,6 +27,14 @@
  *  - watchdog: a counter incremented every period and cleared by the main
  *    loop (fw_watchdog_kick); more than wdg_periods periods without a kick
  *    is a fault.
+ *  - overspeed: |estimated electrical speed| > omega_max, checked while
+ *    running right after the estimator. Level: the machine's rated speed x
+ *    FW_OVERSPEED_REL unless configured (fw_config_t.overspeed_rpm). A drive
+ *    without field weakening has nothing to do above its rated speed; in
+ *    torque mode with a light load the rotor accelerates until the back-EMF
+ *    meets the DC link (3250 r/min for the thesis SPMSM at 220 V, 8 % above
+ *    rated), which this catches. The speed-reference limit is the level /
+ *    FW_OVERSPEED_REL (the rated speed by default).
  */
 #ifndef FIRMWARE_PROTECT_H
 #define FIRMWARE_PROTECT_H
@@ -48,8 +56,12 @@ enum {
     FW_FAULT_DEADLINE = 7,     /* ISR overrun or re-entry */
     FW_FAULT_WATCHDOG = 8,     /* main loop stopped kicking */
     FW_FAULT_CALIB = 9,        /* ADC offset outside the plausible range */
-    FW_FAULT_COUNT = 10
+    FW_FAULT_OVERSPEED = 10,   /* |speed| above the overspeed level */
+    FW_FAULT_COUNT = 11
 };
+
+/* Overspeed level relative to the rated speed (protect.h, criteria above). */
+#define FW_OVERSPEED_REL 1.05
 
 /* Name of a fault code ("overcurrent", ...); "unknown" for others. */
 const char *fw_fault_name(uint32_t code);
@@ -62,6 +74,7 @@ typedef struct {
     int32_t enc_rate_min_q16;   /* counts per period, Q16.16; stuck check armed above */
     uint32_t deadline_cycles;   /* cycle budget per ISR; 0 disables the overrun check */
     uint32_t wdg_periods;       /* periods without a kick before the fault; 0 disables */
+    q24_t omega_max;            /* overspeed level, Q24 pu electrical speed (> 0) */
 } fw_protect_cfg_t;
 
 typedef struct {
@@ -93,11 +106,13 @@ typedef struct {
 /*
  * Thresholds from SI data (protect_config.c, configuration time only):
  * machine (current_max_a, vdc_v, torque_rated_nm, inertia_kgm2, pole pairs),
- * the control frequency, the encoder resolution and the ADC-side bases.
+ * the control frequency, the encoder resolution, the ADC-side bases and the
+ * overspeed level (mechanical r/min, > 0).
  * Returns CTRL_OK or CTRL_EINVAL for missing or non-physical data.
  */
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
-                      uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz);
+                      uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
+                      double overspeed_rpm);
 
 /* Copies cfg and derives the constants of the checks from it: change the
  * configuration only through fw_protect_init. */
@@ -229,6 +244,17 @@ static inline uint32_t fw_protect_deadline_fast(const fw_protect_t *p, uint32_t 
 {
     if (elapsed_cycles > p->deadline_lim) {
         return FW_FAULT_DEADLINE;
+    }
+    return FW_FAULT_NONE;
+}
+
+/* |omega_e| > omega_max, as an unsigned compare (exact for 0 <= omega_max <
+ * 2^31: omega + omega_max in [0, 2 omega_max] exactly when |omega| is within). */
+static inline uint32_t fw_protect_overspeed_fast(const fw_protect_t *p, q24_t omega_e)
+{
+    const uint32_t lim = (uint32_t)p->cfg.omega_max;
+    if ((uint32_t)omega_e + lim > 2u * lim) {
+        return FW_FAULT_OVERSPEED;
     }
     return FW_FAULT_NONE;
 }

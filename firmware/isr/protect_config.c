@@ -18,16 +18,24 @@
 #define FW_ENC_STUCK_MIN_PERIODS 8.0
 
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
-                      uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz)
+                      uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
+                      double overspeed_rpm)
 {
     if (cfg == NULL || m == NULL || b == NULL || fs_hz == 0u || enc_counts_per_rev == 0u) {
         return CTRL_EINVAL;
     }
     if (!(m->current_max_a > 0.0) || !(m->vdc_v > 0.0) || !(m->inertia_kgm2 > 0.0) ||
         !(m->torque_rated_nm >= 0.0) || m->pole_pairs <= 0 || !(b->i_a > 0.0) || !(b->v_v > 0.0) ||
-        !isfinite(m->current_max_a) || !isfinite(m->inertia_kgm2)) {
+        !isfinite(m->current_max_a) || !isfinite(m->inertia_kgm2) || !(overspeed_rpm > 0.0) ||
+        !isfinite(overspeed_rpm) || !(b->w_rad_s > 0.0)) {
         return CTRL_EINVAL;
     }
+    /* Overspeed in Q24 pu electrical speed; must fit below 2^31 (< 128 pu). */
+    const double w_max_pu = overspeed_rpm * 2.0 * FW_PI / 60.0 * (double)m->pole_pairs / b->w_rad_s;
+    if (!(w_max_pu < 127.0)) {
+        return CTRL_EINVAL;
+    }
+    cfg->omega_max = ctrl_q24_from_double(w_max_pu);
     const double fs = (double)fs_hz;
     cfg->i_max = ctrl_q24_from_double(m->current_max_a / b->i_a);
     cfg->vdc_max = ctrl_q24_from_double(FW_VDC_MAX_REL * m->vdc_v / b->v_v);

@@ -194,7 +194,7 @@ void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ct
     l->fw = fw;
     l->write = write;
     l->write_ctx = write_ctx;
-    l->speed_max_rpm = fw->machine != NULL ? 1.2 * fw->machine->speed_rated_rpm : 0.0;
+    l->speed_max_rpm = fw->speed_info.speed_ref_max_rpm;
     tel_init(&l->tel);
     cmd_init(&l->cmd, &fw_link_ops, l);
 }

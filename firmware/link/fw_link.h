@@ -34,7 +34,7 @@ typedef struct {
     volatile uint32_t q_tail; /* written by the main loop */
     uint32_t dropped;         /* samples lost to a full queue */
     uint8_t send_meta;
-    double speed_max_rpm; /* |speed reference| limit (1.2 x rated) */
+    double speed_max_rpm; /* |speed reference| limit (fw_speed_info_t: the rated speed) */
     fw_link_write_fn write;
     void *write_ctx;
 } fw_link_t;

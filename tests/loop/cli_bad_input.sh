@@ -76,6 +76,12 @@ expect_fail "scenario negative passive load" "neg_passive.scn:1: load_passive is
 expect_fail "speed loop on a dynamometer" "--speed-ref-rpm needs --free" --machine "$m" --controller bst --speed-ref-rpm 100
 expect_fail "fixed-point range named" "Lq = 0.3 mH is outside the accepted range \(>= [0-9.]+ mH\)" --machine "$tmp/lq_small.ini" --controller m2ptfc
 expect_fail "fs below the Q format" "fs = 1000 Hz is outside the accepted range \(>= [0-9]+ Hz\)" --machine "$m" --controller bst --fs 1000
+expect_fail "speed bandwidth beyond the dead time" "speed loop: bandwidth 200 Hz is out of range \(0, [0-9.]+\) Hz" --machine "$mdir/thesis_ipmsm_80kw.ini" --controller m2ptfc --free --speed-ref-rpm 100 --speed-bw-hz 200
+expect_fail "sizing and gains together" "give either --speed-bw-hz or --speed-kp" --machine "$m" --controller bst --free --speed-ref-rpm 100 --speed-bw-hz 20 --speed-kp 1
+# A speed reference above the drive's limit (rated speed) warns.
+err="$("$sim" --machine "$m" --controller bst --free --speed-ref-rpm 3500 --duration 0.002 2>&1 >/dev/null)"
+grep -q "warning: speed reference 3500 r/min is outside the drive's speed limit \[-3000, 3000\] r/min (the overspeed trip is at 3150 r/min)" <<<"$err" ||
+  { echo "FAIL: speed reference warning: $err"; fails=$((fails + 1)); }
 # An unwritable metrics path fails before the run: no trace row is written.
 out="$("$sim" --machine "$m" --controller bst --duration 0.01 --trace "$tmp/early.csv" \
        --metrics "$tmp/no/dir/m.json" 2>&1)"; rc=$?

@@ -44,6 +44,7 @@ typedef struct {
     const char *list_tunables;
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
+    double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
     cli_span_t window, trace_window;
     int free_mech, help, list_controllers, continue_on_fault;
     sim_set_t sets[SIM_MAX_SETS];
@@ -84,6 +85,17 @@ static const cli_opt_t k_opts[] = {
      "torque reference, torque mode (default 0)"},
     {"--speed-ref-rpm", "R", K_REAL, -1e5, 1e5, "r/min", M_LOOP, "--free", "--torque-ref",
      F(speed_ref), "speed reference: speed mode (outer PI), needs --free"},
+    {"--speed-bw-hz", "HZ", K_REAL, 0.01, 1e4, "Hz", M_LOOP, NULL, "--speed-kp", F(speed_bw),
+     "speed-loop bandwidth (crossover) of the sizing from the inertia (default: machine "
+     "file, else firmware/isr/speed_loop.h)"},
+    {"--speed-pm-deg", "DEG", K_REAL, 20, 80, "deg", M_LOOP, NULL, "--speed-kp", F(speed_pm),
+     "speed-loop phase margin of the sizing (default: machine file, else 60)"},
+    {"--speed-kp", "K", K_REAL, 1e-12, 1e9, "N*m*s/rad", M_LOOP, NULL, NULL, F(speed_kp),
+     "explicit speed PI gain, per mechanical rad/s (instead of the sizing)"},
+    {"--speed-ki", "K", K_REAL, 0, 1e12, "N*m/rad", M_LOOP, "--speed-kp", NULL, F(speed_ki),
+     "explicit speed PI integral gain, per mechanical rad (default 0 with --speed-kp)"},
+    {"--overspeed-rpm", "R", K_REAL, 1, 1e6, "r/min", M_LOOP, NULL, NULL, F(overspeed),
+     "overspeed trip level (default: machine file, else 1.05 x rated speed)"},
     {"--duration", "S", K_REAL, 1e-4, 100, "s", M_LOOP, NULL, NULL, F(duration),
      "simulated time after arm (default 0.3)"},
     {"--window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, NULL, NULL, F(window),
@@ -441,8 +453,17 @@ static int replay_main(const cli_t *c, const sim_machine_t *pm)
     char err[512];
     plant_config_t base;
     sim_machine_to_plant(pm, &base);
+    static plant_fluxmap_t map;
+    if (pm->fluxmap_path[0] != '\0') {
+        if (plant_fluxmap_load(&map, pm->fluxmap_path, err, sizeof err) != PLANT_OK) {
+            return die("flux map: %s", err);
+        }
+        base.fluxmap = &map;
+    }
     sim_replay_opts_t o = {c->speed_rpm, c->theta0, c->id0, c->iq0};
-    if (sim_replay_files(&base, &o, c->replay, c->trace, err, sizeof err) != 0) {
+    const int rc = sim_replay_files(&base, &o, c->replay, c->trace, err, sizeof err);
+    plant_fluxmap_free(&map);
+    if (rc != 0) {
         fprintf(stderr, "sim: error: replay: %s\n", err);
         return SIM_EXIT_RUN;
     }
@@ -535,6 +556,28 @@ int main(int argc, char **argv)
     memcpy(cfg.sets, c.sets, sizeof c.sets);
     cfg.n_sets = c.n_sets;
     cfg.stop_on_fault = !c.continue_on_fault;
+    if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
+        /* The command line's sizing replaces the machine file's speed loop. */
+        cfg.speed_kp = cfg.speed_ki = 0.0;
+        if (is_given(given, "--speed-bw-hz")) {
+            cfg.speed_bw_hz = c.speed_bw;
+        }
+        if (is_given(given, "--speed-pm-deg")) {
+            cfg.speed_pm_deg = c.speed_pm;
+        }
+    }
+    if (is_given(given, "--speed-kp")) {
+        cfg.speed_kp = c.speed_kp;
+        cfg.speed_ki = c.speed_ki;
+        cfg.speed_bw_hz = cfg.speed_pm_deg = 0.0;
+    }
+    if (is_given(given, "--overspeed-rpm")) {
+        if (!(c.overspeed > pm.speed_rated_rpm)) {
+            return die("--overspeed-rpm %g must exceed the rated speed %g r/min of %s", c.overspeed,
+                       pm.speed_rated_rpm, pm.name);
+        }
+        cfg.overspeed_rpm = c.overspeed;
+    }
     cfg.warnings = &warnings;
 
     static sim_scenario_t scn;

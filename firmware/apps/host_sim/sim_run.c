@@ -1,6 +1,8 @@
 /* Closed loop on the host (see sim_run.h). */
 #include "sim_run.h"
 
+#include "speed_loop.h"
+
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -51,6 +53,11 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->trace_end_s = 1.0e9;
     c->calib_samples = 256u;
     c->stop_on_fault = false;
+    c->speed_bw_hz = m->speed_bw_hz;
+    c->speed_pm_deg = m->speed_pm_deg;
+    c->speed_kp = m->speed_kp;
+    c->speed_ki = m->speed_ki;
+    c->overspeed_rpm = m->overspeed_rpm;
     hal_sim_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
 }
 
@@ -282,6 +289,21 @@ static int sim_ctrl_cfg_build(const sim_run_cfg_t *c, const ctrl_machine_t *m, u
     return 0;
 }
 
+/* The pipeline configuration of the run (controller configuration aside). */
+static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_config_t *fc)
+{
+    fw_config_default(fc, m, c->ctrl);
+    fc->calib_samples = c->calib_samples;
+    fc->speed_bw_hz = c->speed_bw_hz;
+    fc->speed_pm_deg = c->speed_pm_deg;
+    if (c->speed_kp > 0.0) {
+        fc->speed_kp = c->speed_kp;
+        fc->speed_ki = c->speed_ki;
+        fc->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
+    }
+    fc->overspeed_rpm = c->overspeed_rpm;
+}
+
 /* fw_init on a scratch pipeline for (machine, fs): the same steps as the run,
  * plant not touched. Returns FW_OK or the fw_init code. */
 static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_t fs_hz)
@@ -300,9 +322,8 @@ static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_
         return FW_EINVAL;
     }
     fw_config_t fc;
-    fw_config_default(&fc, m, c->ctrl);
+    sim_fw_config(c, m, &fc);
     fc.ctrl_cfg = c->ctrl_cfg != NULL ? c->ctrl_cfg : buf;
-    fc.calib_samples = c->calib_samples;
     return fw_init(&fw, &hal, &fc);
 }
 
@@ -474,6 +495,19 @@ static int sim_scenario_check(sim_run_t *r, char *err, size_t errlen)
                      e->line, trig, e->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm,
                      copysign(r->torque_limit_nm, e->torque_ref_nm));
         }
+        const fw_speed_info_t *si = &r->fw.speed_info;
+        if ((e->set & SIM_SET_SPEED_REF) && fabs(e->speed_ref_rpm) > si->speed_ref_max_rpm) {
+            sim_warn(c->warnings,
+                     "scenario line %d (%s): speed_ref=%g r/min is outside the drive's speed "
+                     "limit [-%g, %g] r/min",
+                     e->line, trig, e->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm);
+        }
+        if ((e->set & SIM_SET_SPEED) && fabs(e->speed_rpm) > si->overspeed_rpm) {
+            sim_warn(c->warnings,
+                     "scenario line %d (%s): speed=%g r/min is above the overspeed trip level "
+                     "%g r/min",
+                     e->line, trig, e->speed_rpm, si->overspeed_rpm);
+        }
         if (e->trig == SIM_TRIG_AT && e->level >= c->duration_s) {
             sim_warn(c->warnings,
                      "scenario line %d (%s): after the end of the run (duration %g s), never fires",
@@ -538,6 +572,14 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     /* The load is applied at the arm instant: a constant load torque on a free
      * rotor during the calibration (no motor torque) would spin it backwards. */
     pc.load_torque_nm = 0.0;
+    if (c->plant_machine.fluxmap_path[0] != '\0') {
+        /* Saturation: the plant integrates in flux coordinates with the map. */
+        if (plant_fluxmap_load(&r->fluxmap, c->plant_machine.fluxmap_path, err, errlen) !=
+            PLANT_OK) {
+            return -1;
+        }
+        pc.fluxmap = &r->fluxmap;
+    }
     if (plant_init(&r->plant, &pc) != PLANT_OK) {
         return sim_err(err, errlen, "plant rejected the machine configuration");
     }
@@ -547,7 +589,19 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         return sim_err(err, errlen, "HAL simulation rejected its configuration");
     }
     fw_config_t fc;
-    fw_config_default(&fc, &c->ctrl_machine, c->ctrl);
+    sim_fw_config(c, &c->ctrl_machine, &fc);
+    if (!(c->speed_kp > 0.0)) {
+        /* The speed-loop design named before fw_init (which only says no). */
+        fw_speed_design_t sd = {c->speed_bw_hz, c->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
+        const uint32_t div = (c->fs_hz + fc.speed_loop_hz / 2u) / fc.speed_loop_hz;
+        const double lpf = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)c->fs_hz
+                               ? CTRL_SPEED_LPF_HZ_DEFAULT
+                               : 0.45 * (double)c->fs_hz;
+        if (fw_speed_loop_design(&sd, &c->ctrl_machine, (double)c->fs_hz / (double)div, lpf, err,
+                                 errlen) != CTRL_OK) {
+            return -1;
+        }
+    }
     if (c->ctrl_cfg == NULL) {
         if (sim_ctrl_cfg_build(c, &c->ctrl_machine, r->ctrl_cfg_buf, err, errlen) != 0) {
             return -1;
@@ -556,7 +610,6 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     } else {
         fc.ctrl_cfg = c->ctrl_cfg;
     }
-    fc.calib_samples = c->calib_samples;
     const int frc = fw_init(&r->fw, &r->hal, &fc);
     if (frc != FW_OK) {
         sim_explain_reject(c, frc, err, errlen);
@@ -566,11 +619,35 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (r->has_scn && sim_scenario_check(r, err, errlen) != 0) {
         return -1;
     }
+    const fw_speed_info_t *si = &r->fw.speed_info;
+    if (c->speed_mode && fabs(c->speed_ref_rpm) > si->speed_ref_max_rpm) {
+        sim_warn(c->warnings,
+                 "speed reference %g r/min is outside the drive's speed limit [-%g, %g] r/min "
+                 "(the overspeed trip is at %g r/min)",
+                 c->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm, si->overspeed_rpm);
+    }
+    if (!c->free_mech && fabs(c->speed_rpm) > si->overspeed_rpm) {
+        sim_warn(c->warnings,
+                 "imposed speed %g r/min is above the overspeed trip level %g r/min: the drive "
+                 "will trip when armed",
+                 c->speed_rpm, si->overspeed_rpm);
+    }
     if (!c->speed_mode && fabs(c->torque_ref_nm) > r->torque_limit_nm) {
+        double t_flux = 0.0;
+        const double t_lim = fw_torque_limit_nm(&c->ctrl_machine, &t_flux);
+        char why[160];
+        if (t_flux > 0.0 && t_lim < c->ctrl_machine.torque_rated_nm) {
+            (void)snprintf(why, sizeof why,
+                           "%g %% of %.4g N*m, the most %s gives at its flux reference %g Wb",
+                           100.0 * FW_TORQUE_FLUX_MARGIN, t_flux, c->ctrl_machine.name,
+                           c->ctrl_machine.psi_ref_wb);
+        } else {
+            (void)snprintf(why, sizeof why, "rated torque of %s", c->ctrl_machine.name);
+        }
         sim_warn(c->warnings,
                  "torque reference %g N*m is outside the drive's torque limit [-%g, %g] N*m "
-                 "(rated torque of %s): the firmware clamps it to %g N*m",
-                 c->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm, c->ctrl_machine.name,
+                 "(%s): the firmware clamps it to %g N*m",
+                 c->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm, why,
                  copysign(r->torque_limit_nm, c->torque_ref_nm));
     }
 
@@ -707,6 +784,13 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     sim_json_num(f, "speed_imposed_rpm", c->free_mech ? NAN : sim_run_speed_rpm(r));
     sim_json_num(f, "load_nm", c->free_mech ? r->plant.load_torque_nm : NAN);
     sim_json_num(f, "load_passive_nm", c->free_mech ? r->plant.load_passive_nm : NAN);
+    const fw_speed_info_t *si = &r->fw.speed_info;
+    sim_json_num(f, "speed_kp_nm_s_per_rad", si->kp_nm_s_rad);
+    sim_json_num(f, "speed_ki_nm_per_rad", si->ki_nm_rad);
+    sim_json_num(f, "speed_bandwidth_hz", si->bandwidth_hz > 0.0 ? si->bandwidth_hz : NAN);
+    sim_json_num(f, "speed_phase_margin_deg",
+                 si->phase_margin_deg > 0.0 ? si->phase_margin_deg : NAN);
+    sim_json_num(f, "overspeed_rpm", si->overspeed_rpm);
     sim_json_num(f, "torque_mean_nm", mp->torque_mean_nm);
     sim_json_num(f, "torque_ripple_nm", mp->torque_ripple_nm);
     sim_json_num(f, "flux_mean_wb", mp->flux_mean_wb);
@@ -746,6 +830,7 @@ void sim_run_free(sim_run_t *r)
     if (r != NULL) {
         metrics_free(&r->m_plant);
         metrics_free(&r->m_ctrl);
+        plant_fluxmap_free(&r->fluxmap);
         /* Idempotent: a second call finds nothing to free. */
         memset(&r->m_plant, 0, sizeof r->m_plant);
         memset(&r->m_ctrl, 0, sizeof r->m_ctrl);

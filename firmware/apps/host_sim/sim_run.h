@@ -72,13 +72,18 @@ typedef struct {
     double trace_start_s, trace_end_s; /* rows written in [start, end] (scenario time) */
     hal_sim_config_t hal;              /* filled by sim_run_config_default, adjustable */
     uint32_t calib_samples;
-    bool stop_on_fault;       /* end the run at a fault (default false) */
-    sim_warnings_t *warnings; /* may be NULL (warnings printed only) */
+    /* Speed loop and overspeed (fw_config_t; from the machine file by default). */
+    double speed_bw_hz, speed_pm_deg; /* sizing (0 = firmware defaults) */
+    double speed_kp, speed_ki;        /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
+    double overspeed_rpm;             /* 0 = 1.05 x rated speed */
+    bool stop_on_fault;               /* end the run at a fault (default false) */
+    sim_warnings_t *warnings;         /* may be NULL (warnings printed only) */
 } sim_run_cfg_t;
 
 typedef struct {
     sim_run_cfg_t cfg;
     plant_t plant;
+    plant_fluxmap_t fluxmap; /* the machine file's [fluxmap], when it names one */
     hal_t hal;
     fw_t fw;
     sim_scenario_t scn;
