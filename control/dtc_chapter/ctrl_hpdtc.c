@@ -9,14 +9,6 @@
 #include "plan.h"
 #include "vectors.h"
 
-/* cos and sin of (n - 1) * 60 deg, n = 1..6, Q30. */
-#define K_HALF_Q30 536870912
-#define K_SQRT3_2_Q30 929887697
-#define K_ONE_Q30 1073741824
-static const int32_t hp_cos_q30[6] = {K_ONE_Q30,  K_HALF_Q30,  -K_HALF_Q30,
-                                      -K_ONE_Q30, -K_HALF_Q30, K_HALF_Q30};
-static const int32_t hp_sin_q30[6] = {0, K_SQRT3_2_Q30,  K_SQRT3_2_Q30,
-                                      0, -K_SQRT3_2_Q30, -K_SQRT3_2_Q30};
 /* Section boundaries at 6 and 18 deg: tan, Q30 (round(tan(x) * 2^30)). */
 #define K_TAN6_Q30 112854813
 #define K_TAN18_Q30 348879867
@@ -49,10 +41,14 @@ int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2)
 
 int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n)
 {
-    const unsigned i = (n >= 1u && n <= 6u) ? (unsigned)(n - 1u) : 0u;
-    /* Rotate by -(n-1) 60 deg: the sector centre onto the x axis (Q54 sums < 2^62). */
-    const int64_t x = (int64_t)psi_alpha * hp_cos_q30[i] + (int64_t)psi_beta * hp_sin_q30[i];
-    const int64_t y = (int64_t)psi_beta * hp_cos_q30[i] - (int64_t)psi_alpha * hp_sin_q30[i];
+    const unsigned i = (n >= 1u && n <= 6u) ? (unsigned)n : 1u;
+    /* Rotate by -(n-1) 60 deg: the sector centre onto the x axis. V_n / Vdc
+     * (Q30, magnitude 2/3) serves as the rotation: the comparisons below are
+     * of y against x tan(b) and do not see the common scale (Q54 sums < 2^62). */
+    const int32_t c = ctrl_vec_ab_q30[i][0];
+    const int32_t sn = ctrl_vec_ab_q30[i][1];
+    const int64_t x = (int64_t)psi_alpha * c + (int64_t)psi_beta * sn;
+    const int64_t y = (int64_t)psi_beta * c - (int64_t)psi_alpha * sn;
     /* Compare y with x tan(b) in Q24 * Q30 (values back to Q24 first). */
     const int64_t xq = fx_rshift64_round(x, 30u);
     const int64_t yq = fx_rshift64_round(y, 30u) * ((int64_t)1 << 30);
@@ -76,31 +72,21 @@ int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n)
 void ctrl_hpdtc_reset(void *state)
 {
     ctrl_hpdtc_state_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     ctrl_hyst2_reset(&s->flux);
     ctrl_hyst2_reset(&s->torque);
     s->last_level = 0u;
     s->last_section = 2u;
 }
 
-void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_hpdtc_state_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u);
-        return;
-    }
     const ctrl_mstate_t *nx = &ctx->est->next; /* delay compensation */
     const q24_t psi_ref = ctx->ref->psi > 0 ? ctx->ref->psi : s->psi_ref;
     const q24_t t_err = fx_sub(ctx->ref->torque, nx->torque);
     const int phi = ctrl_hyst2_update(&s->flux, fx_sub(psi_ref, nx->psi_amp)) > 0;
     const int tau = ctrl_hyst2_update(&s->torque, t_err) > 0;
-    const uint8_t n = ctrl_sector(nx->psi_alpha, nx->psi_beta);
+    const uint8_t n = nx->sector;
     uint8_t k1;
     uint8_t k2;
     const int refl = ctrl_hpdtc_vectors(phi, tau, n, &k1, &k2);
@@ -118,13 +104,14 @@ void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     const q24_t d1 = s->dur[lvl][sec][0];
     const q24_t d2 = s->dur[lvl][sec][1];
     const q24_t d0 = FX_ONE - d1 - d2; /* >= 0: the table keeps t_k1 + t_k2 <= 20 */
-    out->n_seg = 4u;
-    out->vec[0] = k1;
-    out->dur[0] = d1;
-    out->vec[1] = k2;
-    out->dur[1] = d2;
-    out->vec[2] = 0u; /* zero time split equally between V0 and V7 (S1 §5.2.3) */
-    out->dur[2] = d0 / 2;
-    out->vec[3] = 7u;
-    out->dur[3] = d0 - d0 / 2;
+    ctrl_plan_t *p = &out->plan;
+    p->n_seg = 4u;
+    p->vec[0] = k1;
+    p->dur[0] = d1;
+    p->vec[1] = k2;
+    p->dur[1] = d2;
+    p->vec[2] = 0u; /* zero time split equally between V0 and V7 (S1 §5.2.3) */
+    p->dur[2] = d0 / 2;
+    p->vec[3] = 7u;
+    p->dur[3] = d0 - d0 / 2;
 }

@@ -107,10 +107,10 @@ extern const ctrl_desc_t ctrl_desc_hpdtc;
 
 /* ---- Internal: per-sample parts, shared with ctrl_s1_dtc_config.c. ---- */
 void ctrl_hdtc_reset(void *state);
-void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void ctrl_svm_dtc_reset(void *state);
-void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void ctrl_hpdtc_reset(void *state);
-void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_S1_DTC_H */

@@ -10,14 +10,14 @@
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
 #include "ctrl_s1_dtc_config.h"
+#include "ctrl_units.h"
 #include "estimator.h"
 
 #define S1_FS_HZ 10000u /* S1: Ts = 100 us */
 #define S1_BAND 0.01    /* S1 §3.3, §6.1.4: +-0.01 (N*m and Wb) */
 #define S1_KP 1.0       /* S1 §4.1 predictive controller */
 #define S1_KI 0.03
-#define S1_PI 3.14159265358979323846
-#define S1_TILT_DEFAULT (S1_PI / 30.0) /* 6 deg: half a section */
+#define S1_TILT_DEFAULT (CTRL_PI / 30.0) /* 6 deg: half a section */
 
 static const ctrl_tunable_t hdtc_tunables[] = {
     {"h_T", "N*m", "torque hysteresis half band (S1 sec. 3.3: +-0.01)",
@@ -49,15 +49,13 @@ static const ctrl_tunable_t hpdtc_tunables[] = {
      "|T_err| of the full voltage level (5 levels of e_fs/5); 0 = Ts Lq-based, see ctrl_s1_dtc.h",
      offsetof(ctrl_s1_cfg_t, e_fs), 0.0, 1000.0},
     {"tilt", "rad", "timing-table reference tilted from the flux tangent towards V_k1",
-     offsetof(ctrl_s1_cfg_t, tilt), 0.0, S1_PI / 6.0},
+     offsetof(ctrl_s1_cfg_t, tilt), 0.0, CTRL_PI / 6.0},
 };
 
 static void s1_cfg_default(void *cfg, const ctrl_machine_t *m)
 {
+    (void)m;
     ctrl_s1_cfg_t *c = cfg;
-    if (c == NULL) {
-        return;
-    }
     memset(c, 0, sizeof *c);
     c->h_t = S1_BAND;
     c->h_psi = S1_BAND;
@@ -66,69 +64,38 @@ static void s1_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->ki = S1_KI;
     c->omega_ff = 1.0;
     c->tilt = S1_TILT_DEFAULT;
-    ctrl_params_t p;
-    ctrl_bases_t b;
-    if (m == NULL || ctrl_params_init(&p, &b, m, S1_FS_HZ) != CTRL_OK) {
-        return; /* bases stay 0: init refuses */
-    }
-    c->torque_base_nm = b.torque_nm;
-    c->psi_base_wb = b.psi_wb;
-    c->psi_pm_wb = m->psi_pm_wb;
 }
 
 /* SI / base -> Q24 pu in [0, 127). */
 static int s1_q24(double si, double base, q24_t *out)
 {
-    const double pu = si / base;
-    if (!isfinite(pu) || pu < 0.0 || pu >= 127.0) {
-        return CTRL_ERANGE;
-    }
-    *out = ctrl_q24_from_double(pu);
-    return CTRL_OK;
-}
-
-/* Bases present and those of the params' machine (psi_base = psi_pm). */
-static int s1_check(const ctrl_s1_cfg_t *c, const ctrl_params_t *p)
-{
-    if (!(c->torque_base_nm > 0.0) || !(c->psi_base_wb > 0.0) || !isfinite(c->torque_base_nm) ||
-        !isfinite(c->psi_base_wb) || p->fs_hz == 0u) {
-        return CTRL_EINVAL;
-    }
-    if (fabs(c->psi_pm_wb / c->psi_base_wb - ctrl_q24_to_double(p->psi_pm)) > 1e-5) {
-        return CTRL_EINVAL;
-    }
-    return CTRL_OK;
+    return ctrl_q24_from_si(si, base, 0.0, 127.0, out);
 }
 
 /* Flux reference: tunable, else params->psi_ref, else psi_pm. */
-static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_params_t *p, q24_t *out)
+static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_setup_t *su, q24_t *out)
 {
     if (c->psi_ref > 0.0) {
-        return s1_q24(c->psi_ref, c->psi_base_wb, out);
+        return s1_q24(c->psi_ref, su->bases->psi_wb, out);
     }
+    const ctrl_params_t *p = su->params;
     *out = p->psi_ref > 0 ? p->psi_ref : p->psi_pm;
     return *out > 0 ? CTRL_OK : CTRL_EINVAL;
 }
 
-/* Machine consistency and the hysteresis half bands h_T, h_psi in Q24 pu
- * (hdtc and hpdtc share them, S1 §3.3). */
-static int s1_bands(const ctrl_s1_cfg_t *c, const ctrl_params_t *p, q24_t *ht, q24_t *hp)
+/* The hysteresis half bands h_T, h_psi in Q24 pu (hdtc and hpdtc share them,
+ * S1 §3.3). */
+static int s1_bands(const ctrl_s1_cfg_t *c, const ctrl_setup_t *su, q24_t *ht, q24_t *hp)
 {
-    int rc = s1_check(c, p);
+    int rc = s1_q24(c->h_t, su->bases->torque_nm, ht);
     if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_t, c->torque_base_nm, ht);
-    }
-    if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_psi, c->psi_base_wb, hp);
+        rc = s1_q24(c->h_psi, su->bases->psi_wb, hp);
     }
     return rc;
 }
 
-static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int hdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    if (state == NULL || cfg == NULL || p == NULL) {
-        return CTRL_EINVAL;
-    }
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_hdtc_state_t *s = state;
     memset(s, 0, sizeof *s);
@@ -138,9 +105,9 @@ static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     }
     q24_t ht;
     q24_t hp;
-    int rc = s1_bands(c, p, &ht, &hp);
+    int rc = s1_bands(c, su, &ht, &hp);
     if (rc == CTRL_OK) {
-        rc = s1_psi_ref(c, p, &s->psi_ref);
+        rc = s1_psi_ref(c, su, &s->psi_ref);
     }
     if (rc != CTRL_OK) {
         memset(s, 0, sizeof *s);
@@ -152,11 +119,9 @@ static int hdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     return CTRL_OK;
 }
 
-static int svm_dtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int svm_dtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    if (state == NULL || cfg == NULL || p == NULL) {
-        return CTRL_EINVAL;
-    }
+    const ctrl_params_t *p = su->params;
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_svm_dtc_state_t *s = state;
     memset(s, 0, sizeof *s);
@@ -164,10 +129,7 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_params_t *p)
         CTRL_OK) {
         return CTRL_EINVAL;
     }
-    int rc = s1_check(c, p);
-    if (rc == CTRL_OK) {
-        rc = s1_psi_ref(c, p, &s->psi_ref);
-    }
+    int rc = s1_psi_ref(c, su, &s->psi_ref);
     const double ts = ctrl_q24_to_double(p->ts);
     if (rc == CTRL_OK && (!(ts > 0.0) || 1.0 / ts >= 127.0)) {
         rc = CTRL_ERANGE; /* 1/Ts does not fit Q24 */
@@ -190,10 +152,10 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_params_t *p)
 
 int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTIONS][2])
 {
-    if (pts == NULL || !isfinite(tilt) || tilt < 0.0 || tilt > S1_PI / 6.0) {
+    if (pts == NULL || !isfinite(tilt) || tilt < 0.0 || tilt > CTRL_PI / 6.0) {
         return CTRL_EINVAL;
     }
-    const double deg = S1_PI / 180.0;
+    const double deg = CTRL_PI / 180.0;
     for (int l = 0; l < HPDTC_LEVELS; l++) {
         /* Amplitude m of the inscribed circle Vdc/sqrt(3) = (sqrt(3)/2) |V_k|. */
         const double m = (double)(l + 1) / HPDTC_LEVELS;
@@ -221,11 +183,9 @@ int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTION
     return CTRL_OK;
 }
 
-static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    if (state == NULL || cfg == NULL || p == NULL) {
-        return CTRL_EINVAL;
-    }
+    const ctrl_params_t *p = su->params;
     const ctrl_s1_cfg_t *c = cfg;
     ctrl_hpdtc_state_t *s = state;
     memset(s, 0, sizeof *s);
@@ -236,9 +196,9 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
     q24_t ht;
     q24_t hp;
     q24_t efs = 0;
-    int rc = s1_bands(c, p, &ht, &hp);
+    int rc = s1_bands(c, su, &ht, &hp);
     if (rc == CTRL_OK && c->e_fs > 0.0) {
-        rc = s1_q24(c->e_fs, c->torque_base_nm, &efs);
+        rc = s1_q24(c->e_fs, su->bases->torque_nm, &efs);
     } else if (rc == CTRL_OK) {
         /* One level step (0.2 Vdc/sqrt(3)) turns the flux by 0.2 Ts Vdc/(sqrt(3) psi_pm)
          * per period; at delta = 0 dT/d delta = psi_pm^2 / Lq (pu, from S1(7)), so
@@ -253,7 +213,7 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
         rc = CTRL_ERANGE; /* e_fs below the Q24 resolution */
     }
     if (rc == CTRL_OK) {
-        rc = s1_psi_ref(c, p, &s->psi_ref);
+        rc = s1_psi_ref(c, su, &s->psi_ref);
     }
     if (rc == CTRL_OK) {
         rc = ctrl_hpdtc_timing_table(c->tilt, s->pts);
@@ -281,18 +241,17 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_params_t *p)
 
 #define S1_DESC(id, label, st, tun, initfn, resetfn, stepfn)                                       \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
-        #id,                                                                                       \
-        label,                                                                                     \
-        S1_FS_HZ,                                                                                  \
-        sizeof(st),                                                                                \
-        sizeof(ctrl_s1_cfg_t),                                                                     \
-        tun,                                                                                       \
-        sizeof tun / sizeof tun[0],                                                                \
-        s1_cfg_default,                                                                            \
-        initfn,                                                                                    \
-        resetfn,                                                                                   \
-        stepfn,                                                                                    \
-        CTRL_EST_SECTOR_NOW,                                                                       \
+        .name = #id,                                                                               \
+        .title = label,                                                                            \
+        .fs_default_hz = S1_FS_HZ,                                                                 \
+        CTRL_DESC_SIZES(st, ctrl_s1_cfg_t),                                                        \
+        .tunables = tun,                                                                           \
+        .n_tunables = sizeof tun / sizeof tun[0],                                                  \
+        .cfg_default = s1_cfg_default,                                                             \
+        .init = initfn,                                                                            \
+        .reset = resetfn,                                                                          \
+        .step = stepfn,                                                                            \
+        .est_unused = CTRL_EST_SECTOR_NOW,                                                         \
     }
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",

@@ -21,8 +21,6 @@ typedef struct {
     double omega_ff; /* svm_dtc: 1 = add omega_e Ts to Delta delta */
     double e_fs;     /* hpdtc: |T_err| of the full voltage level, N*m; 0 = computed */
     double tilt;     /* hpdtc: reference direction tilted towards V_k1, rad */
-    /* Set by cfg_default from the machine (not tunables). */
-    double torque_base_nm, psi_base_wb, psi_pm_wb;
 } ctrl_s1_cfg_t;
 
 /* Generate the timing table (configuration; hpdtc_config): for level l

@@ -19,9 +19,6 @@
 void ctrl_svm_dtc_reset(void *state)
 {
     ctrl_svm_dtc_state_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     s->integ = 0;
     s->limited = 0u;
     s->dd = 0;
@@ -29,16 +26,9 @@ void ctrl_svm_dtc_reset(void *state)
     s->v_beta = 0;
 }
 
-void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_svm_dtc_state_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u);
-        return;
-    }
     const ctrl_params_t *p = ctx->params;
     const ctrl_mstate_t *nx = &ctx->est->next; /* starting flux psi_s(k+1): delay compensation */
     const q24_t psi_ref = ctx->ref->psi > 0 ? ctx->ref->psi : s->psi_ref;
@@ -77,7 +67,8 @@ void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     q24_t vb = fx_add(fx_mul(fx_sub(ty, nx->psi_beta), s->inv_ts), fx_mul(p->rs, nx->i_beta));
     s->v_alpha = va;
     s->v_beta = vb;
-    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, out);
+    out->plan.n_seg = 0u; /* leg duties (ctrl_types.h) */
+    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, &out->legs);
 
     /* Integrator: conditional integration (hold while the PI output or the
      * voltage is saturated and the error pushes further), clamped to pi/6. */

@@ -15,28 +15,9 @@
  * every int64 intermediate below stays under 2^62. */
 #define DRR_LIM (4 * FX_ONE)
 
-/* round(2^24 sqrt(3) / 2) */
-#define DRR_SQ3_2 14529495
-#define DRR_HALF (FX_ONE / 2)
-
-/* Unit vectors of V1..V6 (angle (i-1) pi/3, Table 4.2), Q24. */
-static const q24_t unit_cos[6] = {FX_ONE, DRR_HALF, -DRR_HALF, -FX_ONE, -DRR_HALF, DRR_HALF};
-static const q24_t unit_sin[6] = {0, DRR_SQ3_2, DRR_SQ3_2, 0, -DRR_SQ3_2, -DRR_SQ3_2};
-
 static q24_t drr_lim(q24_t x)
 {
     return fx_clamp(x, -DRR_LIM, DRR_LIM);
-}
-
-void ctrl_drr_unit(uint8_t idx, q24_t *ux, q24_t *uy)
-{
-    if (idx >= 1u && idx <= 6u) {
-        *ux = unit_cos[idx - 1u];
-        *uy = unit_sin[idx - 1u];
-    } else {
-        *ux = 0;
-        *uy = 0;
-    }
 }
 
 uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err)
@@ -128,9 +109,8 @@ q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24
     const q24_t g = drr_lim(gamma);
     const q24_t w = drr_lim(omega_e);
     const q24_t pamp = fx_min(psi_amp, DRR_LIM);
-    q24_t ux;
-    q24_t uy;
-    ctrl_drr_unit(vec, &ux, &uy);
+    const q24_t ux = ctrl_vec_dir_q24[vec][0];
+    const q24_t uy = ctrl_vec_dir_q24[vec][1];
     /* psi x v_hat = |psi| sin(theta_v - theta_s): positive for V_{x+1}, V_{x+2},
      * negative for V_{x+4}, V_{x+5} in sector x, so A (psi x v_hat) / |psi| is
      * the A |sin(.)| term of (5.6) with the sign of (5.7). */
@@ -174,30 +154,15 @@ q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, 
     if (vec < 1u || vec > 6u || psi_amp <= 0) {
         return fx_neg(kbw); /* zero vector: (5.16) third term */
     }
-    q24_t ux;
-    q24_t uy;
-    ctrl_drr_unit(vec, &ux, &uy);
+    const q24_t ux = ctrl_vec_dir_q24[vec][0];
+    const q24_t uy = ctrl_vec_dir_q24[vec][1];
     const q24_t cross = fx_cross(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
     return fx_sub(fx_div(fx_mul(s->a, cross), psi_amp), kbw);
-}
-
-q24_t ctrl_drr_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t torque)
-{
-    if (ref != NULL && ref->psi > 0) {
-        return ref->psi;
-    }
-    if (p->psi_ref > 0) {
-        return p->psi_ref;
-    }
-    return ctrl_mtpa_psi(p, torque);
 }
 
 void ctrl_drr_reset(void *state)
 {
     ctrl_drr_state_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     s->gamma = 0;
     s->dt_sel = 0;
     s->vec_sel = 0u;
@@ -225,16 +190,15 @@ q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e)
 }
 
 /* (5.16): T(k+1) = T(k) + D(k) Delta T(k) - (1 - D(k)) B w / w_rn, with D(k) and
- * the vector of the plan acting during [k, k+1) and its Delta T computed at k-1
- * for the state predicted at k. */
+ * the vector of the plan acting during [k, k+1) (this controller's choice at
+ * k-1, none after reset) and its Delta T computed at k-1 for the state
+ * predicted at k. */
 static q24_t drr_predict_516(const ctrl_drr_state_t *s, const ctrl_ctx_t *ctx)
 {
-    const ctrl_plan_t *ap = ctx->applied;
     q24_t d = 0;
     q24_t dt = 0;
-    if (ap != NULL && ap->n_seg >= 1u && s->vec_sel >= 1u && s->vec_sel <= 6u &&
-        ap->vec[0] == s->vec_sel) {
-        d = fx_clamp(ap->dur[0], 0, FX_ONE);
+    if (s->vec_sel >= 1u && s->vec_sel <= 6u) {
+        d = fx_clamp(s->last_duty, 0, FX_ONE);
         dt = s->dt_sel;
     }
     const q24_t kbw = fx_mul(s->kb, drr_lim(ctx->est->omega_e));
@@ -242,16 +206,9 @@ static q24_t drr_predict_516(const ctrl_drr_state_t *s, const ctrl_ctx_t *ctx)
     return fx_sub(t, fx_mul(FX_ONE - d, kbw));
 }
 
-void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_drr_state_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u);
-        return;
-    }
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t w = ctx->est->omega_e;
     const q24_t t_k1 = s->pred_516 != 0u ? drr_predict_516(s, ctx) : nx->torque;
@@ -268,7 +225,7 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     const q24_t tv = fx_add(tref, g);
 
     /* Flux reference by MTPA (4.15) of the corrected demand (§5.4). */
-    const q24_t psi_ref = ctrl_drr_psi_ref(ctx->params, ctx->ref, tv);
+    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, tv);
     const q24_t terr = fx_sub(tv, te);
     const q24_t psierr = fx_sub(psi_ref, nx->psi_amp);
 
@@ -289,5 +246,5 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     s->last_psierr = psierr;
     s->last_duty = duty;
     /* Active vector for D Ts, then V0 after V1/V3/V5, V7 after V2/V4/V6 (§5.4). */
-    ctrl_plan_active_zero(out, vec, duty);
+    ctrl_plan_active_zero(&out->plan, vec, duty);
 }

@@ -155,9 +155,6 @@ q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e);
 q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
                        q24_t psi_amp, q24_t omega_e);
 
-/* Unit vector of active vector idx 1..6 (angle (idx-1) pi/3), Q24; (0, 0) otherwise. */
-void ctrl_drr_unit(uint8_t idx, q24_t *ux, q24_t *uy);
-
 /* Duty of each baseline for the already selected vector (tests use these). */
 q24_t ctrl_drr_duty_d1(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t psi_err);
 q24_t ctrl_drr_duty_d2(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t omega_e);
@@ -166,9 +163,6 @@ q24_t ctrl_drr_duty_pi(const ctrl_drr_base_state_t *s, q24_t t_err, q24_t integ,
 /* D_f / D_RMS with (4.10) at the predicted state m (flux, rotor angle sin/cos). */
 q24_t ctrl_drr_duty_df(const ctrl_drr_base_state_t *s, const ctrl_params_t *p,
                        const ctrl_mstate_t *m, uint8_t vec, q24_t vdc, q24_t t_err, q24_t omega_e);
-
-/* Flux reference: ref->psi, else p->psi_ref, else MTPA (4.15) of torque. */
-q24_t ctrl_drr_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref, q24_t torque);
 
 /* The descriptors. */
 extern const ctrl_desc_t ctrl_desc_drr;
@@ -179,8 +173,8 @@ extern const ctrl_desc_t ctrl_desc_drr_df;
 
 /* ---- Internal: shared by ctrl_drr*.c and ctrl_drr_config.c. ---- */
 void ctrl_drr_reset(void *state);
-void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void ctrl_drr_base_reset(void *state);
-void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_DRR_H */

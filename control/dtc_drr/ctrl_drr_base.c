@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "ctrl_drr.h"
+#include "mtpa.h"
 #include "plan.h"
 #include "vectors.h"
 
@@ -104,30 +105,20 @@ q24_t ctrl_drr_duty_df(const ctrl_drr_base_state_t *s, const ctrl_params_t *p,
 void ctrl_drr_base_reset(void *state)
 {
     ctrl_drr_base_state_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     s->integ = 0;
     s->last_duty = 0;
     s->last_terr = 0;
     s->last_psierr = 0;
 }
 
-void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_drr_base_state_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u);
-        return;
-    }
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t w = ctx->est->omega_e;
     const q24_t tref = ctx->ref->torque;
     const q24_t terr = fx_sub(tref, nx->torque);
-    const q24_t psierr = fx_sub(ctrl_drr_psi_ref(ctx->params, ctx->ref, tref), nx->psi_amp);
+    const q24_t psierr = fx_sub(ctrl_flux_ref(ctx->params, ctx->ref->psi, tref), nx->psi_amp);
     const uint8_t vec = ctrl_drr_select(nx->sector, terr, psierr);
     q24_t duty = 0;
     switch ((ctrl_drr_base_kind_t)s->kind) {
@@ -154,5 +145,5 @@ void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     s->last_terr = terr;
     s->last_psierr = psierr;
     s->last_duty = duty;
-    ctrl_plan_active_zero(out, vec, duty);
+    ctrl_plan_active_zero(&out->plan, vec, duty);
 }

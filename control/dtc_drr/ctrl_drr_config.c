@@ -9,16 +9,15 @@
 #include "ctrl_drr.h"
 #include "ctrl_drr_config.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "estimator.h"
 #include "vreplace.h"
 #include "vreplace_config.h"
 
-#define DRR_PI 3.14159265358979323846
-#define DRR_SQRT3 1.73205080756887729353
-#define DRR_LAMBDA_DEFAULT 0.03                   /* §5.3.2: f_c = 50 Hz at 10 kHz by (5.5) */
-#define DRR_SIGMA_DEFAULT (10.0 * DRR_PI / 180.0) /* §5.3.5, Fig. 5.9: sigma = 10 deg */
-#define DRR_SIGMA_MAX (DRR_PI / 12.0)             /* (4.19) */
-#define DRR_PU_MAX 4.0                            /* A, B/w_rn must fit the per-sample clamps */
+#define DRR_LAMBDA_DEFAULT 0.03                    /* §5.3.2: f_c = 50 Hz at 10 kHz by (5.5) */
+#define DRR_SIGMA_DEFAULT (10.0 * CTRL_PI / 180.0) /* §5.3.5, Fig. 5.9: sigma = 10 deg */
+#define DRR_SIGMA_MAX (CTRL_PI / 12.0)             /* (4.19) */
+#define DRR_PU_MAX 4.0                             /* A, B/w_rn must fit the per-sample clamps */
 
 /* Thesis baseline parameters (Table 5.1) for the thesis SPMSM (2.4 N*m, 3000 r/min). */
 #define DRR_THESIS_T_RATED 2.4
@@ -89,7 +88,7 @@ int ctrl_drr_ab_si(const ctrl_machine_t *m, double ts_s, double *a_nm, double *b
         !(isfinite(ts_s) && ts_s > 0.0)) {
         return CTRL_EINVAL;
     }
-    const double w_rn = 2.0 * DRR_PI * m->speed_rated_rpm / 60.0 * p;         /* electrical */
+    const double w_rn = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs);  /* electrical */
     *a_nm = p * m->vdc_v * m->psi_pm_wb * ts_s / ls;                          /* (5.9) */
     *b_nm = 3.0 * p * w_rn * m->psi_pm_wb * m->psi_pm_wb * ts_s / (2.0 * ls); /* (5.10) */
     return CTRL_OK;
@@ -101,31 +100,14 @@ double ctrl_drr_ema_cutoff_hz(double lambda, double fs_hz)
         return NAN;
     }
     /* (5.5) */
-    return fs_hz / (2.0 * DRR_PI) *
+    return fs_hz / (2.0 * CTRL_PI) *
            acos((lambda * lambda + 2.0 * lambda - 2.0) / (2.0 * lambda - 2.0));
 }
 
-/* Bases of the machine in cfg, checked against the params the controller runs with. */
-static int drr_bases(const ctrl_machine_t *m, const ctrl_params_t *p, ctrl_bases_t *b)
-{
-    ctrl_params_t chk;
-    if (ctrl_params_init(&chk, b, m, p->fs_hz) != CTRL_OK) {
-        return CTRL_EINVAL;
-    }
-    if (chk.ts != p->ts || chk.pole_pairs != p->pole_pairs || chk.torque_rated != p->torque_rated ||
-        chk.ld != p->ld) {
-        return CTRL_EINVAL; /* cfg_default was called with another machine */
-    }
-    return CTRL_OK;
-}
-
+/* A per-unit value into Q24 when it lies in [lo, hi], else CTRL_ERANGE. */
 static int drr_q24(double pu, double lo, double hi, q24_t *out)
 {
-    if (!isfinite(pu) || pu < lo || pu > hi) {
-        return CTRL_ERANGE;
-    }
-    *out = ctrl_q24_from_double(pu);
-    return CTRL_OK;
+    return ctrl_q24_from_si(pu, 1.0, lo, hi, out);
 }
 
 /* ---------------- drr ---------------- */
@@ -136,10 +118,8 @@ static void drr_cfg_default(void *cfg, const ctrl_machine_t *m)
     if (c == NULL) {
         return;
     }
+    (void)m;
     memset(c, 0, sizeof *c);
-    if (m != NULL) {
-        c->machine = *m;
-    }
     c->a_nm = 0.0; /* (5.9) at init */
     c->b_nm = 0.0; /* (5.10) at init */
     c->c = 0.0;    /* (5.13) per sample */
@@ -151,27 +131,22 @@ static void drr_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->centre = 1.0; /* plan.h realises every plan centre-aligned */
 }
 
-static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    if (state == NULL || cfg == NULL || p == NULL || p->fs_hz == 0u) {
-        return CTRL_EINVAL;
-    }
     const ctrl_drr_cfg_t *c = cfg;
+    const ctrl_params_t *p = su->params;
+    const ctrl_machine_t *m = su->machine;
+    const ctrl_bases_t b = *su->bases;
     ctrl_drr_state_t *s = state;
     memset(s, 0, sizeof *s);
     if (ctrl_tunables_check(drr_tunables, sizeof drr_tunables / sizeof drr_tunables[0], c) !=
         CTRL_OK) {
         return CTRL_EINVAL;
     }
-    ctrl_bases_t b;
-    int rc = drr_bases(&c->machine, p, &b);
-    if (rc != CTRL_OK) {
-        return rc;
-    }
     const double ts = 1.0 / (double)p->fs_hz;
     double a_nm;
     double b_nm;
-    rc = ctrl_drr_ab_si(&c->machine, ts, &a_nm, &b_nm);
+    int rc = ctrl_drr_ab_si(m, ts, &a_nm, &b_nm);
     if (rc != CTRL_OK) {
         return rc;
     }
@@ -181,8 +156,7 @@ static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
     if (c->b_nm > 0.0) {
         b_nm = c->b_nm;
     }
-    const double w_rn_pu =
-        2.0 * DRR_PI * c->machine.speed_rated_rpm / 60.0 * c->machine.pole_pairs / b.w_rad_s;
+    const double w_rn_pu = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs) / b.w_rad_s;
     const double a_pu = a_nm / b.torque_nm;
     const double kb_pu = b_nm / b.torque_nm / w_rn_pu; /* B / w_rn in pu */
     rc = drr_q24(a_pu, 1e-6, DRR_PU_MAX, &s->a);
@@ -190,16 +164,16 @@ static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
         rc = drr_q24(kb_pu, 0.0, DRR_PU_MAX, &s->kb);
     }
     if (rc == CTRL_OK) {
-        rc = drr_q24(DRR_SQRT3 * a_pu, 0.0, 2.0 * DRR_PU_MAX, &s->sqrt3_a);
+        rc = drr_q24(CTRL_SQRT3 * a_pu, 0.0, 2.0 * DRR_PU_MAX, &s->sqrt3_a);
     }
     if (rc != CTRL_OK) {
         return rc;
     }
     if (c->c == 0.0) {
         /* (5.13) per sample: C = 2 sqrt(3) A / (2 B |w| / w_rn - sqrt(3) A) */
-        s->c_num = ctrl_q24_from_double(2.0 * DRR_SQRT3 * a_pu);
+        s->c_num = ctrl_q24_from_double(2.0 * CTRL_SQRT3 * a_pu);
         s->dc_fixed = 0;
-        s->dc_max = ctrl_q24_from_double(-2.0 * DRR_SQRT3 * a_pu / (double)CTRL_DRR_C_MAX);
+        s->dc_max = ctrl_q24_from_double(-2.0 * CTRL_SQRT3 * a_pu / (double)CTRL_DRR_C_MAX);
         if (s->dc_max >= 0) {
             s->dc_max = -1;
         }
@@ -214,8 +188,7 @@ static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
         return CTRL_ERANGE;
     }
     /* Delta psi_max ~ sqrt(3) Vdc Ts / 3 (from (4.13), §5.3.5) */
-    const double dpsi =
-        c->dpsi_max_wb > 0.0 ? c->dpsi_max_wb : DRR_SQRT3 * c->machine.vdc_v * ts / 3.0;
+    const double dpsi = c->dpsi_max_wb > 0.0 ? c->dpsi_max_wb : CTRL_SQRT3 * m->vdc_v * ts / 3.0;
     rc = drr_q24(0.5 * dpsi / b.psi_wb, 0.0, DRR_PU_MAX, &s->half_dpsi);
     if (rc == CTRL_OK) {
         rc = drr_q24(c->gamma_max_nm / b.torque_nm, 0.0, DRR_PU_MAX, &s->gamma_max);
@@ -234,18 +207,18 @@ static int drr_init(void *state, const void *cfg, const ctrl_params_t *p)
 }
 
 const ctrl_desc_t ctrl_desc_drr = {
-    "drr",
-    "DRR-DTC: multiobjective duty-ratio regulation, virtual reference (thesis ch. 5, (5.1)-(5.16))",
-    CTRL_DRR_FS_HZ,
-    sizeof(ctrl_drr_state_t),
-    sizeof(ctrl_drr_cfg_t),
-    drr_tunables,
-    sizeof drr_tunables / sizeof drr_tunables[0],
-    drr_cfg_default,
-    drr_init,
-    ctrl_drr_reset,
-    ctrl_drr_step,
-    CTRL_EST_SECTOR_NOW, /* reads |psi| and the sector at k+1 only */
+    .name = "drr",
+    .title = "DRR-DTC: multiobjective duty-ratio regulation, virtual reference (thesis ch. 5, "
+             "(5.1)-(5.16))",
+    .fs_default_hz = CTRL_DRR_FS_HZ,
+    CTRL_DESC_SIZES(ctrl_drr_state_t, ctrl_drr_cfg_t),
+    .tunables = drr_tunables,
+    .n_tunables = sizeof drr_tunables / sizeof drr_tunables[0],
+    .cfg_default = drr_cfg_default,
+    .init = drr_init,
+    .reset = ctrl_drr_reset,
+    .step = ctrl_drr_step,
+    .est_unused = CTRL_EST_SECTOR_NOW, /* reads |psi| and the sector at k+1 only */
 };
 
 /* ---------------- baselines ---------------- */
@@ -260,7 +233,6 @@ static void base_cfg_default(void *cfg, const ctrl_machine_t *m)
     if (m == NULL) {
         return;
     }
-    c->machine = *m;
     /* Table 5.1 values for the thesis SPMSM; for another machine scaled by its
      * rated torque (C_T = T_rated / 2, K_a) and rated speed (K_b), C_psi = psi_pm. */
     const double t_scale = m->torque_rated_nm / DRR_THESIS_T_RATED;
@@ -276,28 +248,23 @@ static void base_cfg_default(void *cfg, const ctrl_machine_t *m)
     double b_nm;
     if (ctrl_drr_ab_si(m, 1.0 / (double)CTRL_DRR_FS_HZ, &a_nm, &b_nm) == CTRL_OK) {
         c->kp = 1.0 / a_nm;
-        c->ki = c->kp * 2.0 * DRR_PI * DRR_PI_FI_HZ;
+        c->ki = c->kp * 2.0 * CTRL_PI * DRR_PI_FI_HZ;
     }
     c->rms = 0.0;
 }
 
-static int base_init(void *state, const void *cfg, const ctrl_params_t *p,
+static int base_init(void *state, const void *cfg, const ctrl_setup_t *su,
                      ctrl_drr_base_kind_t kind, const ctrl_tunable_t *tun, size_t ntun)
 {
-    if (state == NULL || cfg == NULL || p == NULL || p->fs_hz == 0u) {
-        return CTRL_EINVAL;
-    }
     const ctrl_drr_base_cfg_t *c = cfg;
+    const ctrl_params_t *p = su->params;
+    const ctrl_bases_t b = *su->bases;
     ctrl_drr_base_state_t *s = state;
     memset(s, 0, sizeof *s);
     if (ctrl_tunables_check(tun, ntun, c) != CTRL_OK) {
         return CTRL_EINVAL;
     }
-    ctrl_bases_t b;
-    int rc = drr_bases(&c->machine, p, &b);
-    if (rc != CTRL_OK) {
-        return rc;
-    }
+    int rc;
     const double lim = 127.0;
     s->kind = (uint8_t)kind;
     switch (kind) {
@@ -309,7 +276,7 @@ static int base_init(void *state, const void *cfg, const ctrl_params_t *p,
         break;
     case CTRL_DRR_BASE_D2: {
         /* K_b w with w in r/min (mechanical): w_rpm = w_pu w_base 60 / (2 pi p) */
-        const double rpm_per_pu = b.w_rad_s * 60.0 / (2.0 * DRR_PI * (double)p->pole_pairs);
+        const double rpm_per_pu = ctrl_elec_to_rpm(b.w_rad_s, p->pole_pairs);
         rc = drr_q24(c->k_a_nm / b.torque_nm, 0.0, DRR_PU_MAX, &s->ka);
         if (rc == CTRL_OK) {
             rc = drr_q24(c->k_b_nm_rpm * rpm_per_pu / b.torque_nm, 0.0, DRR_PU_MAX, &s->kb);
@@ -346,44 +313,43 @@ static int base_init(void *state, const void *cfg, const ctrl_params_t *p,
     return CTRL_OK;
 }
 
-static int d1_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int d1_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return base_init(state, cfg, p, CTRL_DRR_BASE_D1, d1_tunables,
+    return base_init(state, cfg, su, CTRL_DRR_BASE_D1, d1_tunables,
                      sizeof d1_tunables / sizeof d1_tunables[0]);
 }
 
-static int d2_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int d2_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return base_init(state, cfg, p, CTRL_DRR_BASE_D2, d2_tunables,
+    return base_init(state, cfg, su, CTRL_DRR_BASE_D2, d2_tunables,
                      sizeof d2_tunables / sizeof d2_tunables[0]);
 }
 
-static int pi_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int pi_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return base_init(state, cfg, p, CTRL_DRR_BASE_PI, pi_tunables,
+    return base_init(state, cfg, su, CTRL_DRR_BASE_PI, pi_tunables,
                      sizeof pi_tunables / sizeof pi_tunables[0]);
 }
 
-static int df_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int df_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return base_init(state, cfg, p, CTRL_DRR_BASE_DF, df_tunables,
+    return base_init(state, cfg, su, CTRL_DRR_BASE_DF, df_tunables,
                      sizeof df_tunables / sizeof df_tunables[0]);
 }
 
 #define DRR_BASE_DESC(id, label, tun, initfn)                                                      \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
-        #id,                                                                                       \
-        label,                                                                                     \
-        CTRL_DRR_FS_HZ,                                                                            \
-        sizeof(ctrl_drr_base_state_t),                                                             \
-        sizeof(ctrl_drr_base_cfg_t),                                                               \
-        tun,                                                                                       \
-        sizeof tun / sizeof tun[0],                                                                \
-        base_cfg_default,                                                                          \
-        initfn,                                                                                    \
-        ctrl_drr_base_reset,                                                                       \
-        ctrl_drr_base_step,                                                                        \
-        CTRL_EST_SECTOR_NOW,                                                                       \
+        .name = #id,                                                                               \
+        .title = label,                                                                            \
+        .fs_default_hz = CTRL_DRR_FS_HZ,                                                           \
+        CTRL_DESC_SIZES(ctrl_drr_base_state_t, ctrl_drr_base_cfg_t),                               \
+        .tunables = tun,                                                                           \
+        .n_tunables = sizeof tun / sizeof tun[0],                                                  \
+        .cfg_default = base_cfg_default,                                                           \
+        .init = initfn,                                                                            \
+        .reset = ctrl_drr_base_reset,                                                              \
+        .step = ctrl_drr_base_step,                                                                \
+        .est_unused = CTRL_EST_SECTOR_NOW,                                                         \
     }
 
 DRR_BASE_DESC(drr_d1, "DRR baseline D1: D = |T_err/C_T| + |psi_err/C_psi| (thesis (5.19))",

@@ -12,17 +12,16 @@
 
 /* ---------------- drr: SI configuration (tunables are the doubles) ---------------- */
 typedef struct {
-    double a_nm;            /* A (5.9), N*m; 0 = from the machine at init */
-    double b_nm;            /* B (5.10), N*m; 0 = from the machine at init */
-    double c;               /* C (5.13), dimensionless, < 0; 0 = speed-dependent (5.13) */
-    double lambda;          /* EMA smoothing factor (5.4), thesis 0.03 */
-    double sigma;           /* subsector width (4.19) of the replacement, rad; 0 = off */
-    double dpsi_max_wb;     /* Delta psi_max of §5.3.5, Wb; 0 = sqrt(3) Vdc Ts / 3 */
-    double pred_516;        /* 0: model prediction of T(k+1) (default); 1: (5.16) */
-    double gamma_max_nm;    /* |gamma| limit, N*m; 0 = none (thesis) */
-    double centre;          /* 1: plans realised centre-aligned (plan.h, default): T_e is
-                               shifted to the active-vector start; 0: active vector first */
-    ctrl_machine_t machine; /* copied by cfg_default (not a tunable) */
+    double a_nm;         /* A (5.9), N*m; 0 = from the machine at init */
+    double b_nm;         /* B (5.10), N*m; 0 = from the machine at init */
+    double c;            /* C (5.13), dimensionless, < 0; 0 = speed-dependent (5.13) */
+    double lambda;       /* EMA smoothing factor (5.4), thesis 0.03 */
+    double sigma;        /* subsector width (4.19) of the replacement, rad; 0 = off */
+    double dpsi_max_wb;  /* Delta psi_max of §5.3.5, Wb; 0 = sqrt(3) Vdc Ts / 3 */
+    double pred_516;     /* 0: model prediction of T(k+1) (default); 1: (5.16) */
+    double gamma_max_nm; /* |gamma| limit, N*m; 0 = none (thesis) */
+    double centre;       /* 1: plans realised centre-aligned (plan.h, default): T_e is
+                            shifted to the active-vector start; 0: active vector first */
 } ctrl_drr_cfg_t;
 
 /* ---------------- baselines: one SI configuration, each descriptor exposes its part ------ */
@@ -34,7 +33,6 @@ typedef struct {
     double kp;         /* D_PI (5.20) K_P, 1/(N*m) */
     double ki;         /* D_PI (5.20) K_I, 1/(N*m*s) */
     double rms;        /* D_f: 0 = D_f (5.18), 1 = D_RMS (5.17) */
-    ctrl_machine_t machine;
 } ctrl_drr_base_cfg_t;
 
 /* ---------------- configuration helpers (ctrl_drr_config.c, double) ---------------- */

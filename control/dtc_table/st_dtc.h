@@ -8,9 +8,7 @@
  * prediction est->next (torque, flux amplitude, flux vector -> sector), i.e.
  * the state at the instant the vector starts to act.
  *
- * Flux reference: ref->psi if > 0, else params->psi_ref if > 0, else MTPA of
- * the torque reference (4.15) (ctrl_mtpa_psi). A negative amplitude reference
- * is meaningless and is treated like 0.
+ * Flux reference: ctrl_flux_ref (mtpa.h) of the torque reference.
  *
  * Output: one vector for the whole period (n_seg = 1, duration FX_ONE). A
  * table entry "ZVV" becomes V0 or V7 by ctrl_zero_after(previous vector), so
@@ -71,9 +69,6 @@ void st_fst_logic_reset(st_fst_logic_t *l);
  */
 st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24_t omega);
 
-/* Flux amplitude reference used by the tables (see above), Q24 pu. */
-q24_t st_psi_reference(const ctrl_params_t *p, const ctrl_refs_t *ref);
-
 extern const ctrl_desc_t ctrl_desc_bst;
 extern const ctrl_desc_t ctrl_desc_mbst;
 extern const ctrl_desc_t ctrl_desc_ast;
@@ -83,8 +78,8 @@ extern const ctrl_desc_t ctrl_desc_fst;
 /* ---- Internal: shared by st_dtc.c (per sample) and st_dtc_config.c
  * (descriptors, defaults, init). Not for other modules. ---- */
 void st_hyst_reset(void *state);
-void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void st_fst_reset(void *state);
-void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_ST_DTC_H */

@@ -13,9 +13,6 @@
 typedef struct {
     double h_t;   /* torque band half width h_T, N*m (Table 4.7: 2 % of T_rated) */
     double h_psi; /* flux band half width h_psi, Wb (Table 4.7: 2 % of psi_pm) */
-    /* Set by cfg_default from the machine (not tunables): SI value of 1 pu
-     * (ctrl_bases_t) and the rated torque, to convert and cross-check at init. */
-    double torque_base_nm, psi_base_wb, torque_rated_nm;
 } st_hyst_cfg_t;
 
 /* SI configuration of FST. */
@@ -23,7 +20,6 @@ typedef struct {
     double sigma;   /* subsector width of (4.19), rad, [0, pi/12]; 0 = no replacement */
     double dt_step; /* |Delta T_ref| above which a reference step is detected, N*m;
                        0 = any change (thesis §4.5.3: Delta T_ref != 0) */
-    double torque_base_nm, psi_base_wb, torque_rated_nm; /* as in st_hyst_cfg_t */
 } st_fst_cfg_t;
 
 #endif /* CONTROL_ST_DTC_CONFIG_H */

@@ -82,7 +82,7 @@ static int32_t angle_diff(fx_angle_t a, fx_angle_t b)
 }
 
 void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ctrl_meas_t *m,
-                           const ctrl_plan_t *applied, ctrl_estimate_t *est)
+                           const ctrl_legs_t *applied, ctrl_estimate_t *est)
 {
     q24_t i_alpha;
     q24_t i_beta;
@@ -126,7 +126,7 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     q24_t va = 0;
     q24_t vb = 0;
     if (applied != 0) {
-        ctrl_plan_voltage(applied, m->vdc, &va, &vb);
+        ctrl_legs_voltage(applied, m->vdc, &va, &vb);
     }
     /* Prediction (5.15)/(6.10)-(6.12): flux, angle theta + omega Ts, state. */
     q24_t pa;

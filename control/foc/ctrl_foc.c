@@ -6,29 +6,26 @@
 
 #include <stddef.h>
 
+#include "mtpa.h"
 #include "plan.h"
 #include "predict.h"
 #include "svpwm.h"
 #include "transforms.h"
+#include "vectors.h"
 
 #define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
 #define FOC_KI_QBITS 30u
 
-void ctrl_foc_iref(const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d, q24_t *i_q)
+void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d,
+                   q24_t *i_q)
 {
-    const q24_t a = fx_min(fx_abs(t), r->t_max);
-    /* Position on the table, Q24: a * (N / t_max), <= N * 2^24 (fits). */
-    const int64_t pos = fx_rshift64_round((int64_t)a * r->scale, 16u);
-    int64_t idx = (int64_t)((uint64_t)pos >> FX_QBITS); /* pos >= 0 */
-    q24_t frac = (q24_t)(pos & (FX_ONE - 1));
-    if (idx >= CTRL_FOC_MTPA_N) {
-        idx = CTRL_FOC_MTPA_N - 1;
-        frac = FX_ONE;
+    if (r->mtpa != 0u) {
+        ctrl_mtpa_current(p, t, i_d, i_q);
+        return;
     }
-    const size_t k = (size_t)idx;
-    const q24_t d = fx_add(r->id_tab[k], fx_mul(fx_sub(r->id_tab[k + 1u], r->id_tab[k]), frac));
-    const q24_t q = fx_add(r->iq_tab[k], fx_mul(fx_sub(r->iq_tab[k + 1u], r->iq_tab[k]), frac));
-    *i_d = d;
+    /* i_d = 0 (Algorithm 1): Te = psi_pm i_q (3.10). */
+    const q24_t q = fx_mul(fx_min(fx_abs(t), r->t_max), p->inv_psi_pm);
+    *i_d = 0;
     *i_q = t < 0 ? fx_neg(q) : q;
 }
 
@@ -53,9 +50,6 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
 void ctrl_foc_reset(void *state)
 {
     ctrl_foc_state_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     s->legs = 0u;
     s->limited = 0u;
     s->pi_d.integ = 0;
@@ -66,7 +60,7 @@ void ctrl_foc_reset(void *state)
 
 /* foc: PI current loops + SVPWM. */
 static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref, q24_t iq_ref,
-                        ctrl_plan_t *out)
+                        ctrl_out_t *out)
 {
     const ctrl_params_t *p = ctx->params;
     const ctrl_mstate_t *nx = &ctx->est->next; /* state at k+1: delay compensation */
@@ -86,14 +80,15 @@ static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref
     q24_t va;
     q24_t vb;
     ctrl_inv_park(v_d, v_q, sn, cs, &va, &vb);
-    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, out);
+    out->plan.n_seg = 0u; /* leg duties (ctrl_types.h) */
+    s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, &out->legs);
     ctrl_foc_pi_update(&s->pi_d, e_d, v_d, s->limited);
     ctrl_foc_pi_update(&s->pi_q, e_q, v_q, s->limited);
 }
 
 /* foc_hyst: per-phase hysteresis current control, one vector per period. */
 static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref, q24_t iq_ref,
-                          ctrl_plan_t *out)
+                          ctrl_out_t *out)
 {
     const ctrl_mstate_t *nx = &ctx->est->next; /* currents at k+1 (delay compensation) */
     q24_t ra;
@@ -114,22 +109,15 @@ static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_r
         }
     }
     s->legs = legs;
-    ctrl_plan_single(out, ctrl_svpwm_vec_of_mask(legs));
+    ctrl_plan_single(&out->plan, ctrl_vec_of_legs[legs & 7u]);
 }
 
-void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_foc_state_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u); /* no voltage */
-        return;
-    }
     q24_t id_ref;
     q24_t iq_ref;
-    ctrl_foc_iref(&s->iref, ctx->ref->torque, &id_ref, &iq_ref);
+    ctrl_foc_iref(ctx->params, &s->iref, ctx->ref->torque, &id_ref, &iq_ref);
     if (s->hyst != 0u) {
         foc_hyst_step(s, ctx, id_ref, iq_ref, out);
     } else {

@@ -2,11 +2,10 @@
  * Rotor-field-oriented control of the book chapter (S1 §2, Algorithm 1),
  * "foc", and its hysteresis-current variant "foc_hyst".
  *
- * Current references: T_ref -> (i_d, i_q) on the MTPA locus (IPMSM; exact,
- * tabulated at init over CTRL_FOC_MTPA_N + 1 torque points and interpolated
- * linearly) or with i_d = 0 (SPMSM, or tunable mtpa = 0: the chapter's
- * Algorithm 1, alpha_sref = pi/2). |T_ref| is limited to the torque at
- * current_max on that locus (current limit).
+ * Current references: T_ref -> (i_d, i_q) on the MTPA locus (IPMSM: the
+ * machine's MTPA table, ctrl_mtpa_current) or with i_d = 0 (SPMSM, or tunable
+ * mtpa = 0: the chapter's Algorithm 1, alpha_sref = pi/2). |T_ref| is limited
+ * to the torque at current_max on that locus (current limit).
  *
  * foc: d and q current PI regulators with decoupling feed-forward
  *   v_d = -omega psi_q + Kp_d e_d + I_d,  v_q = omega psi_d + Kp_q e_q + I_q,
@@ -21,8 +20,9 @@
  * [k+1, k+2). The feedback currents and fluxes are the prediction for k+1
  * (est->next), and the inverse Park uses the mean rotor angle of the
  * application interval, theta(k+1) + omega Ts / 2 (= theta(k) + 1.5 omega Ts).
- * Output by space-vector PWM (svpwm.h): V_k1, V_k2, V0, V7, over-modulation
- * limited onto the hexagon keeping the angle.
+ * Output: leg duties by space-vector PWM (svpwm.h; V_k1, V_k2 and the zero
+ * time split between V0 and V7), over-modulation limited onto the hexagon
+ * keeping the angle.
  *
  * foc_hyst (S1 §2: current-controlled inverter with hysteresis controllers):
  * per phase x, e_x = i_x,ref - i_x at k+1 (predicted); leg x high if
@@ -37,8 +37,6 @@
 #include "controller.h"
 #include "fx.h"
 
-#define CTRL_FOC_MTPA_N 32 /* segments of the current-reference table */
-
 /* One current PI (Q formats at the fields). */
 typedef struct {
     q24_t kp;      /* V pu per A pu, Q24 */
@@ -48,10 +46,8 @@ typedef struct {
 
 /* Torque -> current references (both controllers). */
 typedef struct {
-    q24_t t_max;                       /* |T| limit, Q24 pu */
-    int32_t scale;                     /* CTRL_FOC_MTPA_N / t_max, Q16 */
-    q24_t id_tab[CTRL_FOC_MTPA_N + 1]; /* i_d at |T| = k t_max / N, Q24 pu (<= 0) */
-    q24_t iq_tab[CTRL_FOC_MTPA_N + 1]; /* |i_q| at the same points, Q24 pu */
+    uint8_t mtpa; /* 1: ctrl_mtpa_current (salient machine); 0: i_d = 0 */
+    q24_t t_max;  /* i_d = 0: |T| limit psi_pm i_max, Q24 pu */
 } ctrl_foc_iref_t;
 
 typedef struct {
@@ -65,7 +61,8 @@ typedef struct {
 } ctrl_foc_state_t;
 
 /* Current references for torque t (Q24 pu): i_d <= 0, i_q with the sign of t. */
-void ctrl_foc_iref(const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d, q24_t *i_q);
+void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d,
+                   q24_t *i_q);
 
 /* PI output before limiting: Kp e + I (Q24 pu, saturated). */
 q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err);
@@ -80,6 +77,6 @@ extern const ctrl_desc_t ctrl_desc_foc_hyst;
 
 /* ---- Internal: shared by ctrl_foc.c and ctrl_foc_config.c. ---- */
 void ctrl_foc_reset(void *state);
-void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_FOC_H */

@@ -10,12 +10,12 @@
 #include "ctrl_foc.h"
 #include "ctrl_foc_config.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "estimator.h"
 
 #define FOC_FS_HZ 10000u   /* S1 §2: Ts = 100 us */
 #define FOC_WC_PER_FS 20.0 /* default wc = 2 pi fs / 20 */
 #define FOC_HI_REL 0.05    /* default foc_hyst band: 5 % of the rated current */
-#define FOC_PI 3.14159265358979323846
 
 static const ctrl_tunable_t foc_tunables[] = {
     {"wc", "rad/s", "current-loop bandwidth for Kp = L wc, Ki = R wc; 0 = 2 pi fs/20",
@@ -42,88 +42,34 @@ static const ctrl_tunable_t foc_hyst_tunables[] = {
 static void foc_cfg_default(void *cfg, const ctrl_machine_t *m)
 {
     ctrl_foc_cfg_t *c = cfg;
-    if (c == NULL) {
-        return;
-    }
     memset(c, 0, sizeof *c);
     c->mtpa = 1.0;
-    ctrl_params_t p;
-    ctrl_bases_t b;
-    if (m == NULL || ctrl_params_init(&p, &b, m, FOC_FS_HZ) != CTRL_OK) {
-        return; /* bases 0: init refuses the configuration */
+    if (m != NULL) {
+        c->h_i = FOC_HI_REL * m->current_rated_a;
     }
-    c->r_base_ohm = b.r_ohm;
-    c->i_base_a = b.i_a;
-    c->rs_ohm = m->rs_ohm;
-    c->h_i = FOC_HI_REL * m->current_rated_a;
 }
 
-/* MTPA point at current amplitude i (pu, psi_pm = 1): i_d, i_q and torque. */
-static void foc_mtpa_point(double ld, double lq, double i, double *id, double *iq, double *te)
+/* Torque -> current references: the MTPA table of the params for a salient
+ * machine with Lq > Ld and mtpa on, else i_d = 0 up to T(current_max). */
+static int foc_iref_init(ctrl_foc_iref_t *r, const ctrl_params_t *p, int mtpa)
 {
-    const double dl = lq - ld; /* > 0 for an IPMSM */
-    *id = (1.0 - sqrt(1.0 + 8.0 * dl * dl * i * i)) / (4.0 * dl);
-    *iq = sqrt(fmax(i * i - *id * *id, 0.0));
-    *te = *iq * (1.0 + (ld - lq) * *id);
-}
-
-/* Torque -> (i_d, i_q) table over [0, T(current_max)]. */
-static int foc_iref_table(ctrl_foc_iref_t *r, const ctrl_params_t *p, int mtpa)
-{
-    const double ld = ctrl_q24_to_double(p->ld);
-    const double lq = ctrl_q24_to_double(p->lq);
-    const double imax = ctrl_q24_to_double(p->current_max);
-    if (!(imax > 0.0) || !(ld > 0.0) || !(lq > 0.0)) {
-        return CTRL_EINVAL;
-    }
-    const int salient_mtpa = mtpa && p->salient && lq > ld;
-    double t_max = imax; /* i_d = 0: T = i_q (psi_pm = 1 pu) */
-    if (salient_mtpa) {
-        double id;
-        double iq;
-        foc_mtpa_point(ld, lq, imax, &id, &iq, &t_max);
-    }
-    const double scale = (double)CTRL_FOC_MTPA_N / t_max;
-    if (!(t_max > 0.0) || t_max >= 127.0 || scale * 65536.0 >= 2147483647.0) {
-        return CTRL_ERANGE;
-    }
-    for (int k = 0; k <= CTRL_FOC_MTPA_N; k++) {
-        const double tk = t_max * k / CTRL_FOC_MTPA_N;
-        double id = 0.0;
-        double iq = tk;
-        if (salient_mtpa) {
-            double lo = 0.0;
-            double hi = imax;
-            for (int it = 0; it < 60; it++) { /* torque increases with |i| on the locus */
-                const double mid = 0.5 * (lo + hi);
-                double te;
-                foc_mtpa_point(ld, lq, mid, &id, &iq, &te);
-                if (te < tk) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            double te;
-            foc_mtpa_point(ld, lq, 0.5 * (lo + hi), &id, &iq, &te);
-        }
-        r->id_tab[k] = ctrl_q24_from_double(id);
-        r->iq_tab[k] = ctrl_q24_from_double(iq);
-    }
-    r->t_max = ctrl_q24_from_double(t_max);
-    r->scale = (int32_t)llround(scale * 65536.0);
-    return CTRL_OK;
+    r->mtpa = (uint8_t)(mtpa && p->salient && p->lq > p->ld);
+    const double t_max =
+        ctrl_q24_to_double(p->psi_pm) * ctrl_q24_to_double(p->current_max); /* (3.10) */
+    return ctrl_q24_from_si(t_max, 1.0, 0.0, 127.0, &r->t_max);
 }
 
 static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l_pu, double wc,
-                         const ctrl_foc_cfg_t *c, const ctrl_params_t *p)
+                         const ctrl_setup_t *su)
 {
+    const ctrl_params_t *p = su->params;
     const double fs = (double)p->fs_hz;
     const double ts_pu = ctrl_q24_to_double(p->ts);
     const double r_pu = ctrl_q24_to_double(p->rs);
+    const double r_base = su->bases->r_ohm;
     /* Kp = L wc (pu: L_pu * wc / w_base, w_base = ts_pu * fs); Ki Ts = R wc Ts. */
-    const double kp = kp_si > 0.0 ? kp_si / c->r_base_ohm : l_pu * (wc / fs) / ts_pu;
-    const double ki_ts = ki_si > 0.0 ? ki_si / c->r_base_ohm / fs : r_pu * wc / fs;
+    const double kp = kp_si > 0.0 ? kp_si / r_base : l_pu * (wc / fs) / ts_pu;
+    const double ki_ts = ki_si > 0.0 ? ki_si / r_base / fs : r_pu * wc / fs;
     if (!isfinite(kp) || !isfinite(ki_ts) || kp >= 127.0 || ki_ts >= 1.99) {
         return CTRL_ERANGE;
     }
@@ -133,11 +79,9 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     return CTRL_OK;
 }
 
-static int foc_init_common(void *state, const void *cfg, const ctrl_params_t *p, int hyst)
+static int foc_init_common(void *state, const void *cfg, const ctrl_setup_t *su, int hyst)
 {
-    if (state == NULL || cfg == NULL || p == NULL) {
-        return CTRL_EINVAL;
-    }
+    const ctrl_params_t *p = su->params;
     const ctrl_foc_cfg_t *c = cfg;
     ctrl_foc_state_t *s = state;
     memset(s, 0, sizeof *s);
@@ -147,77 +91,65 @@ static int foc_init_common(void *state, const void *cfg, const ctrl_params_t *p,
                             sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0], c) != CTRL_OK) {
         return CTRL_EINVAL;
     }
-    if (!(c->r_base_ohm > 0.0) || !(c->i_base_a > 0.0) || !isfinite(c->r_base_ohm) ||
-        !isfinite(c->i_base_a) || p->fs_hz == 0u) {
-        return CTRL_EINVAL;
-    }
-    /* cfg_default must have been called with the machine of these params. */
-    const double rs_pu = c->rs_ohm / c->r_base_ohm;
-    if (fabs(rs_pu - ctrl_q24_to_double(p->rs)) > 1e-5 * fmax(1.0, rs_pu)) {
-        return CTRL_EINVAL;
-    }
     const double fs = (double)p->fs_hz;
-    const double wc = c->wc > 0.0 ? c->wc : 2.0 * FOC_PI * fs / FOC_WC_PER_FS;
+    const double wc = c->wc > 0.0 ? c->wc : CTRL_TWO_PI * fs / FOC_WC_PER_FS;
     if (wc / fs > 1.5) {
         return CTRL_EINVAL; /* discrete loop gain wc Ts beyond the stable range */
     }
-    int rc = foc_iref_table(&s->iref, p, c->mtpa >= 0.5);
+    int rc = foc_iref_init(&s->iref, p, c->mtpa >= 0.5);
     if (rc == CTRL_OK) {
-        rc = foc_pi_config(&s->pi_d, c->kp_d, c->ki_d, ctrl_q24_to_double(p->ld), wc, c, p);
+        rc = foc_pi_config(&s->pi_d, c->kp_d, c->ki_d, ctrl_q24_to_double(p->ld), wc, su);
     }
     if (rc == CTRL_OK) {
-        rc = foc_pi_config(&s->pi_q, c->kp_q, c->ki_q, ctrl_q24_to_double(p->lq), wc, c, p);
+        rc = foc_pi_config(&s->pi_q, c->kp_q, c->ki_q, ctrl_q24_to_double(p->lq), wc, su);
     }
-    const double h = c->h_i / c->i_base_a;
-    if (rc == CTRL_OK && (!isfinite(h) || h >= 127.0)) {
-        rc = CTRL_ERANGE;
+    if (rc == CTRL_OK) {
+        rc = ctrl_q24_from_si(c->h_i, su->bases->i_a, 0.0, 127.0, &s->h_i);
     }
     if (rc != CTRL_OK) {
         memset(s, 0, sizeof *s);
         return rc;
     }
-    s->h_i = ctrl_q24_from_double(h);
     s->hyst = (uint8_t)(hyst != 0);
     ctrl_foc_reset(s);
     return CTRL_OK;
 }
 
-static int foc_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int foc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return foc_init_common(state, cfg, p, 0);
+    return foc_init_common(state, cfg, su, 0);
 }
 
-static int foc_hyst_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int foc_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
-    return foc_init_common(state, cfg, p, 1);
+    return foc_init_common(state, cfg, su, 1);
 }
 
 const ctrl_desc_t ctrl_desc_foc = {
-    "foc",
-    "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
-    FOC_FS_HZ,
-    sizeof(ctrl_foc_state_t),
-    sizeof(ctrl_foc_cfg_t),
-    foc_tunables,
-    sizeof foc_tunables / sizeof foc_tunables[0],
-    foc_cfg_default,
-    foc_init,
-    ctrl_foc_reset,
-    ctrl_foc_step,
-    CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* FOC reads currents, not |psi| or sectors */
+    .name = "foc",
+    .title =
+        "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
+    .fs_default_hz = FOC_FS_HZ,
+    CTRL_DESC_SIZES(ctrl_foc_state_t, ctrl_foc_cfg_t),
+    .tunables = foc_tunables,
+    .n_tunables = sizeof foc_tunables / sizeof foc_tunables[0],
+    .cfg_default = foc_cfg_default,
+    .init = foc_init,
+    .reset = ctrl_foc_reset,
+    .step = ctrl_foc_step,
+    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* currents, not |psi| or sectors */
 };
 
 const ctrl_desc_t ctrl_desc_foc_hyst = {
-    "foc_hyst",
-    "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
-    FOC_FS_HZ,
-    sizeof(ctrl_foc_state_t),
-    sizeof(ctrl_foc_cfg_t),
-    foc_hyst_tunables,
-    sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0],
-    foc_cfg_default,
-    foc_hyst_init,
-    ctrl_foc_reset,
-    ctrl_foc_step,
-    CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* FOC reads currents, not |psi| or sectors */
+    .name = "foc_hyst",
+    .title = "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
+    .fs_default_hz = FOC_FS_HZ,
+    CTRL_DESC_SIZES(ctrl_foc_state_t, ctrl_foc_cfg_t),
+    .tunables = foc_hyst_tunables,
+    .n_tunables = sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0],
+    .cfg_default = foc_cfg_default,
+    .init = foc_hyst_init,
+    .reset = ctrl_foc_reset,
+    .step = ctrl_foc_step,
+    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* currents, not |psi| or sectors */
 };

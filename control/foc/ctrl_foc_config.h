@@ -16,8 +16,6 @@ typedef struct {
     double ki_d, ki_q; /* V/(A s); 0 = Rs wc */
     double mtpa;       /* 1 = MTPA i_d (IPMSM), 0 = i_d = 0 */
     double h_i;        /* foc_hyst current band half width, A */
-    /* Set by cfg_default from the machine (not tunables). */
-    double r_base_ohm, i_base_a, rs_ohm;
 } ctrl_foc_cfg_t;
 
 #endif /* CONTROL_CTRL_FOC_CONFIG_H */

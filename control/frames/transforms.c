@@ -4,24 +4,18 @@
  */
 #include "transforms.h"
 
-/* Q30 constants. */
-#define K_INV_SQRT3_Q30 619925131 /* 1/sqrt(3) */
-#define K_2_SQRT3_Q30 1239850262  /* 2/sqrt(3) */
-#define K_SQRT3_2_Q30 929887697   /* sqrt(3)/2 */
-#define K_HALF_Q30 536870912      /* 1/2 */
-
 void ctrl_clarke(q24_t ia, q24_t ib, q24_t *al, q24_t *be)
 {
     /* alpha = a; beta = (a + 2b)/sqrt(3) with c = -a - b (3.3). |sum| <=
      * 2^31 (1/sqrt3 + 2/sqrt3) 2^30 < 2^62: no overflow. */
     *al = ia;
-    *be = fx_round_sat((int64_t)ia * K_INV_SQRT3_Q30 + (int64_t)ib * K_2_SQRT3_Q30, 30u);
+    *be = fx_round_sat((int64_t)ia * FX_Q30_INV_SQRT3 + (int64_t)ib * FX_Q30_2_SQRT3, 30u);
 }
 
 void ctrl_inv_clarke(q24_t al, q24_t be, q24_t *a, q24_t *b, q24_t *c)
 {
-    const int64_t half = (int64_t)al * K_HALF_Q30;
-    const int64_t bq = (int64_t)be * K_SQRT3_2_Q30;
+    const int64_t half = (int64_t)al * FX_Q30_HALF;
+    const int64_t bq = (int64_t)be * FX_Q30_SQRT3_2;
     *a = al;
     *b = fx_round_sat(bq - half, 30u);
     *c = fx_round_sat(-bq - half, 30u);

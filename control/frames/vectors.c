@@ -3,35 +3,47 @@
  */
 #include "vectors.h"
 
-/* Leg states per vector: bit 0 = leg a (S1), bit 1 = leg b (S2), bit 2 = leg c (S3).
- * V0=000, V1=100, V2=110, V3=010, V4=011, V5=001, V6=101, V7=111 (Table 4.2). */
-const uint8_t ctrl_vec_legs[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+/* V0=000, V1=100, V2=110, V3=010, V4=011, V5=001, V6=101, V7=111 (Table 4.2);
+ * the remaining entries are 0. */
+const uint8_t ctrl_vec_legs[256] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+
+/* 000->V0, 100->V1, 010->V3, 110->V2, 001->V5, 101->V6, 011->V4, 111->V7. */
+const uint8_t ctrl_vec_of_legs[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
 
 /* One leg switches: V1, V3, V5 have one leg high -> V0; V2, V4, V6 two -> V7. */
 const uint8_t ctrl_vec_zero_after[8] = {0u, 0u, 7u, 0u, 7u, 0u, 7u, 7u};
 
-/* V_i / Vdc, Q30: alpha = 2/3 cos((i-1) pi/3), beta = 2/3 sin((i-1) pi/3). */
-#define K_2_3 715827883
-#define K_1_3 357913941
-#define K_1_SQRT3 619925131
-static const int32_t vec_alpha_q30[8] = {0, K_2_3, K_1_3, -K_1_3, -K_2_3, -K_1_3, K_1_3, 0};
-static const int32_t vec_beta_q30[8] = {0, 0, K_1_SQRT3, K_1_SQRT3, 0, -K_1_SQRT3, -K_1_SQRT3, 0};
+/* V_i / Vdc: alpha = 2/3 cos((i-1) pi/3), beta = 2/3 sin((i-1) pi/3). */
+const int32_t ctrl_vec_ab_q30[8][2] = {
+    {0, 0},
+    {FX_Q30_2_3, 0},
+    {FX_Q30_1_3, FX_Q30_INV_SQRT3},
+    {-FX_Q30_1_3, FX_Q30_INV_SQRT3},
+    {-FX_Q30_2_3, 0},
+    {-FX_Q30_1_3, -FX_Q30_INV_SQRT3},
+    {FX_Q30_1_3, -FX_Q30_INV_SQRT3},
+    {0, 0},
+};
 
-uint8_t ctrl_vector_leg(uint8_t idx, unsigned leg)
-{
-    if (idx > 7u || leg > 2u) {
-        return 0u;
-    }
-    return (uint8_t)((ctrl_vec_legs[idx] >> leg) & 1u);
-}
+/* cos, sin of (i-1) pi/3. */
+const q24_t ctrl_vec_dir_q24[8][2] = {
+    {0, 0},
+    {FX_ONE, 0},
+    {FX_Q24_HALF, FX_Q24_SQRT3_2},
+    {-FX_Q24_HALF, FX_Q24_SQRT3_2},
+    {-FX_ONE, 0},
+    {-FX_Q24_HALF, -FX_Q24_SQRT3_2},
+    {FX_Q24_HALF, -FX_Q24_SQRT3_2},
+    {0, 0},
+};
 
 void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
 {
     if (idx > 7u) {
         idx = 0u;
     }
-    *v_alpha = fx_round_sat((int64_t)vdc * vec_alpha_q30[idx], 30u);
-    *v_beta = fx_round_sat((int64_t)vdc * vec_beta_q30[idx], 30u);
+    *v_alpha = fx_round_sat((int64_t)vdc * ctrl_vec_ab_q30[idx][0], 30u);
+    *v_beta = fx_round_sat((int64_t)vdc * ctrl_vec_ab_q30[idx][1], 30u);
 }
 
 uint8_t ctrl_vec_wrap(int x)

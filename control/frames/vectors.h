@@ -15,16 +15,22 @@
 
 #include "fx.h"
 
-/* Leg states per vector index 0..7 (Table 4.2): bit 0 = leg a (S1), bit 1 = leg b
- * (S2), bit 2 = leg c (S3). One table for every module that maps vectors to legs. */
-extern const uint8_t ctrl_vec_legs[8];
-
-/* ctrl_zero_after() as a table, for per-sample code that indexes it directly. */
+/* The geometry of Table 4.2, one table per format (vectors.c):
+ *   ctrl_vec_legs[v]      leg states of vector index v: bit 0 = leg a (S1), bit 1 = leg b
+ *                         (S2), bit 2 = leg c (S3); 256 entries, 0 (no leg high) for
+ *                         v > 7, so any uint8_t index is safe without a test;
+ *   ctrl_vec_of_legs[m]   the vector index of leg-state mask m (inverse of the above);
+ *   ctrl_vec_zero_after[v] the zero vector that switches one leg after v (V0 after
+ *                         V0/V1/V3/V5, V7 after V7/V2/V4/V6);
+ *   ctrl_vec_ab_q30[v]    V_v / Vdc in alpha/beta, Q30 ((4.4): 2/3 e^{j(v-1)pi/3}, 0 for V0, V7);
+ *   ctrl_vec_dir_q24[v]   unit vector of V_v (direction (v-1) pi/3), Q24 (0 for V0, V7).
+ * Sector boundaries of (4.5) bisect two neighbouring vectors: the lower
+ * boundary of sector x lies at V_x rotated by -pi/6. */
+extern const uint8_t ctrl_vec_legs[256];
+extern const uint8_t ctrl_vec_of_legs[8];
 extern const uint8_t ctrl_vec_zero_after[8];
-
-/* Switching state of leg 0..2 (a, b, c) for vector idx 0..7 (1 = upper switch on).
- * idx > 7 gives 0 (treated as V0). */
-uint8_t ctrl_vector_leg(uint8_t idx, unsigned leg);
+extern const int32_t ctrl_vec_ab_q30[8][2];
+extern const q24_t ctrl_vec_dir_q24[8][2];
 
 /* alpha/beta voltage of vector idx 0..7 at DC link vdc (Q24 pu), Table 4.2.
  * V0, V7 and idx > 7 give (0, 0). */

@@ -4,11 +4,13 @@
  * desc->state_size bytes owned by the caller (no heap, no globals).
  *
  * Life cycle:
- *   desc->cfg_default(cfg, machine)         SI tunables with the seed's defaults
+ *   desc->cfg_default(cfg, machine)         SI tunables with the source's defaults
  *   ctrl_tunable_set(desc, cfg, "A", 1.3)   optional overrides by name (checked)
- *   desc->init(state, cfg, params)          SI -> fixed point, once (*_config.c)
+ *   ctrl_init(desc, state, cfg, &setup)     SI -> fixed point, once (*_config.c)
  *   desc->reset(state)                      clear dynamic state, keep config
- *   desc->step(state, &ctx, &plan)          every PWM period, integer-only
+ *   desc->step(state, &ctx, &out)           every PWM period, integer-only
+ * ctrl_init, ctrl_reset and ctrl_step (controller_registry.c) check the
+ * pointers once; the descriptor's own functions assume valid arguments.
  */
 #ifndef CONTROL_CONTROLLER_H
 #define CONTROL_CONTROLLER_H
@@ -24,8 +26,16 @@ typedef struct {
     const ctrl_params_t *params; /* machine parameters for this fs */
     const ctrl_estimate_t *est;  /* estimates at k and predictions for k+1 */
     const ctrl_refs_t *ref;      /* references */
-    const ctrl_plan_t *applied;  /* plan acting during [k, k+1) (chosen at k-1) */
 } ctrl_ctx_t;
+
+/* Everything a controller's init reads (configuration time): the SI machine,
+ * the SI value of 1 pu of each quantity and the fixed-point parameters, all
+ * from one ctrl_params_init(params, bases, machine, fs). */
+typedef struct {
+    const ctrl_machine_t *machine;
+    const ctrl_bases_t *bases;
+    const ctrl_params_t *params;
+} ctrl_setup_t;
 
 /*
  * A tunable: a double field of the controller's SI configuration struct, set
@@ -35,57 +45,76 @@ typedef struct {
 typedef struct {
     const char *name; /* e.g. "h_T" */
     const char *unit; /* e.g. "N*m"; "0/1" marks a switch (only 0 and 1 accepted) */
-    const char *help; /* one line, cites the seed */
+    const char *help; /* one line, cites the source */
     size_t offset;    /* offsetof(cfg struct, field), field is a double */
     double min, max;  /* accepted range (inclusive) */
 } ctrl_tunable_t;
 
 typedef struct ctrl_desc {
     const char *name;       /* run-time selector: "bst", "fst", "drr", "m2ptfc", ... */
-    const char *title;      /* one line with the seed reference */
-    uint32_t fs_default_hz; /* the sampling frequency the seed uses */
+    const char *title;      /* one line with the source reference */
+    uint32_t fs_default_hz; /* the sampling frequency the source uses */
     size_t state_size;      /* bytes of runtime state */
     size_t cfg_size;        /* bytes of the SI configuration struct */
     const ctrl_tunable_t *tunables;
     size_t n_tunables;
-    /* Fill cfg with the seed's default parameters for this machine. */
+    /* Fill cfg with the source's default parameters for this machine (SI). */
     void (*cfg_default)(void *cfg, const ctrl_machine_t *machine);
     /* Convert cfg to fixed point into state; returns CTRL_OK or a CTRL_E* code. */
-    int (*init)(void *state, const void *cfg, const ctrl_params_t *params);
+    int (*init)(void *state, const void *cfg, const ctrl_setup_t *setup);
     /* Clear the dynamic state (integrators, flags, filters), keep the config. */
     void (*reset)(void *state);
-    /* One control period: choose the plan for [k+1, k+2). Integer-only. */
-    void (*step)(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+    /* One control period: the output for [k+1, k+2), a plan or leg duties
+     * (ctrl_out_t). Integer-only. */
+    void (*step)(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
     /* Optional estimator outputs (CTRL_EST_* of estimator.h) this controller never
      * reads, so the pipeline can skip computing them; 0 = it may read all. */
     uint8_t est_unused;
 } ctrl_desc_t;
 
-/* Largest state_size / cfg_size of any registered controller, for static buffers. */
+/* Size of the caller's state and configuration blocks (the firmware's fw_t):
+ * every descriptor checks its types against them at compile time
+ * (CTRL_DESC_SIZES). */
 #define CTRL_STATE_MAX 1024
 #define CTRL_CFG_MAX 512
 
-/* Registry (controller_registry.c). */
+/* The state_size and cfg_size fields of a descriptor, with the compile-time
+ * check that both types fit the blocks above. */
+#define CTRL_DESC_SIZES(state_type, cfg_type)                                                      \
+    .state_size = sizeof(state_type) +                                                             \
+                  0 * sizeof(struct {                                                              \
+                      _Static_assert(sizeof(state_type) <= CTRL_STATE_MAX, "state too large");     \
+                      int ok;                                                                      \
+                  }),                                                                              \
+    .cfg_size = sizeof(cfg_type) +                                                                 \
+                0 * sizeof(struct {                                                                \
+                    _Static_assert(sizeof(cfg_type) <= CTRL_CFG_MAX, "config too large");          \
+                    int ok;                                                                        \
+                })
+
+/* Registry (controller_registry.c; the entries are chosen at build time by
+ * the CMake list PMSM_CONTROLLERS). */
 size_t ctrl_count(void);
 const ctrl_desc_t *ctrl_at(size_t index);
 const ctrl_desc_t *ctrl_find(const char *name); /* NULL if unknown */
+
+/* Guarded calls (controller_registry.c): every pointer (and the setup's and
+ * context's members) is checked here, once. ctrl_cfg_default and ctrl_init
+ * return CTRL_EINVAL for a missing one; ctrl_step writes the zero vector V0 for the whole period
+ * when the context is incomplete (nothing when out is NULL). */
+int ctrl_cfg_default(const ctrl_desc_t *d, void *cfg, const ctrl_machine_t *machine);
+int ctrl_init(const ctrl_desc_t *d, void *state, const void *cfg, const ctrl_setup_t *setup);
+void ctrl_reset(const ctrl_desc_t *d, void *state);
+void ctrl_step(const ctrl_desc_t *d, void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 /* Tunables by name (controller_config.c, may use double). Return CTRL_OK,
  * CTRL_ENOENT for an unknown name, CTRL_EINVAL for a value out of range or not finite. */
 int ctrl_tunable_set(const ctrl_desc_t *d, void *cfg, const char *name, double value);
 int ctrl_tunable_get(const ctrl_desc_t *d, const void *cfg, const char *name, double *value);
 
-/* (appended by review) Every field listed in t[0..n) of cfg is finite and inside
- * [min, max]: CTRL_OK, else CTRL_EINVAL (also for NULL t or cfg with n > 0).
- * For init functions that validate a whole SI configuration struct. */
+/* Every field listed in t[0..n) of cfg is finite and inside [min, max]:
+ * CTRL_OK, else CTRL_EINVAL (also for NULL t or cfg with n > 0). For init
+ * functions that validate a whole SI configuration struct. */
 int ctrl_tunables_check(const ctrl_tunable_t *t, size_t n, const void *cfg);
-
-/* (appended by review) 1 when ctx and every pointer a step needs (params,
- * est, ref) are non-NULL; ctx->applied may be NULL. Steps answer an invalid
- * context with the zero vector. */
-static inline int ctrl_ctx_ok(const ctrl_ctx_t *ctx)
-{
-    return ctx != NULL && ctx->params != NULL && ctx->est != NULL && ctx->ref != NULL;
-}
 
 #endif /* CONTROL_CONTROLLER_H */

@@ -63,7 +63,6 @@ typedef struct {
     q24_t current_max;    /* pu */
     q24_t psi_ref;        /* fixed flux reference, pu; 0 = MTPA */
     uint8_t salient;      /* 1 when Ld != Lq (IPMSM) */
-    /* ---- appended by core (ctrl_params_config.c computes them) ---- */
     /* Angle increment per control period for 1.0 pu electrical speed, in
      * fx_angle_t units (2^32 = one turn), integer (Q0):
      * omega_to_dangle = round(Ts_pu / (2 pi) * 2^32); then
@@ -76,14 +75,20 @@ typedef struct {
      * 1 - exp(-2 pi fc Ts), fc = CTRL_SPEED_LPF_HZ_DEFAULT unless changed with
      * ctrl_params_set_speed_lpf(). */
     q24_t speed_lpf_k;
-    /* MTPA (mtpa.c). SPMSM: psi_s = |(psi_pm, T * mtpa_k)|, mtpa_k = Lq / psi_pm, Q24.
-     * IPMSM: mtpa_psi[i] = psi_s at |T| = i * mtpa_t_max / CTRL_MTPA_N (Q24 pu),
-     * exact MTPA locus; index position = |T| * mtpa_scale / 2^16 (mtpa_scale is
-     * Q16: CTRL_MTPA_N / mtpa_t_max). Beyond mtpa_t_max: the last segment extended. */
+    /* MTPA (mtpa.c), one table for every user. SPMSM: psi_s = |(psi_pm, T * mtpa_k)|,
+     * mtpa_k = Lq / psi_pm, Q24; i_d = 0, i_q = T / psi_pm.
+     * IPMSM: the exact MTPA locus at CTRL_MTPA_N + 1 uniform torques
+     * |T| = i * mtpa_t_max / CTRL_MTPA_N: mtpa_psi (|psi_s|), mtpa_id (i_d <= 0 for
+     * Lq > Ld), mtpa_iq (i_q >= 0), all Q24 pu; index position = |T| * mtpa_scale
+     * / 2^16 (mtpa_scale is Q16: CTRL_MTPA_N / mtpa_t_max). Filled for the SPMSM
+     * too (closed forms), for tools that read them. */
     q24_t mtpa_k;
     q24_t mtpa_t_max;                /* torque at current_max on the MTPA locus, pu */
     int32_t mtpa_scale;              /* Q16 */
     q24_t mtpa_psi[CTRL_MTPA_N + 1]; /* Q24 pu */
+    q24_t mtpa_id[CTRL_MTPA_N + 1];  /* Q24 pu */
+    q24_t mtpa_iq[CTRL_MTPA_N + 1];  /* Q24 pu */
+    q24_t inv_psi_pm;                /* 1 / psi_pm, Q24 pu */
 } ctrl_params_t;
 
 /* Error codes shared by configuration functions. */
@@ -100,9 +105,14 @@ typedef struct {
 int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m,
                      uint32_t fs_hz);
 
-/* SI -> Q24 per-unit conversion helper for *_config.c files (saturates). */
+/* A per-unit value -> Q24, rounded half away from zero, saturated (NaN: 0). */
 q24_t ctrl_q24_from_double(double pu);
 double ctrl_q24_to_double(q24_t x);
+
+/* The one SI -> Q24 conversion of the configuration code: si / base (base =
+ * the SI value of 1 pu, ctrl_bases_t) into *out when it is finite and inside
+ * [lo_pu, hi_pu]: CTRL_OK; else CTRL_ERANGE and *out unchanged. */
+int ctrl_q24_from_si(double si, double base, double lo_pu, double hi_pu, q24_t *out);
 
 /* Change the speed-filter cut-off (Hz, 0 < fc < fs/2): sets p->speed_lpf_k.
  * Returns CTRL_OK or CTRL_EINVAL. */

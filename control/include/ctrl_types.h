@@ -53,7 +53,7 @@ typedef struct {
  * vector index 0..7 (Table 4.2) and its on-time as a Q24 fraction of the
  * period (sum of durations == FX_ONE). Segment 0 is the "selected" active
  * vector reported by telemetry. The order of segments carries no timing: the
- * PWM stage realises the plan's volt-seconds as centre-aligned leg duties.
+ * plan's volt-seconds are realised as centre-aligned leg duties (plan.h).
  */
 #define CTRL_PLAN_MAX_SEG 4
 typedef struct {
@@ -67,5 +67,14 @@ typedef struct {
 typedef struct {
     q24_t duty[3];
 } ctrl_legs_t;
+
+/* What a controller's step writes for [k+1, k+2): a switching plan (switching
+ * tables, duty-ratio DTC, predictive control), whose leg duties ctrl_out_legs()
+ * (plan.h) derives, or the leg duties themselves (space-vector modulation),
+ * marked by plan.n_seg == 0. */
+typedef struct {
+    ctrl_plan_t plan;
+    ctrl_legs_t legs;
+} ctrl_out_t;
 
 #endif /* CONTROL_CTRL_TYPES_H */

@@ -9,7 +9,7 @@
  *     (first-order EMA with coefficient p->speed_lpf_k; the default cut-off is
  *     CTRL_SPEED_LPF_HZ_DEFAULT, see ctrl_params.h);
  *   - prediction to k+1 (5.15)/(6.10)-(6.12) with the period-average voltage of
- *     the plan applied during [k, k+1).
+ *     the leg duties applied during [k, k+1).
  * One fx_sincos for the measured angle and one for the predicted angle.
  */
 #ifndef CONTROL_ESTIMATOR_H
@@ -53,9 +53,10 @@ void ctrl_estimator_init(ctrl_estimator_t *e, const ctrl_params_t *p);
 /* Forget the history (speed, previous angle, voltage model), keep the settings. */
 void ctrl_estimator_reset(ctrl_estimator_t *e);
 
-/* Estimate at k and predict k+1. applied may be NULL (treated as a zero vector). */
+/* Estimate at k and predict k+1; applied: the leg duties acting during [k, k+1)
+ * (NULL: a zero vector). */
 void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ctrl_meas_t *m,
-                           const ctrl_plan_t *applied, ctrl_estimate_t *est);
+                           const ctrl_legs_t *applied, ctrl_estimate_t *est);
 
 /* Current model (3.9) for a measured alpha/beta current at angle theta_e with
  * its sin/cos (Q24): fills every field of out. */

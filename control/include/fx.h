@@ -27,6 +27,18 @@ typedef uint32_t fx_angle_t; /* 2^32 = 2*pi rad, wraps modulo one turn */
 #define FX_MAX INT32_MAX
 #define FX_MIN INT32_MIN
 
+/* Irrational constants, round(x * 2^30) (Q30) and round(x * 2^24) (Q24): the
+ * one home of each (transforms, vector tables, rotations). */
+#define FX_Q30_ONE ((int32_t)1 << 30)
+#define FX_Q30_HALF ((int32_t)1 << 29)
+#define FX_Q30_SQRT3_2 929887697   /* sqrt(3)/2 */
+#define FX_Q30_INV_SQRT3 619925131 /* 1/sqrt(3) */
+#define FX_Q30_2_SQRT3 1239850262  /* 2/sqrt(3) */
+#define FX_Q30_2_3 715827883       /* 2/3 */
+#define FX_Q30_1_3 357913941       /* 1/3 */
+#define FX_Q24_HALF ((int32_t)1 << 23)
+#define FX_Q24_SQRT3_2 14529495 /* sqrt(3)/2 */
+
 /* Angle constants (fx_angle_t). */
 #define FX_ANGLE_PI ((fx_angle_t)0x80000000u)
 #define FX_ANGLE_PI_3 ((fx_angle_t)0x2AAAAAABu) /* pi/3 rounded */

@@ -10,8 +10,7 @@
 #include <string.h>
 
 #include "ctrl_params.h"
-
-#define CTRL_PI 3.14159265358979323846
+#include "ctrl_units.h"
 
 /* Plausibility limits of the SI data (CTRL_EINVAL outside): generous, they
  * only catch unit mistakes (mH typed as H, r/min as rad/s, ...). */
@@ -51,6 +50,16 @@ double ctrl_q24_to_double(q24_t x)
     return (double)x / (double)FX_ONE;
 }
 
+int ctrl_q24_from_si(double si, double base, double lo_pu, double hi_pu, q24_t *out)
+{
+    const double pu = si / base;
+    if (out == NULL || !isfinite(pu) || !(pu >= lo_pu) || !(pu <= hi_pu)) {
+        return CTRL_ERANGE;
+    }
+    *out = ctrl_q24_from_double(pu);
+    return CTRL_OK;
+}
+
 static int pos_finite(double x, double lim)
 {
     return isfinite(x) && x > 0.0 && x <= lim;
@@ -69,30 +78,35 @@ int ctrl_params_set_speed_lpf(ctrl_params_t *p, double fc_hz)
         return CTRL_EINVAL;
     }
     /* EMA y += k (x - y): pole exp(-2 pi fc Ts) matched (impulse invariance). */
-    const double k = 1.0 - exp(-2.0 * CTRL_PI * fc_hz / (double)p->fs_hz);
+    const double k = 1.0 - exp(-CTRL_TWO_PI * fc_hz / (double)p->fs_hz);
     p->speed_lpf_k = ctrl_q24_from_double(k);
     return p->speed_lpf_k > 0 ? CTRL_OK : CTRL_EINVAL;
 }
 
-/* Exact MTPA point (pu, Ld = psi_pm = 1, Lq = lq) for current amplitude i:
- * maximise Te = i_q (1 + (1 - lq) i_d) on |i| = i, giving
- * i_d = (1 - sqrt(1 + 8 dL^2 i^2)) / (4 dL), dL = lq - 1 (either sign). */
-static void mtpa_point(double lq, double i, double *te, double *psi)
+/* The one MTPA solver (pu, any Ld, Lq, psi_pm > 0): the current vector of
+ * amplitude i maximising Te = i_q (psi_pm + (Ld - Lq) i_d) (3.10) on |i| = i,
+ *   i_d = (psi_pm - sqrt(psi_pm^2 + 8 dL^2 i^2)) / (4 dL),  dL = Lq - Ld != 0,
+ * i_d = 0 for dL = 0; returns i_d, i_q, Te and |psi_s|. */
+static void mtpa_point(double ld, double lq, double psi_pm, double i, double *id, double *iq,
+                       double *te, double *psi)
 {
-    const double dl = lq - 1.0;
-    const double id = (1.0 - sqrt(1.0 + 8.0 * dl * dl * i * i)) / (4.0 * dl);
-    const double iq = sqrt(fmax(i * i - id * id, 0.0));
-    *te = iq * (1.0 - dl * id);
-    *psi = hypot(1.0 + id, lq * iq);
+    const double dl = lq - ld;
+    *id = dl == 0.0 ? 0.0 : (psi_pm - sqrt(psi_pm * psi_pm + 8.0 * dl * dl * i * i)) / (4.0 * dl);
+    *iq = sqrt(fmax(i * i - *id * *id, 0.0));
+    *te = *iq * (psi_pm - dl * *id);
+    *psi = hypot(psi_pm + ld * *id, lq * *iq);
 }
 
-/* Table psi_s(|T|) at CTRL_MTPA_N + 1 uniform torques up to T(current_max);
- * T(i) is increasing along the MTPA locus, so each point is found by bisection. */
-static int mtpa_table(ctrl_params_t *p, double lq, double i_max)
+/* The MTPA table: psi_s, i_d, i_q at CTRL_MTPA_N + 1 uniform torques up to
+ * T(current_max); T(i) increases along the locus, so each point is found by
+ * bisection on the current amplitude. */
+static int mtpa_table(ctrl_params_t *p, double ld, double lq, double psi_pm, double i_max)
 {
+    double id;
+    double iq;
     double t_max;
     double psi;
-    mtpa_point(lq, i_max, &t_max, &psi);
+    mtpa_point(ld, lq, psi_pm, i_max, &id, &iq, &t_max, &psi);
     if (!fits(t_max) || !(t_max > 0.0) || !fits(psi)) {
         return CTRL_ERANGE;
     }
@@ -100,20 +114,20 @@ static int mtpa_table(ctrl_params_t *p, double lq, double i_max)
         const double t = t_max * (double)k / (double)CTRL_MTPA_N;
         double lo = 0.0;
         double hi = i_max;
+        double tm;
         for (int it = 0; it < 80; it++) {
             const double mid = 0.5 * (lo + hi);
-            double tm;
-            double pm;
-            mtpa_point(lq, mid, &tm, &pm);
+            mtpa_point(ld, lq, psi_pm, mid, &id, &iq, &tm, &psi);
             if (tm < t) {
                 lo = mid;
             } else {
                 hi = mid;
             }
         }
-        double tk;
-        mtpa_point(lq, 0.5 * (lo + hi), &tk, &psi);
+        mtpa_point(ld, lq, psi_pm, 0.5 * (lo + hi), &id, &iq, &tm, &psi);
         p->mtpa_psi[k] = ctrl_q24_from_double(psi);
+        p->mtpa_id[k] = ctrl_q24_from_double(id);
+        p->mtpa_iq[k] = ctrl_q24_from_double(iq);
     }
     const double scale = (double)CTRL_MTPA_N / t_max; /* Q16 */
     if (!(scale * 65536.0 < 2147483647.0)) {
@@ -154,7 +168,7 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     const double ts = 1.0 / ((double)fs_hz * b->t_s);
     const double rs = m->rs_ohm / b->r_ohm;
     const double lq = m->lq_h / b->l_h;
-    const double w_rated = (double)m->pole_pairs * m->speed_rated_rpm * 2.0 * CTRL_PI / 60.0;
+    const double w_rated = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs);
     const double vals[] = {
         ts,
         rs,
@@ -198,7 +212,7 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     p->salient = fabs(lq - 1.0) > 1.0e-6 ? 1u : 0u;
 
     /* Angle per period at 1 pu speed: Ts_pu rad = Ts_pu / (2 pi) turns. */
-    const double k_ang = ts / (2.0 * CTRL_PI) * 4294967296.0;
+    const double k_ang = ts / CTRL_TWO_PI * 4294967296.0;
     p->omega_to_dangle = (int32_t)llround(k_ang);
     /* Inverse: omega_q24 = dtheta * 2^24 / k_ang, coefficient in Q28 (fixed
      * shift: cheap on the target). It must fit an int32_t (Ts_pu >= 0.0031)
@@ -215,18 +229,9 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     }
 
     p->mtpa_k = ctrl_q24_from_double(lq); /* Lq / psi_pm, psi_pm = 1 pu */
-    if (p->salient != 0u) {
-        return mtpa_table(p, lq, vals[8]);
-    }
-    /* SPMSM: table unused; filled with (4.15) for tools that read it. */
-    const double t_max = vals[8]; /* Te = psi_pm i_q = i at MTPA (pu) */
-    for (int k = 0; k <= CTRL_MTPA_N; k++) {
-        const double t = t_max * (double)k / (double)CTRL_MTPA_N;
-        p->mtpa_psi[k] = ctrl_q24_from_double(hypot(1.0, lq * t));
-    }
-    p->mtpa_t_max = ctrl_q24_from_double(t_max);
-    p->mtpa_scale = (int32_t)llround((double)CTRL_MTPA_N / t_max * 65536.0);
-    return CTRL_OK;
+    p->inv_psi_pm = FX_ONE;               /* psi_pm = 1 pu */
+    /* SPMSM: the same table from the closed forms (dL = 0), for tools. */
+    return mtpa_table(p, 1.0, p->salient != 0u ? lq : 1.0, 1.0, vals[8]);
 }
 
 int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m, uint32_t fs_hz)

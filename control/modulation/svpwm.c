@@ -5,15 +5,6 @@
 
 #include "transforms.h"
 
-/* Vector index for a leg mask (bit 0 = leg a, 1 = b, 2 = c), inverse of Table 4.2:
- * 000->V0, 100->V1, 010->V3, 110->V2, 001->V5, 101->V6, 011->V4, 111->V7. */
-static const uint8_t svpwm_vec_of_mask[8] = {0u, 1u, 3u, 2u, 5u, 6u, 4u, 7u};
-
-uint8_t ctrl_svpwm_vec_of_mask(unsigned mask)
-{
-    return svpwm_vec_of_mask[mask & 7u];
-}
-
 /* Phase voltages of (v_alpha, v_beta) and their max and min (inverse Clarke). */
 static void svpwm_phases(q24_t va, q24_t vb, q24_t ph[3], q24_t *mx, q24_t *mn)
 {
@@ -70,58 +61,9 @@ void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs
     }
 }
 
-void ctrl_svpwm_plan_from_legs(const ctrl_legs_t *legs, ctrl_plan_t *out)
-{
-    /* Sort legs by duty: hi >= mid >= lo. */
-    unsigned hi = 0u;
-    unsigned mid = 1u;
-    unsigned lo = 2u;
-    unsigned t;
-    if (legs->duty[mid] > legs->duty[hi]) {
-        t = hi;
-        hi = mid;
-        mid = t;
-    }
-    if (legs->duty[lo] > legs->duty[mid]) {
-        t = mid;
-        mid = lo;
-        lo = t;
-    }
-    if (legs->duty[mid] > legs->duty[hi]) {
-        t = hi;
-        hi = mid;
-        mid = t;
-    }
-    const q24_t d_hi = fx_clamp(legs->duty[hi], 0, FX_ONE);
-    const q24_t d_mid = fx_clamp(legs->duty[mid], 0, d_hi);
-    const q24_t d_lo = fx_clamp(legs->duty[lo], 0, d_mid);
-    const uint8_t v_one = svpwm_vec_of_mask[1u << hi];                 /* one leg high */
-    const uint8_t v_two = svpwm_vec_of_mask[(1u << hi) | (1u << mid)]; /* two legs high */
-    const q24_t t_one = d_hi - d_mid;
-    const q24_t t_two = d_mid - d_lo;
-    out->n_seg = 4u;
-    if (t_one >= t_two) {
-        out->vec[0] = v_one;
-        out->dur[0] = t_one;
-        out->vec[1] = v_two;
-        out->dur[1] = t_two;
-    } else {
-        out->vec[0] = v_two;
-        out->dur[0] = t_two;
-        out->vec[1] = v_one;
-        out->dur[1] = t_one;
-    }
-    out->vec[2] = 0u;
-    out->dur[2] = FX_ONE - d_hi;
-    out->vec[3] = 7u;
-    out->dur[3] = d_lo;
-}
-
-uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_plan_t *out)
+uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs)
 {
     const uint8_t lim = ctrl_svpwm_limit(vdc, v_alpha, v_beta);
-    ctrl_legs_t legs;
-    ctrl_svpwm_duties(*v_alpha, *v_beta, vdc, &legs);
-    ctrl_svpwm_plan_from_legs(&legs, out);
+    ctrl_svpwm_duties(*v_alpha, *v_beta, vdc, legs);
     return lim;
 }

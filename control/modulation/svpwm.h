@@ -5,12 +5,12 @@
  * classical sector/dwell-time SVM with the zero time split equally between V0
  * and V7: with phase voltages v_x of the reference (inverse Clarke, (3.3)),
  *   d_x = 1/2 + (v_x - (max + min) / 2) / Vdc          (leg x duty)
- * The plan lists the same thing as vectors: sorting the legs by duty
- * d_hi >= d_mid >= d_lo gives V7 for d_lo, the two-legs-high active vector for
- * d_mid - d_lo, the one-leg-high active vector for d_hi - d_mid, and V0 for
- * 1 - d_hi, i.e. the two active vectors adjacent to the reference with the
- * dwell times of the sector formulas, and t0/2 for each zero vector. So
- * ctrl_plan_to_legs() of the plan gives back exactly the duties above.
+ As vectors: sorting the legs by duty d_hi >= d_mid >= d_lo gives V7 for
+ * d_lo, the two-legs-high active vector for d_mid - d_lo, the one-leg-high
+ * active vector for d_hi - d_mid and V0 for 1 - d_hi, i.e. the two active
+ * vectors adjacent to the reference with the dwell times of the sector
+ * formulas and t0/2 for each zero vector. The controllers output the duties
+ * (ctrl_out_t with no plan).
  *
  * Over-modulation: the two-level inverter can synthesise v iff
  * max(v_x) - min(v_x) <= Vdc (the hexagon spanned by V1..V6). Outside, v is
@@ -27,10 +27,6 @@
 #include "ctrl_types.h"
 #include "fx.h"
 
-/* Vector index 0..7 of Table 4.2 for the leg states mask (bit 0 = leg a,
- * bit 1 = b, bit 2 = c; 1 = upper switch on); bits above 2 are ignored. */
-uint8_t ctrl_svpwm_vec_of_mask(unsigned mask);
-
 /* Scale (v_alpha, v_beta) onto the voltage hexagon of DC link vdc if it lies
  * outside, keeping its angle. Returns 1 if it was limited, 0 if unchanged.
  * vdc <= 0 (nothing can be synthesised): the vector becomes 0, returns 1. */
@@ -41,13 +37,8 @@ uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
  * first; residual rounding is clamped. vdc <= 0 gives 0, 0, 0 (V0). */
 void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs);
 
-/* Plan realising leg duties as vectors: segment 0 = the active vector with the
- * longer dwell time, segment 1 = the other active vector, segments 2 and 3 =
- * V0 and V7 (durations sum to FX_ONE; zero durations are kept). */
-void ctrl_svpwm_plan_from_legs(const ctrl_legs_t *legs, ctrl_plan_t *out);
-
-/* Limit + duties + plan in one call. Returns the ctrl_svpwm_limit result; the
+/* Limit + duties in one call. Returns the ctrl_svpwm_limit result; the
  * limited reference is written back to *v_alpha, *v_beta. */
-uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_plan_t *out);
+uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs);
 
 #endif /* CONTROL_SVPWM_H */

@@ -1,6 +1,7 @@
 /* Discrete-duty M2PTFC (M2), thesis §6.4.2 with (6.15)-(6.17). Integer only. */
 #include "ctrl_m2.h"
 
+#include "mtpa.h"
 #include "plan.h"
 #include "st_tables.h"
 #include "vectors.h"
@@ -15,20 +16,17 @@ uint8_t ctrl_m2_table(uint8_t sector, int torque_up, int flux_up)
 void ctrl_m2_reset(void *state)
 {
     ctrl_m2_t *s = state;
-    if (s != NULL) {
-        s->trace.n = 0u;
-    }
+    s->trace.n = 0u;
+    s->last_vec = 0u;
 }
 
-void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m2_t *s = state;
     ctrl_mpc_basis_t b;
-    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
-        return;
-    }
+    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref = ctrl_mpc_psi_ref(ctx->params, ctx->ref);
+    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
     const int32_t r2 = ctrl_mpc_ref_amp2(&b, psi_ref);
     const uint8_t vec =
@@ -72,8 +70,9 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
         best = best_flux;
     }
     if (best == 0u) {
-        ctrl_plan_single(out, ctrl_mpc_zero_vector(ctx->applied));
+        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
     } else {
-        ctrl_plan_active_zero(out, vec, s->d_nu[best]);
+        ctrl_plan_active_zero(&out->plan, vec, s->d_nu[best]);
+        s->last_vec = vec;
     }
 }

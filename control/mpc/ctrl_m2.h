@@ -31,6 +31,7 @@ typedef struct {
     q24_t eps_psi; /* Q24 pu */
     uint8_t y;
     q24_t d_nu[CTRL_M2_Y_MAX + 1]; /* nu / y, Q24 */
+    uint8_t last_vec;              /* segment 0 of the last plan (0 after reset) */
     ctrl_mpc_trace_t trace;        /* y + 1 entries: the table vector with D_nu */
 } ctrl_m2_t;
 
@@ -40,6 +41,6 @@ extern const ctrl_desc_t ctrl_desc_m2;
 uint8_t ctrl_m2_table(uint8_t sector, int torque_up, int flux_up);
 
 void ctrl_m2_reset(void *state);
-void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_M2_H */

@@ -20,32 +20,26 @@ static const ctrl_tunable_t m2_tunables[] = {
 
 static void m2_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
+    (void)machine;
     ctrl_m2_cfg_t *c = cfg;
-    if (c == NULL) {
-        return;
-    }
     memset(c, 0, sizeof *c);
     c->eps_psi = 6.60e-3; /* Table 6.2, 750 r/min */
     c->y = 4.0;           /* Table 6.1 */
-    ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 
-static int m2_init(void *state, const void *cfg, const ctrl_params_t *params)
+static int m2_init(void *state, const void *cfg, const ctrl_setup_t *setup)
 {
     ctrl_m2_t *s = state;
     const ctrl_m2_cfg_t *c = cfg;
-    if (s == NULL || c == NULL || params == NULL) {
-        return CTRL_EINVAL;
-    }
     memset(s, 0, sizeof *s);
     if (ctrl_tunables_check(m2_tunables, sizeof m2_tunables / sizeof m2_tunables[0], c) !=
             CTRL_OK ||
         c->y != floor(c->y)) {
         return CTRL_EINVAL;
     }
-    int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    int rc = ctrl_mpc_model_init(&s->model, &c->model, setup);
     if (rc == CTRL_OK) {
-        rc = ctrl_mpc_flux_pu(&c->model, params, c->eps_psi, &s->eps_psi);
+        rc = ctrl_q24_from_si(c->eps_psi, setup->bases->psi_wb, 0.0, 127.0, &s->eps_psi);
     }
     if (rc != CTRL_OK) {
         return rc;
@@ -62,8 +56,7 @@ const ctrl_desc_t ctrl_desc_m2 = {
     .title = "Discrete-duty M2PTFC: D = nu/y (6.15), cost (6.16) with flux band (6.17) "
              "(thesis 6.4.2)",
     .fs_default_hz = 10000u,
-    .state_size = sizeof(ctrl_m2_t),
-    .cfg_size = sizeof(ctrl_m2_cfg_t),
+    CTRL_DESC_SIZES(ctrl_m2_t, ctrl_m2_cfg_t),
     .tunables = m2_tunables,
     .n_tunables = sizeof m2_tunables / sizeof m2_tunables[0],
     .cfg_default = m2_cfg_default,

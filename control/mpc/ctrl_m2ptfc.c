@@ -46,9 +46,6 @@ q24_t ctrl_m2ptfc_t_eval(const ctrl_m2ptfc_t *s, q24_t t1, q24_t t0)
 void ctrl_m2ptfc_reset(void *state)
 {
     ctrl_m2ptfc_t *s = state;
-    if (s == NULL) {
-        return;
-    }
     s->sigma = 0;
     s->trace.n = 0u;
     s->psi2_params = NULL; /* no valid psi_ref^2 cached */
@@ -67,16 +64,9 @@ static int32_t m2ptfc_psi2(ctrl_m2ptfc_t *s, const ctrl_params_t *p, const ctrl_
     return s->psi2;
 }
 
-void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m2ptfc_t *s = state;
-    if (out == NULL) {
-        return;
-    }
-    if (s == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u); /* no voltage (as ctrl_mpc_step_begin) */
-        return;
-    }
     /* Only V1..V3 are rotated: the two candidates are any V_i (ctrl_mpc_vec3_dq). */
     ctrl_mpc_basis3_t b;
     ctrl_mpc_basis3(&s->model, ctx->params, ctx->est, &b);
@@ -126,5 +116,5 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     s->trace.vec[1] = cand[1];
     s->trace.duty[0] = duty[0];
     s->trace.duty[1] = duty[1];
-    ctrl_plan_active_zero(out, cand[best], duty[best]);
+    ctrl_plan_active_zero(&out->plan, cand[best], duty[best]);
 }

@@ -98,6 +98,6 @@ q24_t ctrl_m2ptfc_duty(q24_t num, q24_t den);
 q24_t ctrl_m2ptfc_t_eval(const ctrl_m2ptfc_t *s, q24_t t1, q24_t t0);
 
 void ctrl_m2ptfc_reset(void *state);
-void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_M2PTFC_H */

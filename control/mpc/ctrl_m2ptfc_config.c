@@ -20,29 +20,23 @@ static const ctrl_tunable_t m2ptfc_tunables[] = {
 
 static void m2ptfc_cfg_default(void *cfg, const ctrl_machine_t *machine)
 {
+    (void)machine;
     ctrl_m2ptfc_cfg_t *c = cfg;
-    if (c == NULL) {
-        return;
-    }
     memset(c, 0, sizeof *c);
     c->lambda = 0.03; /* Table 6.2 */
     c->centre = 1.0;  /* plan.h realises plans centre-aligned */
-    ctrl_mpc_model_cfg_default(&c->model, machine);
 }
 
-static int m2ptfc_init(void *state, const void *cfg, const ctrl_params_t *params)
+static int m2ptfc_init(void *state, const void *cfg, const ctrl_setup_t *setup)
 {
     ctrl_m2ptfc_t *s = state;
     const ctrl_m2ptfc_cfg_t *c = cfg;
-    if (s == NULL || c == NULL || params == NULL) {
-        return CTRL_EINVAL;
-    }
     memset(s, 0, sizeof *s);
     if (!isfinite(c->lambda) || !(c->lambda > 0.0) || c->lambda > 1.0 ||
         !(c->centre == 0.0 || c->centre == 1.0)) {
         return CTRL_EINVAL;
     }
-    const int rc = ctrl_mpc_model_init(&s->model, &c->model, params);
+    const int rc = ctrl_mpc_model_init(&s->model, &c->model, setup);
     if (rc != CTRL_OK) {
         return rc;
     }
@@ -56,8 +50,7 @@ const ctrl_desc_t ctrl_desc_m2ptfc = {
     .name = "m2ptfc",
     .title = "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
     .fs_default_hz = 10000u,
-    .state_size = sizeof(ctrl_m2ptfc_t),
-    .cfg_size = sizeof(ctrl_m2ptfc_cfg_t),
+    CTRL_DESC_SIZES(ctrl_m2ptfc_t, ctrl_m2ptfc_cfg_t),
     .tunables = m2ptfc_tunables,
     .n_tunables = sizeof m2ptfc_tunables / sizeof m2ptfc_tunables[0],
     .cfg_default = m2ptfc_cfg_default,

@@ -8,10 +8,6 @@
 #include "predict.h"
 #include "vectors.h"
 
-/* sqrt(3)/2 and 1/2 in Q24 (0.8660254037844386 * 2^24, rounded). */
-#define MPC_SQRT3_2 ((q24_t)14529495)
-#define MPC_HALF ((q24_t)(FX_ONE / 2))
-
 /* Forced inlining of the shared basis core: an out-of-line call costs each
  * step more than it saves in code (measured, tools/bench). */
 #if defined(__GNUC__)
@@ -57,8 +53,8 @@ static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
      * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
      * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
     const q24_t mv = fx_mul_nosat(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
-    const q24_t c1 = fx_dot_nosat(c, s, MPC_HALF, MPC_SQRT3_2);
-    const q24_t s1 = fx_dot_nosat(s, -c, MPC_HALF, MPC_SQRT3_2);
+    const q24_t c1 = fx_dot_nosat(c, s, FX_Q24_HALF, FX_Q24_SQRT3_2);
+    const q24_t s1 = fx_dot_nosat(s, -c, FX_Q24_HALF, FX_Q24_SQRT3_2);
     w[0] = fx_mul_nosat(mv, c);
     w[1] = -fx_mul_nosat(mv, s);
     w[2] = fx_mul_nosat(mv, c1);
@@ -104,37 +100,11 @@ void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ct
     b->wq[2] = w[3] - w[1];
 }
 
-int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_plan_t *out,
-                        ctrl_mpc_basis_t *b)
-{
-    if (out == NULL) {
-        return 0;
-    }
-    if (m == NULL || b == NULL || !ctrl_ctx_ok(ctx)) {
-        ctrl_plan_single(out, 0u); /* no voltage */
-        return 0;
-    }
-    ctrl_mpc_basis(m, ctx->params, ctx->est, b);
-    return 1;
-}
-
 void ctrl_mpc_wreset(void *state)
 {
     ctrl_mpc_wstate_t *s = state;
-    if (s != NULL) {
-        s->trace.n = 0u;
-    }
-}
-
-q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref)
-{
-    if (ref->psi > 0) {
-        return ref->psi;
-    }
-    if (p->psi_ref > 0) {
-        return p->psi_ref;
-    }
-    return ctrl_mtpa_psi(p, ref->torque);
+    s->trace.n = 0u;
+    s->last_vec = 0u;
 }
 
 int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref)
@@ -150,14 +120,6 @@ int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref)
         return ctrl_mpc_amp2(p->psi_pm, fx_mul(fx_abs(ref->torque), p->mtpa_k));
     }
     return ctrl_mpc_amp2(ctrl_mtpa_psi(p, ref->torque), 0); /* table, no square root */
-}
-
-uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied)
-{
-    if (applied == NULL || applied->n_seg == 0u) {
-        return 0u;
-    }
-    return ctrl_zero_after(applied->vec[0]);
 }
 
 q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d)

@@ -29,6 +29,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
+#include "vectors.h"
 
 /* Model constants, computed once from the machine (ctrl_m2ptfc_model_config.c). */
 typedef struct {
@@ -83,20 +84,15 @@ typedef struct {
 typedef struct {
     ctrl_mpc_model_t model;
     q24_t zeta;             /* Q24 pu (T_base / psi_base) */
+    uint8_t last_vec;       /* segment 0 of the last plan (0 after reset) */
     ctrl_mpc_trace_t trace; /* candidates of the last step (see each controller) */
 } ctrl_mpc_wstate_t;
 
 /* ---- per sample (ctrl_m2ptfc_model.c, integer only) ---- */
 
-/* ctrl_desc_t.reset of m1, m3, mptfc (ctrl_mpc_wstate_t): clears the trace;
- * the controllers keep no other dynamic state. NULL is ignored. */
+/* ctrl_desc_t.reset of m1, m3, mptfc (ctrl_mpc_wstate_t): clears the trace
+ * and the last vector; the controllers keep no other dynamic state. */
 void ctrl_mpc_wreset(void *state);
-
-/* Common start of the chapter-6 steps: with valid inputs (m, out non-NULL,
- * ctrl_ctx_ok(ctx)) fills the basis b of this sample and returns 1; else
- * writes the zero-vector plan to out (if any) and returns 0. */
-int ctrl_mpc_step_begin(const ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_plan_t *out,
-                        ctrl_mpc_basis_t *b);
 
 /* Basis for the candidates of this sample from the k+1 state of est. */
 void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
@@ -107,20 +103,23 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
 void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
                      ctrl_mpc_basis3_t *b);
 
-/* Stator-flux amplitude reference: ref->psi if > 0, else the machine's fixed
- * reference p->psi_ref if > 0, else MTPA of the torque reference (4.15). */
-q24_t ctrl_mpc_psi_ref(const ctrl_params_t *p, const ctrl_refs_t *ref);
-
-/* The same reference squared, in ctrl_mpc_amp2 units (Q24 pu^2), for the
- * amplitude comparisons on squares: for the SPMSM MTPA, (4.15) squared,
+/* The flux reference ctrl_flux_ref (mtpa.h) of the torque reference, squared, in ctrl_mpc_amp2
+ * units (Q24 pu^2), for the amplitude comparisons on squares: for the SPMSM MTPA, (4.15) squared,
  * psi_pm^2 + (Lq T / psi_pm)^2, needs no square root (saves 69 of the
  * m2ptfc step's 697 Cortex-M4 instructions, tests/mpc/bench_mpc_qemu.c); the
  * other cases square the amplitude. */
 int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref);
 
-/* Zero vector for a whole period: the one that switches one leg from the end
- * state of the applied plan (V0 after V0/V1/V3/V5, V7 after V7/V2/V4/V6). */
-uint8_t ctrl_mpc_zero_vector(const ctrl_plan_t *applied);
+/* A zero vector for the whole period after a plan whose segment 0 was
+ * last_vec (the one that switches one leg), recorded as the new last vector. */
+static inline void ctrl_mpc_plan_zero(ctrl_plan_t *out, uint8_t *last_vec)
+{
+    const uint8_t z = *last_vec <= 7u ? ctrl_vec_zero_after[*last_vec] : 0u;
+    out->n_seg = 1u;
+    out->vec[0] = z;
+    out->dur[0] = FX_ONE;
+    *last_vec = z;
+}
 
 /* n / d as a Q24 fraction for 0 <= n <= d, d > 0, rounded (<= FX_ONE). Three
  * 32-bit divisions (one UDIV each on a Cortex-M4), no 64-bit division. */

@@ -14,13 +14,10 @@
 #include "ctrl_params.h"
 #include "fx.h"
 
-/* SI overrides of the prediction model (0 = the machine's value) and the
- * machine data needed to convert SI tunables to per unit. Part of each MPC
- * controller's configuration struct; filled by ctrl_mpc_model_cfg_default(). */
+/* SI overrides of the prediction model (0 = the machine's value). Part of
+ * each MPC controller's configuration struct. */
 typedef struct {
     double rs_ohm, ld_h, lq_h, psi_pm_wb; /* tunables "rs_model" ... (0 = machine) */
-    /* Copied from the machine (not tunables): */
-    double m_rs_ohm, m_ld_h, m_lq_h, m_psi_pm_wb, m_torque_rated_nm;
 } ctrl_mpc_model_cfg_t;
 
 /* Configuration shared by the weighted-cost controllers m1, m3 and
@@ -39,9 +36,9 @@ typedef struct {
 void ctrl_mpc_wcfg_default(void *cfg, const ctrl_machine_t *machine);
 
 /* ctrl_desc_t.init of m1, m3, mptfc: model constants and zeta in pu; state
- * is a ctrl_mpc_wstate_t, cfg a ctrl_mpc_wcfg_t. CTRL_OK, CTRL_EINVAL (NULL,
- * zeta < 0 or not finite, bad model) or CTRL_ERANGE. */
-int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_params_t *params);
+ * is a ctrl_mpc_wstate_t, cfg a ctrl_mpc_wcfg_t. CTRL_OK, CTRL_EINVAL
+ * (zeta < 0 or not finite, bad model) or CTRL_ERANGE. */
+int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_setup_t *setup);
 
 /* Tunable-table entries of the model overrides, for a cfg struct T with a
  * member "model" (expanded only in *_config.c files). */
@@ -59,22 +56,16 @@ int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_params_t *params);
      offsetof(T, model.psi_pm_wb), 0.0, CTRL_MPC_LPSI_MODEL_MAX}
 /* clang-format on */
 
-/* Copy the machine data into c, overrides off. */
-void ctrl_mpc_model_cfg_default(ctrl_mpc_model_cfg_t *c, const ctrl_machine_t *machine);
-
-/* Model constants for params (with the overrides of c). CTRL_OK, CTRL_EINVAL
- * (NULL, an override negative, not finite or above its tunable's maximum) or
- * CTRL_ERANGE (model outside the CTRL_MPC_* limits of ctrl_m2ptfc_model.h). */
+/* Model constants for the setup (with the overrides of c). CTRL_OK,
+ * CTRL_EINVAL (an override negative, not finite or above its tunable's
+ * maximum) or CTRL_ERANGE (model outside the CTRL_MPC_* limits of
+ * ctrl_m2ptfc_model.h). */
 int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
-                        const ctrl_params_t *params);
+                        const ctrl_setup_t *setup);
 
 /* A torque per flux weight zeta (N*m/Wb) of (6.13) in pu (Q24); zeta == 0 gives
- * the equal-importance value T_rated / psi_pm (§6.5). CTRL_OK or CTRL_EINVAL. */
-int ctrl_mpc_zeta_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double zeta,
-                     q24_t *out);
-
-/* A flux (Wb) in pu (Q24). CTRL_OK or CTRL_EINVAL. */
-int ctrl_mpc_flux_pu(const ctrl_mpc_model_cfg_t *c, const ctrl_params_t *params, double wb,
-                     q24_t *out);
+ * the equal-importance value T_rated / psi_pm (§6.5). CTRL_OK, CTRL_EINVAL or
+ * CTRL_ERANGE. */
+int ctrl_mpc_zeta_pu(const ctrl_setup_t *setup, double zeta, q24_t *out);
 
 #endif /* CONTROL_CTRL_M2PTFC_MODEL_CONFIG_H */

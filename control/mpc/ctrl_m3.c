@@ -1,19 +1,19 @@
 /* Three-candidate M2PTFC (M3), thesis §6.4.2 with (6.1), (5.18), (6.13). Integer only. */
 #include "ctrl_m3.h"
 
+#include "mtpa.h"
 #include "plan.h"
 #include "vectors.h"
 
-void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m3_t *s = state;
     ctrl_mpc_basis_t b;
-    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
-        return;
-    }
+    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
     const ctrl_mstate_t *n = &ctx->est->next;
-    const q24_t psi_ref = ctrl_mpc_ref_amp(&b, ctrl_mpc_psi_ref(ctx->params, ctx->ref));
+    const q24_t psi_ref =
+        ctrl_mpc_ref_amp(&b, ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque));
 
     /* (6.1) by the sign of the torque error. */
     const int x = (int)n->sector;
@@ -50,8 +50,9 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
     s->trace.duty[2] = 0;
     s->trace.n = 3u;
     if (g0 < best_g) {
-        ctrl_plan_single(out, ctrl_mpc_zero_vector(ctx->applied));
+        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
     } else {
-        ctrl_plan_active_zero(out, cand[best], duty[best]);
+        ctrl_plan_active_zero(&out->plan, cand[best], duty[best]);
+        s->last_vec = cand[best];
     }
 }

@@ -38,6 +38,6 @@ typedef ctrl_mpc_wstate_t ctrl_m3_t;
 
 extern const ctrl_desc_t ctrl_desc_m3;
 
-void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_M3_H */

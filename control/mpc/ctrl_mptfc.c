@@ -1,17 +1,17 @@
 /* FS-MPTFC, thesis §6.4.1 with (6.13). Integer only. */
 #include "ctrl_mptfc.h"
 
+#include "mtpa.h"
 #include "plan.h"
 
-void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_mptfc_t *s = state;
     ctrl_mpc_basis_t b;
-    if (!ctrl_mpc_step_begin(s != NULL ? &s->model : NULL, ctx, out, &b)) {
-        return;
-    }
+    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref = ctrl_mpc_ref_amp(&b, ctrl_mpc_psi_ref(ctx->params, ctx->ref));
+    const q24_t psi_ref =
+        ctrl_mpc_ref_amp(&b, ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque));
 
     /* Zero vector (V0 = V7): duty 0 of any active vector. */
     int64_t best_g = ctrl_mpc_cost_weighted(&s->model, &b, 0, 0, 0, t_ref, psi_ref, s->zeta);
@@ -32,5 +32,10 @@ void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
         }
     }
     s->trace.n = 7u;
-    ctrl_plan_single(out, best_v == 0u ? ctrl_mpc_zero_vector(ctx->applied) : best_v);
+    if (best_v == 0u) {
+        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
+    } else {
+        ctrl_plan_single(&out->plan, best_v);
+        s->last_vec = best_v;
+    }
 }

@@ -25,6 +25,6 @@ typedef ctrl_mpc_wstate_t ctrl_mptfc_t;
 
 extern const ctrl_desc_t ctrl_desc_mptfc;
 
-void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out);
+void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 
 #endif /* CONTROL_CTRL_MPTFC_H */

@@ -1,34 +1,17 @@
-/* The list of controllers selectable by name. Add one line per controller. */
+/* The list of controllers selectable by name, chosen at build time: the CMake
+ * list PMSM_CONTROLLERS (or pmsm_controller_registry(<lib> names...)) becomes
+ * ctrl_registry_list.h, CTRL_REGISTRY_LIST(X) = X(bst) X(fst) ... Only the
+ * listed controllers' objects are linked. */
 #include <string.h>
 
 #include "controller.h"
+#include "ctrl_registry_list.h"
 
-/* Descriptors are defined in each controller's own file. */
-/* CONTROLLER-DECLARATIONS (keep sorted by chapter) */
-/* chapter 4: switching-table DTC (st_dtc.h) */
-extern const ctrl_desc_t ctrl_desc_bst, ctrl_desc_mbst, ctrl_desc_ast, ctrl_desc_zst, ctrl_desc_fst;
-/* chapter 5: duty-ratio-regulated DTC and its baselines (ctrl_drr.h) */
-extern const ctrl_desc_t ctrl_desc_drr, ctrl_desc_drr_d1, ctrl_desc_drr_d2, ctrl_desc_drr_pi,
-    ctrl_desc_drr_df;
-/* chapter 6: M2PTFC and its baselines (ctrl_m2ptfc.h, ctrl_m1.h, ctrl_mptfc.h, ctrl_m3.h,
- * ctrl_m2.h) */
-extern const ctrl_desc_t ctrl_desc_m2ptfc, ctrl_desc_m1, ctrl_desc_mptfc, ctrl_desc_m3,
-    ctrl_desc_m2;
-/* chapter S1: FOC, HDTC, SVM-DTC, HP-DTC (ctrl_foc.h, ctrl_s1_dtc.h) */
-extern const ctrl_desc_t ctrl_desc_foc, ctrl_desc_foc_hyst, ctrl_desc_hdtc, ctrl_desc_svm_dtc,
-    ctrl_desc_hpdtc;
+#define CTRL_REGISTRY_DECLARE(n) extern const ctrl_desc_t ctrl_desc_##n;
+CTRL_REGISTRY_LIST(CTRL_REGISTRY_DECLARE)
 
-/* One entry per line, grouped by chapter; keep clang-format from packing it. */
-/* clang-format off */
-static const ctrl_desc_t *const registry[] = {
-    /* CONTROLLER-ENTRIES */
-    &ctrl_desc_bst, &ctrl_desc_mbst, &ctrl_desc_ast, &ctrl_desc_zst, &ctrl_desc_fst,
-    &ctrl_desc_drr, &ctrl_desc_drr_d1, &ctrl_desc_drr_d2, &ctrl_desc_drr_pi, &ctrl_desc_drr_df,
-    &ctrl_desc_m2ptfc, &ctrl_desc_m1, &ctrl_desc_mptfc, &ctrl_desc_m3, &ctrl_desc_m2,
-    &ctrl_desc_foc, &ctrl_desc_foc_hyst, &ctrl_desc_hdtc, &ctrl_desc_svm_dtc, &ctrl_desc_hpdtc,
-    NULL,
-};
-/* clang-format on */
+#define CTRL_REGISTRY_ENTRY(n) &ctrl_desc_##n,
+static const ctrl_desc_t *const registry[] = {CTRL_REGISTRY_LIST(CTRL_REGISTRY_ENTRY) NULL};
 
 size_t ctrl_count(void)
 {

@@ -1,7 +1,7 @@
 /* The PWM-period interrupt (order and Q formats in pipeline.h). Integer-only. */
 #include "pipeline.h"
 
-#include "legs_fast.h"
+#include "fw_pwm.h"
 #include "plan.h"
 
 /* Plausible ADC offset: within 1/16 of full scale from mid-scale. */
@@ -19,7 +19,7 @@ static void fw_pwm_off(fw_t *fw)
     const hal_pwm_t off = {{0u, 0u, 0u}};
     hal_gate_enable(fw->hal, false);
     hal_pwm_write(fw->hal, &off);
-    ctrl_plan_single(&fw->applied, 0u);
+    fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
     fw->tm.legs[0] = fw->tm.legs[1] = fw->tm.legs[2] = 0;
 }
 
@@ -37,17 +37,6 @@ static inline q24_t fw_current_pu(uint16_t raw, int32_t off_q8, int32_t gain_q30
 static inline q24_t fw_vdc_pu(uint16_t raw, int32_t gain_q30)
 {
     return fx_round_sat((int64_t)(int32_t)raw * gain_q30, 6u);
-}
-
-/* Leg duties of a plan fw_legs_fast does not take (n_seg 0 or above 4, an
- * on-time outside [0, FX_ONE]); plan.h: each in [0, FX_ONE], clamped here as
- * well since the compare values rely on it. */
-static void fw_legs_general(const ctrl_plan_t *p, ctrl_legs_t *legs)
-{
-    ctrl_plan_to_legs(p, legs);
-    for (int x = 0; x < 3; x++) {
-        legs->duty[x] = fx_clamp(legs->duty[x], 0, FX_ONE);
-    }
 }
 
 static void fw_calibrate(fw_t *fw, const hal_adc_raw_t *raw)
@@ -192,7 +181,7 @@ static void fw_apply_commands(fw_t *fw)
             ctrl_speed_pi_reset(&fw->speed_pi, 0);
             fw->speed_tref = 0;
             fw->speed_cnt = 0u;
-            ctrl_plan_single(&fw->applied, 0u);
+            fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
             hal_gate_enable(fw->hal, true);
         }
     }
@@ -202,7 +191,7 @@ static void fw_apply_commands(fw_t *fw)
  * the gates go off before anything else is computed. Returns the fault or 0. */
 static inline uint32_t fw_protect_fast(fw_t *fw, hal_t *hal, q24_t i_a, q24_t i_b)
 {
-    uint32_t f = fw_protect_current_fast(&fw->prot, i_a, i_b);
+    uint32_t f = fw_protect_current(&fw->prot, i_a, i_b);
     if (f == FW_FAULT_NONE && hal_trip_active(hal)) {
         f = FW_FAULT_HW_TRIP;
     }
@@ -216,9 +205,9 @@ static inline uint32_t fw_protect_fast(fw_t *fw, hal_t *hal, q24_t i_a, q24_t i_
  * returns the first fault or 0. */
 static inline uint32_t fw_protect_slow(fw_t *fw, q24_t vdc, uint32_t enc_count)
 {
-    uint32_t f = fw_protect_vdc_fast(&fw->prot, vdc);
+    uint32_t f = fw_protect_vdc(&fw->prot, vdc);
     if (f == FW_FAULT_NONE) {
-        f = fw_protect_encoder_fast(&fw->prot, enc_count);
+        f = fw_protect_encoder(&fw->prot, enc_count);
     }
     return f;
 }
@@ -256,7 +245,7 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, const ctrl_legs_t *legs)
 static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
 {
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, &fw->estimate);
-    if (fw_protect_overspeed_fast(&fw->prot, fw->estimate.omega_e) != FW_FAULT_NONE) {
+    if (fw_protect_overspeed(&fw->prot, fw->estimate.omega_e) != FW_FAULT_NONE) {
         fw_fault_now(fw, FW_FAULT_OVERSPEED);
         fw->tm.vec = 0u;
         fw->tm.duty = 0;
@@ -282,27 +271,19 @@ static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
     fw->refs.torque = tref;
     fw->refs.psi = 0;
 
-    const ctrl_ctx_t ctx = {&fw->params, &fw->estimate, &fw->refs, &fw->applied};
-    /* Pre-set to the zero vector for the whole period (ctrl_plan_single(0)). */
-    ctrl_plan_t next = {1u, {0u, 0u, 0u, 0u}, {FX_ONE, 0, 0, 0}};
-    fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &next);
-
-    /* Separate variables for the two forms keep the fast one in registers. */
-    ctrl_legs_t legs;
-    if (fw_legs_fast(&next, &legs)) {
-        fw_pwm_out(fw, hal, &legs);
-        fw->tm.vec = next.vec[0]; /* n_seg >= 1 */
-        fw->tm.duty = next.dur[0];
-    } else {
-        ctrl_legs_t legs_g;
-        fw_legs_general(&next, &legs_g);
-        fw_pwm_out(fw, hal, &legs_g);
-        fw->tm.vec = next.n_seg > 0u ? next.vec[0] : 0u;
-        fw->tm.duty = next.n_seg > 0u ? next.dur[0] : 0;
-    }
-    /* The plan written now acts during [k+1, k+2): it is "applied" for the
-     * estimator's prediction at k+1. */
-    fw->applied = next;
+    const ctrl_ctx_t ctx = {&fw->params, &fw->estimate, &fw->refs};
+    /* The descriptor and its state were validated when it was installed
+     * (fw_select_controller): its step is called directly. */
+    ctrl_out_t out;
+    ctrl_plan_single(&out.plan, 0u); /* V0 unless the step writes its output */
+    fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &out);
+    ctrl_out_legs(&out);
+    fw_pwm_out(fw, hal, &out.legs);
+    fw->tm.vec = out.plan.n_seg > 0u ? out.plan.vec[0] : 0u;
+    fw->tm.duty = out.plan.n_seg > 0u ? out.plan.dur[0] : 0;
+    /* The duties written now act during [k+1, k+2): they are "applied" for
+     * the estimator's prediction at k+1. */
+    fw->applied = out.legs;
     fw->tm.psi_amp = fw->estimate.now.psi_amp;
     fw->tm.torque = fw->estimate.now.torque;
     fw->tm.omega_e = fw->estimate.omega_e;
@@ -397,7 +378,7 @@ void fw_isr(fw_t *fw)
         fw_period_idle(fw, &raw, &enc);
     }
 
-    const uint32_t wf = fw_protect_watchdog_tick_fast(&fw->prot);
+    const uint32_t wf = fw_protect_watchdog_tick(&fw->prot);
     if (wf != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, wf);
     }
@@ -410,7 +391,7 @@ void fw_isr(fw_t *fw)
     /* Deadline: duration of this ISR against the period's cycle budget. */
     const uint32_t elapsed = hal_cycles(hal) - t0;
     fw->tm.cycles = elapsed;
-    const uint32_t df = fw_protect_deadline_fast(&fw->prot, elapsed);
+    const uint32_t df = fw_protect_deadline(&fw->prot, elapsed);
     if (df != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, df);
         fw->tm.state = (uint8_t)fw->sm.state;

@@ -11,9 +11,9 @@
  *   ctrl_estimator_update                   estimate at k, predict k+1 with
  *                                           the plan acting in [k, k+1)
  *   speed PI (speed mode) -> torque reference
- *   desc->step                              plan for [k+1, k+2)
- *   plan -> leg duties (legs_fast.h: one or two segments; else
- *   ctrl_plan_to_legs) -> compare values -> hal_pwm_write (effective at k+1)
+ *   desc->step                              plan or leg duties for [k+1, k+2)
+ *   plan -> leg duties (ctrl_out_legs, plan.h) -> compare values ->
+ *   hal_pwm_write (effective at k+1)
  *   telemetry sample
  *   deadline check (hal_cycles against the period budget)
  *
@@ -137,7 +137,7 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
-    ctrl_plan_t applied; /* acting in [k, k+1): chosen at k-1 (or zero vector) */
+    ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
     ctrl_refs_t refs;
     ctrl_speed_pi_t speed_pi;
     fw_ref_mode_t ref_mode;

@@ -5,12 +5,12 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "pipeline.h"
 #include "plan.h"
 #include "speed_loop.h"
 #include "speed_pi_config.h"
 
-#define FW_PI 3.14159265358979323846
 #define FW_CALIB_DEFAULT 256u
 
 void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl)
@@ -137,7 +137,9 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
                           fw->speed_info.overspeed_rpm) != CTRL_OK) {
         return FW_EINVAL;
     }
-    fw_protect_init(&fw->prot, &pc);
+    if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
+        return FW_ERANGE;
+    }
 
     /* Speed loop rate: fs / speed_div, speed_div >= 1 rounded to the nearest. */
     const uint32_t loop_hz = cfg->speed_loop_hz == 0u || cfg->speed_loop_hz > in->pwm_freq_hz
@@ -179,7 +181,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
     fw->torque_ref_min = fx_neg(fw->torque_ref_max);
     fw->ref_mode = FW_REF_TORQUE;
-    ctrl_plan_single(&fw->applied, 0u);
+    memset(&fw->applied, 0, sizeof fw->applied);
     fw_state_init(&fw->sm);
     return FW_OK;
 }
@@ -192,7 +194,8 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
         unsigned char bytes[CTRL_STATE_MAX];
     } st;
     memset(&st, 0, sizeof st);
-    if (d->init(st.bytes, cfg, &fw->params) != CTRL_OK) {
+    const ctrl_setup_t setup = {fw->machine, &fw->bases, &fw->params};
+    if (ctrl_init(d, st.bytes, cfg, &setup) != CTRL_OK) {
         return FW_ECTRL;
     }
     d->reset(st.bytes);
@@ -272,7 +275,7 @@ void fw_set_torque_ref_nm(fw_t *fw, double nm)
 void fw_set_speed_ref_rpm(fw_t *fw, double rpm)
 {
     if (fw != NULL && isfinite(rpm)) {
-        const double we = rpm * 2.0 * FW_PI / 60.0 * (double)fw->params.pole_pairs;
+        const double we = ctrl_rpm_to_elec(rpm, fw->params.pole_pairs);
         fw_set_speed_ref(fw, ctrl_q24_from_double(we / fw->bases.w_rad_s));
     }
 }

@@ -1,4 +1,5 @@
-/* Drive protections (criteria in protect.h). Integer-only: per period. */
+/* Drive protections (criteria and the inline checks in protect.h): names,
+ * set-up and the rare encoder paths. Integer-only. */
 #include "protect.h"
 
 #include <stddef.h>
@@ -13,22 +14,21 @@ const char *fw_fault_name(uint32_t code)
     return code < (uint32_t)FW_FAULT_COUNT ? names[code] : "unknown";
 }
 
-void fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg)
+int fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg)
 {
-    if (p == NULL || cfg == NULL) {
-        return;
+    if (p == NULL || cfg == NULL || cfg->i_max < 0 || cfg->i_max > FW_PROTECT_I_MAX_LIM) {
+        return CTRL_EINVAL;
     }
     p->cfg = *cfg;
     /* Constants of the unsigned compares (fw_protect_t). */
-    const q24_t lim = cfg->i_max;
-    p->i_fast = lim >= 0 && lim <= ((q24_t)1 << 30) ? 1u : 0u;
-    p->i_off = p->i_fast != 0u ? (uint32_t)lim : (lim < 0 ? 1u : 0u);
-    p->i_span = p->i_fast != 0u ? 2u * (uint32_t)lim : 0u;
+    p->i_off = (uint32_t)cfg->i_max;
+    p->i_span = 2u * (uint32_t)cfg->i_max;
     p->j_off = cfg->enc_jump_max >= 0 ? (uint32_t)cfg->enc_jump_max : 0u;
     p->j_span = 2u * p->j_off;
     p->deadline_lim = cfg->deadline_cycles != 0u ? cfg->deadline_cycles : UINT32_MAX;
     p->wdg_lim = cfg->wdg_periods != 0u ? cfg->wdg_periods : UINT32_MAX;
     fw_protect_reset(p);
+    return CTRL_OK;
 }
 
 void fw_protect_reset(fw_protect_t *p)
@@ -43,22 +43,6 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_move_still = 0u;
     p->enc_primed = 0u;
     p->wdg_count = 0u;
-}
-
-uint32_t fw_protect_current(const fw_protect_t *p, q24_t i_a, q24_t i_b)
-{
-    /* i_c = -(i_a + i_b): the third phase is checked from the other two. */
-    const q24_t i_c = fx_neg(fx_add(i_a, i_b));
-    const q24_t lim = p->cfg.i_max;
-    if (fx_abs(i_a) > lim || fx_abs(i_b) > lim || fx_abs(i_c) > lim) {
-        return FW_FAULT_OVERCURRENT;
-    }
-    return FW_FAULT_NONE;
-}
-
-uint32_t fw_protect_vdc(const fw_protect_t *p, q24_t vdc)
-{
-    return fw_protect_vdc_fast(p, vdc);
 }
 
 uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
@@ -78,21 +62,6 @@ uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
         return FW_FAULT_NONE;
     }
     return fw_protect_encoder_check(p, count);
-}
-
-uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count)
-{
-    return fw_protect_encoder_fast(p, count);
-}
-
-uint32_t fw_protect_deadline(const fw_protect_t *p, uint32_t elapsed_cycles)
-{
-    return fw_protect_deadline_fast(p, elapsed_cycles);
-}
-
-uint32_t fw_protect_watchdog_tick(fw_protect_t *p)
-{
-    return fw_protect_watchdog_tick_fast(p);
 }
 
 void fw_protect_watchdog_kick(fw_protect_t *p)

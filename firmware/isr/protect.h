@@ -1,7 +1,9 @@
 /*
- * Drive protections. Each check is a small integer-only function the
+ * Drive protections. Each check is a small integer-only inline function the
  * pipeline calls in a fixed order every PWM period; each returns 0 or a fault
  * code (FW_FAULT_*), which the pipeline latches through the state machine.
+ * The straightforward forms they are checked against (saturating |i| > i_max,
+ * the per-move Q16.16 encoder rate) live in tests/loop/test_fw_fast.c.
  *
  * Criteria (thresholds derived from the machine in protect_config.c):
  *  - over-current: |i_a|, |i_b| or |i_c| > i_max (machine current_max_a). The
@@ -84,8 +86,7 @@ typedef struct {
      * 0 <= lim <= INT32_MAX, x + lim lies in [0, 2 lim] exactly when |x| <= lim,
      * in (2 lim, 2^32) when x > lim and, wrapped, in [2^31 + lim, 2^32) when
      * x < -lim. */
-    uint32_t i_off, i_span; /* i_max (i_fast: 0 <= i_max <= 2^30), see below */
-    uint8_t i_fast;
+    uint32_t i_off, i_span; /* i_max, 0 <= i_max <= FW_PROTECT_I_MAX_LIM */
     uint32_t j_off, j_span; /* enc_jump_max (enc_primed 2 only when it is >= 0) */
     uint32_t enc_last;      /* counter at the previous period */
     int32_t enc_last_delta; /* counts moved in the previous period */
@@ -114,50 +115,45 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
                       uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
                       double overspeed_rpm);
 
+/* Largest trip level the current check takes (64 pu): then i_c = -(i_a + i_b)
+ * of two in-range phases stays below 2^31 and one unsigned compare decides. */
+#define FW_PROTECT_I_MAX_LIM ((q24_t)1 << 30)
+
 /* Copies cfg and derives the constants of the checks from it: change the
- * configuration only through fw_protect_init. */
-void fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg);
+ * configuration only through fw_protect_init. CTRL_OK, or CTRL_EINVAL (p
+ * unchanged) for i_max outside [0, FW_PROTECT_I_MAX_LIM]. */
+int fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg);
 /* Forget the encoder history (on arm) and the watchdog count. */
 void fw_protect_reset(fw_protect_t *p);
 
-uint32_t fw_protect_current(const fw_protect_t *p, q24_t i_a, q24_t i_b);
-uint32_t fw_protect_vdc(const fw_protect_t *p, q24_t vdc);
-uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count);
-uint32_t fw_protect_deadline(const fw_protect_t *p, uint32_t elapsed_cycles);
-/* Called once per period; returns FW_FAULT_WATCHDOG when the kick is overdue. */
-uint32_t fw_protect_watchdog_tick(fw_protect_t *p);
 void fw_protect_watchdog_kick(fw_protect_t *p);
 
-/* ---- The same checks inlined into the interrupt, with identical results for
- * every input (tests/loop/test_fw_fast.c): the functions above call them,
- * except fw_protect_current, the saturating form they are checked against. */
+/* ---- The checks, inlined into the interrupt. ---- */
 
 /* fw_protect_encoder while the counter history is incomplete, or with a
  * negative enc_jump_max (enc_primed != 2; protect.c). */
 uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count);
 
 /*
- * fw_protect_current with the unsigned compare of fw_protect_t, exact for
- * 0 <= i_max <= 2^30. i_c = -(i_a + i_b) is tested only when |i_a|, |i_b| <=
- * i_max: then |i_a + i_b| <= 2^31 and the compare is exact for it too
- * (3 i_max < 2^32); fx_add's saturation at 2^31 gives the same verdict. For
- * any other i_max the constants make (nearly) every input a candidate that the
- * saturating form decides: off = span = 0 (i_max > 2^30: all but
- * i_a = i_b = 0, which does not trip) or off = 1, span = 0 (i_max < 0: all).
+ * Over-current: |i_a|, |i_b| or |i_c| = |i_a + i_b| > i_max with the unsigned
+ * compare of fw_protect_t (0 <= i_max <= 2^30). i_c is decided only when
+ * |i_a|, |i_b| <= i_max: then |i_a + i_b| <= 2^31 and the compare is exact
+ * for it too (3 i_max < 2^32); when i_a or i_b already trips, the third term
+ * does not matter.
  */
-static inline uint32_t fw_protect_current_fast(const fw_protect_t *p, q24_t i_a, q24_t i_b)
+static inline uint32_t fw_protect_current(const fw_protect_t *p, q24_t i_a, q24_t i_b)
 {
     const uint32_t off = p->i_off;
     const uint32_t span = p->i_span;
     const uint32_t a = (uint32_t)i_a;
     const uint32_t b = (uint32_t)i_b;
     if (a + off > span || b + off > span || a + b + off > span) {
-        return p->i_fast != 0u ? FW_FAULT_OVERCURRENT : fw_protect_current(p, i_a, i_b);
+        return FW_FAULT_OVERCURRENT;
     }
     return FW_FAULT_NONE;
 }
 
-static inline uint32_t fw_protect_vdc_fast(const fw_protect_t *p, q24_t vdc)
+static inline uint32_t fw_protect_vdc(const fw_protect_t *p, q24_t vdc)
 {
     if (vdc > p->cfg.vdc_max) {
         return FW_FAULT_DC_OVERVOLT;
@@ -232,7 +228,7 @@ static inline uint32_t fw_protect_encoder_check(fw_protect_t *p, uint32_t count)
     return fault;
 }
 
-static inline uint32_t fw_protect_encoder_fast(fw_protect_t *p, uint32_t count)
+static inline uint32_t fw_protect_encoder(fw_protect_t *p, uint32_t count)
 {
     if (p->enc_primed != 2u) {
         return fw_protect_encoder_prime(p, count); /* 0, 1, or 3 */
@@ -240,7 +236,7 @@ static inline uint32_t fw_protect_encoder_fast(fw_protect_t *p, uint32_t count)
     return fw_protect_encoder_check(p, count);
 }
 
-static inline uint32_t fw_protect_deadline_fast(const fw_protect_t *p, uint32_t elapsed_cycles)
+static inline uint32_t fw_protect_deadline(const fw_protect_t *p, uint32_t elapsed_cycles)
 {
     if (elapsed_cycles > p->deadline_lim) {
         return FW_FAULT_DEADLINE;
@@ -250,7 +246,7 @@ static inline uint32_t fw_protect_deadline_fast(const fw_protect_t *p, uint32_t 
 
 /* |omega_e| > omega_max, as an unsigned compare (exact for 0 <= omega_max <
  * 2^31: omega + omega_max in [0, 2 omega_max] exactly when |omega| is within). */
-static inline uint32_t fw_protect_overspeed_fast(const fw_protect_t *p, q24_t omega_e)
+static inline uint32_t fw_protect_overspeed(const fw_protect_t *p, q24_t omega_e)
 {
     const uint32_t lim = (uint32_t)p->cfg.omega_max;
     if ((uint32_t)omega_e + lim > 2u * lim) {
@@ -259,7 +255,7 @@ static inline uint32_t fw_protect_overspeed_fast(const fw_protect_t *p, q24_t om
     return FW_FAULT_NONE;
 }
 
-static inline uint32_t fw_protect_watchdog_tick_fast(fw_protect_t *p)
+static inline uint32_t fw_protect_watchdog_tick(fw_protect_t *p)
 {
     if (p->wdg_count < UINT32_MAX) {
         p->wdg_count++;

@@ -5,9 +5,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "ctrl_units.h"
 #include "protect.h"
-
-#define FW_PI 3.14159265358979323846
 
 /* DC-link window around the nominal voltage. */
 #define FW_VDC_MAX_REL 1.25
@@ -37,7 +36,10 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
     }
     cfg->omega_max = ctrl_q24_from_double(w_max_pu);
     const double fs = (double)fs_hz;
-    cfg->i_max = ctrl_q24_from_double(m->current_max_a / b->i_a);
+    if (ctrl_q24_from_si(m->current_max_a, b->i_a, 0.0, ctrl_q24_to_double(FW_PROTECT_I_MAX_LIM),
+                         &cfg->i_max) != CTRL_OK) {
+        return CTRL_ERANGE; /* the trip level must fit the check (protect.h) */
+    }
     cfg->vdc_max = ctrl_q24_from_double(FW_VDC_MAX_REL * m->vdc_v / b->v_v);
     cfg->vdc_min = ctrl_q24_from_double(FW_VDC_MIN_REL * m->vdc_v / b->v_v);
 
@@ -46,7 +48,7 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
     const double t_imax =
         1.5 * (double)m->pole_pairs * (m->psi_pm_wb + dl * m->current_max_a) * m->current_max_a;
     const double a_mech = (t_imax + m->torque_rated_nm) / m->inertia_kgm2; /* rad/s^2 */
-    const double a_cpp2 = a_mech * (double)enc_counts_per_rev / (2.0 * FW_PI) / (fs * fs);
+    const double a_cpp2 = a_mech * (double)enc_counts_per_rev / CTRL_TWO_PI / (fs * fs);
     /* Quantisation moves each difference by +-1 count, the second difference by +-2. */
     cfg->enc_jump_max = (int32_t)(4.0 + ceil(a_cpp2));
     const double rate_min = sqrt(4.0 * a_cpp2); /* r^2 / (2 a) >= 2 counts */

@@ -4,9 +4,8 @@
 #include <string.h>
 
 #include "controller.h"
+#include "ctrl_units.h"
 #include "vectors.h"
-
-#define FW_LINK_PI 3.14159265358979323846
 
 static fw_link_t *fw_link_of(void *ctx)
 {
@@ -23,8 +22,7 @@ static void op_write(void *ctx, const char *text, size_t len)
 
 static double fw_link_rpm(const fw_t *fw, q24_t omega_e)
 {
-    return ctrl_q24_to_double(omega_e) * fw->bases.w_rad_s / (double)fw->params.pole_pairs * 60.0 /
-           (2.0 * FW_LINK_PI);
+    return ctrl_elec_to_rpm(ctrl_q24_to_double(omega_e) * fw->bases.w_rad_s, fw->params.pole_pairs);
 }
 
 static void op_get_status(void *ctx, cmd_status_t *st)

@@ -5,6 +5,8 @@
 
 #include <string.h>
 
+#include "ctrl_units.h"
+
 #define TEL_SIG(name, unit, help, kind, field)                                                     \
     {                                                                                              \
         name, unit, help, kind, offsetof(tel_sample_t, field)                                      \
@@ -53,7 +55,6 @@ int tel_signal_find(const char *s, size_t len)
 double tel_signal_scale(size_t index, const ctrl_bases_t *b, int32_t pole_pairs)
 {
     const double q24 = 1.0 / 16777216.0; /* 2^-24 */
-    const double two_pi = 6.283185307179586;
     if (index >= (size_t)TEL_SIG_COUNT) {
         return 0.0;
     }
@@ -65,7 +66,7 @@ double tel_signal_scale(size_t index, const ctrl_bases_t *b, int32_t pole_pairs)
         return q24;
     }
     if (kind == TEL_KIND_ANGLE) {
-        return two_pi * q24;
+        return CTRL_TWO_PI * q24;
     }
     if (b == NULL) {
         return 0.0; /* unknown bases: the PC shows raw values */
@@ -80,7 +81,7 @@ double tel_signal_scale(size_t index, const ctrl_bases_t *b, int32_t pole_pairs)
     case TEL_KIND_TORQUE:
         return b->torque_nm * q24;
     case TEL_KIND_SPEED:
-        return (pole_pairs > 0) ? b->w_rad_s / (double)pole_pairs * 60.0 / two_pi * q24 : 0.0;
+        return (pole_pairs > 0) ? ctrl_elec_to_rpm(b->w_rad_s, pole_pairs) * q24 : 0.0;
     default:
         return 0.0;
     }

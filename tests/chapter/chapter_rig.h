@@ -12,6 +12,7 @@
 
 #include "controller.h"
 #include "ctrl_params.h"
+#include "plan.h"
 #include "unity.h"
 
 typedef struct {
@@ -19,6 +20,7 @@ typedef struct {
     ctrl_bases_t bases;
     ctrl_estimate_t est;
     ctrl_refs_t ref;
+    ctrl_setup_t su;
     ctrl_ctx_t ctx;
     _Alignas(8) unsigned char state[CTRL_STATE_MAX];
     _Alignas(8) unsigned char cfg[CTRL_CFG_MAX];
@@ -34,11 +36,20 @@ static inline void chapter_rig_init(chapter_rig_t *rig, const char *name, const 
     TEST_ASSERT_TRUE(rig->d->cfg_size <= CTRL_CFG_MAX);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&rig->params, &rig->bases, m, 10000u));
     rig->d->cfg_default(rig->cfg, m);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig->d->init(rig->state, rig->cfg, &rig->params));
+    rig->su = (ctrl_setup_t){m, &rig->bases, &rig->params};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(rig->d, rig->state, rig->cfg, &rig->su));
     rig->ctx.params = &rig->params;
     rig->ctx.est = &rig->est;
     rig->ctx.ref = &rig->ref;
     rig->est.vdc = rig->params.vdc_nom;
+}
+
+/* One step of the rig's controller; its output as leg duties in out->legs. */
+static inline void chapter_rig_step(chapter_rig_t *rig, ctrl_out_t *out)
+{
+    ctrl_plan_single(&out->plan, 0u);
+    rig->d->step(rig->state, &rig->ctx, out);
+    ctrl_out_legs(out);
 }
 
 #endif /* TESTS_CHAPTER_CHAPTER_RIG_H */

@@ -109,10 +109,8 @@ static void test_svpwm_reference(void)
         double d[3];
         bool lim;
         svpwm_ref(Eigen::Vector2d(q(va), q(vb)), q(vd), d, &lim);
-        ctrl_plan_t p;
-        const uint8_t got_lim = ctrl_svpwm(&va, &vb, vd, &p);
         ctrl_legs_t legs;
-        ctrl_plan_to_legs(&p, &legs);
+        const uint8_t got_lim = ctrl_svpwm(&va, &vb, vd, &legs);
         const double tol = (got_lim ? 16.0 : 8.0) * L;
         for (int x = 0; x < 3; x++) {
             const double e = std::fabs(q(legs.duty[x]) - d[x]);
@@ -128,6 +126,7 @@ typedef struct {
     ctrl_bases_t bases;
     ctrl_estimate_t est;
     ctrl_refs_t ref;
+    ctrl_setup_t su;
     ctrl_ctx_t ctx;
     alignas(8) unsigned char state[CTRL_STATE_MAX];
     alignas(8) unsigned char cfg[CTRL_CFG_MAX];
@@ -143,7 +142,8 @@ static void rig_init(const char *name, const ctrl_machine_t *m)
     TEST_ASSERT_NOT_NULL(rig.d);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&rig.params, &rig.bases, m, 10000u));
     rig.d->cfg_default(rig.cfg, m);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
+    rig.su = ctrl_setup_t{m, &rig.bases, &rig.params};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(rig.d, rig.state, rig.cfg, &rig.su));
     rig.ctx.params = &rig.params;
     rig.ctx.est = &rig.est;
     rig.ctx.ref = &rig.ref;
@@ -175,7 +175,7 @@ static void test_svm_dtc_reference(void)
             rig.ref.psi = ctrl_q24_from_double(1.0 + 0.2 * u(rng));
             rig.est.omega_e = ctrl_q24_from_double(u(rng));
             rig.d->reset(rig.state);
-            ctrl_plan_t out;
+            ctrl_out_t out;
             rig.d->step(rig.state, &rig.ctx, &out);
             /* Reference S1(19)-(20). */
             const double e = q(rig.ref.torque) - q(nx->torque);
@@ -219,10 +219,11 @@ static void test_foc_reference(void)
         rig.ref.torque = ctrl_q24_from_double(0.5 * u(rng));
         q24_t idr;
         q24_t iqr;
-        ctrl_foc_iref(&s->iref, rig.ref.torque, &idr, &iqr);
+        ctrl_foc_iref(&rig.params, &s->iref, rig.ref.torque, &idr, &iqr);
         rig.d->reset(rig.state);
-        ctrl_plan_t out;
+        ctrl_out_t out;
         rig.d->step(rig.state, &rig.ctx, &out);
+        ctrl_out_legs(&out);
         const double w = q(rig.est.omega_e);
         const double vd = -w * q(nx->psi_q) + kp_d * (q(idr) - q(nx->i_d));
         const double vq = w * q(nx->psi_d) + kp_q * (q(iqr) - q(nx->i_q));
@@ -237,7 +238,7 @@ static void test_foc_reference(void)
         TEST_ASSERT_EQUAL_INT(lim ? 1 : 0, s->limited);
         q24_t pa;
         q24_t pb;
-        ctrl_plan_voltage(&out, rig.est.vdc, &pa, &pb);
+        ctrl_legs_voltage(&out.legs, rig.est.vdc, &pa, &pb);
         const double tol = 2.0 * S * std::hypot(vd, vq) + 24.0 * L;
         const double err = std::fmax(std::fabs(q(pa) - v.x()), std::fabs(q(pb) - v.y()));
         worst = std::fmax(worst, err / tol);

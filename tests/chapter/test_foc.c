@@ -52,7 +52,7 @@ static void test_iref(void)
         const q24_t t = ctrl_q24_from_double(0.01 * k);
         q24_t id;
         q24_t iq;
-        ctrl_foc_iref(&s->iref, t, &id, &iq);
+        ctrl_foc_iref(&rig.params, &s->iref, t, &id, &iq);
         TEST_ASSERT_INT32_WITHIN(2, 0, id); /* SPMSM: i_d = 0 */
         TEST_ASSERT_INT32_WITHIN(4, t, iq); /* T = psi_pm i_q, psi_pm = 1 pu */
     }
@@ -60,16 +60,16 @@ static void test_iref(void)
     s = (const ctrl_foc_state_t *)rig.state;
     const double ld = q(rig.params.ld);
     const double lq = q(rig.params.lq);
-    const double tmax = q(s->iref.t_max);
+    const double tmax = q(rig.params.mtpa_t_max); /* the MTPA locus at current_max */
     for (int k = -40; k <= 40; k++) {
         const double tq = tmax * k / 40.0 * 0.999;
         q24_t id;
         q24_t iq;
-        ctrl_foc_iref(&s->iref, ctrl_q24_from_double(tq), &id, &iq);
+        ctrl_foc_iref(&rig.params, &s->iref, ctrl_q24_from_double(tq), &id, &iq);
         const double d = q(id);
         const double qq = q(iq);
         /* Torque of the references, (1) in pu: i_q (1 + (Ld - Lq) i_d). Linear
-         * interpolation of a smooth locus over 32 segments: < 0.1 % of t_max. */
+         * interpolation of a smooth locus over 64 segments: < 0.1 % of t_max. */
         TEST_ASSERT_DOUBLE_WITHIN(1e-3 * tmax, tq, qq * (1.0 + (ld - lq) * d));
         /* On the MTPA locus: i_d = (1 - sqrt(1 + 8 (Lq-Ld)^2 i^2)) / (4 (Lq-Ld)). */
         const double is = hypot(d, qq);
@@ -81,9 +81,9 @@ static void test_iref(void)
     /* Beyond the limit: clamped to current_max. */
     q24_t id;
     q24_t iq;
-    ctrl_foc_iref(&s->iref, FX_MAX, &id, &iq);
+    ctrl_foc_iref(&rig.params, &s->iref, FX_MAX, &id, &iq);
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, q(rig.params.current_max), hypot(q(id), q(iq)));
-    ctrl_foc_iref(&s->iref, FX_MIN, &id, &iq);
+    ctrl_foc_iref(&rig.params, &s->iref, FX_MIN, &id, &iq);
     TEST_ASSERT_TRUE(iq < 0);
 }
 
@@ -127,23 +127,22 @@ static void run_loop(double omega_pu, double torque_pu)
     q24_t c0;
     fx_sincos(th0, &s0, &c0);
     ctrl_mstate_from_flux(&rig.params, c0, s0, th0, &x); /* i = 0: psi = psi_pm on d */
-    ctrl_plan_t applied;
-    ctrl_plan_single(&applied, 0u);
+    ctrl_legs_t applied = {{0, 0, 0}};
     rig.d->reset(rig.state);
     rig.est.omega_e = ctrl_q24_from_double(omega_pu);
     rig.ref.torque = ctrl_q24_from_double(torque_pu);
     for (int k = 0; k < NSTEP; k++) {
         q24_t va;
         q24_t vb;
-        ctrl_plan_voltage(&applied, rig.est.vdc, &va, &vb);
+        ctrl_legs_voltage(&applied, rig.est.vdc, &va, &vb);
         rig.est.now = x;
         ctrl_predict(&rig.params, &x, va, vb, rig.est.omega_e, &rig.est.next);
         rec_d[k] = q(x.i_d);
         rec_q[k] = q(x.i_q);
-        ctrl_plan_t out;
-        rig.d->step(rig.state, &rig.ctx, &out);
+        ctrl_out_t out;
+        chapter_rig_step(&rig, &out);
         x = rig.est.next; /* the plant is the same model */
-        applied = out;
+        applied = out.legs;
     }
 }
 
@@ -174,7 +173,7 @@ static void check_step(const char *label, double omega_pu, double torque_pu)
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     q24_t idr;
     q24_t iqr;
-    ctrl_foc_iref(&s->iref, ctrl_q24_from_double(torque_pu), &idr, &iqr);
+    ctrl_foc_iref(&rig.params, &s->iref, ctrl_q24_from_double(torque_pu), &idr, &iqr);
     run_loop(omega_pu, torque_pu);
     const double wc_ts = 2.0 * PI / 20.0;
     const double design = 2.2 / wc_ts; /* periods */
@@ -244,18 +243,18 @@ static void test_foc_hyst_decisions(void)
     memset(nx, 0, sizeof *nx);
     nx->cos_theta = FX_ONE;
     rig.ref.torque = ctrl_q24_from_double(0.5);
-    ctrl_plan_t out;
-    rig.d->step(rig.state, &rig.ctx, &out);
-    TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
-    TEST_ASSERT_EQUAL_UINT8(3, out.vec[0]); /* V3 = 010: only leg b high */
+    ctrl_out_t out;
+    chapter_rig_step(&rig, &out);
+    TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg);
+    TEST_ASSERT_EQUAL_UINT8(3, out.plan.vec[0]); /* V3 = 010: only leg b high */
     /* Errors inside the band: legs hold. */
     rig.ref.torque = ctrl_q24_from_double(0.5 * h);
-    rig.d->step(rig.state, &rig.ctx, &out);
-    TEST_ASSERT_EQUAL_UINT8(3, out.vec[0]);
+    chapter_rig_step(&rig, &out);
+    TEST_ASSERT_EQUAL_UINT8(3, out.plan.vec[0]);
     /* Negative torque: b low, c high -> V5 = 001. */
     rig.ref.torque = ctrl_q24_from_double(-0.5);
-    rig.d->step(rig.state, &rig.ctx, &out);
-    TEST_ASSERT_EQUAL_UINT8(5, out.vec[0]);
+    chapter_rig_step(&rig, &out);
+    TEST_ASSERT_EQUAL_UINT8(5, out.plan.vec[0]);
 }
 
 static void test_config_errors(void)
@@ -263,18 +262,17 @@ static void test_config_errors(void)
     chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "wc", 1.0e5));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL,
-                          rig.d->init(rig.state, rig.cfg, &rig.params)); /* wc Ts > 1.5 */
+                          ctrl_init(rig.d, rig.state, rig.cfg, &rig.su)); /* wc Ts > 1.5 */
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(rig.d, rig.cfg, "mtpa", 2.0));
-    rig.d->cfg_default(rig.cfg, &ini_chapter_ipmsm); /* another machine than the params */
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, rig.d->init(rig.state, rig.cfg, &rig.params));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, rig.d->init(NULL, rig.cfg, &rig.params));
-    ctrl_plan_t out;
-    rig.d->step(rig.state, NULL, &out);
-    TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(rig.d, NULL, rig.cfg, &rig.su));
+    ctrl_out_t out;
+    ctrl_step(rig.d, rig.state, NULL, &out);
+    TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg);
+    TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
     /* SI gains override the computed ones: Kp = 10 V/A. */
     rig.d->cfg_default(rig.cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "Kp_q", 10.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, rig.d->init(rig.state, rig.cfg, &rig.params));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(rig.d, rig.state, rig.cfg, &rig.su));
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 10.0 / rig.bases.r_ohm, q(s->pi_q.kp));
 }

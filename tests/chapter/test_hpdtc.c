@@ -153,6 +153,7 @@ static void set_next(double lam, double t)
     nx->psi_beta = ctrl_q24_from_double(sin(lam));
     nx->psi_amp = FX_ONE;
     nx->torque = ctrl_q24_from_double(t);
+    nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta); /* (4.5), as the estimator */
 }
 
 static void test_step_geometry(void)
@@ -171,8 +172,9 @@ static void test_step_geometry(void)
                     rig.ref.torque = ctrl_q24_from_double(0.1 + e);
                     rig.ref.psi = ctrl_q24_from_double(phi ? 1.2 : 0.8); /* beyond the band */
                     rig.d->reset(rig.state);
-                    ctrl_plan_t out;
-                    rig.d->step(rig.state, &rig.ctx, &out);
+                    ctrl_out_t o;
+                    chapter_rig_step(&rig, &o);
+                    const ctrl_plan_t out = o.plan;
                     TEST_ASSERT_EQUAL_UINT8(l, s->last_level);
                     TEST_ASSERT_EQUAL_UINT8(4, out.n_seg);
                     int64_t sum = 0;
@@ -185,7 +187,7 @@ static void test_step_geometry(void)
                     TEST_ASSERT_TRUE(out.dur[3] - out.dur[2] >= 0 && out.dur[3] - out.dur[2] <= 1);
                     q24_t va;
                     q24_t vb;
-                    ctrl_plan_voltage(&out, rig.est.vdc, &va, &vb);
+                    ctrl_legs_voltage(&o.legs, rig.est.vdc, &va, &vb);
                     const double m = (l + 1) / 5.0;
                     const double vmag = hypot(q(va), q(vb));
                     /* Amplitude m Vdc/sqrt(3) within one point of |V_k| (2/3 / 20). */
@@ -223,13 +225,10 @@ static void test_defaults_and_bad_config(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, efs_nm / 5.0, q(s->lvl_thr[0]) * rig.bases.torque_nm);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(rig.d, rig.cfg, "tilt", 1.0));
     TEST_ASSERT_EQUAL_INT(CTRL_ENOENT, ctrl_tunable_set(rig.d, rig.cfg, "nope", 1.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, rig.d->init(rig.state, rig.cfg, NULL));
-    unsigned char cfg0[CTRL_CFG_MAX];
-    memset(cfg0, 0, sizeof cfg0); /* no cfg_default: bases missing */
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, rig.d->init(rig.state, cfg0, &rig.params));
-    ctrl_plan_t out;
-    rig.d->step(rig.state, NULL, &out); /* no context: zero vector, no crash */
-    TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(rig.d, rig.state, rig.cfg, NULL));
+    ctrl_out_t out;
+    ctrl_step(rig.d, rig.state, NULL, &out); /* no context: zero vector, no crash */
+    TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
 }
 
 int main(void)

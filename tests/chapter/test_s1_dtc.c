@@ -16,6 +16,7 @@
 #include "ctrl_s1_dtc.h"
 #include "plan.h"
 #include "unity.h"
+#include "vectors.h"
 
 void setUp(void)
 {
@@ -48,6 +49,7 @@ static void set_next(double lam, double amp, double t)
     nx->psi_amp = ctrl_q24_from_double(amp);
     nx->torque = ctrl_q24_from_double(t);
     nx->cos_theta = FX_ONE;
+    nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta); /* (4.5), as the estimator */
 }
 
 /* S1 Table 3 as printed: [phi 1/0][tau 1/0/-1][sector 1..6]. */
@@ -73,24 +75,24 @@ static void test_hdtc_table3(void)
             rig.d->reset(rig.state);
             set_next(lam, amp, 0.1);
             rig.ref.torque = ctrl_q24_from_double(0.1 + big);
-            ctrl_plan_t out;
-            rig.d->step(rig.state, &rig.ctx, &out);
-            TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
-            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][0][sec - 1], out.vec[0]);
+            ctrl_out_t out;
+            chapter_rig_step(&rig, &out);
+            TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][0][sec - 1], out.plan.vec[0]);
             /* tau = 0: torque reached the reference after an increase; Table 3's
              * zero vector is the one after the active vector just applied. */
             rig.ref.torque = ctrl_q24_from_double(0.1);
-            rig.d->step(rig.state, &rig.ctx, &out);
-            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][1][sec - 1], out.vec[0]);
+            chapter_rig_step(&rig, &out);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][1][sec - 1], out.plan.vec[0]);
             /* tau = -1 */
             rig.ref.torque = ctrl_q24_from_double(0.1 - big);
-            rig.d->step(rig.state, &rig.ctx, &out);
-            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][2][sec - 1], out.vec[0]);
+            chapter_rig_step(&rig, &out);
+            TEST_ASSERT_EQUAL_UINT8(s1_table3[ph][2][sec - 1], out.plan.vec[0]);
         }
     }
-    ctrl_plan_t out;
-    rig.d->step(rig.state, NULL, &out); /* no context: a zero vector, no crash */
-    TEST_ASSERT_TRUE(out.vec[0] == 0u || out.vec[0] == 7u);
+    ctrl_out_t out;
+    ctrl_step(rig.d, rig.state, NULL, &out); /* no context: a zero vector, no crash */
+    TEST_ASSERT_TRUE(out.plan.vec[0] == 0u || out.plan.vec[0] == 7u);
 }
 
 static void test_svm_dtc_basics(void)
@@ -105,36 +107,41 @@ static void test_svm_dtc_basics(void)
     /* No error, no speed, flux at its reference, no current: no voltage. */
     set_next(0.3, 1.0, 0.2);
     rig.ref.torque = ctrl_q24_from_double(0.2);
-    ctrl_plan_t out;
-    rig.d->step(rig.state, &rig.ctx, &out);
+    ctrl_out_t out;
+    chapter_rig_step(&rig, &out);
     TEST_ASSERT_INT32_WITHIN(64, 0, s->v_alpha);
     TEST_ASSERT_INT32_WITHIN(64, 0, s->v_beta);
     /* Positive torque error: Delta delta = Kp e (first sample, empty
      * integrator) and the voltage advances the flux (positive tangential). */
     rig.d->reset(rig.state);
     rig.ref.torque = ctrl_q24_from_double(0.21);
-    rig.d->step(rig.state, &rig.ctx, &out);
+    chapter_rig_step(&rig, &out);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.01, q(s->dd));
     const double vt = -q(s->v_alpha) * sin(0.3) + q(s->v_beta) * cos(0.3);
     const double ts = q(rig.params.ts);
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, sin(0.01) / ts, vt);
     /* Second sample: the integrator added Ki e = 0.0003 rad. */
-    rig.d->step(rig.state, &rig.ctx, &out);
+    chapter_rig_step(&rig, &out);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.01 + 0.03 * 0.01, q(s->dd));
     /* Speed feed-forward: omega Ts added. */
     rig.d->reset(rig.state);
     rig.ref.torque = ctrl_q24_from_double(0.2);
     rig.est.omega_e = ctrl_q24_from_double(0.3);
-    rig.d->step(rig.state, &rig.ctx, &out);
+    chapter_rig_step(&rig, &out);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.3 * ts, q(s->dd));
     /* A large error saturates: the voltage is limited, the plan still sums to 1. */
     rig.ref.torque = ctrl_q24_from_double(5.0);
-    rig.d->step(rig.state, &rig.ctx, &out);
+    chapter_rig_step(&rig, &out);
     TEST_ASSERT_EQUAL_UINT8(1, s->limited);
-    TEST_ASSERT_EQUAL_INT32(FX_ONE, out.dur[0] + out.dur[1] + out.dur[2] + out.dur[3]);
+    /* ... as leg duties inside [0, 1] of which one is 1 and one is 0 (on the hexagon). */
+    TEST_ASSERT_EQUAL_UINT8(0, out.plan.n_seg);
+    const q24_t dmax = fx_max(out.legs.duty[0], fx_max(out.legs.duty[1], out.legs.duty[2]));
+    const q24_t dmin = fx_min(out.legs.duty[0], fx_min(out.legs.duty[1], out.legs.duty[2]));
+    TEST_ASSERT_INT32_WITHIN(4, FX_ONE, dmax);
+    TEST_ASSERT_INT32_WITHIN(4, 0, dmin);
     /* Integrator bounded (pi/6) whatever the error. */
     for (int k = 0; k < 1000; k++) {
-        rig.d->step(rig.state, &rig.ctx, &out);
+        chapter_rig_step(&rig, &out);
     }
     TEST_ASSERT_TRUE(fabs(q(s->dd) - 0.3 * ts) <= PI / 3.0 + 1e-6);
 }

@@ -222,7 +222,15 @@ void run_machine(const ctrl_machine_t &mach, uint32_t fs, int n, std::mt19937_64
         if (gen() % 2u) {
             ctrl_plan_active_zero(&plan, vec, q(u01(gen)));
         } else {
-            ctrl_plan_two_active(&plan, vec, q(u01(gen)), ctrl_vec_wrap(vec + 1), q(u01(gen)));
+            const q24_t d1 = q(u01(gen));
+            const q24_t d2 = static_cast<q24_t>((FX_ONE - d1) * u01(gen));
+            plan.n_seg = 3u;
+            plan.vec[0] = vec;
+            plan.dur[0] = d1;
+            plan.vec[1] = ctrl_vec_wrap(vec + 1);
+            plan.dur[1] = d2;
+            plan.vec[2] = ctrl_zero_after(vec);
+            plan.dur[2] = FX_ONE - d1 - d2;
         }
         const double ia = d(ia_q), ib = d(ib_q), w = d(w_q), vdc = d(vdc_q);
 
@@ -233,7 +241,9 @@ void run_machine(const ctrl_machine_t &mach, uint32_t fs, int n, std::mt19937_64
         ctrl_mstate_t now, next;
         ctrl_mstate_from_current(&p, al, be, th_q, s, c, &now);
         q24_t va, vb;
-        ctrl_plan_voltage(&plan, vdc_q, &va, &vb);
+        ctrl_legs_t legs;
+        ctrl_plan_legs(&plan, &legs);
+        ctrl_legs_voltage(&legs, vdc_q, &va, &vb);
         ctrl_predict(&p, &now, va, vb, w_q, &next);
 
         // ---- reference ----
@@ -377,15 +387,17 @@ void test_estimator_matches_components()
     ctrl_meas_t m{q(0.3), q(-0.7), q(1.02), 0x87654321u};
     ctrl_plan_t plan;
     ctrl_plan_active_zero(&plan, 5u, q(0.6));
+    ctrl_legs_t legs;
+    ctrl_plan_legs(&plan, &legs);
     ctrl_estimate_t est;
-    ctrl_estimator_update(&e, &p, &m, &plan, &est);
+    ctrl_estimator_update(&e, &p, &m, &legs, &est);
     q24_t al, be, s, c;
     ctrl_clarke(m.i_a, m.i_b, &al, &be);
     fx_sincos(m.theta_e, &s, &c);
     ctrl_mstate_t now, next;
     ctrl_mstate_from_current(&p, al, be, m.theta_e, s, c, &now);
     q24_t va, vb;
-    ctrl_plan_voltage(&plan, m.vdc, &va, &vb);
+    ctrl_legs_voltage(&legs, m.vdc, &va, &vb);
     ctrl_predict(&p, &now, va, vb, est.omega_e, &next);
     TEST_ASSERT_EQUAL_INT32(now.torque, est.now.torque);
     TEST_ASSERT_EQUAL_INT32(now.psi_alpha, est.now.psi_alpha);

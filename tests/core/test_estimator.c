@@ -138,13 +138,15 @@ static void test_prediction_with_plan(void)
     ctrl_estimate_t est;
     ctrl_meas_t m;
     ctrl_plan_t plan;
+    ctrl_legs_t legs;
     ctrl_estimator_init(&e, &P);
     meas_from_dq(-0.05, 0.3, 0x10000000u, &m);
     ctrl_plan_active_zero(&plan, 2u, FX_ONE / 2); /* V2 half the period, then V7 */
-    ctrl_estimator_update(&e, &P, &m, &plan, &est);
+    ctrl_plan_legs(&plan, &legs);
+    ctrl_estimator_update(&e, &P, &m, &legs, &est);
     q24_t va;
     q24_t vb;
-    ctrl_plan_voltage(&plan, m.vdc, &va, &vb);
+    ctrl_legs_voltage(&legs, m.vdc, &va, &vb);
     /* (5.15) exactly as specified: one rounding of Ts v - Ts Rs i */
     const int64_t da = (int64_t)P.ts * va - (int64_t)P.ts_rs * est.now.i_alpha;
     const int64_t db = (int64_t)P.ts * vb - (int64_t)P.ts_rs * est.now.i_beta;
@@ -204,15 +206,17 @@ static void test_optional_outputs(void)
     TEST_ASSERT_EQUAL_UINT8(CTRL_EST_ALL, full.outputs);
     lean.outputs = 0u;
     ctrl_plan_t plan;
+    ctrl_legs_t legs;
     ctrl_plan_active_zero(&plan, 2u, FX_ONE / 3);
+    ctrl_plan_legs(&plan, &legs);
     for (int k = 0; k < 200; k++) {
         ctrl_meas_t m;
         const fx_angle_t th = (fx_angle_t)(uint32_t)k * 0x01234567u;
         meas_from_dq(0.1 * sin(0.3 * k), 0.25 * cos(0.17 * k), th, &m);
         ctrl_estimate_t ef;
         ctrl_estimate_t el;
-        ctrl_estimator_update(&full, &P, &m, &plan, &ef);
-        ctrl_estimator_update(&lean, &P, &m, &plan, &el);
+        ctrl_estimator_update(&full, &P, &m, &legs, &ef);
+        ctrl_estimator_update(&lean, &P, &m, &legs, &el);
         TEST_ASSERT_EQUAL_INT32(fx_mag(ef.now.psi_d, ef.now.psi_q), ef.now.psi_amp);
         TEST_ASSERT_EQUAL_INT32(fx_mag(ef.next.psi_alpha, ef.next.psi_beta), ef.next.psi_amp);
         TEST_ASSERT_EQUAL_UINT8(ctrl_sector(ef.now.psi_alpha, ef.now.psi_beta), ef.now.sector);
@@ -335,8 +339,7 @@ static void test_estimator_voltage_model_source(void)
     ctrl_estimator_t e;
     ctrl_estimate_t est;
     ctrl_meas_t m;
-    ctrl_plan_t zero;
-    ctrl_plan_single(&zero, 0u);
+    const ctrl_legs_t zero = {{0, 0, 0}};
     ctrl_estimator_init(&e, &P);
     e.flux_source = CTRL_FLUX_VOLTAGE_MODEL;
     meas_from_dq(0.0, 0.0, 0x20000000u, &m);

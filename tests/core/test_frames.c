@@ -93,6 +93,12 @@ static void test_park_roundtrip(void)
     }
 }
 
+/* Leg state of leg l (0..2) in vector v, from the core's table. */
+static unsigned vleg(uint8_t v, unsigned l)
+{
+    return (ctrl_vec_legs[v] >> l) & 1u;
+}
+
 static void test_vectors_table_4_2(void)
 {
     static const uint8_t legs[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
@@ -100,7 +106,7 @@ static void test_vectors_table_4_2(void)
     const q24_t vdc = q(1.05);
     for (uint8_t i = 0; i < 8u; i++) {
         for (unsigned l = 0; l < 3u; l++) {
-            TEST_ASSERT_EQUAL_UINT8(legs[i][l], ctrl_vector_leg(i, l));
+            TEST_ASSERT_EQUAL_UINT8(legs[i][l], vleg(i, l));
         }
         q24_t va;
         q24_t vb;
@@ -116,7 +122,18 @@ static void test_vectors_table_4_2(void)
     ctrl_vector_ab(9u, vdc, &va, &vb);
     TEST_ASSERT_EQUAL_INT32(0, va);
     TEST_ASSERT_EQUAL_INT32(0, vb);
-    TEST_ASSERT_EQUAL_UINT8(0u, ctrl_vector_leg(8u, 0u));
+    TEST_ASSERT_EQUAL_UINT8(0u, vleg(8u, 0u));
+    for (unsigned v = 8u; v < 256u; v++) {
+        TEST_ASSERT_EQUAL_UINT8(0u, ctrl_vec_legs[v]); /* any index is safe: no leg */
+    }
+    for (uint8_t i = 0; i < 8u; i++) {
+        TEST_ASSERT_EQUAL_UINT8(i, ctrl_vec_of_legs[ctrl_vec_legs[i]]); /* inverse */
+        /* unit directions: 3/2 of V_i / Vdc (Q30 -> Q24 within a rounding) */
+        TEST_ASSERT_INT32_WITHIN(1, (q24_t)(1.5 * ctrl_vec_ab_q30[i][0] / 64.0),
+                                 ctrl_vec_dir_q24[i][0]);
+        TEST_ASSERT_INT32_WITHIN(1, (q24_t)(1.5 * ctrl_vec_ab_q30[i][1] / 64.0),
+                                 ctrl_vec_dir_q24[i][1]);
+    }
 }
 
 static void test_vec_wrap_and_zero(void)
@@ -136,7 +153,7 @@ static void test_vec_wrap_and_zero(void)
         if (v >= 1u && v <= 6u) {
             unsigned diff = 0;
             for (unsigned l = 0; l < 3u; l++) {
-                diff += ctrl_vector_leg(v, l) != ctrl_vector_leg(zero[v], l);
+                diff += vleg(v, l) != vleg(zero[v], l);
             }
             TEST_ASSERT_EQUAL_UINT(1u, diff);
         }
@@ -223,12 +240,11 @@ static void test_plan_legs_every_vector(void)
             TEST_ASSERT_EQUAL_INT32(dc, p.dur[0]);
             TEST_ASSERT_EQUAL_INT32(FX_ONE, p.dur[0] + p.dur[1]);
             ctrl_legs_t legs;
-            ctrl_plan_to_legs(&p, &legs);
+            ctrl_plan_legs(&p, &legs);
             const uint8_t z = ctrl_zero_after(v);
             unsigned switching = 0;
             for (unsigned l = 0; l < 3u; l++) {
-                const q24_t expect =
-                    (q24_t)(ctrl_vector_leg(v, l) * dc + ctrl_vector_leg(z, l) * (FX_ONE - dc));
+                const q24_t expect = (q24_t)(vleg(v, l) * dc + vleg(z, l) * (FX_ONE - dc));
                 TEST_ASSERT_EQUAL_INT32(expect, legs.duty[l]);
                 switching += legs.duty[l] != 0 && legs.duty[l] != FX_ONE;
             }
@@ -239,7 +255,7 @@ static void test_plan_legs_every_vector(void)
             q24_t vb;
             q24_t ea;
             q24_t eb;
-            ctrl_plan_voltage(&p, vdc, &va, &vb);
+            ctrl_legs_voltage(&legs, vdc, &va, &vb);
             ctrl_vector_ab(v, vdc, &ea, &eb);
             TEST_ASSERT_TRUE(fabs(d(va) - d(ea) * d(dc)) <= 2.0 * LSB);
             TEST_ASSERT_TRUE(fabs(d(vb) - d(eb) * d(dc)) <= 2.0 * LSB);
@@ -247,28 +263,37 @@ static void test_plan_legs_every_vector(void)
     }
 }
 
-static void test_plan_two_active_and_single(void)
+/* A three-segment plan: v1 for d1, v2 for d2, the zero vector after v1 the rest. */
+static void plan_two(ctrl_plan_t *p, uint8_t v1, q24_t d1, uint8_t v2, q24_t d2)
+{
+    p->n_seg = 3u;
+    p->vec[0] = v1;
+    p->dur[0] = d1;
+    p->vec[1] = v2;
+    p->dur[1] = d2;
+    p->vec[2] = ctrl_zero_after(v1);
+    p->dur[2] = FX_ONE - d1 - d2;
+}
+
+static void test_plan_legs_three_and_single(void)
 {
     ctrl_plan_t p;
-    ctrl_plan_two_active(&p, 1u, q(0.4), 2u, q(0.8)); /* d2 reduced to 0.6 */
-    TEST_ASSERT_EQUAL_UINT8(3u, p.n_seg);
-    TEST_ASSERT_EQUAL_INT32(q(0.4), p.dur[0]);
-    TEST_ASSERT_EQUAL_INT32(FX_ONE - q(0.4), p.dur[1]);
-    TEST_ASSERT_EQUAL_INT32(0, p.dur[2]);
     ctrl_legs_t l;
-    ctrl_plan_to_legs(&p, &l);
+    plan_two(&p, 1u, q(0.4), 2u, FX_ONE - q(0.4));
+    ctrl_plan_legs(&p, &l);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, l.duty[0]);
     TEST_ASSERT_EQUAL_INT32(FX_ONE - q(0.4), l.duty[1]);
     TEST_ASSERT_EQUAL_INT32(0, l.duty[2]);
     /* V1 0.25 + V2 0.25 + V0 0.5: v = 0.25 (V1 + V2) */
-    ctrl_plan_two_active(&p, 1u, FX_ONE / 4, 2u, FX_ONE / 4);
+    plan_two(&p, 1u, FX_ONE / 4, 2u, FX_ONE / 4);
+    ctrl_plan_legs(&p, &l);
     q24_t va;
     q24_t vb;
-    ctrl_plan_voltage(&p, FX_ONE, &va, &vb);
+    ctrl_legs_voltage(&l, FX_ONE, &va, &vb);
     TEST_ASSERT_TRUE(fabs(d(va) - 0.25 * (2.0 / 3.0 + 1.0 / 3.0)) <= 2.0 * LSB);
     TEST_ASSERT_TRUE(fabs(d(vb) - 0.25 * (1.0 / sqrt(3.0))) <= 2.0 * LSB);
     ctrl_plan_single(&p, 4u);
-    ctrl_plan_to_legs(&p, &l);
+    ctrl_plan_legs(&p, &l);
     TEST_ASSERT_EQUAL_INT32(0, l.duty[0]);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, l.duty[1]);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, l.duty[2]);
@@ -282,9 +307,13 @@ static void test_plan_two_active_and_single(void)
     p.dur[2] = FX_ONE;
     p.vec[3] = 7u;
     p.dur[3] = FX_ONE;
-    ctrl_plan_to_legs(&p, &l);
+    ctrl_plan_legs(&p, &l);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, l.duty[0]);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, l.duty[2]);
+    /* no segment: V0 */
+    p.n_seg = 0u;
+    ctrl_plan_legs(&p, &l);
+    TEST_ASSERT_EQUAL_INT32(0, l.duty[0] | l.duty[1] | l.duty[2]);
 }
 
 int main(void)
@@ -296,6 +325,6 @@ int main(void)
     RUN_TEST(test_vec_wrap_and_zero);
     RUN_TEST(test_sectors_boundaries);
     RUN_TEST(test_plan_legs_every_vector);
-    RUN_TEST(test_plan_two_active_and_single);
+    RUN_TEST(test_plan_legs_three_and_single);
     return UNITY_END();
 }

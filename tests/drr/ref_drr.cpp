@@ -134,7 +134,8 @@ void *make(const char *name, void (*tweak)(void *))
     if (tweak != nullptr) {
         tweak(CFG);
     }
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, desc->init(STATE, CFG, &P));
+    const ctrl_setup_t su{&ini_thesis_spmsm, &B, &P};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(desc, STATE, CFG, &su));
     return STATE;
 }
 
@@ -205,13 +206,10 @@ void test_drr_vs_reference(void)
         const double g_prev = d(s->gamma); // the same (Q24) previous output
         s->last_duty = q(std::uniform_real_distribution<double>(0.0, 1.0)(rng));
         const double d_last = d(s->last_duty);
-        ctrl_plan_t applied;
-        applied.n_seg = 1;
-        applied.vec[0] = 0;
-        applied.dur[0] = FX_ONE;
-        ctrl_ctx_t ctx{&P, &smp.est, &smp.ref, &applied};
-        ctrl_plan_t out;
-        desc->step(s, &ctx, &out);
+        ctrl_ctx_t ctx{&P, &smp.est, &smp.ref};
+        ctrl_out_t o;
+        desc->step(s, &ctx, &o);
+        const ctrl_plan_t &out = o.plan;
 
         // ---- reference
         const ctrl_mstate_t &nx = smp.est.next;
@@ -345,9 +343,10 @@ void run_baseline(const char *name, Kind kind)
         std::uniform_real_distribution<double> u(-0.3, 0.3);
         s->integ = q(u(rng));
         const double integ_prev = d(s->integ);
-        ctrl_ctx_t ctx{&P, &smp.est, &smp.ref, nullptr};
-        ctrl_plan_t out;
-        desc->step(state, &ctx, &out);
+        ctrl_ctx_t ctx{&P, &smp.est, &smp.ref};
+        ctrl_out_t o;
+        desc->step(state, &ctx, &o);
+        const ctrl_plan_t &out = o.plan;
 
         const ctrl_mstate_t &nx = smp.est.next;
         const Vec2 psi(d(nx.psi_alpha), d(nx.psi_beta));

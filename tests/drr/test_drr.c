@@ -21,12 +21,14 @@
 
 static ctrl_params_t P;
 static ctrl_bases_t BASES;
+static ctrl_setup_t SU;
 static _Alignas(8) unsigned char STATE[CTRL_STATE_MAX];
 static _Alignas(8) unsigned char CFG[CTRL_CFG_MAX];
 
 void setUp(void)
 {
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &BASES, &ini_thesis_spmsm, CTRL_DRR_FS_HZ));
+    SU = (ctrl_setup_t){&ini_thesis_spmsm, &BASES, &P};
 }
 
 void tearDown(void)
@@ -54,7 +56,7 @@ static void *make(const char *name, void (*tweak)(void *cfg))
     if (tweak != NULL) {
         tweak(CFG);
     }
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(desc, STATE, CFG, &SU));
     return STATE;
 }
 
@@ -248,37 +250,35 @@ static void test_vreplace_condition(void)
     ctrl_estimate_t est;
     fill_est(&est, -25.0 * PI / 180.0, 1.02, 0.1, 0.2);
     ctrl_refs_t ref = {q(0.25), 0};
-    ctrl_plan_t applied;
-    ctrl_plan_single(&applied, 0);
-    ctrl_ctx_t ctx = {&P, &est, &ref, &applied};
-    ctrl_plan_t out;
+    ctrl_ctx_t ctx = {&P, &est, &ref};
+    ctrl_out_t o;
     TEST_ASSERT_EQUAL_UINT8(1, est.next.sector);
 
     ref.psi = est.next.psi_amp - s->half_dpsi / 2;
     ctrl_drr_reset(s);
-    ctrl_drr_step(s, &ctx, &out);
+    ctrl_drr_step(s, &ctx, &o);
     TEST_ASSERT_EQUAL_UINT8(3, s->last_vec_51);
-    TEST_ASSERT_EQUAL_UINT8(2, out.vec[0]);
+    TEST_ASSERT_EQUAL_UINT8(2, o.plan.vec[0]);
 
     ref.psi = est.next.psi_amp - 2 * s->half_dpsi;
     ctrl_drr_reset(s);
-    ctrl_drr_step(s, &ctx, &out);
+    ctrl_drr_step(s, &ctx, &o);
     TEST_ASSERT_EQUAL_UINT8(3, s->last_vec_51);
-    TEST_ASSERT_EQUAL_UINT8(3, out.vec[0]);
+    TEST_ASSERT_EQUAL_UINT8(3, o.plan.vec[0]);
 
     /* Subsector II (theta_s = +25 deg), psi_err >= 0: V2 = V_{x+1} -> V3 (4.21). */
     fill_est(&est, 25.0 * PI / 180.0, 1.02, 0.1, 0.2);
     ref.psi = est.next.psi_amp + s->half_dpsi / 2;
     ctrl_drr_reset(s);
-    ctrl_drr_step(s, &ctx, &out);
+    ctrl_drr_step(s, &ctx, &o);
     TEST_ASSERT_EQUAL_UINT8(2, s->last_vec_51);
-    TEST_ASSERT_EQUAL_UINT8(3, out.vec[0]);
+    TEST_ASSERT_EQUAL_UINT8(3, o.plan.vec[0]);
 
     /* sigma = 0 disables the replacement. */
     s = make("drr", sigma_off);
     TEST_ASSERT_FALSE(ctrl_drr_vreplace_active(s, 0));
-    ctrl_drr_step(s, &ctx, &out);
-    TEST_ASSERT_EQUAL_UINT8(2, out.vec[0]);
+    ctrl_drr_step(s, &ctx, &o);
+    TEST_ASSERT_EQUAL_UINT8(2, o.plan.vec[0]);
 }
 
 /* ---- Plan shape: active vector for D, then V0 after V1/V3/V5, V7 after
@@ -288,28 +288,26 @@ static void test_plan_zero_vector(void)
     ctrl_drr_state_t *s = make("drr", sigma_off);
     ctrl_estimate_t est;
     ctrl_refs_t ref = {0, 0};
-    ctrl_plan_t applied;
-    ctrl_plan_single(&applied, 0);
-    ctrl_ctx_t ctx = {&P, &est, &ref, &applied};
-    ctrl_plan_t out;
+    ctrl_ctx_t ctx = {&P, &est, &ref};
+    ctrl_out_t o;
     for (int x = 1; x <= 6; x++) {
         for (int sgn = -1; sgn <= 1; sgn += 2) {
             fill_est(&est, (x - 1) * PI / 3 + 0.05, 1.0, 0.05 * sgn, 0.1);
             ref.torque = fx_add(est.next.torque, q(0.02 * sgn));
             ctrl_drr_reset(s);
-            ctrl_drr_step(s, &ctx, &out);
-            const uint8_t v = out.vec[0];
+            ctrl_drr_step(s, &ctx, &o);
+            const uint8_t v = o.plan.vec[0];
             TEST_ASSERT_TRUE(v >= 1 && v <= 6);
-            TEST_ASSERT_TRUE(out.n_seg >= 1 && out.n_seg <= CTRL_PLAN_MAX_SEG);
+            TEST_ASSERT_TRUE(o.plan.n_seg >= 1 && o.plan.n_seg <= CTRL_PLAN_MAX_SEG);
             int64_t sum = 0;
-            for (unsigned i = 0; i < out.n_seg; i++) {
-                sum += out.dur[i];
-                if (i > 0 && out.dur[i] > 0) {
-                    TEST_ASSERT_EQUAL_UINT8((v % 2u) == 1u ? 0u : 7u, out.vec[i]);
+            for (unsigned i = 0; i < o.plan.n_seg; i++) {
+                sum += o.plan.dur[i];
+                if (i > 0 && o.plan.dur[i] > 0) {
+                    TEST_ASSERT_EQUAL_UINT8((v % 2u) == 1u ? 0u : 7u, o.plan.vec[i]);
                 }
             }
             TEST_ASSERT_EQUAL_INT64(FX_ONE, sum);
-            TEST_ASSERT_EQUAL_INT32(s->last_duty, out.dur[0]);
+            TEST_ASSERT_EQUAL_INT32(s->last_duty, o.plan.dur[0]);
         }
     }
 }
@@ -355,26 +353,24 @@ static void test_pred_516(void)
     ctrl_estimate_t est;
     fill_est(&est, 0.3, 1.02, 0.2, 0.25);
     ctrl_refs_t ref = {q(0.22), 0};
-    ctrl_plan_t applied;
-    ctrl_plan_active_zero(&applied, 3, q(0.35));
-    ctrl_ctx_t ctx = {&P, &est, &ref, &applied};
-    ctrl_plan_t out;
+    ctrl_ctx_t ctx = {&P, &est, &ref};
+    ctrl_out_t o;
+    /* V3 for 0.35 of [k, k+1): the vector and duty this controller chose at k-1. */
     s->vec_sel = 3;
+    s->last_duty = q(0.35);
     s->dt_sel = q(0.1);
-    ctrl_drr_step(s, &ctx, &out);
+    ctrl_drr_step(s, &ctx, &o);
     const double pred = d(est.now.torque) + 0.35 * 0.1 - 0.65 * d(s->kb) * 0.25;
     TEST_ASSERT_INT_WITHIN(4, q(pred), fx_sub(s->last_tvref, s->last_terr));
     /* The stored Delta T of the new vector is (5.6)/(5.7) at the predicted flux. */
     const ctrl_mstate_t *nx = &est.next;
-    q24_t ux;
-    q24_t uy;
-    ctrl_drr_unit(out.vec[0], &ux, &uy);
+    const q24_t ux = ctrl_vec_dir_q24[o.plan.vec[0]][0];
+    const q24_t uy = ctrl_vec_dir_q24[o.plan.vec[0]][1];
     const double cr = (d(nx->psi_alpha) * d(uy) - d(nx->psi_beta) * d(ux)) / d(nx->psi_amp);
     TEST_ASSERT_DOUBLE_WITHIN(8 * LSB, d(s->a) * cr - d(s->kb) * 0.25, d(s->dt_sel));
-    /* A plan that is not the stored vector counts as a zero vector: T(k) - B w / w_rn. */
-    ctrl_plan_single(&applied, 0);
-    s->vec_sel = 3;
-    ctrl_drr_step(s, &ctx, &out);
+    /* No active vector chosen at k-1 (after reset): a zero vector, T(k) - B w / w_rn. */
+    s->vec_sel = 0;
+    ctrl_drr_step(s, &ctx, &o);
     TEST_ASSERT_INT_WITHIN(4, q(d(est.now.torque) - d(s->kb) * 0.25),
                            fx_sub(s->last_tvref, s->last_terr));
 }
@@ -429,39 +425,32 @@ static void test_descriptors(void)
             TEST_ASSERT_TRUE(desc->tunables[k].offset + sizeof(double) <= desc->cfg_size);
         }
         make(names[i], NULL);
-        /* wrong params (another fs): the cfg is for this machine, still OK */
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(NULL, CFG, &P));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, NULL, &P));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, NULL));
-        /* cfg made for another machine */
-        desc->cfg_default(CFG, &ini_thesis_ipmsm80);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
-        /* cfg_default without a machine: init refuses */
-        desc->cfg_default(CFG, NULL);
-        TEST_ASSERT_NOT_EQUAL(CTRL_OK, desc->init(STATE, CFG, &P));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, NULL, CFG, &SU));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, NULL, &SU));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, CFG, NULL));
         /* NULL context: a zero-vector plan, no crash */
         make(names[i], NULL);
-        ctrl_plan_t out;
-        desc->step(STATE, NULL, &out);
-        TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
-        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
-        desc->step(STATE, NULL, NULL);
-        desc->reset(NULL);
+        ctrl_out_t o;
+        ctrl_step(desc, STATE, NULL, &o);
+        TEST_ASSERT_EQUAL_UINT8(1, o.plan.n_seg);
+        TEST_ASSERT_EQUAL_UINT8(0, o.plan.vec[0]);
+        ctrl_step(desc, STATE, NULL, NULL);
+        ctrl_reset(desc, NULL);
     }
     const ctrl_desc_t *desc = ctrl_find("drr");
     desc->cfg_default(CFG, &ini_thesis_spmsm);
     bad_lambda(CFG);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, CFG, &SU));
     desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_cfg_t *)CFG)->c = 1.0; /* C must be < 0 */
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, CFG, &SU));
     desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_cfg_t *)CFG)->sigma = NAN;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, CFG, &SU));
     desc = ctrl_find("drr_d1");
     desc->cfg_default(CFG, &ini_thesis_spmsm);
     ((ctrl_drr_base_cfg_t *)CFG)->c_t_nm = 0.0;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(desc, STATE, CFG, &SU));
 }
 
 /* ---- Tunables by name (SI): the thesis' Table 5.1 values A = 1.27, B = 1.02 N*m
@@ -479,7 +468,7 @@ static void test_tunables_by_name(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(desc, CFG, "lambda", 1.5));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(desc, CFG, "sigma", 1.0));
     TEST_ASSERT_EQUAL_INT(CTRL_ENOENT, ctrl_tunable_set(desc, CFG, "no_such", 1.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, desc->init(STATE, CFG, &P));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(desc, STATE, CFG, &SU));
     const ctrl_drr_state_t *s = (const ctrl_drr_state_t *)STATE;
     TEST_ASSERT_INT_WITHIN(1, q(1.27 / BASES.torque_nm), s->a);
     const double w_rn_pu = 2.0 * PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
@@ -498,7 +487,7 @@ static void test_tunables_by_name(void)
         desc->cfg_default(CFG, &ini_thesis_spmsm);
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(desc, CFG, first[i], &v));
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(desc, CFG, first[i], v));
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, desc->init(STATE, CFG, &P));
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(desc, STATE, CFG, &SU));
     }
     /* Table 5.1 defaults for the thesis SPMSM */
     desc = ctrl_find("drr_d1");

@@ -1,12 +1,13 @@
 /*
- * The interrupt's fast forms against the forms they replace (no plant, runs
- * on the host and in QEMU):
- *  - fw_legs_fast / fw_legs_from_plan (firmware/legs_fast.h) against
- *    ctrl_plan_to_legs for every vector pair (and bad indices), every n_seg
- *    and random, edge and out-of-range durations;
+ * The interrupt's fast forms against the straightforward forms they replace,
+ * kept here as the oracles (no plant, runs on the host and in QEMU):
+ *  - ctrl_plan_legs (plan.h) against the plain per-segment sum for every
+ *    vector pair (and bad indices), every n_seg and random, edge and
+ *    out-of-range durations;
  *  - fw_pwm_compare8 (one UMULL) against the 64-bit rounding of compare values;
- *  - fw_protect_current_fast against the saturating |i_a|, |i_b|,
- *    |-(i_a + i_b)| > i_max test, for limits inside and outside its fast range;
+ *  - fw_protect_current against the saturating |i_a|, |i_b|,
+ *    |-(i_a + i_b)| > i_max test for every limit fw_protect_init takes (and
+ *    the refusal of the others);
  *  - fw_protect_encoder (jump test without 64-bit arithmetic, rate without a
  *    division) against the original per-move Q16.16 rate and 64-bit jump test,
  *    on random count sequences (steady, stops, jumps, the 2^32 wrap).
@@ -16,7 +17,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "legs_fast.h"
+#include "fw_pwm.h"
 #include "plan.h"
 #include "protect.h"
 #include "unity.h"
@@ -59,13 +60,33 @@ static q24_t rnd_dur(void)
     return (q24_t)(rnd() % ((uint32_t)FX_ONE + 1u));
 }
 
+/* The oracle: each on-time clamped to [0, FX_ONE], summed per leg over the
+ * segments whose vector has that leg high (Table 4.2; indices > 7: no leg),
+ * at most CTRL_PLAN_MAX_SEG segments, each sum capped at FX_ONE. */
+static void ref_plan_to_legs(const ctrl_plan_t *p, ctrl_legs_t *legs)
+{
+    static const uint8_t mask[8] = {0u, 1u, 3u, 2u, 6u, 4u, 5u, 7u};
+    int32_t acc[3] = {0, 0, 0};
+    const unsigned n = p->n_seg < CTRL_PLAN_MAX_SEG ? p->n_seg : CTRL_PLAN_MAX_SEG;
+    for (unsigned i = 0u; i < n; i++) {
+        const q24_t dur = fx_clamp(p->dur[i], 0, FX_ONE);
+        const unsigned m = p->vec[i] <= 7u ? mask[p->vec[i]] : 0u;
+        for (unsigned x = 0u; x < 3u; x++) {
+            acc[x] += ((m >> x) & 1u) != 0u ? dur : 0;
+        }
+    }
+    for (unsigned x = 0u; x < 3u; x++) {
+        legs->duty[x] = fx_min(acc[x], FX_ONE);
+    }
+}
+
 static void legs_check(const ctrl_plan_t *p)
 {
     ctrl_legs_t want;
     ctrl_legs_t got;
-    ctrl_plan_to_legs(p, &want);
+    ref_plan_to_legs(p, &want);
     memset(&got, 0x5A, sizeof got);
-    fw_legs_from_plan(p, &got);
+    ctrl_plan_legs(p, &got);
     for (int x = 0; x < 3; x++) {
         if (want.duty[x] != got.duty[x]) {
             char msg[160];
@@ -74,15 +95,6 @@ static void legs_check(const ctrl_plan_t *p)
             TEST_ASSERT_EQUAL_INT32_MESSAGE(want.duty[x], got.duty[x], msg);
         }
     }
-    /* The fast form takes every plan of one to four segments with on-times
-     * in [0, FX_ONE] (those used), and nothing else. */
-    ctrl_legs_t tmp;
-    const bool fast = fw_legs_fast(p, &tmp);
-    bool in = p->n_seg >= 1u && p->n_seg <= 4u;
-    for (unsigned i = 0; in && i < p->n_seg; i++) {
-        in = p->dur[i] >= 0 && p->dur[i] <= FX_ONE;
-    }
-    TEST_ASSERT_EQUAL_INT(in, fast);
 }
 
 static void test_legs_every_pair(void)
@@ -123,8 +135,14 @@ static void test_legs_helper_plans(void)
             ctrl_plan_single(&p, v);
             legs_check(&p);
             /* Two active vectors and a zero vector (SVM-like). */
-            const q24_t d2 = (q24_t)(rnd() % (FX_ONE + 1u));
-            ctrl_plan_two_active(&p, v, d, (uint8_t)(1u + rnd() % 6u), d2);
+            const q24_t d2 = (q24_t)(rnd() % ((uint32_t)(FX_ONE - d) + 1u));
+            p.n_seg = 3u;
+            p.vec[0] = v;
+            p.dur[0] = d;
+            p.vec[1] = (uint8_t)(1u + rnd() % 6u);
+            p.dur[1] = d2;
+            p.vec[2] = ctrl_zero_after(v);
+            p.dur[2] = FX_ONE - d - d2;
             legs_check(&p);
         }
     }
@@ -179,18 +197,22 @@ static q24_t near(q24_t lim)
 
 static void test_current_fast(void)
 {
-    static const q24_t lims[] = {
-        0,         1,  FX_ONE / 2, FX_ONE * 3, 1 << 30, (1 << 30) + 1, INT32_MAX - 1,
-        INT32_MAX, -1, INT32_MIN,  123456789};
+    static const q24_t bad[] = {(1 << 30) + 1, INT32_MAX - 1, INT32_MAX, -1, INT32_MIN};
+    for (size_t l = 0; l < sizeof bad / sizeof bad[0]; l++) {
+        fw_protect_cfg_t cfg = {bad[l], FX_ONE, 0, 5, 8, 65536, 0u, 0u};
+        fw_protect_t p;
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, fw_protect_init(&p, &cfg));
+    }
+    static const q24_t lims[] = {0, 1, FX_ONE / 2, FX_ONE * 3, 1 << 30, 123456789};
     for (size_t l = 0; l < sizeof lims / sizeof lims[0]; l++) {
         fw_protect_cfg_t cfg = {lims[l], FX_ONE, 0, 5, 8, 65536, 0u, 0u};
         fw_protect_t p;
-        fw_protect_init(&p, &cfg);
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, fw_protect_init(&p, &cfg));
         for (int r = 0; r < 20000; r++) {
             const q24_t a = (r & 1) != 0 ? near(lims[l]) : rnd_i32();
             const q24_t b = (r & 2) != 0 ? near(lims[l]) : rnd_i32();
             const uint32_t want = ref_current(lims[l], a, b);
-            if (fw_protect_current_fast(&p, a, b) != want || fw_protect_current(&p, a, b) != want) {
+            if (fw_protect_current(&p, a, b) != want) {
                 char msg[120];
                 snprintf(msg, sizeof msg, "lim %ld i_a %ld i_b %ld", (long)lims[l], (long)a,
                          (long)b);
@@ -277,7 +299,7 @@ static void test_encoder_fast(void)
             for (size_t s = 0; s < sizeof stucks / sizeof stucks[0]; s++) {
                 fw_protect_cfg_t cfg = {FX_ONE, FX_ONE, 0, jumps[j], stucks[s], rmins[r], 0u, 0u};
                 fw_protect_t p;
-                fw_protect_init(&p, &cfg);
+                TEST_ASSERT_EQUAL_INT(CTRL_OK, fw_protect_init(&p, &cfg));
                 ref_enc_t ref;
                 memset(&ref, 0, sizeof ref);
                 uint32_t c = rnd();
@@ -312,7 +334,7 @@ static void test_deadline_watchdog_limits(void)
     for (size_t l = 0; l < sizeof lims / sizeof lims[0]; l++) {
         fw_protect_cfg_t cfg = {FX_ONE, FX_ONE, 0, 5, 8, 65536, lims[l], lims[l]};
         fw_protect_t p;
-        fw_protect_init(&p, &cfg);
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, fw_protect_init(&p, &cfg));
         static const uint32_t el[] = {0u, 1u, 2u, 999u, 1000u, 1001u, UINT32_MAX - 1u, UINT32_MAX};
         for (size_t e = 0; e < sizeof el / sizeof el[0]; e++) {
             const uint32_t want =

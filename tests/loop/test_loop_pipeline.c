@@ -23,12 +23,11 @@ void tearDown(void)
 }
 
 /* ---- open-loop test controller: V(1 + k mod 6) for duty (k mod 4 + 1)/8,
- * recording what it was given as "applied" ---- */
+ * recording its plans ---- */
 #define OL_HIST 16
 typedef struct {
     uint32_t k;
     ctrl_plan_t out[OL_HIST];
-    ctrl_plan_t applied[OL_HIST];
 } ol_state_t;
 
 static void ol_cfg_default(void *cfg, const ctrl_machine_t *m)
@@ -36,10 +35,10 @@ static void ol_cfg_default(void *cfg, const ctrl_machine_t *m)
     (void)cfg;
     (void)m;
 }
-static int ol_init(void *state, const void *cfg, const ctrl_params_t *p)
+static int ol_init(void *state, const void *cfg, const ctrl_setup_t *su)
 {
     (void)cfg;
-    (void)p;
+    (void)su;
     memset(state, 0, sizeof(ol_state_t));
     return CTRL_OK;
 }
@@ -47,34 +46,38 @@ static void ol_reset(void *state)
 {
     memset(state, 0, sizeof(ol_state_t));
 }
-static void ol_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+static void ol_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
+    (void)ctx;
     ol_state_t *s = (ol_state_t *)state;
-    ctrl_plan_active_zero(out, (uint8_t)(1u + s->k % 6u), (q24_t)((s->k % 4u + 1u) * (FX_ONE / 8)));
+    ctrl_plan_active_zero(&out->plan, (uint8_t)(1u + s->k % 6u),
+                          (q24_t)((s->k % 4u + 1u) * (FX_ONE / 8)));
     if (s->k < OL_HIST) {
-        s->out[s->k] = *out;
-        s->applied[s->k] = *ctx->applied;
+        s->out[s->k] = out->plan;
     }
     s->k++;
 }
-static const ctrl_desc_t ol_desc = {"test_ol", "open-loop test sequence",
-                                    20000u,    sizeof(ol_state_t),
-                                    8u,        NULL,
-                                    0u,        ol_cfg_default,
-                                    ol_init,   ol_reset,
-                                    ol_step,   0u};
+static const ctrl_desc_t ol_desc = {
+    .name = "test_ol",
+    .title = "open-loop test sequence",
+    .fs_default_hz = 20000u,
+    .state_size = sizeof(ol_state_t),
+    .cfg_size = 8u,
+    .cfg_default = ol_cfg_default,
+    .init = ol_init,
+    .reset = ol_reset,
+    .step = ol_step,
+};
 
-static void plans_equal(const ctrl_plan_t *a, const ctrl_plan_t *b)
+static void legs_equal(const ctrl_legs_t *a, const ctrl_legs_t *b)
 {
-    TEST_ASSERT_EQUAL_UINT8(a->n_seg, b->n_seg);
-    for (unsigned i = 0; i < a->n_seg; i++) {
-        TEST_ASSERT_EQUAL_UINT8(a->vec[i], b->vec[i]);
-        TEST_ASSERT_EQUAL_INT32(a->dur[i], b->dur[i]);
+    for (unsigned x = 0; x < 3u; x++) {
+        TEST_ASSERT_EQUAL_INT32(a->duty[x], b->duty[x]);
     }
 }
 
 /* The plan chosen at k is applied by the PWM in period k+1 and handed to the
- * estimator/controller as "applied" at k+1. */
+ * estimator as the applied leg duties at k+1. */
 static void test_one_period_delay(void)
 {
     TEST_ASSERT_TRUE(sizeof(ol_state_t) <= CTRL_STATE_MAX);
@@ -85,24 +88,27 @@ static void test_one_period_delay(void)
     loop_start(&run, &c);
     const uint32_t n = run.hal.period_counts;
     TEST_ASSERT_EQUAL_UINT32(2500u, n); /* 100 MHz / (2 * 20 kHz) */
-    for (int k = 0; k < OL_HIST; k++) {
-        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-    }
+    /* First step after arm: the gates were off, nothing applied (all legs low). */
+    const ctrl_legs_t none = {{0, 0, 0}};
+    legs_equal(&none, &run.fw.applied);
     const ol_state_t *s = (const ol_state_t *)fw_ctrl_state(&run.fw);
-    TEST_ASSERT_EQUAL_STRING("none", fw_fault_name(fw_fault(&run.fw)));
-    TEST_ASSERT_EQUAL_UINT32(OL_HIST, s->k);
-    /* First step after arm: the gates were off, nothing applied (zero vector). */
-    TEST_ASSERT_EQUAL_UINT8(0u, s->applied[0].vec[0]);
-    for (uint32_t k = 1; k < OL_HIST; k++) {
-        plans_equal(&s->out[k - 1u], &s->applied[k]);
+    for (uint32_t k = 0; k < OL_HIST; k++) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+        /* After period k the duties of the plan chosen at k are the applied
+         * ones of period k+1. */
+        TEST_ASSERT_EQUAL_UINT32(k + 1u, s->k);
+        ctrl_legs_t want;
+        ctrl_plan_legs(&s->out[k], &want);
+        legs_equal(&want, &run.fw.applied);
     }
+    TEST_ASSERT_EQUAL_STRING("none", fw_fault_name(fw_fault(&run.fw)));
     /* The compare values active in the last period realise the plan chosen one
      * period earlier: V(x) with duty d -> legs of Table 4.2 at d*N counts. */
     hal_pwm_t act;
     hal_sim_pwm_active(&run.hal, &act);
     const ctrl_plan_t *p = &s->out[s->k - 2u];
     ctrl_legs_t legs;
-    ctrl_plan_to_legs(p, &legs);
+    ctrl_plan_legs(p, &legs);
     for (int x = 0; x < 3; x++) {
         const uint32_t want = (uint32_t)(((uint64_t)(uint32_t)legs.duty[x] * n + (1u << 23)) >> 24);
         TEST_ASSERT_EQUAL_UINT32(want, act.cmp[x]);
@@ -196,7 +202,7 @@ static void test_protect_checks(void)
     fw_protect_cfg_t cfg = {FX_ONE / 2, FX_ONE + FX_ONE / 4, FX_ONE * 7 / 10, 5, 8, 65536, 1000u,
                             10u};
     fw_protect_t p;
-    fw_protect_init(&p, &cfg);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, fw_protect_init(&p, &cfg));
     TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_current(&p, FX_ONE / 4, -FX_ONE / 4));
     TEST_ASSERT_EQUAL_UINT32(FW_FAULT_OVERCURRENT, fw_protect_current(&p, FX_ONE / 2 + 1, 0));
     /* i_c = -(i_a + i_b) is checked too. */

@@ -101,7 +101,7 @@ static void test_instruction_counts(void)
     static unsigned char state[NC][CTRL_STATE_MAX] __attribute__((aligned(8)));
     static unsigned char cfg[NC][CTRL_CFG_MAX] __attribute__((aligned(8)));
     const ctrl_desc_t *d[NC];
-    ctrl_plan_t applied[NC];
+    ctrl_legs_t applied[NC];
     stat_t st_est = {0, 0, 0};
     stat_t st_legs = {0, 0, 0};
     stat_t st_step[NC];
@@ -112,8 +112,9 @@ static void test_instruction_counts(void)
         d[c] = ctrl_find(names[c]);
         TEST_ASSERT_NOT_NULL(d[c]);
         d[c]->cfg_default(cfg[c], &ini_thesis_spmsm);
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, d[c]->init(state[c], cfg[c], &p));
-        ctrl_plan_single(&applied[c], 0u);
+        const ctrl_setup_t su = {&ini_thesis_spmsm, &b, &p};
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d[c], state[c], cfg[c], &su));
+        memset(&applied[c], 0, sizeof applied[c]);
     }
     ctrl_estimator_t e;
     ctrl_estimator_init(&e, &p);
@@ -143,13 +144,12 @@ static void test_instruction_counts(void)
         const double n_est = instr(t1 - t0);
         stat_add(&st_est, n_est);
         for (int c = 0; c < NC; c++) {
-            const ctrl_ctx_t ctx = {&p, &est, &ref, &applied[c]};
-            ctrl_plan_t out;
-            ctrl_legs_t legs;
+            const ctrl_ctx_t ctx = {&p, &est, &ref};
+            ctrl_out_t out;
             t0 = timer1_read();
             d[c]->step(state[c], &ctx, &out);
             t1 = timer1_read();
-            ctrl_plan_to_legs(&out, &legs);
+            ctrl_out_legs(&out);
             const uint32_t t2 = timer1_read();
             const double n_step = instr(t1 - t0);
             const double n_legs = instr(t2 - t1);
@@ -158,7 +158,7 @@ static void test_instruction_counts(void)
                 stat_add(&st_legs, n_legs);
             }
             stat_add(&st_pipe[c], n_est + n_step + n_legs);
-            applied[c] = out;
+            applied[c] = out.legs;
         }
     }
     /* Integer output: the target's printf has no floating point. */

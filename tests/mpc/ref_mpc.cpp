@@ -236,11 +236,12 @@ static void run_model(const ctrl_machine_t &mach, uint32_t fs, double *e_t, doub
     ctrl_params_t p;
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &mach, fs));
+    const ctrl_setup_t su{&mach, &b, &p};
     const RefMachine rm(mach, fs);
     ctrl_m2ptfc_t s;
     ctrl_m2ptfc_cfg_t cfg;
     ctrl_desc_m2ptfc.cfg_default(&cfg, &mach);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(&ctrl_desc_m2ptfc, &s, &cfg, &su));
     for (int n = 0; n < N_POINTS; n++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
@@ -288,22 +289,23 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, double centre, S
     ctrl_params_t p;
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &mach, fs));
+    const ctrl_setup_t su{&mach, &b, &p};
     const RefMachine rm(mach, fs);
     ctrl_m2ptfc_t s;
     ctrl_m2ptfc_cfg_t cfg;
     ctrl_desc_m2ptfc.cfg_default(&cfg, &mach);
     cfg.centre = centre;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(&ctrl_desc_m2ptfc, &s, &cfg, &su));
     for (int n = 0; n < N_POINTS; n++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         random_point(p, est, ref);
-        const ctrl_plan_t applied = {1u, {1u, 0u, 0u, 0u}, {FX_ONE, 0, 0, 0}};
         s.sigma = ctrl_q24_from_double(uni(-0.03, 0.03) * d24(p.torque_rated));
         const double sigma_old = d24(s.sigma);
-        ctrl_plan_t out;
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        ctrl_desc_m2ptfc.step(&s, &ctx, &out);
+        ctrl_out_t out_o;
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        ctrl_desc_m2ptfc.step(&s, &ctx, &out_o);
+        const ctrl_plan_t &out = out_o.plan;
         st.decisions++;
 
         const RefPoint rp(rm, est);
@@ -394,12 +396,13 @@ static void run_weighted(Kind kind, const ctrl_machine_t &mach, uint32_t fs, Sta
     ctrl_params_t p;
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &mach, fs));
+    const ctrl_setup_t su{&mach, &b, &p};
     const RefMachine rm(mach, fs);
     alignas(8) unsigned char state[CTRL_STATE_MAX], cfg[CTRL_CFG_MAX];
     d->cfg_default(cfg, &mach);
     double zeta_si = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(d, cfg, "zeta", &zeta_si));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(state, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d, state, cfg, &su));
     if (zeta_si == 0.0) {
         zeta_si = mach.torque_rated_nm / mach.psi_pm_wb; /* 0 = equal importance (6.5) */
     }
@@ -408,10 +411,10 @@ static void run_weighted(Kind kind, const ctrl_machine_t &mach, uint32_t fs, Sta
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         random_point(p, est, ref);
-        const ctrl_plan_t applied = {1u, {2u, 0u, 0u, 0u}, {FX_ONE, 0, 0, 0}};
-        ctrl_plan_t out;
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        d->step(state, &ctx, &out);
+        ctrl_out_t out_o;
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        d->step(state, &ctx, &out_o);
+        const ctrl_plan_t &out = out_o.plan;
         st.decisions++;
 
         const RefPoint rp(rm, est);
@@ -540,21 +543,22 @@ static void run_m2(const ctrl_machine_t &mach, uint32_t fs, Stats &st)
     ctrl_params_t p;
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &mach, fs));
+    const ctrl_setup_t su{&mach, &b, &p};
     const RefMachine rm(mach, fs);
     ctrl_m2_t s;
     ctrl_m2_cfg_t cfg;
     ctrl_desc_m2.cfg_default(&cfg, &mach);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2.init(&s, &cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(&ctrl_desc_m2, &s, &cfg, &su));
     const double eps = cfg.eps_psi / rm.psi_base;
     const int y = (int)cfg.y;
     for (int n = 0; n < N_POINTS; n++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         random_point(p, est, ref);
-        const ctrl_plan_t applied = {1u, {3u, 0u, 0u, 0u}, {FX_ONE, 0, 0, 0}};
-        ctrl_plan_t out;
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        ctrl_desc_m2.step(&s, &ctx, &out);
+        ctrl_out_t out_o;
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        ctrl_desc_m2.step(&s, &ctx, &out_o);
+        const ctrl_plan_t &out = out_o.plan;
         st.decisions++;
 
         const RefPoint rp(rm, est);

@@ -29,6 +29,7 @@
 #include "ctrl_m3.h"
 #include "ctrl_mptfc.h"
 #include "mpc_machines.h"
+#include "mtpa.h"
 #include "plan.h"
 #include "predict.h"
 #include "unity.h"
@@ -73,10 +74,21 @@ static q24_t q24(double x)
     return ctrl_q24_from_double(x);
 }
 
+/* The machine and bases of the last params_for (for init's setup). */
+static const ctrl_machine_t *g_machine;
+static ctrl_bases_t g_bases;
+
 static void params_for(const ctrl_machine_t *m, uint32_t fs, ctrl_params_t *p)
 {
-    ctrl_bases_t b;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(p, &b, m, fs));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(p, &g_bases, m, fs));
+    g_machine = m;
+}
+
+/* ctrl_init with the setup of the last params_for and these params. */
+static int init_for(const ctrl_desc_t *d, void *state, const void *cfg, const ctrl_params_t *p)
+{
+    const ctrl_setup_t su = {g_machine, &g_bases, p};
+    return ctrl_init(d, state, cfg, &su);
 }
 
 /* A random operating point: rotor angle anywhere (all sectors), current up to
@@ -117,7 +129,7 @@ static void predict2(const ctrl_params_t *p, const ctrl_estimate_t *est, uint8_t
 
 static double psi_ref_of(const ctrl_params_t *p, const ctrl_refs_t *ref)
 {
-    return d24(ctrl_mpc_psi_ref(p, ref));
+    return d24(ctrl_flux_ref(p, ref->psi, ref->torque));
 }
 
 /* ---------------------------------------------------------------- (6.7) */
@@ -237,19 +249,20 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs, double centre)
     TEST_ASSERT_TRUE(d->state_size == sizeof s);
     d->cfg_default(cfg, m);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(d, cfg, "centre", centre));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(&s, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(d, &s, cfg, &p));
     int checked_duty = 0;
     int checked_set = 0;
     for (int i = 0; i < N_RANDOM; i++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         ctrl_plan_t applied;
-        ctrl_plan_t out;
+        ctrl_out_t out_o;
         random_point(&p, &est, &ref, &applied);
         const double sigma_old = rng_uniform(-0.03, 0.03) * d24(p.torque_rated);
         s.sigma = q24(sigma_old);
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        d->step(&s, &ctx, &out);
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        d->step(&s, &ctx, &out_o);
+        const ctrl_plan_t out = out_o.plan;
         TEST_ASSERT_EQUAL_UINT8(2, s.trace.n);
         /* Te of (6.5)-(6.8): Te(k+1), with centre + half the zero-vector change. */
         ctrl_mstate_t zero;
@@ -344,15 +357,16 @@ static void check_weighted(const ctrl_machine_t *m, uint32_t fs, const ctrl_desc
     params_for(m, fs, &p);
     uint8_t cfg[CTRL_CFG_MAX];
     d->cfg_default(cfg, m);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(state, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(d, state, cfg, &p));
     for (int i = 0; i < N_RANDOM; i++) {
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         ctrl_plan_t applied;
-        ctrl_plan_t out;
+        ctrl_out_t out_o;
         random_point(&p, &est, &ref, &applied);
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        d->step(state, &ctx, &out);
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        d->step(state, &ctx, &out_o);
+        const ctrl_plan_t out = out_o.plan;
         const q24_t z = *zeta; /* as initialised from the SI tunable */
         ctrl_mstate_t zero;
         predict2(&p, &est, 0u, 0, &zero);
@@ -421,7 +435,7 @@ static void test_m2_band_and_argmin(void)
     uint8_t cfg[CTRL_CFG_MAX];
     ctrl_m2_t s;
     ctrl_desc_m2.cfg_default(cfg, &ini_thesis_spmsm);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2.init(&s, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2, &s, cfg, &p));
     TEST_ASSERT_EQUAL_UINT8(4, s.y);
     const double eps = d24(s.eps_psi);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 6.60e-3 / ini_thesis_spmsm.psi_pm_wb, eps);
@@ -429,10 +443,11 @@ static void test_m2_band_and_argmin(void)
         ctrl_estimate_t est;
         ctrl_refs_t ref;
         ctrl_plan_t applied;
-        ctrl_plan_t out;
+        ctrl_out_t out_o;
         random_point(&p, &est, &ref, &applied);
-        const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
-        ctrl_desc_m2.step(&s, &ctx, &out);
+        const ctrl_ctx_t ctx = {&p, &est, &ref};
+        ctrl_desc_m2.step(&s, &ctx, &out_o);
+        const ctrl_plan_t out = out_o.plan;
         TEST_ASSERT_EQUAL_UINT8(5, s.trace.n);
         uint8_t cv;
         q24_t cd;
@@ -516,14 +531,14 @@ static void test_zeta_in_pu(void)
     ctrl_m1_t s;
     ctrl_desc_m1.cfg_default(cfg, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 250.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m1, &s, cfg, &p));
     const double t_base = 1.5 * 4.0 * 0.09427 * 0.09427 / 6.552e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-5, 250.0 * 0.09427 / t_base, d24(s.zeta));
     /* zeta = 0: T_rated / psi_pm (6.5): 2133 N*m/Wb for the 80 kW IPMSM. */
     params_for(&ini_thesis_ipmsm80, 20000u, &p);
     ctrl_desc_m1.cfg_default(cfg, &ini_thesis_ipmsm80);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(&ctrl_desc_m1, cfg, "zeta", 0.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m1.init(&s, cfg, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m1, &s, cfg, &p));
     const double t_base80 = 1.5 * 4.0 * 0.1875 * 0.1875 / 0.6e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-5, 400.0 / 0.1875 * 0.1875 / t_base80, d24(s.zeta));
 }
@@ -535,25 +550,21 @@ static void test_bad_input(void)
     ctrl_m2ptfc_cfg_t c;
     ctrl_m2ptfc_t s;
     ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(NULL, &c, &p));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, NULL, &p));
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, NULL));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, NULL, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, NULL, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, &c, NULL));
     c.lambda = 0.0;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
     c.lambda = NAN;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
     c.lambda = 0.03;
     c.centre = 0.5; /* 0 or 1 only */
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
     c.centre = 1.0;
     c.model.ld_h = -1.0;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
     c.model.ld_h = 0.0;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
-    /* cfg_default without a machine: model overrides cannot be scaled. */
-    ctrl_desc_m2ptfc.cfg_default(&c, NULL);
-    c.model.ld_h = 1e-3;
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
 }
 
 /* Every chapter-6 descriptor: NULL state / cfg / params refused, NaN and
@@ -570,34 +581,35 @@ static void test_bad_input_all(void)
     static _Alignas(16) uint8_t cfg[CTRL_CFG_MAX];
     for (size_t i = 0; i < sizeof descs / sizeof descs[0]; i++) {
         const ctrl_desc_t *d = descs[i];
-        d->cfg_default(NULL, &ini_thesis_spmsm);
-        d->reset(NULL);
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_cfg_default(d, NULL, &ini_thesis_spmsm));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_cfg_default(d, cfg, NULL));
+        ctrl_reset(d, NULL);
         d->cfg_default(cfg, &ini_thesis_spmsm);
-        TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_OK, d->init(st, cfg, &p), d->name);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(NULL, cfg, &p));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, NULL, &p));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, NULL));
+        TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_OK, init_for(d, st, cfg, &p), d->name);
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(d, NULL, cfg, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(d, st, NULL, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, init_for(d, st, cfg, NULL));
         for (size_t k = 0; k < d->n_tunables; k++) {
             const ctrl_tunable_t *t = &d->tunables[k];
             const double bad[3] = {NAN, t->max * 2.0 + 1.0, t->min - 1.0};
             for (int b = 0; b < 3; b++) {
                 d->cfg_default(cfg, &ini_thesis_spmsm);
                 memcpy(cfg + t->offset, &bad[b], sizeof bad[b]);
-                const int rc = d->init(st, cfg, &p);
+                const int rc = init_for(d, st, cfg, &p);
                 TEST_ASSERT_TRUE_MESSAGE(rc == CTRL_EINVAL || rc == CTRL_ERANGE, t->name);
             }
         }
         d->cfg_default(cfg, &ini_thesis_spmsm);
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(st, cfg, &p));
-        ctrl_plan_t out;
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(d, st, cfg, &p));
+        ctrl_out_t out;
         memset(&out, 0xA5, sizeof out);
-        d->step(st, NULL, &out);
-        TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
-        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
-        d->step(st, NULL, NULL);
-        const ctrl_ctx_t no_est = {&p, NULL, NULL, NULL};
-        d->step(st, &no_est, &out);
-        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
+        ctrl_step(d, st, NULL, &out);
+        TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg);
+        TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
+        ctrl_step(d, st, NULL, NULL);
+        const ctrl_ctx_t no_est = {&p, NULL, NULL};
+        ctrl_step(d, st, &no_est, &out);
+        TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
     }
 }
 
@@ -625,7 +637,7 @@ static void test_t_eval(void)
     TEST_ASSERT_EQUAL_INT32(12345, ctrl_m2ptfc_t_eval(&s, 12345, -FX_ONE));
 }
 
-/* ctrl_mpc_psi_ref2 == ctrl_mpc_psi_ref squared within the roundings: the
+/* ctrl_mpc_psi_ref2 == ctrl_flux_ref squared within the roundings: the
  * square of a rounded square root differs by up to 2 |psi| LSB (+1 rounding). */
 static void test_psi_ref2(void)
 {
@@ -637,7 +649,7 @@ static void test_psi_ref2(void)
             ctrl_refs_t ref;
             ref.torque = q24(rng_uniform(-2.0, 2.0) * d24(p.torque_rated));
             ref.psi = (i % 3 == 0) ? q24(rng_uniform(0.5, 1.5)) : 0;
-            const q24_t lin = ctrl_mpc_psi_ref(&p, &ref);
+            const q24_t lin = ctrl_flux_ref(&p, ref.psi, ref.torque);
             const double want = d24(lin) * d24(lin) * 16777216.0;
             const double tol = 2.0 * d24(lin) + 2.0;
             TEST_ASSERT_DOUBLE_WITHIN(tol, want, (double)ctrl_mpc_psi_ref2(&p, &ref));
@@ -657,7 +669,7 @@ static void test_basis3_equals_basis(void)
         ctrl_m2ptfc_cfg_t c;
         ctrl_m2ptfc_t s;
         ctrl_desc_m2ptfc.cfg_default(&c, ms[k]);
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
         for (int i = 0; i < N_RANDOM; i++) {
             ctrl_estimate_t est;
             ctrl_refs_t ref;
@@ -706,7 +718,7 @@ static void test_m2ptfc_psi2_cache(void)
     ctrl_m2ptfc_cfg_t c;
     ctrl_m2ptfc_t s;
     ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &pa));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &pa));
     TEST_ASSERT_NULL(s.psi2_params);
     ctrl_estimate_t est;
     ctrl_refs_t ref;
@@ -728,14 +740,14 @@ static void test_m2ptfc_psi2_cache(void)
         const ctrl_params_t *cached = s.psi2_params;
         const q24_t cached_t = s.psi2_torque;
         const q24_t cached_psi = s.psi2_psi;
-        const ctrl_ctx_t ctx = {p, &est, &ref, &applied};
-        ctrl_plan_t o1;
-        ctrl_plan_t o2;
+        const ctrl_ctx_t ctx = {p, &est, &ref};
+        ctrl_out_t o1;
+        ctrl_out_t o2;
         ctrl_desc_m2ptfc.step(&s, &ctx, &o1);
         ctrl_desc_m2ptfc.step(&fresh, &ctx, &o2);
-        TEST_ASSERT_EQUAL_UINT8(o2.n_seg, o1.n_seg);
-        TEST_ASSERT_EQUAL_UINT8_ARRAY(o2.vec, o1.vec, o1.n_seg);
-        TEST_ASSERT_EQUAL_INT32_ARRAY(o2.dur, o1.dur, o1.n_seg);
+        TEST_ASSERT_EQUAL_UINT8(o2.plan.n_seg, o1.plan.n_seg);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(o2.plan.vec, o1.plan.vec, o1.plan.n_seg);
+        TEST_ASSERT_EQUAL_INT32_ARRAY(o2.plan.dur, o1.plan.dur, o1.plan.n_seg);
         TEST_ASSERT_EQUAL_INT32(fresh.sigma, s.sigma);
         TEST_ASSERT_EQUAL_INT32(ctrl_mpc_psi_ref2(p, &ref), s.psi2);
         TEST_ASSERT_TRUE(s.psi2_params == p);
@@ -756,14 +768,14 @@ static void test_sigma_ema(void)
     ctrl_m2ptfc_t s;
     ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
     c.centre = 0.0; /* Te = Te(k+1): the error below is exactly T_ref - Te */
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_desc_m2ptfc.init(&s, &c, &p));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
     ctrl_estimate_t est;
     ctrl_refs_t ref;
     ctrl_plan_t applied;
-    ctrl_plan_t out;
+    ctrl_out_t out;
     random_point(&p, &est, &ref, &applied);
     ref.torque = fx_add(est.next.torque, FX_ONE / 100);
-    const ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+    const ctrl_ctx_t ctx = {&p, &est, &ref};
     for (int n = 1; n <= 50; n++) {
         ctrl_desc_m2ptfc.step(&s, &ctx, &out);
         const double want = 0.01 * (1.0 - pow(0.97, n));

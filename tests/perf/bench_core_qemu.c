@@ -55,6 +55,7 @@ typedef struct {
     fx_angle_t th;
     uint64_t u64;
     ctrl_plan_t plan;
+    ctrl_legs_t legs; /* of plan */
     ctrl_meas_t meas;
     ctrl_mstate_t now;
 } input_t;
@@ -105,6 +106,7 @@ static void make_inputs(void)
         t->torque = ctrl_q24_from_double((2.0 * urand() - 1.0) * 0.5);
         ctrl_plan_active_zero(&t->plan, (uint8_t)(1u + (rng >> 8) % 6u),
                               ctrl_q24_from_double(urand()));
+        ctrl_plan_legs(&t->plan, &t->legs);
         t->meas.i_a = t->ia;
         t->meas.i_b = t->ib;
         t->meas.vdc = t->vdc;
@@ -169,17 +171,17 @@ __attribute__((noinline)) static void w_angle_step(int k)
 {
     sink = (int32_t)(ctrl_angle_step(&P, in[k].omega) >> 1);
 }
-__attribute__((noinline)) static void w_plan_voltage(int k)
+__attribute__((noinline)) static void w_legs_voltage(int k)
 {
     q24_t a;
     q24_t b;
-    ctrl_plan_voltage(&in[k].plan, in[k].vdc, &a, &b);
+    ctrl_legs_voltage(&in[k].legs, in[k].vdc, &a, &b);
     sink = a + b;
 }
 __attribute__((noinline)) static void w_plan_legs(int k)
 {
     ctrl_legs_t l;
-    ctrl_plan_to_legs(&in[k].plan, &l);
+    ctrl_plan_legs(&in[k].plan, &l);
     sink = l.duty[0] + l.duty[1] + l.duty[2];
 }
 __attribute__((noinline)) static void w_predict_flux(int k)
@@ -224,14 +226,14 @@ __attribute__((noinline)) static void w_mtpa_ipm(int k)
 __attribute__((noinline)) static void w_estimator(int k)
 {
     ctrl_estimate_t est;
-    ctrl_estimator_update(&E, &P, &in[k].meas, &in[k].plan, &est);
+    ctrl_estimator_update(&E, &P, &in[k].meas, &in[k].legs, &est);
     sink = est.next.torque;
 }
 
 __attribute__((noinline)) static void w_estimator_lean(int k)
 {
     ctrl_estimate_t est;
-    ctrl_estimator_update(&E_lean, &P, &in[k].meas, &in[k].plan, &est);
+    ctrl_estimator_update(&E_lean, &P, &in[k].meas, &in[k].legs, &est);
     sink = est.next.torque;
 }
 __attribute__((noinline)) static void w_from_flux_noamp(int k)
@@ -256,8 +258,8 @@ static const bench_t benches[] = {
     {"ctrl_park", w_park},
     {"ctrl_sector", w_sector},
     {"ctrl_angle_step", w_angle_step},
-    {"ctrl_plan_voltage", w_plan_voltage},
-    {"ctrl_plan_to_legs", w_plan_legs},
+    {"ctrl_legs_voltage", w_legs_voltage},
+    {"ctrl_plan_legs", w_plan_legs},
     {"ctrl_predict_flux", w_predict_flux},
     {"ctrl_mstate_from_current", w_from_current},
     {"ctrl_mstate_from_flux_sc", w_from_flux_sc},

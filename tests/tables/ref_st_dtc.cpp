@@ -279,7 +279,8 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
         ref.torque2.h = ref.h_t;
         ref.torque3.h = ref.h_t;
     }
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(state, cfg, &params));
+    const ctrl_setup_t su{&SPMSM, &bases, &params};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d, state, cfg, &su));
     d->reset(state);
     /* bands for the error generator (FST: errors around 0 with a 2 % scale) */
     const double gh_t = kind == FSTK ? 0.02 * params.torque_rated / Q : ref.h_t;
@@ -287,11 +288,9 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
 
     ctrl_estimate_t est;
     ctrl_refs_t refs;
-    ctrl_plan_t applied;
     std::memset(&est, 0, sizeof est);
     std::memset(&refs, 0, sizeof refs);
-    std::memset(&applied, 0, sizeof applied);
-    ctrl_ctx_t ctx{&params, &est, &refs, &applied};
+    ctrl_ctx_t ctx{&params, &est, &refs};
 
     double tref = 0.0;
     double omega = 0.5;
@@ -345,6 +344,7 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
         refs.psi = mtpa ? 0 : q24(psi_ref);
         est.next.psi_alpha = q24(amp * std::cos(th));
         est.next.psi_beta = q24(amp * std::sin(th));
+        est.next.sector = ctrl_sector(est.next.psi_alpha, est.next.psi_beta); /* (4.5) */
         est.next.psi_amp = q24(psi_amp);
         est.next.torque = q24(torque);
         est.omega_e = q24(omega);
@@ -377,11 +377,10 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
                    std::fabs(e_psi) < me;
         }
 
-        ctrl_plan_t out;
+        ctrl_out_t out;
         d->step(state, &ctx, &out);
-        applied = out;
         const int want = ref.step(th, psi_amp, torque, tref, psi_ref, omega);
-        const int got = out.vec[0];
+        const int got = out.plan.vec[0];
         st.samples++;
         (targeted ? st.targeted : st.uniform)++;
         if (near) {

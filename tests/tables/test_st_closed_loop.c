@@ -65,17 +65,17 @@ static loop_result_t run_loop_ex(const char *name, double tref, double omega, in
     static _Alignas(8) unsigned char cfg[CTRL_CFG_MAX];
     static _Alignas(8) unsigned char st[CTRL_STATE_MAX];
     d->cfg_default(cfg, &SPMSM);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(st, cfg, &p));
+    const ctrl_setup_t su = {&SPMSM, &b, &p};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d, st, cfg, &su));
     d->reset(st);
 
     ctrl_mstate_t x;
     ctrl_mstate_from_flux(&p, FX_ONE, 0, 0u, &x); /* rotor flux only, i = 0 */
-    ctrl_plan_t applied;
-    ctrl_plan_single(&applied, 0u);
+    ctrl_legs_t applied = {{0, 0, 0}};
     ctrl_estimate_t est;
     memset(&est, 0, sizeof est);
     ctrl_refs_t ref = {q24(tref), 0}; /* flux reference: MTPA (4.15) */
-    ctrl_ctx_t ctx = {&p, &est, &ref, &applied};
+    ctrl_ctx_t ctx = {&p, &est, &ref};
     const q24_t w = q24(omega);
     const q24_t psi_ref = ctrl_mtpa_psi(&p, ref.torque);
 
@@ -89,13 +89,15 @@ static loop_result_t run_loop_ex(const char *name, double tref, double omega, in
         est.now = x;
         est.omega_e = w;
         est.vdc = p.vdc_nom;
-        ctrl_plan_voltage(&applied, p.vdc_nom, &va, &vb);
+        ctrl_legs_voltage(&applied, p.vdc_nom, &va, &vb);
         ctrl_predict(&p, &x, va, vb, w, &est.next);
-        ctrl_plan_t out;
-        d->step(st, &ctx, &out);
+        ctrl_out_t o;
+        d->step(st, &ctx, &o);
+        ctrl_out_legs(&o);
+        const ctrl_plan_t out = o.plan;
         /* plant: [k, k+1) with the applied plan; then the new plan takes over */
         x = est.next;
-        applied = out;
+        applied = o.legs;
         if (k >= n_settle) {
             const double te = pu(x.torque) - tref;
             const double pe = pu(x.psi_amp) - pu(psi_ref);

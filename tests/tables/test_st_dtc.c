@@ -17,6 +17,7 @@
 #include "st_dtc_config.h"
 #include "thesis_tables.h"
 #include "unity.h"
+#include "vectors.h"
 
 void setUp(void)
 {
@@ -31,27 +32,13 @@ static const ctrl_machine_t SPMSM = {
     "thesis SPMSM", 4,   0.901,  6.552e-3, 6.552e-3, 0.09427, 220.0,
     1.2e-4,         2.4, 3000.0, 4.2,      8.4,      0.0,
 };
-static const ctrl_machine_t IPMSM80 = {
-    "thesis 80 kW IPMSM",
-    4,
-    0.0075,
-    0.6e-3,
-    1.33e-3,
-    0.1875,
-    540.0,
-    0.16526,
-    400.0,
-    3000.0,
-    400.0,
-    600.0,
-    0.1837,
-};
 
 typedef struct {
     ctrl_params_t params;
     ctrl_bases_t bases;
     ctrl_estimate_t est;
     ctrl_refs_t ref;
+    ctrl_setup_t su;
     ctrl_plan_t applied;
     ctrl_ctx_t ctx;
     _Alignas(8) unsigned char state[CTRL_STATE_MAX];
@@ -73,12 +60,12 @@ static void rig_open(const char *name)
     R.d = ctrl_find(name);
     TEST_ASSERT_NOT_NULL(R.d);
     R.d->cfg_default(R.cfg, &SPMSM);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, R.d->init(R.state, R.cfg, &R.params));
+    R.su = (ctrl_setup_t){&SPMSM, &R.bases, &R.params};
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
     R.d->reset(R.state);
     R.ctx.params = &R.params;
     R.ctx.est = &R.est;
     R.ctx.ref = &R.ref;
-    R.ctx.applied = &R.applied;
 }
 
 /* Predicted state at k+1: flux |psi| = amp at angle theta, torque te (pu). The
@@ -95,21 +82,24 @@ static void set_next(double theta, double amp, double te, double omega)
     R.est.now.torque = q24(-te);
     R.est.omega_e = q24(omega);
     R.est.vdc = FX_ONE;
+    /* The sector at k+1 (4.5), as the estimator hands it over. */
+    R.est.next.sector = ctrl_sector(R.est.next.psi_alpha, R.est.next.psi_beta);
+    R.est.now.sector = ctrl_sector(R.est.now.psi_alpha, R.est.now.psi_beta);
 }
 
 static uint8_t g_prev; /* vector of the period before the last step() */
 
 static uint8_t step(void)
 {
-    ctrl_plan_t out;
+    ctrl_out_t out;
     g_prev = R.applied.vec[0];
     memset(&out, 0xA5, sizeof out);
     R.d->step(R.state, &R.ctx, &out);
-    TEST_ASSERT_EQUAL_UINT8(1, out.n_seg); /* one vector for the whole period */
-    TEST_ASSERT_EQUAL_INT32(FX_ONE, out.dur[0]);
-    TEST_ASSERT_TRUE(out.vec[0] <= 7u);
-    R.applied = out;
-    return out.vec[0];
+    TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg); /* one vector for the whole period */
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, out.plan.dur[0]);
+    TEST_ASSERT_TRUE(out.plan.vec[0] <= 7u);
+    R.applied = out.plan;
+    return out.plan.vec[0];
 }
 
 static int legs_changed(uint8_t a, uint8_t b)
@@ -154,33 +144,32 @@ static void test_registry_and_defaults(void)
             }
         }
         _Alignas(8) unsigned char st[CTRL_STATE_MAX];
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, d->init(st, cfg, &p));
+        const ctrl_setup_t su = {&SPMSM, &b, &p};
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d, st, cfg, &su));
         /* bad configuration is refused, never a crash */
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(NULL, cfg, &p));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, NULL, &p));
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, NULL));
+        const ctrl_setup_t no_bases = {&SPMSM, NULL, &p};
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, NULL, cfg, &su));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, st, NULL, &su));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, st, cfg, NULL));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, st, cfg, &no_bases));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(NULL, st, cfg, &su));
         const double bad = d->tunables[0].max * 2.0 + 1.0;
         memcpy(cfg + d->tunables[0].offset, &bad, sizeof bad);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, &p));
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, st, cfg, &su));
         const double nan = NAN;
         memcpy(cfg + d->tunables[0].offset, &nan, sizeof nan);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, &p));
-        /* a configuration made for another machine */
-        d->cfg_default(cfg, &IPMSM80);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, &p));
-        /* no machine: no bases, refused at init */
-        d->cfg_default(cfg, NULL);
-        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, d->init(st, cfg, &p));
-        /* NULL context is not a crash: a zero vector */
-        TEST_ASSERT_EQUAL_INT(CTRL_OK, (d->cfg_default(cfg, &SPMSM), d->init(st, cfg, &p)));
-        ctrl_plan_t out;
-        d->step(st, NULL, &out);
-        TEST_ASSERT_EQUAL_UINT8(1, out.n_seg);
-        TEST_ASSERT_TRUE(out.vec[0] == 0u || out.vec[0] == 7u);
-        d->step(NULL, NULL, &out);
-        TEST_ASSERT_EQUAL_UINT8(0, out.vec[0]);
-        d->step(st, NULL, NULL);
-        d->reset(NULL);
+        TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(d, st, cfg, &su));
+        /* An incomplete context is not a crash: a zero vector. */
+        d->cfg_default(cfg, &SPMSM);
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(d, st, cfg, &su));
+        ctrl_out_t out;
+        ctrl_step(d, st, NULL, &out);
+        TEST_ASSERT_EQUAL_UINT8(1, out.plan.n_seg);
+        TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
+        ctrl_step(d, NULL, NULL, &out);
+        TEST_ASSERT_EQUAL_UINT8(0, out.plan.vec[0]);
+        ctrl_step(d, st, NULL, NULL);
+        ctrl_reset(d, NULL);
     }
 }
 
@@ -197,7 +186,7 @@ static void test_tunables_by_name(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "h_psi", 1e3));
     TEST_ASSERT_EQUAL_INT(CTRL_ENOENT, ctrl_tunable_set(R.d, R.cfg, "sigma", 0.1));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "h_T", 1.0));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, R.d->init(R.state, R.cfg, &R.params));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
     const st_hyst_state_t *s = (const st_hyst_state_t *)R.state;
     TEST_ASSERT_INT32_WITHIN(2, q24(1.0 / R.bases.torque_nm), s->torque3.band);
     /* error of 0.5 N*m: inside the new band, the three-level regulator holds 0 */
@@ -215,7 +204,7 @@ static void test_tunables_by_name(void)
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "sigma", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "dT_step", 0.1));
     TEST_ASSERT_EQUAL_INT(CTRL_ENOENT, ctrl_tunable_set(R.d, R.cfg, "h_T", 0.1));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, R.d->init(R.state, R.cfg, &R.params));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
     const st_fst_state_t *f = (const st_fst_state_t *)R.state;
     TEST_ASSERT_EQUAL_UINT8(0, f->vr.enabled);
     TEST_ASSERT_INT32_WITHIN(2, q24(0.1 / R.bases.torque_nm), f->logic.dt_step);
@@ -339,19 +328,19 @@ static void test_flux_reference(void)
 {
     rig_open("bst");
     ctrl_refs_t ref = {q24(0.5), q24(1.1)};
-    TEST_ASSERT_EQUAL_INT32(q24(1.1), st_psi_reference(&R.params, &ref));
+    TEST_ASSERT_EQUAL_INT32(q24(1.1), ctrl_flux_ref(&R.params, ref.psi, ref.torque));
     ref.psi = 0;
     TEST_ASSERT_EQUAL_INT32(ctrl_mtpa_psi(&R.params, ref.torque),
-                            st_psi_reference(&R.params, &ref));
+                            ctrl_flux_ref(&R.params, ref.psi, ref.torque));
     /* SPMSM (4.15) in pu: sqrt(1 + (Lq T)^2), Lq = 1 pu */
-    TEST_ASSERT_INT32_WITHIN(64, q24(sqrt(1.0 + 0.25)), st_psi_reference(&R.params, &ref));
+    TEST_ASSERT_INT32_WITHIN(64, q24(sqrt(1.0 + 0.25)),
+                             ctrl_flux_ref(&R.params, ref.psi, ref.torque));
     ref.psi = q24(-0.5); /* negative amplitude: ignored */
     TEST_ASSERT_EQUAL_INT32(ctrl_mtpa_psi(&R.params, ref.torque),
-                            st_psi_reference(&R.params, &ref));
+                            ctrl_flux_ref(&R.params, ref.psi, ref.torque));
     ref.psi = 0;
     R.params.psi_ref = q24(0.9);
-    TEST_ASSERT_EQUAL_INT32(q24(0.9), st_psi_reference(&R.params, &ref));
-    TEST_ASSERT_EQUAL_INT32(FX_ONE, st_psi_reference(NULL, &ref)); /* no params: psi_pm */
+    TEST_ASSERT_EQUAL_INT32(q24(0.9), ctrl_flux_ref(&R.params, ref.psi, ref.torque));
     /* with ref psi = 0 the controller follows MTPA: flux below it -> increase */
     R.params.psi_ref = 0;
     R.ref.torque = q24(0.5);
@@ -500,7 +489,7 @@ static void test_fst_controller_replacement(void)
         if (pass == 1) {
             const double zero = 0.0;
             memcpy(R.cfg + offsetof(st_fst_cfg_t, sigma), &zero, sizeof zero);
-            TEST_ASSERT_EQUAL_INT(CTRL_OK, R.d->init(R.state, R.cfg, &R.params));
+            TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
         }
         R.ref.psi = q24(1.0);
         R.ref.torque = q24(0.4);

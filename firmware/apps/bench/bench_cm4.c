@@ -13,7 +13,7 @@
  *   end_est    ctrl_estimator_update alone, on a copy of the pre-ISR state
  *   end_step   the controller's step alone, on a copy of the pre-ISR state
  * The split (est, step) repeats exactly what fw_isr computed in that period
- * (its plan is compared with the ISR's), so its parts add up to the ISR's
+ * (its leg duties are compared with the ISR's), so its parts add up to the ISR's
  * estimator and controller cost.
  *
  * UART0 prints one summary line; the exit status is 0 when the replay matched
@@ -46,23 +46,15 @@ static fw_t fw;
 static hal_t hal;
 static bench_replay_t rep;
 static ctrl_estimator_t est_saved;
-static ctrl_plan_t applied_saved;
+static ctrl_legs_t applied_saved;
 static union {
     max_align_t align;
     unsigned char bytes[CTRL_STATE_MAX];
 } state_saved;
 
-static int plan_equal(const ctrl_plan_t *a, const ctrl_plan_t *b)
+static int legs_equal(const ctrl_legs_t *a, const ctrl_legs_t *b)
 {
-    if (a->n_seg != b->n_seg) {
-        return 0;
-    }
-    for (unsigned s = 0; s < a->n_seg && s < CTRL_PLAN_MAX_SEG; s++) {
-        if (a->vec[s] != b->vec[s] || a->dur[s] != b->dur[s]) {
-            return 0;
-        }
-    }
-    return 1;
+    return a->duty[0] == b->duty[0] && a->duty[1] == b->duty[1] && a->duty[2] == b->duty[2];
 }
 
 /* Estimator and controller step of period k alone, from the saved state. */
@@ -79,13 +71,14 @@ static uint32_t bench_split(const ctrl_desc_t *desc)
     ctrl_estimator_update(&est_saved, &fw.params, &m, &applied_saved, &est);
     bench_mark_end_est();
     const ctrl_refs_t refs = fw.refs;
-    const ctrl_ctx_t ctx = {&fw.params, &est, &refs, &applied_saved};
-    ctrl_plan_t plan;
-    ctrl_plan_single(&plan, 0u);
+    const ctrl_ctx_t ctx = {&fw.params, &est, &refs};
+    ctrl_out_t out;
+    ctrl_plan_single(&out.plan, 0u);
     bench_mark_begin();
-    desc->step(state_saved.bytes, &ctx, &plan);
+    desc->step(state_saved.bytes, &ctx, &out);
     bench_mark_end_step();
-    return plan_equal(&plan, &fw.applied) ? 0u : 1u;
+    ctrl_out_legs(&out);
+    return legs_equal(&out.legs, &fw.applied) ? 0u : 1u;
 }
 
 int main(void)

@@ -164,11 +164,12 @@ static void sim_scenario_step(sim_run_t *r, double t)
 /* One period without the scenario/metrics bookkeeping (boot phase too). */
 static int sim_period_raw(sim_run_t *r)
 {
-    /* The plan chosen at k-1 acts in this period (gates on) or nothing does. */
-    const ctrl_plan_t *a = &r->fw.applied;
-    const bool on = fw_state(&r->fw) == FW_STATE_RUNNING && a->n_seg > 0u;
-    r->vec_now = on ? a->vec[0] : 0u;
-    r->duty_now = on ? ctrl_q24_to_double(a->dur[0]) : 0.0;
+    /* The plan chosen at k-1 acts in this period (gates on) or nothing does
+     * (its segment 0 from the last period's telemetry; 0 for leg duties). */
+    const fw_telemetry_t *tm = fw_telemetry(&r->fw);
+    const bool on = fw_state(&r->fw) == FW_STATE_RUNNING;
+    r->vec_now = on ? tm->vec : 0u;
+    r->duty_now = on ? ctrl_q24_to_double(tm->duty) : 0.0;
     hal_sim_period_begin(&r->hal);
     fw_isr(&r->fw);
     /* The host main loop: kicks the watchdog once per period. */

@@ -110,7 +110,7 @@ __attribute__((noinline)) static void pil_busy(uint32_t n)
     }
 }
 
-static void pil_slow_step(void *state, const ctrl_ctx_t *ctx, ctrl_plan_t *out)
+static void pil_slow_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     pil.inner->step(state, ctx, out);
     if (pil.overrun_on) {
