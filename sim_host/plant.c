@@ -789,12 +789,6 @@ void plant_i_ab(const plant_t *p, double *i_alpha, double *i_beta)
     *i_beta = p->id * s + p->iq * c;
 }
 
-void plant_psi_dq(const plant_t *p, double *psi_d, double *psi_q)
-{
-    *psi_d = p->psi_d;
-    *psi_q = p->psi_q;
-}
-
 void plant_psi_ab(const plant_t *p, double *psi_alpha, double *psi_beta)
 {
     const double c = cos(p->theta_e), s = sin(p->theta_e);

@@ -180,7 +180,6 @@ double plant_time(const plant_t *p);
 void plant_i_abc(const plant_t *p, double i_abc[3]);
 void plant_i_dq(const plant_t *p, double *id, double *iq);
 void plant_i_ab(const plant_t *p, double *i_alpha, double *i_beta);
-void plant_psi_dq(const plant_t *p, double *psi_d, double *psi_q);
 void plant_psi_ab(const plant_t *p, double *psi_alpha, double *psi_beta);
 double plant_psi_amp(const plant_t *p); /* |psi_s| (4.3) */
 double plant_torque(const plant_t *p);  /* (3.10): 1.5 p (psi_d iq - psi_q id) */

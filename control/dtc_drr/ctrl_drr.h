@@ -1,44 +1,22 @@
 /*
  * Duty-ratio-regulated DTC (thesis chapter 5) and the duty-ratio baselines of
- * §5.5, all as "active vector for D Ts, then the zero vector" plans (§5.3.1).
+ * §5.5, each period an active vector for D Ts, then the zero vector (§5.3.1):
  *
- *   drr     the thesis' multiobjective DRR-DTC (§5.3-§5.4):
- *           active vector (5.1) from the error signs, sector x (4.5);
- *           virtual reference T_vref = T_ref + gamma, gamma = EMA of
- *           (T_ref - T_e) (5.3)-(5.5); flux reference MTPA (4.15) of T_vref;
- *           voltage replacement (4.19)-(4.21) while |psi_err| < dpsi_max / 2
- *           (§5.3.5); optimised duty (5.14) with Delta T+- (5.6)-(5.7),
- *           A (5.9), B (5.10), C (5.13); zero vector of §5.4.
- *   drr_d1  D1 (5.19): D = |T_err / C_T| + |psi_err / C_psi|.
- *   drr_d2  D2 (5.21): torque deviation proportional to speed, K_a, K_b.
- *   drr_pi  D_PI (5.20): back-EMF feed-forward + PI of the torque error.
- *   drr_df  D_f (5.18) (or D_RMS (5.17)) with the deviations of (4.10).
- * The baselines select the active vector by the same error-sign rule
- * (Table 4.4, AST = (5.1)) without virtual reference and replacement.
+ *   drr     multiobjective DRR-DTC (§5.3-§5.4): active vector (5.1), virtual
+ *           reference with the EMA (5.3)-(5.5), MTPA flux reference (4.15) of
+ *           T_vref, voltage replacement (4.19)-(4.21) while |psi_err| <
+ *           dpsi_max / 2 (§5.3.5), optimised duty (5.14) with (5.6)-(5.10),
+ *           (5.13), zero vector of §5.4;
+ *   drr_d1  D1 (5.19);  drr_d2  D2 (5.21);  drr_pi  D_PI (5.20);
+ *   drr_df  D_f (5.18) or D_RMS (5.17) with the deviations of (4.10).
  *
- * Delay compensation (REFERENCE §1, §5.4): every decision uses the state
- * predicted for k+1 (est->next: flux by (5.15) with the plan applied during
- * [k, k+1)). For the torque at k+1, drr uses by default the estimator's model
- * prediction (est->next.torque: (4.6)/(4.7) evaluated on the (5.15) flux at the
- * predicted rotor angle), which keeps the load angle and Rs that (5.16)
- * neglects and needs no division; the tunable "pred_516" = 1 selects the
- * thesis' (5.16) instead.
- *
- * Timing: plan.h realises every plan centre-aligned, while the thesis' period
- * starts with the active vector (Fig. 5.4); drr therefore evaluates (5.3) and
- * (5.8)-(5.14) at the torque where the active vector starts (ctrl_drr_t_start,
- * tunable "centre" = 1, default). Without it the sampled torque is the period
- * mean and a mean error of about gamma remains (measured: T_sse 0.11 N*m at
- * 750 r/min, 1.8 N*m instead of 0.003 N*m).
- *
- * Divisions per sample (fx_div): one for the duty (5.14) (C and |psi| are
- * folded into numerator and denominator), one for C gamma in
- * ctrl_drr_t_start when C is speed-dependent (5.13), one more for Delta T
- * with pred_516; the baselines D2, D_f/D_RMS one each, D1 and D_PI none.
- *
- * Units: every q24_t is Q24 per-unit (ctrl_params.h bases); in pu the torque
- * is psi x i, so A (5.9) = (2/3) Vdc psi_pm Ts / Ls and B (5.10) / w_rn =
- * psi_pm^2 Ts / Ls (speeds electrical, REFERENCE §1).
+ * Decisions on the k+1 prediction; torque at k+1 from the estimator's model
+ * (tunable pred_516 = 1: (5.16)); with centre-aligned PWM (5.3) and (5.8)-(5.14)
+ * are evaluated at the active-vector start (tunable centre, default 1). One
+ * division per period for the duty, one more for C gamma when C follows the
+ * speed (5.13). Units: Q24 per-unit throughout; A (5.9) = (2/3) Vdc psi_pm Ts
+ * / Ls, B (5.10) / w_rn = psi_pm^2 Ts / Ls in pu. Reasoning and measured
+ * effects: docs/algorithms.md, "Duty-ratio-regulated DTC".
  */
 #ifndef CONTROL_CTRL_DRR_H
 #define CONTROL_CTRL_DRR_H

@@ -3,7 +3,7 @@
  * MBST (Table 4.3, sectors (4.18)), AST (Table 4.4), ZST (Table 4.5) and the
  * flexible table FST (Table 4.6, §4.5.3, voltage replacement (4.19)-(4.21)).
  *
- * Delay compensation (REFERENCE §1, thesis §4.6.2): the vector chosen at
+ * Delay compensation (docs/conventions.md, thesis §4.6.2): the vector chosen at
  * sample k acts during [k+1, k+2), so every decision uses the one-step-ahead
  * prediction est->next (torque, flux amplitude, flux vector -> sector), i.e.
  * the state at the instant the vector starts to act.

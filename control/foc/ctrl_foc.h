@@ -4,30 +4,16 @@
  *
  * Current references: T_ref -> (i_d, i_q) on the MTPA locus (IPMSM: the
  * machine's MTPA table, ctrl_mtpa_current) or with i_d = 0 (SPMSM, or tunable
- * mtpa = 0: the chapter's Algorithm 1, alpha_sref = pi/2). |T_ref| is limited
- * to the torque at current_max on that locus (current limit).
- *
- * foc: d and q current PI regulators with decoupling feed-forward
+ * mtpa = 0: Algorithm 1), |T_ref| limited to the torque at current_max.
+ * foc: d and q current PI with decoupling feed-forward (S1(1)),
  *   v_d = -omega psi_q + Kp_d e_d + I_d,  v_q = omega psi_d + Kp_q e_q + I_q,
- * where psi_d = Ld i_d + psi_pm, psi_q = Lq i_q (= omega L i and omega psi_pm
- * terms of S1(1)). Gains by pole-zero cancellation for a first-order current
- * loop of bandwidth wc: Kp = L wc, Ki = R wc (default wc = 2 pi fs / 20 rad/s,
- * i.e. fs/20 Hz: 500 Hz at 10 kHz, rise time 2.2/wc = 0.70 ms).
- * Anti-windup: conditional integration - an axis integrates only if the
- * voltage is not limited by the hexagon or its error drives its output away
- * from the limit; integrators clamped to +-1 pu.
- * Delay compensation (REFERENCE §1): the voltage computed at k acts during
- * [k+1, k+2). The feedback currents and fluxes are the prediction for k+1
- * (est->next), and the inverse Park uses the mean rotor angle of the
- * application interval, theta(k+1) + omega Ts / 2 (= theta(k) + 1.5 omega Ts).
- * Output: leg duties by space-vector PWM (svpwm.h; V_k1, V_k2 and the zero
- * time split between V0 and V7), over-modulation limited onto the hexagon
- * keeping the angle.
- *
- * foc_hyst (S1 §2: current-controlled inverter with hysteresis controllers):
- * per phase x, e_x = i_x,ref - i_x at k+1 (predicted); leg x high if
- * e_x >= h_i, low if e_x <= -h_i, else unchanged. One vector per period
- * (state changes only at sampling instants).
+ * gains Kp = L wc, Ki = R wc (default wc = 2 pi fs / 20), conditional
+ * integration, integrators within +-1 pu; feedback on the k+1 prediction,
+ * inverse Park at theta(k+1) + omega Ts / 2; output: leg duties by SVPWM
+ * (svpwm.h), over-modulation limited onto the hexagon.
+ * foc_hyst: per phase, e_x = i_x,ref - i_x at k+1; leg high if e_x >= h_i, low
+ * if e_x <= -h_i, else unchanged; one vector per period.
+ * Notes: docs/algorithms.md, "FOC".
  */
 #ifndef CONTROL_CTRL_FOC_H
 #define CONTROL_CTRL_FOC_H

@@ -41,7 +41,7 @@ void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
 uint8_t ctrl_vec_wrap(int x);
 
 /* Zero vector that switches one leg after vec: V0 after V0, V1, V3, V5;
- * V7 after V7, V2, V4, V6 (thesis §5.4 / REFERENCE §1). Other idx: V0. */
+ * V7 after V7, V2, V4, V6 (thesis §5.4, docs/conventions.md). Other idx: V0. */
 uint8_t ctrl_zero_after(uint8_t vec);
 
 /* Sector 1..6 of the vector (x, y) by (4.5): (2s-3)pi/6 < theta <= (2s-1)pi/6. */

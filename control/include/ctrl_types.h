@@ -3,7 +3,7 @@
  * All q24_t fields are Q24 per-unit (bases in ctrl_params.h); angles are
  * fx_angle_t (2^32 = 2*pi, electrical).
  *
- * Conventions (REFERENCE.md section 1): amplitude-invariant Clarke (3.3), alpha
+ * Conventions (docs/conventions.md): amplitude-invariant Clarke (3.3), alpha
  * on phase a; voltage vectors of Table 4.2, V1=100 ... V6=101, V0=000, V7=111;
  * sector x of (4.5): (2x-3)pi/6 < theta_s <= (2x-1)pi/6, x = 1..6.
  */

@@ -1,22 +1,13 @@
 /*
- * Discrete-duty M2PTFC, "M2" of thesis §6.4.2 / §6.6 (ref. [123]).
- * Descriptor "m2".
+ * Discrete-duty M2PTFC, "M2" of thesis §6.4.2 / §6.6. Descriptor "m2".
  *
- * Each sample, with the k+1 state of the estimator (delay compensation §6.3.4):
- *   1. predict Te and |psi| at k+2 with the zero vector;
- *   2. the active vector from the switching table (Table 4.1 with two-level
- *      torque) on the signs of the errors left by the zero vector:
- *        T up, psi up: V_{x+1};  T up, psi down: V_{x+2};
- *        T down, psi up: V_{x+5}; T down, psi down: V_{x+4}  (error >= 0 = up);
- *   3. the y + 1 candidates D_nu = nu / y, nu = 0..y (6.15), each predicted to
- *      k+2 and evaluated with g = |T_ref - Te| + phi (6.16), phi = 0 inside
- *      psi_ref +- eps_psi and infinite outside (6.17); the argmin (first on
- *      ties) is applied with D_nu (nu = 0: the zero vector all period).
- * If no candidate keeps |psi| in the band, (6.17) leaves every cost infinite;
- * then the candidate with the smallest flux error |psi_ref - |psi|| is taken.
- * The band test compares squared amplitudes (exact, no square root).
- * Table 6.2: eps_psi 6.60 mWb at 750 r/min (default), 9.42 mWb at 2250 r/min
- * (--set eps_psi=0.00942); fs 10 kHz; y = 4 (Table 6.1).
+ * Each period, on the k+2 model: the active vector of Table 4.1 (two-level
+ * torque) on the error signs the zero vector leaves; the y + 1 duties
+ * D_nu = nu / y (6.15) evaluated with g = |T_ref - Te| + phi (6.16), phi = 0
+ * inside psi_ref +- eps_psi and infinite outside (6.17), compared on squared
+ * amplitudes; if no candidate keeps |psi| in the band the smallest flux error
+ * wins. Table 6.2: eps_psi 6.60 mWb (750 r/min), 9.42 mWb (2250 r/min); y = 4
+ * (Table 6.1).
  */
 #ifndef CONTROL_CTRL_M2_H
 #define CONTROL_CTRL_M2_H

@@ -2,21 +2,13 @@
  * k+2 prediction model shared by the modulated predictive controllers of
  * thesis chapter 6 (m2ptfc, m1, mptfc, m3, m2).
  *
- * Delay compensation (§6.3.4): the estimator hands over the state at k+1
- * predicted with the plan applied during [k, k+1) ((6.10)-(6.12)); a vector
- * chosen now acts during [k+1, k+2), so every candidate is evaluated at k+2.
- *
- * The prediction is (6.10)-(6.12) with the current in the rotor frame
- * ((6.12) generalised to Ld != Lq, as ctrl_predict() in predict.h), but
- * arranged so that one sample needs one fx_sincos and no square root:
- *   psi(k+2) = psi0 + D Ts V_i,   psi0 = psi(k+1) - Ts Rs i(k+1)   (6.10)
- * is linear in the duty D, so psi0 and every Ts V_i are rotated once into the
- * rotor frame at theta(k+2) = theta(k+1) + omega Ts. There, from
- * i_d = (psi_d - psi_pm)/Ld, i_q = psi_q/Lq and Te = psi x i (3.6)/(6.11):
- *   Te = psi_q (psi_pm/Ld + psi_d (1/Lq - 1/Ld)) = psi_q (a + b psi_d)   [pu]
- * and the amplitude is rotation invariant, |psi|^2 = psi_d^2 + psi_q^2.
- * The six active vectors in the rotor frame follow from V1 by the exact
- * rotations e^{j pi/3} (V2), e^{j 2pi/3} = e^{j pi/3} - 1 (V3), and V_{i+3} = -V_i.
+ * The estimator hands over the state at k+1; a vector chosen now acts during
+ * [k+1, k+2), so every candidate is evaluated at k+2 (§6.3.4). With
+ * psi(k+2) = psi0 + D Ts V_i, psi0 = psi(k+1) - Ts Rs i(k+1) (6.10), linear in
+ * the duty D, psi0 and every Ts V_i are rotated once into the rotor frame at
+ * theta(k+2); there Te = psi_q (a + b psi_d) (3.10)/(6.11) with a = psi_pm/Ld,
+ * b = 1/Lq - 1/Ld, and |psi|^2 = psi_d^2 + psi_q^2: one rotation, no square
+ * root per period (docs/algorithms.md, "The k+2 model").
  *
  * All q24_t values are Q24 per-unit (bases in ctrl_params.h).
  */

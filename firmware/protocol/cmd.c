@@ -17,18 +17,11 @@ typedef struct {
     size_t len;
 } cmd_tok_t;
 
+/* Reason word of each error code, in the "err <code> <reason>" line. */
 static const char *const cmd_reasons[CMD_E_COUNT] = {
     "ok",   "unknown", "args",  "number", "range",    "name",        "long",
     "char", "state",   "fault", "failed", "readonly", "unsupported",
 };
-
-const char *cmd_err_reason(int code)
-{
-    if (code < 0 || code >= (int)CMD_E_COUNT) {
-        return "failed";
-    }
-    return cmd_reasons[code];
-}
 
 /* ---- output: one line at a time, printable only, truncated to CMD_OUT_MAX ---- */
 

@@ -48,9 +48,6 @@ typedef enum {
     CMD_E_COUNT
 } cmd_err_t;
 
-/* Short reason word of an error code ("unknown", "args", ...). */
-const char *cmd_err_reason(int code);
-
 typedef enum { CMD_MODE_TORQUE = 0, CMD_MODE_SPEED = 1 } cmd_mode_t;
 
 /* Snapshot of the drive for "status", "fault" and for precondition checks. */

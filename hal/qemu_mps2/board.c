@@ -87,16 +87,6 @@ void uart_put_u32(uint32_t v)
     }
 }
 
-void uart_put_i32(int32_t v)
-{
-    if (v < 0) {
-        uart_putc('-');
-        uart_put_u32(0u - (uint32_t)v); /* modulo 2^32: also right for INT32_MIN */
-    } else {
-        uart_put_u32((uint32_t)v);
-    }
-}
-
 static int semihost_call(int op, const void *arg)
 {
     register int r0 __asm__("r0") = op;

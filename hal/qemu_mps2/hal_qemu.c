@@ -73,13 +73,6 @@ void hal_qemu_period_begin(hal_t *h)
     }
 }
 
-int hal_qemu_period(hal_t *h)
-{
-    const int rc = hal_qemu_period_end(h);
-    hal_qemu_period_begin(h);
-    return rc;
-}
-
 hal_qemu_plant_t *hal_qemu_plant_models(hal_t *h)
 {
     return h != NULL ? h->plant : NULL;

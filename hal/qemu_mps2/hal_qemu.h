@@ -8,9 +8,10 @@
  *
  * Timing (see README-pil.md): CMSDK Timer0 fires at a rate slow enough for
  * plant + pipeline; each firing is ONE control period Ts of plant time:
- *   hal_qemu_period(h):  advance the plant through the previous period with
- *                        the compare values active then, sample ADC and
- *                        encoder at the new period start (not timed)
+ *   hal_qemu_period_end, hal_qemu_period_begin: advance the plant through
+ *                        the previous period with the compare values active
+ *                        then, sample ADC and encoder at the new period start
+ *                        (not timed)
  *   fw_isr(fw):          the pipeline, timed with hal_cycles (Timer1) only
  * The deadline budget the firmware sees is that of a 1-instruction-per-cycle
  * Cortex-M4 at cpu_hz (hal_qemu_init's argument; the PIL application uses
@@ -35,7 +36,7 @@ struct hal {
     hal_qemu_plant_t *plant;   /* plant + ADC/encoder/PWM models */
     hal_info_t info;           /* the plant models' info, cycle clock replaced */
     uint32_t ticks_per_kinstr; /* Timer1 ticks of 1000 emulated instructions */
-    uint64_t periods;          /* hal_qemu_period calls */
+    uint64_t periods;          /* hal_qemu_period_begin calls */
     bool primed;               /* a period has been sampled */
     int plant_rc;              /* first plant error (PLANT_OK while fine) */
 };
@@ -45,19 +46,17 @@ struct hal {
  * clock for the deadline budget (> 0). */
 int hal_qemu_init(hal_t *h, hal_qemu_plant_t *plant, uint32_t cpu_hz);
 
-/* Plant part of the PWM interrupt (before fw_isr, excluded from its timing).
- * Returns PLANT_OK or the plant's error code. */
-int hal_qemu_period(hal_t *h);
-
 /* Timer1 ticks per 1000 emulated instructions (measured by hal_qemu_init). */
 uint32_t hal_qemu_ticks_per_kinstr(const hal_t *h);
 
 /* Emulated instructions in `ticks` Timer1 ticks (rounded). */
 uint32_t hal_qemu_ticks_to_instr(const hal_t *h, uint32_t ticks);
 
-/* Split form of hal_qemu_period, for callers that observe the plant between
- * the two halves (metrics at the period boundary): end = advance through the
- * period that just ended (no-op before the first begin); begin = sample. */
+/* Plant part of the PWM interrupt (before fw_isr, excluded from its timing),
+ * in two halves so that callers can observe the plant between them (metrics
+ * at the period boundary): end = advance through the period that just ended
+ * (no-op before the first begin; PLANT_OK or the plant's error code);
+ * begin = sample. */
 int hal_qemu_period_end(hal_t *h);
 void hal_qemu_period_begin(hal_t *h);
 

@@ -2,7 +2,9 @@
  * Board support for the QEMU `mps2-an386` machine (Cortex-M4F, 25 MHz):
  * start-up, CMSDK UART0 output, ARM semihosting (console and exit status),
  * CMSDK Timer0 periodic interrupt and Timer1 as a free-running counter.
- * Register map and QEMU behaviour: /work/shared/notes/QEMU.md.
+ * Register map: ARM's "Application Note AN386" (MPS2+ Cortex-M4 FPGA image)
+ * and the CMSDK peripherals' Technical Reference Manual; QEMU's model of the
+ * board (hw/arm/mps2.c) is what runs; docs/architecture.md, "QEMU".
  *
  * The start-up code (startup.c) enables the FPU, copies .data, zeroes .bss,
  * calls board_init(), runs the C/C++ constructors and calls exit(main()): main's return value is
@@ -31,7 +33,6 @@ void board_init(void);
 void uart_putc(char c);
 void uart_puts(const char *s);
 void uart_put_u32(uint32_t v); /* decimal */
-void uart_put_i32(int32_t v);  /* decimal */
 
 /* Semihosting: a string to QEMU's console (stderr, or the muxed chardev). */
 void semihost_write0(const char *s);

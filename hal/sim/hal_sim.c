@@ -218,11 +218,6 @@ void hal_sim_pwm_active(const hal_t *h, hal_pwm_t *pwm)
     }
 }
 
-double hal_sim_fault_current(const hal_t *h)
-{
-    return h != NULL ? h->short_i_a : 0.0;
-}
-
 void hal_sim_inject_short(hal_t *h, double slope_a_per_s)
 {
     if (h != NULL && isfinite(slope_a_per_s)) {

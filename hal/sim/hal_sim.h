@@ -130,7 +130,6 @@ int hal_sim_period_end(hal_t *h);
 uint64_t hal_sim_period(const hal_t *h);
 bool hal_sim_gates_on(const hal_t *h); /* switches may conduct in this period */
 void hal_sim_pwm_active(const hal_t *h, hal_pwm_t *pwm);
-double hal_sim_fault_current(const hal_t *h);
 
 /* Fault injection. */
 void hal_sim_inject_short(hal_t *h, double slope_a_per_s);

@@ -1,5 +1,5 @@
 /*
- * Machines of REFERENCE §2 used by the chapter tests: the shipped machine
+ * Machines (docs/README.md) used by the chapter tests: the shipped machine
  * files (tests/plant/ini_machines.h). The chapter IPMSM ratings are the
  * project's assumption in sim_host/machines/chapter_ipmsm.ini (S1 gives none).
  */

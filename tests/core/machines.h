@@ -1,5 +1,5 @@
 /*
- * Machine parameter sets of REFERENCE.md §2 as ctrl_machine_t, for tests:
+ * Machine parameter sets of docs/README.md ("Machines") as ctrl_machine_t, for tests:
  * the shipped machine files (tests/plant/ini_machines.h, checked against
  * sim_host/machines/*.ini by tests/plant/test_plant_files.c), with the
  * ratings the core tests were written for where those differ (marked
@@ -35,7 +35,7 @@ static inline ctrl_machine_t machine_thesis_ipmsm80(void)
     return m;
 }
 
-/* Book-chapter IPMSM, S1 Table 2 (Ld < Lq per REFERENCE §2). */
+/* Book-chapter IPMSM, S1 Table 2 (printed with the labels crossed; Ld < Lq for an IPMSM). */
 static inline ctrl_machine_t machine_chapter_ipmsm(void)
 {
     ctrl_machine_t m = ini_chapter_ipmsm;

@@ -1,6 +1,6 @@
 /*
  * ctrl_params_init (bases, Q24 fit, rejection of bad machines), the Q24
- * conversion helpers, MTPA ((4.15)-(4.16) oracle of REFERENCE §4 and the IPMSM
+ * conversion helpers, MTPA ((4.15)-(4.16) for the thesis SPMSM and the IPMSM
  * table), the speed filter coefficient, the speed PI and the tunables API.
  */
 #include <math.h>
@@ -66,7 +66,7 @@ static void test_bases_spmsm(void)
     TEST_ASSERT_TRUE(fabs(d(p.ts_rs) - wb * 1e-4 * 0.901 / (220.0 / ib)) <= 0.5 * LSB);
     TEST_ASSERT_TRUE(fabs(d(p.speed_rated_e) - 4 * 3000 * 2 * PI / 60 / wb) <= 0.5 * LSB);
     TEST_ASSERT_TRUE(fabs(d(p.current_max) - 8.4 / ib) <= 0.5 * LSB);
-    /* REFERENCE §4: omega_e psi_pm at 3000 r/min = 118.5 V (0.5386 pu of Vdc) */
+    /* Thesis SPMSM: omega_e psi_pm at 3000 r/min = 118.5 V (0.5386 pu of Vdc) */
     TEST_ASSERT_DOUBLE_WITHIN(0.05, 118.5, d(p.speed_rated_e) * b.v_v);
     /* angle increment per period: Ts_pu / (2 pi) turns, integer rounding */
     TEST_ASSERT_DOUBLE_WITHIN(0.5, wb * 1e-4 / (2 * PI) * 4294967296.0, (double)p.omega_to_dangle);
@@ -177,7 +177,7 @@ static void test_q24_conversion(void)
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.25, ctrl_q24_to_double(FX_ONE / 4));
 }
 
-/* REFERENCE §4: MTPA at 1.8 N*m on the thesis SPMSM, psi_s = 0.09655 Wb and
+/* (4.15)-(4.16): MTPA at 1.8 N*m on the thesis SPMSM, psi_s = 0.09655 Wb and
  * delta = 0.2177 rad (4.15)-(4.16). The reference values are printed to 4
  * significant digits: tolerance half a unit of the last digit (5e-6 Wb,
  * 5e-5 rad) plus the fixed-point error (< 1e-6 pu, README). */

@@ -60,7 +60,7 @@ static void *make(const char *name, void (*tweak)(void *cfg))
     return STATE;
 }
 
-/* ---- (5.9), (5.10): REFERENCE §4 gives A = 1.266, B = 1.023 N*m rounded to
+/* ---- (5.9), (5.10): A = 1.266, B = 1.023 N*m (thesis Table 5.1: 1.27, 1.02) rounded to
  * 1e-3, so the exact values lie within +-0.5e-3 of them. ---- */
 static void test_ab_thesis_spmsm(void)
 {
@@ -92,7 +92,7 @@ static void test_ab_thesis_spmsm(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_drr_ab_si(&ini_thesis_spmsm, 0.0, &a, &b));
 }
 
-/* ---- (5.5): lambda = 0.03 at 10 kHz -> 48.5 Hz (REFERENCE §4, 3 digits). ---- */
+/* ---- (5.5): lambda = 0.03 at 10 kHz -> 48.5 Hz (thesis §5.3.2, 3 digits). ---- */
 static void test_ema_cutoff(void)
 {
     const double fc = ctrl_drr_ema_cutoff_hz(0.03, 10000.0);
@@ -397,7 +397,7 @@ static void test_baselines_thesis_values(void)
     TEST_ASSERT_EQUAL_INT32(0, ctrl_drr_duty_d2(s, q(-0.1 / tb), q(w1000)));
 
     /* D_PI (5.20): 3 w psi_pm / (2 Vdc) = back-EMF over |V_active|: at 3000 r/min
-     * 118.5 V / 146.7 V = 0.808 (REFERENCE §4), no error, no integral. */
+     * 118.5 V / 146.7 V = 0.808 (thesis SPMSM), no error, no integral. */
     s = make("drr_pi", NULL);
     const double w3000 = 2 * PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
     const double ff = 3.0 * (w3000 * BASES.w_rad_s) * 0.09427 / (2.0 * 220.0);

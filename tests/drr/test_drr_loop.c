@@ -3,10 +3,10 @@
  * thesis SPMSM, load point of thesis §5.6: 1.8 N*m at 750 and 2250 r/min,
  * dynamometer (imposed speed), torque mode. DRR methods at 10 kHz, BST at
  * 20 kHz (thesis §5.6: DRR methods at half the CDTC sampling frequency).
- * Indices (REFERENCE §5) from the plant's true torque on a Ts/10 grid
+ * Indices (thesis Appendix B, (B.1)-(B.2)) from the plant's true torque on a Ts/10 grid
  * (plant sampling), window 30..70 ms after arming.
  *
- * What the thesis reports (§5.6.2, Fig. 5.17, REFERENCE §6): torque ripple of
+ * What the thesis reports (§5.6.2, Fig. 5.17, thesis §5.6.2): torque ripple of
  * the proposed DRR -65 % vs CDTC, -15 % vs D1, -41 % vs D2; |T_sse| lower by
  * 92 % (CDTC), 95 % (D1), 76 % (D2). Asserted ratios (margin: each thesis
  * improvement about halved, the 15 % over D1 reduced to "not worse"):

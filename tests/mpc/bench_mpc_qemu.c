@@ -3,7 +3,7 @@
  * Cortex-M4 in QEMU (cm4 build only). QEMU counts instructions, not cycles:
  * under -icount the virtual time is instructions x 2^shift ns, read here from
  * the 25 MHz Timer1 and calibrated against a block of exactly 1000 NOPs, so the
- * result does not depend on the shift (/work/shared/notes/QEMU.md).
+ * result does not depend on the shift (docs/architecture.md, "QEMU").
  *
  * Workload: the thesis SPMSM at 10 kHz, operating points along steady-state
  * trajectories (750 and 2250 r/min, both directions, torque -rated..+rated,

@@ -5,7 +5,7 @@
  * 2 = dynamics (Fig. 6.17), 3 = IPMSMs (§6.5.1 case study).
  *
  * Torque series: the plant's true torque on the Ts/10 grid (plant sampling,
- * REFERENCE §5); ripple = standard deviation (B.1) over the window.
+ * thesis Appendix B); ripple = standard deviation (B.1) over the window.
  *
  * Settings. Proposed m2ptfc: Table 6.2 (fs 10 kHz at 750, 11 kHz at 2250 r/min,
  * lambda 0.03), centre = 1 (default, ctrl_m2ptfc.h). M2: Table 6.2 (eps_psi

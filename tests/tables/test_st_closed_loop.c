@@ -3,7 +3,7 @@
  * discrete machine model (ctrl_predict: psi += Ts (v - Rs i), theta += omega Ts,
  * (5.15)/(6.10)-(6.12)) at constant speed, the estimate is exact and the
  * prediction to k+1 uses the vector applied during [k, k+1) (one-step delay,
- * REFERENCE §1). Each table must hold torque and flux in steady state in the
+ * docs/conventions.md). Each table must hold torque and flux in steady state in the
  * four quadrants of Fig. 3.9 (forward/backward motoring and braking), within
  * bounds from the physics, not from a run:
  *   |T - Tref| <= h_T + dT_max,  |psi - psi_ref| <= h_psi + dpsi_max,

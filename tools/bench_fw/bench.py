@@ -29,7 +29,7 @@ TORQUE_NM = 1.8
 # Section indices of the plugin's end markers (order of the end= arguments).
 SECTIONS = ("empty", "boot", "run", "est", "step")
 MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
-# Thesis execution times (REFERENCE.md section 6), dSPACE DS1202 at 2 GHz, us.
+# Thesis execution times (thesis Fig. 6.14), dSPACE DS1202 at 2 GHz, us.
 THESIS_US = {"m2ptfc": 4.6, "m1": 6.96, "m2": 9.24, "m3": 4.8}
 
 
