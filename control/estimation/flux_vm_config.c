@@ -2,10 +2,10 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "ctrl_units.h"
 #include "flux_vm.h"
 #include "flux_vm_config.h"
 
-#define PI_CONST 3.14159265358979323846
 
 int ctrl_flux_vm_gain(const ctrl_params_t *p, double fc_hz, q24_t *k_corr)
 {
@@ -13,7 +13,7 @@ int ctrl_flux_vm_gain(const ctrl_params_t *p, double fc_hz, q24_t *k_corr)
         return CTRL_EINVAL;
     }
     /* Discrete first-order section: k = w_c Ts (forward Euler). */
-    const double k = 2.0 * PI_CONST * fc_hz / (double)p->fs_hz;
+    const double k = CTRL_TWO_PI * fc_hz / (double)p->fs_hz;
     if (k >= 0.5) {
         return CTRL_EINVAL;
     }

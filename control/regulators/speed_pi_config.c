@@ -10,10 +10,10 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "ctrl_units.h"
 #include "speed_pi.h"
 #include "speed_pi_config.h"
 
-#define PI_CONST 3.14159265358979323846
 
 /* Normalise a positive gain g to a mantissa in [2^30, 2^31) and a shift in
  * [1, max_shift]; a gain needing more than max_shift fractional bits keeps
@@ -61,7 +61,7 @@ int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pol
         f_u = 1.0 / (double)pole_pairs;
         break;
     case CTRL_SPEED_UNIT_RPM:
-        f_u = 60.0 / (2.0 * PI_CONST * (double)pole_pairs);
+        f_u = 60.0 / (CTRL_TWO_PI * (double)pole_pairs);
         break;
     case CTRL_SPEED_UNIT_RAD_S_ELEC:
         f_u = 1.0;

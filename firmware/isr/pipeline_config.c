@@ -167,7 +167,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         si->zero_hz = d.zero_hz;
     }
     /* The gains in SI per mechanical rad/s for reports. */
-    const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / (2.0 * FW_PI)
+    const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / CTRL_TWO_PI
                            : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)cfg->machine->pole_pairs
                                                                 : 1.0;
     si->kp_nm_s_rad = kp * per_rad;

@@ -30,7 +30,7 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
         return CTRL_EINVAL;
     }
     /* Overspeed in Q24 pu electrical speed; must fit below 2^31 (< 128 pu). */
-    const double w_max_pu = overspeed_rpm * 2.0 * FW_PI / 60.0 * (double)m->pole_pairs / b->w_rad_s;
+    const double w_max_pu = ctrl_rpm_to_elec(overspeed_rpm, m->pole_pairs) / b->w_rad_s;
     if (!(w_max_pu < 127.0)) {
         return CTRL_EINVAL;
     }

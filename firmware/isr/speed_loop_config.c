@@ -3,10 +3,10 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include "ctrl_units.h"
 #include "speed_loop.h"
 
-#define FW_SL_PI 3.14159265358979323846
-#define FW_SL_DEG (FW_SL_PI / 180.0)
+#define FW_SL_DEG (CTRL_PI / 180.0)
 
 static int fw_sl_fail(char *why, size_t len, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
@@ -41,17 +41,17 @@ int fw_speed_loop_design(fw_speed_design_t *d, const ctrl_machine_t *m, double l
                           "speed loop: phase margin %g deg is out of range [%g, %g] deg", pm, 20.0,
                           80.0);
     }
-    const double td = 1.0 / loop_hz + 1.0 / (2.0 * FW_SL_PI * lpf_hz) + FW_SPEED_TORQUE_DELAY_S;
+    const double td = 1.0 / loop_hz + 1.0 / (2.0 * CTRL_PI * lpf_hz) + FW_SPEED_TORQUE_DELAY_S;
     /* The phase budget left for the dead time: 90 deg - PM (with wz -> 0). */
     const double wc_max = (90.0 - pm) * FW_SL_DEG / td;
     double wc;
     if (d->bandwidth_hz > 0.0) {
-        wc = 2.0 * FW_SL_PI * d->bandwidth_hz;
+        wc = 2.0 * CTRL_PI * d->bandwidth_hz;
         if (!(wc < wc_max) || !isfinite(wc)) {
             return fw_sl_fail(why, why_len,
                               "speed loop: bandwidth %g Hz is out of range (0, %.4g) Hz: with "
                               "phase margin %g deg the loop's dead time allows no more",
-                              d->bandwidth_hz, wc_max / (2.0 * FW_SL_PI), pm);
+                              d->bandwidth_hz, wc_max / (2.0 * CTRL_PI), pm);
         }
     } else {
         wc = (90.0 - atan(FW_SPEED_ZERO_RATIO) / FW_SL_DEG - pm) * FW_SL_DEG / td;
@@ -64,11 +64,11 @@ int fw_speed_loop_design(fw_speed_design_t *d, const ctrl_machine_t *m, double l
     }
     const double wz = wc * tan((90.0 - pm) * FW_SL_DEG - wc * td);
     const double kp = m->inertia_kgm2 * wc / sqrt(1.0 + (wz / wc) * (wz / wc));
-    d->bandwidth_hz = wc / (2.0 * FW_SL_PI);
+    d->bandwidth_hz = wc / (2.0 * CTRL_PI);
     d->phase_margin_deg = pm;
     d->kp_nm_s_rad = kp;
     d->ki_nm_rad = kp * wz;
-    d->zero_hz = wz / (2.0 * FW_SL_PI);
+    d->zero_hz = wz / (2.0 * CTRL_PI);
     d->dead_time_s = td;
     return CTRL_OK;
 }
