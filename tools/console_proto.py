@@ -4,8 +4,9 @@ Mirrors firmware/telemetry_frame.c and firmware/telemetry.c (PROTOCOL.md):
 COBS framing with 0x00 delimiters, CRC-16/CCITT-FALSE (high byte first),
 SAMPLE and META frames, and a stream decoder that separates text response
 lines from binary frames on the shared UART byte stream.
-Pure Python (struct only) so it runs without numpy or pyserial.
+Standard library only (struct, binascii), so it runs without numpy or pyserial.
 """
+import binascii
 import struct
 
 TYPE_SAMPLE = 0x01
@@ -37,12 +38,9 @@ def signal_names(mask):
 
 
 def crc16(data, crc=0xFFFF):
-    """CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, no reflection, xorout 0."""
-    for b in data:
-        crc ^= b << 8
-        for _ in range(8):
-            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
-    return crc
+    """CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, no reflection, xorout 0.
+    The standard library's binascii.crc_hqx is this CRC with a given start value."""
+    return binascii.crc_hqx(bytes(data), crc)
 
 
 def cobs_encode(data):

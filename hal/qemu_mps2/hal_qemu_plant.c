@@ -28,6 +28,31 @@
 
 static struct hal_qemu_plant hal_qemu_plant_instance;
 
+void hal_qemu_plant_config_default(hal_qemu_plant_config_t *cfg, uint32_t pwm_freq_hz,
+                                   double current_max_a, double vdc_v)
+{
+    hal_sim_config_t c;
+    hal_sim_config_default(&c, pwm_freq_hz, current_max_a, vdc_v);
+    memset(cfg, 0, sizeof *cfg);
+    cfg->pwm_freq_hz = c.pwm_freq_hz;
+    cfg->timer_clock_hz = c.timer_clock_hz;
+    cfg->cycle_clock_hz = c.cycle_clock_hz;
+    cfg->cycles_per_read = c.cycles_per_read;
+    cfg->adc_bits = c.adc_bits;
+    cfg->i_fullscale_a = c.i_fullscale_a;
+    cfg->vdc_fullscale_v = c.vdc_fullscale_v;
+    for (int i = 0; i < 4; i++) {
+        cfg->adc_offset_counts[i] = c.adc_offset_counts[i];
+        cfg->adc_gain_err[i] = c.adc_gain_err[i];
+    }
+    cfg->adc_noise_counts = c.adc_noise_counts;
+    cfg->enc_lines = c.enc_lines;
+    cfg->enc_index = c.enc_index;
+    cfg->enc_zero_count = c.enc_zero_count;
+    cfg->trip_level_a = c.trip_level_a;
+    cfg->seed = c.seed;
+}
+
 hal_qemu_plant_t *hal_qemu_plant_init(const hal_qemu_plant_config_t *cfg, plant_t *plant)
 {
     if (cfg == NULL || plant == NULL) {

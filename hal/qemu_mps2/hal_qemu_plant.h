@@ -34,6 +34,10 @@ typedef struct {
     uint64_t seed;
 } hal_qemu_plant_config_t;
 
+/* hal_sim_config_default's values (hal_sim.h). */
+void hal_qemu_plant_config_default(hal_qemu_plant_config_t *c, uint32_t pwm_freq_hz,
+                                   double current_max_a, double vdc_v);
+
 /* The one instance of the image (static storage in hal_qemu_plant.c); binds
  * the plant (not owned). NULL on a configuration hal_sim rejects. */
 hal_qemu_plant_t *hal_qemu_plant_init(const hal_qemu_plant_config_t *cfg, plant_t *plant);

@@ -58,7 +58,9 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->speed_kp = m->speed_kp;
     c->speed_ki = m->speed_ki;
     c->overspeed_rpm = m->overspeed_rpm;
-    hal_sim_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
+    c->auto_arm = true;
+    c->kick_watchdog = true;
+    engine_hal_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
 }
 
 static double sim_torque_ref_nm(const sim_run_t *r)
@@ -170,16 +172,41 @@ static int sim_period_raw(sim_run_t *r)
     const bool on = fw_state(&r->fw) == FW_STATE_RUNNING;
     r->vec_now = on ? tm->vec : 0u;
     r->duty_now = on ? ctrl_q24_to_double(tm->duty) : 0.0;
-    hal_sim_period_begin(&r->hal);
+    engine_hal_begin(&r->hal);
     fw_isr(&r->fw);
-    /* The host main loop: kicks the watchdog once per period. */
-    fw_watchdog_kick(&r->fw);
-    const int rc = hal_sim_period_end(&r->hal);
+    if (r->cfg.after_isr != NULL) {
+        r->cfg.after_isr(r->cfg.after_isr_ctx);
+    }
+    if (r->cfg.kick_watchdog) {
+        /* The host's main loop: kicks the watchdog once per period. */
+        fw_watchdog_kick(&r->fw);
+    }
+    const int rc = engine_hal_end(&r->hal);
     if (rc != PLANT_OK) {
         r->plant_rc = rc;
         return -1;
     }
     return 0;
+}
+
+/* The arm instant (scenario time 0): the references and loads of the run. */
+static void sim_arm(sim_run_t *r)
+{
+    const sim_run_cfg_t *c = &r->cfg;
+    if (c->speed_mode) {
+        fw_set_speed_ref_rpm(&r->fw, c->speed_ref_rpm);
+        r->torque_ref_requested_nm = NAN;
+    } else {
+        fw_set_torque_ref_nm(&r->fw, c->torque_ref_nm);
+        r->torque_ref_requested_nm = c->torque_ref_nm;
+    }
+    fw_cmd_arm(&r->fw);
+    if (c->free_mech) {
+        plant_set_load_torque(&r->plant, c->load_nm);
+        plant_set_load_passive(&r->plant, c->load_passive_nm);
+    }
+    r->t_arm = plant_time(&r->plant);
+    r->armed = true;
 }
 
 /* Leg transitions between the window start and t (period boundaries). */
@@ -211,8 +238,23 @@ static void sim_observer_update(sim_run_t *r, double t)
     }
 }
 
+bool sim_run_done(const sim_run_t *r)
+{
+    return r->armed && sim_run_time(r) + 0.5 / (double)r->cfg.fs_hz >= r->t_end;
+}
+
 int sim_run_period(sim_run_t *r)
 {
+    if (!r->armed) {
+        /* Boot and calibration: gates off, no bookkeeping; armed (with the
+         * run's references) right after the period that ends the
+         * calibration, so the first gated period is the next one. */
+        const int rc = sim_period_raw(r);
+        if (rc == 0 && r->cfg.auto_arm && fw_state(&r->fw) == FW_STATE_READY) {
+            sim_arm(r);
+        }
+        return rc;
+    }
     const double t = sim_run_time(r);
     sim_observer_update(r, t);
     sim_scenario_step(r, t);
@@ -305,6 +347,7 @@ static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_co
     fc->overspeed_rpm = c->overspeed_rpm;
 }
 
+#if !defined(ENGINE_PORT_QEMU)
 /* fw_init on a scratch pipeline for (machine, fs): the same steps as the run,
  * plant not touched. Returns FW_OK or the fw_init code. */
 static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_t fs_hz)
@@ -317,9 +360,9 @@ static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_
     if (c->ctrl_cfg == NULL && sim_ctrl_cfg_build(c, m, buf, err, sizeof err) != 0) {
         return FW_EINVAL;
     }
-    hal_sim_config_t hc = c->hal;
+    engine_hal_config_t hc = c->hal;
     hc.pwm_freq_hz = fs_hz;
-    if (hal_sim_init(&hal, &hc, &dummy) != HAL_SIM_OK) {
+    if (engine_hal_init(&hal, &hc, &dummy) != 0) {
         return FW_EINVAL;
     }
     fw_config_t fc;
@@ -439,6 +482,15 @@ static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, siz
                     ". No single machine value, fs or tunable changed alone makes it acceptable");
     }
 }
+
+#else
+/* The QEMU port has one instance of the HAL models: no trial configurations. */
+static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, size_t errlen)
+{
+    (void)snprintf(err, errlen, "the firmware refuses this drive: %s (controller %s, fs %u Hz)",
+                   fw_strerror(fw_rc), c->ctrl->name, (unsigned)c->fs_hz);
+}
+#endif
 
 static const char *sim_trig_text(const sim_event_t *e, char *buf, size_t len)
 {
@@ -574,19 +626,23 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
      * rotor during the calibration (no motor torque) would spin it backwards. */
     pc.load_torque_nm = 0.0;
     if (c->plant_machine.fluxmap_path[0] != '\0') {
+#if defined(ENGINE_PORT_QEMU)
+        return sim_err(err, errlen, "flux maps are files: the QEMU images have none");
+#else
         /* Saturation: the plant integrates in flux coordinates with the map. */
         if (plant_fluxmap_load(&r->fluxmap, c->plant_machine.fluxmap_path, err, errlen) !=
             PLANT_OK) {
             return -1;
         }
         pc.fluxmap = &r->fluxmap;
+#endif
     }
     if (plant_init(&r->plant, &pc) != PLANT_OK) {
         return sim_err(err, errlen, "plant rejected the machine configuration");
     }
     c->hal.pwm_freq_hz = c->fs_hz;
     c->hal.seed = c->seed;
-    if (hal_sim_init(&r->hal, &c->hal, &r->plant) != HAL_SIM_OK) {
+    if (engine_hal_init(&r->hal, &c->hal, &r->plant) != 0) {
         return sim_err(err, errlen, "HAL simulation rejected its configuration");
     }
     fw_config_t fc;
@@ -658,6 +714,9 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (c->free_mech) {
         f1 = 1.0; /* placeholder: samples are kept, f1 set from the mean speed later */
     }
+    if (c->skip_thd) {
+        f1 = 0.0;
+    }
     metrics_init(&r->m_plant, METRICS_SAMPLING_PLANT, f1);
     metrics_init(&r->m_ctrl, METRICS_SAMPLING_CONTROL, 0.0);
     /* THD is a distortion ratio only where there is a fundamental to refer
@@ -665,10 +724,19 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
      * torque it reached ~1000 %), so it is reported as undefined. */
     r->m_plant.thd_i1_min_a = 0.05 * c->plant_machine.current_rated_a;
 
-    /* Boot and offset calibration with the gates off. */
+    r->t_end = c->duration_s;
+    r->obs_on = false;
+    if (c->trace != NULL) {
+        fprintf(c->trace, "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,"
+                          "speed_ref_rpm,load_nm\n");
+    }
+    if (c->defer_start) {
+        return 0; /* the caller runs the periods from boot on (sim_run_period) */
+    }
+    /* Boot and offset calibration with the gates off, then the arm. */
     const uint32_t max_boot = c->calib_samples + 16u;
-    for (uint32_t k = 0; k < max_boot && fw_state(&r->fw) != FW_STATE_READY; k++) {
-        if (sim_period_raw(r) != 0) {
+    for (uint32_t k = 0; k < max_boot && !r->armed; k++) {
+        if (sim_run_period(r) != 0) {
             return sim_err(err, errlen, "plant failed during calibration");
         }
         if (fw_state(&r->fw) == FW_STATE_FAULT) {
@@ -678,27 +746,8 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
             return sim_err(err, errlen, msg);
         }
     }
-    if (fw_state(&r->fw) != FW_STATE_READY) {
+    if (!r->armed && c->auto_arm) {
         return sim_err(err, errlen, "firmware did not finish calibration");
-    }
-    if (c->speed_mode) {
-        fw_set_speed_ref_rpm(&r->fw, c->speed_ref_rpm);
-        r->torque_ref_requested_nm = NAN;
-    } else {
-        fw_set_torque_ref_nm(&r->fw, c->torque_ref_nm);
-        r->torque_ref_requested_nm = c->torque_ref_nm;
-    }
-    fw_cmd_arm(&r->fw);
-    if (c->free_mech) {
-        plant_set_load_torque(&r->plant, c->load_nm);
-        plant_set_load_passive(&r->plant, c->load_passive_nm);
-    }
-    r->t_arm = plant_time(&r->plant);
-    r->t_end = c->duration_s;
-    r->obs_on = false;
-    if (c->trace != NULL) {
-        fprintf(c->trace, "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,"
-                          "speed_ref_rpm,load_nm\n");
     }
     return 0;
 }
@@ -710,8 +759,7 @@ bool sim_run_faulted(const sim_run_t *r)
 
 int sim_run_all(sim_run_t *r, char *err, size_t errlen)
 {
-    const double half = 0.5 / (double)r->cfg.fs_hz;
-    while (sim_run_time(r) + half < r->t_end) {
+    while (!sim_run_done(r)) {
         if (sim_run_period(r) != 0) {
             char msg[200];
             (void)snprintf(msg, sizeof msg, "plant integration failed at t = %.6f s (code %d)",
@@ -740,7 +788,7 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
     if (!r->win_done && r->win_started) {
         sim_count_transitions(r, sim_run_time(r));
     }
-    if (r->cfg.free_mech) {
+    if (r->cfg.free_mech && !r->cfg.skip_thd) {
         const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : 0.0;
         r->m_plant.f1_hz = fabs(mean_rpm) * (double)r->cfg.plant_machine.pole_pairs / 60.0;
     }

@@ -1,6 +1,8 @@
 /*
- * Closed loop on the host: plant (sim_host) + HAL simulation back-end
- * (hal/sim) + the firmware pipeline (firmware/), period by period.
+ * The closed-loop engine: plant (sim_host) + the HAL back-end that carries it
+ * (engine_port.h: hal/sim on the host, hal/qemu_mps2 in the QEMU images) + the
+ * firmware pipeline (firmware/), period by period. The same code runs the
+ * host simulator (./tools/sim, the tests) and the PIL images in QEMU.
  *
  * Time line: the firmware boots and calibrates its ADC offsets with the gates
  * off (calib_samples periods, plant running: imposed speed or coasting), then
@@ -32,7 +34,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "hal_sim.h"
+#include "engine_port.h"
 #include "metrics.h"
 #include "pipeline.h"
 #include "plant.h"
@@ -70,14 +72,21 @@ typedef struct {
     FILE *trace;                       /* may be NULL */
     uint32_t trace_decimation;         /* every n-th sample of the Ts/10 grid, >= 1 */
     double trace_start_s, trace_end_s; /* rows written in [start, end] (scenario time) */
-    hal_sim_config_t hal;              /* filled by sim_run_config_default, adjustable */
+    engine_hal_config_t hal;           /* filled by sim_run_config_default, adjustable */
     uint32_t calib_samples;
     /* Speed loop and overspeed (fw_config_t; from the machine file by default). */
     double speed_bw_hz, speed_pm_deg; /* sizing (0 = firmware defaults) */
     double speed_kp, speed_ki;        /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
     double overspeed_rpm;             /* 0 = 1.05 x rated speed */
     bool stop_on_fault;               /* end the run at a fault (default false) */
-    sim_warnings_t *warnings;         /* may be NULL (warnings printed only) */
+    /* Driving the periods (defaults: the host simulator). */
+    bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
+    bool auto_arm;                /* arm with the references above once calibrated (default) */
+    bool kick_watchdog;           /* kick after each ISR (default; a target's main loop does it) */
+    void (*after_isr)(void *ctx); /* called right after fw_isr, may be NULL */
+    void *after_isr_ctx;
+    bool skip_thd;            /* no THD (the QEMU images: its sums cost ~10^10 soft-float ops) */
+    sim_warnings_t *warnings; /* may be NULL (warnings printed only) */
 } sim_run_cfg_t;
 
 typedef struct {
@@ -88,6 +97,7 @@ typedef struct {
     fw_t fw;
     sim_scenario_t scn;
     bool has_scn;
+    bool armed;   /* the run's arm instant has passed */
     double t_arm; /* plant time of the arm instant */
     double t_end;
     double obs_dt;
@@ -116,10 +126,17 @@ void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out);
  * at 0 r/min, torque mode 0 N*m, 0.3 s, window 0.1 s .. end, seed 1. */
 void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl_desc_t *ctrl);
 
-/* Build everything and run boot + calibration + arm. Returns 0 or -1 with a message. */
+/* Build everything and run boot + calibration + arm (unless cfg.defer_start).
+ * Returns 0 or -1 with a message. */
 int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errlen);
-/* One PWM period (scenario, ISR, plant). Returns 0, or -1 if the plant failed. */
+/* One PWM period: before the arm, boot/calibration (arming at the end of
+ * it with auto_arm); after it, scenario and metrics bookkeeping at the period
+ * start, then HAL begin, fw_isr, after_isr, watchdog kick, plant through the
+ * period. The host calls it in a loop, a QEMU image from its Timer0
+ * interrupt. Returns 0, or -1 if the plant failed. */
 int sim_run_period(sim_run_t *r);
+/* Armed and the duration reached. */
+bool sim_run_done(const sim_run_t *r);
 /* Scenario time of the next period start (seconds since arm). */
 double sim_run_time(const sim_run_t *r);
 /* Run until the end of the duration (or the fault, with stop_on_fault). */

@@ -1,0 +1,105 @@
+/*
+ * Interactive image: the firmware on the emulated Cortex-M4 (QEMU
+ * mps2-an386) with the thesis SPMSM in the loop, driven only by the commands
+ * it receives on UART0 (firmware/PROTOCOL.md; tools/console --qemu). It has no
+ * script and no end: it runs until QEMU is stopped.
+ *
+ * Plant: free rotor (J of the machine file) with a passive load of
+ * PIL_APP_LOAD_NM (it opposes the rotation and never drives it), at rest at
+ * power-up. The closed-loop engine (firmware/apps/engine) runs one PWM period
+ * per Timer0 interrupt (pil_common.h) from boot on: calibration (256 periods,
+ * gates off), then ready; "arm" is the user's. Default controller
+ * PIL_APP_CTRL at its default fs; "ctrl select" changes it while disarmed.
+ * Wall time: a running period costs 50-110 k emulated instructions, so plant
+ * time runs at about 1/20 of real time (-icount shift=3).
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "controller.h"
+#include "fw_link.h"
+#include "pil_cl.h"
+#include "pil_common.h"
+#include "pipeline.h"
+#include "qemu_mps2.h"
+#include "sim_run.h"
+
+#ifndef PIL_APP_CTRL
+#define PIL_APP_CTRL "fst"
+#endif
+#ifndef PIL_APP_LOAD_NM
+#define PIL_APP_LOAD_NM 0.3
+#endif
+
+static struct {
+    sim_run_t run;
+    fw_link_t link;
+    pil_timer_t timer;
+    volatile int plant_failed;
+} app;
+
+static void app_after_isr(void *ctx)
+{
+    (void)ctx;
+    fw_link_isr(&app.link);
+}
+
+/* The PWM-period interrupt (Timer0). */
+static void app_isr(void)
+{
+    if (app.plant_failed) {
+        return;
+    }
+    const uint32_t t_enter = timer1_read();
+    if (sim_run_period(&app.run) != 0) {
+        app.plant_failed = 1;
+        timer0_stop();
+        return;
+    }
+    pil_timer_account(&app.timer, timer1_read() - t_enter, app_isr);
+}
+
+int main(void)
+{
+    memset(&app, 0, sizeof app);
+    (void)setvbuf(stdout, NULL, _IONBF, 0);
+    const ctrl_desc_t *desc = ctrl_find(PIL_APP_CTRL);
+    if (desc == NULL) {
+        printf("interactive: controller %s is not registered\n", PIL_APP_CTRL);
+        return 2;
+    }
+    static sim_run_cfg_t c;
+    sim_run_config_default(&c, &pil_machine, desc);
+    c.fs_hz = desc->fs_default_hz;
+    c.free_mech = true;
+    c.duration_s = 100.0; /* never reached: the engine is not armed by itself */
+    c.win_start_s = 99.0; /* no metrics window, no Ts/10 observer */
+    c.win_end_s = 100.0;
+    c.defer_start = true;    /* the interrupt runs every period from boot on */
+    c.auto_arm = false;      /* only the user arms */
+    c.kick_watchdog = false; /* the main loop kicks */
+    c.after_isr = app_after_isr;
+    c.skip_thd = true;
+    char err[256];
+    if (sim_run_init(&app.run, &c, err, sizeof err) != 0) {
+        printf("interactive: %s\n", err);
+        return 2;
+    }
+    plant_set_load_passive(&app.run.plant, PIL_APP_LOAD_NM);
+    fw_link_init(&app.link, &app.run.fw, pil_uart_write, NULL);
+    hal_qemu_uart_rx_enable();
+    printf("pmsm-dtc on QEMU mps2-an386: %s, free rotor, passive load %.2f N*m; controller %s "
+           "at %u Hz; calibrating (256 periods), then 'arm' (PROTOCOL.md, 'help')\n",
+           pil_machine.name, PIL_APP_LOAD_NM, desc->name, (unsigned)c.fs_hz);
+    pil_timer_start(&app.timer, app_isr);
+    for (;;) {
+        pil_poll_uart(&app.link);
+        fw_watchdog_kick(&app.run.fw);
+        if (app.plant_failed == 1) {
+            app.plant_failed = 2;
+            printf("interactive: the plant integration failed (code %d); the drive is stopped\n",
+                   app.run.plant_rc);
+        }
+        board_idle();
+    }
+}
