@@ -31,7 +31,7 @@ class ConsoleQemuTest(unittest.TestCase):
     def test_drives_the_interactive_image(self):
         with tempfile.TemporaryDirectory() as tmp:
             csv = os.path.join(tmp, "run.csv")
-            r = console("--qemu", ELF, "--cmd", "ref speed 500", "--cmd", "arm",
+            r = console("--qemu", ELF, "--timeout", "30", "--cmd", "ref speed 500", "--cmd", "arm",
                         "--cmd", "tel start speed torque every 10", "--duration", "3",
                         "--cmd", "tel stop", "--cmd", "status", "--cmd", "disarm",
                         "--record", csv)
@@ -57,7 +57,10 @@ class ConsoleQemuTest(unittest.TestCase):
             self.assertLess(max(abs(s - 500.0) for s in tail), 25.0, tail)
 
     def test_reports_the_target_exit(self):
-        r = console("--qemu", ELF_EXITS, "--wait-ready", "0", "--cmd", "status", "--duration", "60")
+        # The test image calibrates on a turning rotor (RK4 with the gates
+        # off, millions of instructions a period): a patient response timeout.
+        r = console("--qemu", ELF_EXITS, "--wait-ready", "0", "--timeout", "60", "--cmd", "status",
+                    "--duration", "60")
         self.assertEqual(r.returncode, 3, r.stderr)
         self.assertRegex(r.stderr, r"console: the target exited with status \d+")
 
