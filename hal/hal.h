@@ -49,6 +49,14 @@ typedef struct {
     /* Appended by "loop": rate of hal_cycles() in Hz, for the deadline check
      * (cycle budget = cycle_clock_hz / pwm_freq_hz); 0 = unknown, check off. */
     uint32_t cycle_clock_hz;
+    /* Appended by "board": the largest compare value the back-end applies;
+     * hal_pwm_write limits larger ones to it. Low-side shunt sensing needs a
+     * zero vector around the sampling instant (dead time, settling, sampling),
+     * so a board keeps every leg low for at least period_counts - pwm_cmp_max
+     * counts at the period boundary. The firmware should plan within it (the
+     * estimator then sees the voltage actually applied). 0 = no limit
+     * (period_counts), as on the simulated back-ends. */
+    uint32_t pwm_cmp_max;
 } hal_info_t;
 
 void hal_info_get(const hal_t *h, hal_info_t *info);

@@ -58,11 +58,28 @@ static bool op_ctrl_at(void *ctx, size_t index, const char **name, const char **
     return true;
 }
 
+/* The application parameter called name, or NULL. */
+static const fw_link_param_t *fw_link_param(const fw_link_t *l, const char *name)
+{
+    for (size_t i = 0; i < l->n_params; i++) {
+        if (strcmp(l->params[i].info.name, name) == 0) {
+            return &l->params[i];
+        }
+    }
+    return NULL;
+}
+
 static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
 {
-    const fw_t *fw = fw_link_of(ctx)->fw;
-    if (fw->ctrl == NULL || index >= fw->ctrl->n_tunables) {
-        return false;
+    const fw_link_t *l = fw_link_of(ctx);
+    const fw_t *fw = l->fw;
+    const size_t n_tun = fw->ctrl != NULL ? fw->ctrl->n_tunables : 0u;
+    if (index >= n_tun) {
+        if (index - n_tun >= l->n_params) {
+            return false;
+        }
+        *info = l->params[index - n_tun].info;
+        return true;
     }
     const ctrl_tunable_t *t = &fw->ctrl->tunables[index];
     info->name = t->name;
@@ -92,7 +109,12 @@ static int fw_link_err(int fw_rc)
 
 static int op_param_get(void *ctx, const char *name, double *value)
 {
-    return fw_link_err(fw_tunable_get(fw_link_of(ctx)->fw, name, value));
+    const fw_link_t *l = fw_link_of(ctx);
+    const fw_link_param_t *p = fw_link_param(l, name);
+    if (p != NULL) {
+        return p->get(l->params_ctx, value);
+    }
+    return fw_link_err(fw_tunable_get(l->fw, name, value));
 }
 
 static int op_select_controller(void *ctx, const char *name)
@@ -146,7 +168,12 @@ static int op_set_speed_ref(void *ctx, double rpm)
 
 static int op_param_set(void *ctx, const char *name, double value)
 {
-    return fw_link_err(fw_tunable_set(fw_link_of(ctx)->fw, name, value));
+    fw_link_t *l = fw_link_of(ctx);
+    const fw_link_param_t *p = fw_link_param(l, name);
+    if (p != NULL) {
+        return p->set != NULL ? p->set(l->params_ctx, value) : CMD_E_READONLY;
+    }
+    return fw_link_err(fw_tunable_set(l->fw, name, value));
 }
 
 static int op_clear_fault(void *ctx)
@@ -195,6 +222,15 @@ void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ct
     l->speed_max_rpm = fw->speed_info.speed_ref_max_rpm;
     tel_init(&l->tel);
     cmd_init(&l->cmd, &fw_link_ops, l);
+}
+
+void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, void *ctx)
+{
+    if (l != NULL) {
+        l->params = params;
+        l->n_params = params != NULL ? n : 0u;
+        l->params_ctx = ctx;
+    }
 }
 
 void fw_link_rx(fw_link_t *l, uint8_t byte)

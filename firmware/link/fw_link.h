@@ -25,6 +25,17 @@
 
 typedef void (*fw_link_write_fn)(void *ctx, const uint8_t *bytes, size_t len);
 
+/* A parameter of the application (machine data, board values), listed by
+ * "param list" after the controller's tunables and reached by "param get/set"
+ * (PROTOCOL.md: "the firmware's own parameters"). Names must not collide with
+ * tunables (use a prefix such as "m." or "b."). get/set return CMD_OK or a
+ * cmd_err_t code; set is NULL when info.read_only. They run in the main loop. */
+typedef struct {
+    cmd_param_info_t info;
+    int (*get)(void *ctx, double *value);
+    int (*set)(void *ctx, double value);
+} fw_link_param_t;
+
 typedef struct {
     fw_t *fw;
     cmd_t cmd;
@@ -37,9 +48,14 @@ typedef struct {
     double speed_max_rpm; /* |speed reference| limit (fw_speed_info_t: the rated speed) */
     fw_link_write_fn write;
     void *write_ctx;
+    const fw_link_param_t *params; /* application parameters (fw_link_set_params) */
+    size_t n_params;
+    void *params_ctx;
 } fw_link_t;
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
+/* Application parameters (after fw_link_init; the table must outlive the link). */
+void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, void *ctx);
 /* Main loop: one received byte. */
 void fw_link_rx(fw_link_t *l, uint8_t byte);
 /* ISR, after fw_isr: queue this period's telemetry sample when due. */

@@ -147,10 +147,70 @@ static void test_fault_over_link(void)
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
 }
 
+/* Application parameters (fw_link_set_params, e.g. a board's machine data):
+ * listed after the controller's tunables, read and written by name, the
+ * interpreter's range check applies, a read-only one answers err 11, the
+ * setter's refusal (err 8 while running) passes through. */
+static double app_value = 2.5;
+static int app_get(void *ctx, double *v)
+{
+    (void)ctx;
+    *v = app_value;
+    return CMD_OK;
+}
+static int app_set(void *ctx, double v)
+{
+    const fw_t *fw = (const fw_t *)ctx;
+    if (fw_state(fw) == FW_STATE_RUNNING) {
+        return CMD_E_STATE;
+    }
+    app_value = v;
+    return CMD_OK;
+}
+static const fw_link_param_t app_params[] = {
+    {{"m.rs_ohm", "ohm", "stator resistance", 0.001, 100.0, false}, app_get, app_set},
+    {{"b.temp_c", "C", "board temperature", 0.0, 0.0, true}, app_get, NULL},
+};
+
+static void test_application_parameters(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_link_init(&link, &run.fw, capture, NULL);
+    fw_link_set_params(&link, app_params, 2u, &run.fw);
+    periods(2);
+    send("param list");
+    const char *rs = strstr(out, "  m.rs_ohm 2.5 ohm [0.001, 100]");
+    const char *tc = strstr(out, "  b.temp_c 2.5 C");
+    TEST_ASSERT_NOT_NULL(rs);
+    TEST_ASSERT_NOT_NULL(tc);
+    TEST_ASSERT_NOT_NULL(strstr(tc, " ro "));
+    TEST_ASSERT_TRUE(run.fw.ctrl->n_tunables > 0u);
+    char first[40];
+    (void)snprintf(first, sizeof first, "  %s ", run.fw.ctrl->tunables[0].name);
+    TEST_ASSERT_TRUE(strstr(out, first) != NULL && strstr(out, first) < rs);
+    send("param set m.rs_ohm 0.5"); /* armed */
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 8", 5));
+    send("disarm");
+    periods(1);
+    send("param set m.rs_ohm 0.5");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, app_value);
+    send("param get m.rs_ohm");
+    TEST_ASSERT_NOT_NULL(strstr(out, "ok m.rs_ohm 0.5 ohm"));
+    send("param set m.rs_ohm 200");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 4", 5));
+    send("param set b.temp_c 20");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 11", 6));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, app_value);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_commands_reach_the_pipeline);
+    RUN_TEST(test_application_parameters);
     RUN_TEST(test_telemetry_frames);
     RUN_TEST(test_fault_over_link);
     return UNITY_END();
