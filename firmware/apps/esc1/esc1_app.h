@@ -1,0 +1,67 @@
+/*
+ * The B-G431B-ESC1 application: board HAL (hal/stm32g4 + the board
+ * description), the firmware's period in the ADC end-of-conversion
+ * interrupt, the command and telemetry link on USART2, machine data that the
+ * command interface can change (esc1_params.c).
+ */
+#ifndef FIRMWARE_APPS_ESC1_ESC1_APP_H
+#define FIRMWARE_APPS_ESC1_ESC1_APP_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "ctrl_params.h"
+#include "esc1_uart.h"
+#include "fw_link.h"
+#include "g4_hal.h"
+#include "pipeline.h"
+
+/* Build-time defaults (compile definitions may override them). */
+#ifndef ESC1_FS_HZ
+#define ESC1_FS_HZ 20000u /* PWM = control frequency */
+#endif
+#ifndef ESC1_CTRL
+#define ESC1_CTRL "foc" /* controller after power-up ("ctrl select" changes it) */
+#endif
+#ifndef ESC1_ENCODER_CPR
+#define ESC1_ENCODER_CPR 4096u /* 1024-line encoder on J8, x4 */
+#endif
+#define ESC1_IWDG_MS 100u /* independent watchdog time-out */
+
+typedef struct {
+    hal_t hal;
+    fw_t fw;
+    fw_link_t link;
+    fw_config_t fc;
+    ctrl_machine_t machine; /* the machine data the firmware runs with */
+    uint32_t encoder_cpr;
+    g4_hal_cfg_t hc;
+    esc1_uart_t uart;
+    volatile uint32_t isr_count;
+    bool temp_check; /* board over-temperature trip enabled */
+    double temp_c;   /* last board temperature (NaN: sensor open/short) */
+} esc1_t;
+
+/* The compiled-in machine: a small 12 V gimbal-class outrunner (see
+ * esc1_params.c for its values and how to change them). */
+extern const ctrl_machine_t esc1_default_machine;
+
+/* Hardware over-current threshold for a machine: 1.5 x current_max_a, at
+ * least 8 A (below that the comparator's input offset and the DAC step are a
+ * large share of the threshold), at most the board's peak rating. */
+double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m);
+
+/* Re-initialises the firmware with new machine data / encoder resolution
+ * (drive not running; control interrupt masked meanwhile). On failure the
+ * previous data are restored. Returns CMD_OK or a cmd_err_t code. */
+int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
+
+/* The body of the ADC1_2 interrupt (end of the injected sequence): flags
+ * acknowledged, the firmware's period, the telemetry sample. esc1_isr.c, also
+ * built into the QEMU image that counts its instructions. */
+void esc1_control_isr(esc1_t *s);
+
+/* The parameter table for fw_link_set_params. */
+void esc1_params_attach(esc1_t *s);
+
+#endif /* FIRMWARE_APPS_ESC1_ESC1_APP_H */

@@ -1,0 +1,180 @@
+/*
+ * The firmware on the ST B-G431B-ESC1 (esc1_app.h).
+ *
+ * Start-up: DWT cycle counter, core lockup -> TIM1 break, clock (HSE 8 MHz ->
+ * PLL 170 MHz, boost mode); on a clock failure the board stays on HSI16 with
+ * the gates never enabled and says so on USART2 once a second. Then USART2,
+ * the board HAL (gates off, op-amps, ADCs calibrated, comparator thresholds,
+ * TIM1 with break, encoder, TIM1 started and its phase checked), fw_init with
+ * the compiled-in machine, the command link, the interrupts, the independent
+ * watchdog.
+ *
+ * Interrupts (priority: lower number first):
+ *   0 TIM1_BRK_TIM15  break: the hardware has cleared MOE; latch the cause
+ *   1 ADC1_2          end of the injected sequence: fw_isr, fw_link_isr
+ *   2 USART2          byte rings
+ * Main loop: received bytes -> command interpreter, telemetry frames out,
+ * firmware watchdog kick, board temperature every 100 ms, independent
+ * watchdog refreshed only while the control interrupt keeps running.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "board_esc1.h"
+#include "controller.h"
+#include "esc1_app.h"
+#include "g4_clock.h"
+#include "g4_core.h"
+#include "g4_periph.h"
+#include "g4_regs.h"
+#include "g4_startup.h"
+
+/* Everything lives in one instance; the interrupt handlers take no argument,
+ * so it is reachable at file scope. */
+static esc1_t esc1;
+
+void ADC1_2_IRQHandler(void);
+void TIM1_BRK_TIM15_IRQHandler(void);
+void USART2_IRQHandler(void);
+
+void ADC1_2_IRQHandler(void)
+{
+    esc1_control_isr(&esc1);
+}
+
+void TIM1_BRK_TIM15_IRQHandler(void)
+{
+    g4_tim1_gates_off_now();
+    g4_hal_break_irq(&esc1.hal);
+}
+
+void USART2_IRQHandler(void)
+{
+    esc1_uart_irq(&esc1.uart);
+}
+
+/* After the gates are off in a fault handler: the PWM pins as outputs at
+ * their inactive level as well (in case TIM1 itself is misconfigured). */
+void g4_board_fault_hook(void)
+{
+    const g4_board_t *b = &g4_board_esc1;
+    for (unsigned x = 0; x < 3u; x++) {
+        g4_gpio_write(b->pwm_high[x], b->gate_active_low);
+        g4_gpio_write(b->pwm_low[x], b->gate_active_low);
+        g4_gpio_config(b->pwm_high[x], G4_PIN_OUTPUT, 2u);
+        g4_gpio_config(b->pwm_low[x], G4_PIN_OUTPUT, 2u);
+    }
+}
+
+static void esc1_write(void *ctx, const uint8_t *bytes, size_t len)
+{
+    esc1_uart_write((esc1_uart_t *)ctx, bytes, len);
+}
+
+/* Start-up failed: gates off for good, the reason on the serial link once a
+ * second (no watchdog refresh needed: the watchdog is not started). */
+static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_cpu_hz)
+{
+    g4_tim1_gates_off_now();
+    char line[96];
+    (void)snprintf(line, sizeof line, "esc1: %s failed: %s; gates off, not armable\r\n", what, why);
+    for (;;) {
+        esc1_uart_puts(&s->uart, line);
+        g4_delay_cycles(f_cpu_hz);
+    }
+}
+
+/* Board temperature every 100 ms; over-temperature or a broken sensor latch
+ * the board trip (gates off; the firmware latches hw_trip). */
+static void esc1_temperature(esc1_t *s)
+{
+    const int32_t counts = g4_hal_temp_counts(&s->hal);
+    s->temp_c = g4_hal_temp_c(s->hal.board, counts);
+    if (!s->temp_check) {
+        s->hal.trip &= ~(uint32_t)G4_TRIP_BOARD;
+        return;
+    }
+    if (isnan(s->temp_c) || s->temp_c > s->hal.board->temp_trip_c) {
+        g4_hal_trip_board(&s->hal);
+    } else if (s->temp_c < s->hal.board->temp_trip_c - 10.0) {
+        s->hal.trip &= ~(uint32_t)G4_TRIP_BOARD; /* 10 C hysteresis */
+    }
+}
+
+int main(void)
+{
+    esc1_t *s = &esc1;
+    const g4_board_t *b = &g4_board_esc1;
+    g4_cycle_counter_init();
+    /* A core lockup (fault inside a fault handler) breaks TIM1 in hardware. */
+    g4_set(G4_RCC + G4_RCC_APB2ENR, G4_RCC_APB2ENR_SYSCFGEN);
+    g4_set(G4_SYSCFG + G4_SYSCFG_CFGR2, G4_SYSCFG_CFGR2_CLL);
+
+    const int clk = g4_clock_init(b->hse_hz, b->sysclk_hz);
+    const uint32_t f_cpu = clk == G4_OK ? b->sysclk_hz : G4_HSI_HZ;
+    (void)esc1_uart_init(&s->uart, f_cpu, b->baud);
+    if (clk != G4_OK) {
+        esc1_halt(s, "clock", g4_strerror(clk), f_cpu);
+    }
+    g4_gpio_config(b->led, G4_PIN_OUTPUT, 0u);
+
+    s->machine = esc1_default_machine;
+    s->encoder_cpr = ESC1_ENCODER_CPR;
+    s->temp_check = true;
+    s->temp_c = NAN;
+    s->hc.fs_hz = ESC1_FS_HZ;
+    s->hc.encoder_cpr = s->encoder_cpr;
+    s->hc.trip_current_a = esc1_hw_trip_a(b, &s->machine);
+    const int hrc = g4_hal_init(&s->hal, b, &s->hc);
+    if (hrc != G4_OK) {
+        esc1_halt(s, "board init", g4_strerror(hrc), f_cpu);
+    }
+    fw_config_default(&s->fc, &s->machine, ctrl_find(ESC1_CTRL));
+    const int frc = fw_init(&s->fw, &s->hal, &s->fc);
+    if (frc != FW_OK) {
+        esc1_halt(s, "fw_init", fw_strerror(frc), f_cpu);
+    }
+    fw_link_init(&s->link, &s->fw, esc1_write, &s->uart);
+    esc1_params_attach(s);
+
+    g4_nvic_set_priority(G4_IRQ_TIM1_BRK_TIM15, 0u);
+    g4_nvic_set_priority(G4_IRQ_ADC1_2, 1u);
+    g4_nvic_set_priority(G4_IRQ_USART2, 2u);
+    g4_nvic_enable(G4_IRQ_TIM1_BRK_TIM15);
+    g4_nvic_enable(G4_IRQ_USART2);
+    g4_nvic_enable(G4_IRQ_ADC1_2);
+
+    uint32_t pr, rlr;
+    if (g4_iwdg_config(ESC1_IWDG_MS, 32000u, &pr, &rlr) != G4_OK ||
+        g4_iwdg_start(pr, rlr, f_cpu) != G4_OK) {
+        esc1_halt(s, "watchdog", "LSI not ready", f_cpu);
+    }
+
+    uint32_t last_isr = s->isr_count;
+    uint32_t t_temp = g4_cycles();
+    const uint32_t temp_period = f_cpu / 10u;
+    for (;;) {
+        int c;
+        while ((c = esc1_uart_getc(&s->uart)) >= 0) {
+            fw_link_rx(&s->link, (uint8_t)c);
+        }
+        fw_link_poll(&s->link);
+        fw_watchdog_kick(&s->fw);
+        if (g4_cycles() - t_temp >= temp_period) {
+            t_temp += temp_period;
+            esc1_temperature(s);
+            /* LED: on while running, blinking (5 Hz) on a fault. */
+            const fw_state_id_t st = fw_state(&s->fw);
+            static bool blink;
+            blink = !blink;
+            g4_gpio_write(b->led, st == FW_STATE_RUNNING || (st == FW_STATE_FAULT && blink));
+        }
+        /* The independent watchdog proves that the control interrupt runs. */
+        const uint32_t n = s->isr_count;
+        if (n != last_isr) {
+            last_isr = n;
+            g4_iwdg_refresh();
+        }
+    }
+}

@@ -1,0 +1,283 @@
+/*
+ * Machine data and board values of the B-G431B-ESC1 image on the command
+ * interface (PROTOCOL.md "param list / get / set", the firmware's own
+ * parameters). Machine data change only while the drive is not running;
+ * every change re-initialises the firmware (state boot -> calibration ->
+ * ready, controller tunables back to their defaults) and moves the hardware
+ * over-current threshold with m.i_max_a. Nothing is stored across a reset:
+ * after power-up the compiled-in machine below is active again.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "board_esc1.h"
+#include "cmd.h"
+#include "esc1_app.h"
+#include "g4_core.h"
+
+/* The compiled-in machine: a typical 12 V gimbal-class outrunner (7 pole
+ * pairs, a few ohms: at 12 V it cannot draw more than a few amperes, a safe
+ * first motor for bring-up). Not one specific product: replace it with your
+ * motor's data ("param set m.rs_ohm 0.12" ...; docs/bringup.md). Checked in
+ * closed loop on the host plant (m2ptfc, foc, fst, drr at 400 r/min).
+ * T_rated = 1.5 p psi I_rated = 1.5 x 7 x 3.6 mWb x 1.5 A = 0.057 N*m. */
+const ctrl_machine_t esc1_default_machine = {
+    .name = "esc1_default_gimbal",
+    .pole_pairs = 7,
+    .rs_ohm = 2.5,
+    .ld_h = 1.0e-3,
+    .lq_h = 1.0e-3,
+    .psi_pm_wb = 3.6e-3,
+    .vdc_v = 12.0,
+    .inertia_kgm2 = 2.0e-6,
+    .torque_rated_nm = 0.05,
+    .speed_rated_rpm = 2000.0,
+    .current_rated_a = 1.5,
+    .current_max_a = 3.0,
+    .psi_ref_wb = 0.0,
+};
+
+double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m)
+{
+    double a = 1.5 * m->current_max_a;
+    if (a < 8.0) {
+        a = 8.0;
+    }
+    return a > b->current_peak_a ? b->current_peak_a : a;
+}
+
+static esc1_t *esc1_of(void *ctx)
+{
+    return (esc1_t *)ctx;
+}
+
+/* Machine fields reachable by name. */
+typedef enum {
+    M_P,
+    M_RS,
+    M_LD,
+    M_LQ,
+    M_PSI,
+    M_VDC,
+    M_J,
+    M_T,
+    M_N,
+    M_IR,
+    M_IMAX,
+    M_PSIREF,
+    M_CPR
+} esc1_field_t;
+
+static double *esc1_field(ctrl_machine_t *m, esc1_field_t f)
+{
+    switch (f) {
+    case M_RS:
+        return &m->rs_ohm;
+    case M_LD:
+        return &m->ld_h;
+    case M_LQ:
+        return &m->lq_h;
+    case M_PSI:
+        return &m->psi_pm_wb;
+    case M_VDC:
+        return &m->vdc_v;
+    case M_J:
+        return &m->inertia_kgm2;
+    case M_T:
+        return &m->torque_rated_nm;
+    case M_N:
+        return &m->speed_rated_rpm;
+    case M_IR:
+        return &m->current_rated_a;
+    case M_IMAX:
+        return &m->current_max_a;
+    case M_PSIREF:
+        return &m->psi_ref_wb;
+    default:
+        return NULL;
+    }
+}
+
+static int esc1_get_field(esc1_t *s, esc1_field_t f, double *v)
+{
+    if (f == M_P) {
+        *v = (double)s->machine.pole_pairs;
+    } else if (f == M_CPR) {
+        *v = (double)s->encoder_cpr;
+    } else {
+        *v = *esc1_field(&s->machine, f);
+    }
+    return CMD_OK;
+}
+
+static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
+{
+    if (fw_state(&s->fw) == FW_STATE_RUNNING) {
+        return CMD_E_STATE;
+    }
+    ctrl_machine_t m = s->machine;
+    uint32_t cpr = s->encoder_cpr;
+    if (f == M_P || f == M_CPR) {
+        if (v != floor(v)) {
+            return CMD_E_RANGE; /* integers only */
+        }
+        if (f == M_P) {
+            m.pole_pairs = (int)v;
+        } else {
+            cpr = (uint32_t)v;
+        }
+    } else {
+        *esc1_field(&m, f) = v;
+    }
+    m.name = "esc1_user";
+    return esc1_reconfigure(s, &m, cpr);
+}
+
+/* get/set functions per field (the link's callbacks take only a context). */
+#define ESC1_FIELD_FNS(F)                                                                          \
+    static int esc1_get_##F(void *ctx, double *v)                                                  \
+    {                                                                                              \
+        return esc1_get_field(esc1_of(ctx), F, v);                                                 \
+    }                                                                                              \
+    static int esc1_set_##F(void *ctx, double v)                                                   \
+    {                                                                                              \
+        return esc1_set_field(esc1_of(ctx), F, v);                                                 \
+    }
+ESC1_FIELD_FNS(M_P)
+ESC1_FIELD_FNS(M_RS)
+ESC1_FIELD_FNS(M_LD)
+ESC1_FIELD_FNS(M_LQ)
+ESC1_FIELD_FNS(M_PSI)
+ESC1_FIELD_FNS(M_VDC)
+ESC1_FIELD_FNS(M_J)
+ESC1_FIELD_FNS(M_T)
+ESC1_FIELD_FNS(M_N)
+ESC1_FIELD_FNS(M_IR)
+ESC1_FIELD_FNS(M_IMAX)
+ESC1_FIELD_FNS(M_PSIREF)
+ESC1_FIELD_FNS(M_CPR)
+
+static int esc1_get_fs(void *ctx, double *v)
+{
+    *v = (double)esc1_of(ctx)->hal.info.pwm_freq_hz;
+    return CMD_OK;
+}
+
+static int esc1_get_duty_max(void *ctx, double *v)
+{
+    const hal_info_t *i = &esc1_of(ctx)->hal.info;
+    *v = (double)i->pwm_cmp_max / (double)i->period_counts;
+    return CMD_OK;
+}
+
+static int esc1_get_hw_trip(void *ctx, double *v)
+{
+    *v = esc1_of(ctx)->hal.trip_current_a;
+    return CMD_OK;
+}
+
+static int esc1_get_temp(void *ctx, double *v)
+{
+    const double t = esc1_of(ctx)->temp_c;
+    if (isnan(t)) {
+        return CMD_E_FAILED; /* sensor open or shorted */
+    }
+    *v = t;
+    return CMD_OK;
+}
+
+static int esc1_get_trip(void *ctx, double *v)
+{
+    *v = (double)esc1_of(ctx)->hal.trip;
+    return CMD_OK;
+}
+
+static int esc1_get_temp_check(void *ctx, double *v)
+{
+    *v = esc1_of(ctx)->temp_check ? 1.0 : 0.0;
+    return CMD_OK;
+}
+
+static int esc1_set_temp_check(void *ctx, double v)
+{
+    if (v != 0.0 && v != 1.0) {
+        return CMD_E_RANGE;
+    }
+    esc1_of(ctx)->temp_check = v != 0.0;
+    return CMD_OK;
+}
+
+#define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
+    {                                                                                              \
+        {name, unit, help, lo, hi, false}, esc1_get_##F, esc1_set_##F                              \
+    }
+#define ESC1_RO(name, unit, help, get)                                                             \
+    {                                                                                              \
+        {name, unit, help, 0.0, 0.0, true}, get, NULL                                              \
+    }
+
+static const fw_link_param_t esc1_params[] = {
+    ESC1_RW("m.p", "-", 1.0, 50.0, "pole pairs (re-initialises, disarmed only)", M_P),
+    ESC1_RW("m.rs_ohm", "ohm", 0.001, 100.0, "stator resistance per phase", M_RS),
+    ESC1_RW("m.ld_h", "H", 1e-6, 1.0, "d inductance", M_LD),
+    ESC1_RW("m.lq_h", "H", 1e-6, 1.0, "q inductance", M_LQ),
+    ESC1_RW("m.psi_wb", "Wb", 1e-4, 1.0, "PM flux linkage, peak per phase", M_PSI),
+    ESC1_RW("m.vdc_v", "V", 8.0, 25.2, "nominal DC link (board max 25.2 V)", M_VDC),
+    ESC1_RW("m.j_kgm2", "kg*m^2", 1e-9, 1.0, "rotor inertia", M_J),
+    ESC1_RW("m.t_rated_nm", "N*m", 1e-4, 100.0, "rated torque (torque reference limit)", M_T),
+    ESC1_RW("m.n_rated_rpm", "r/min", 10.0, 100000.0, "rated speed", M_N),
+    ESC1_RW("m.i_rated_a", "A", 0.01, 40.0, "rated current, peak", M_IR),
+    ESC1_RW("m.i_max_a", "A", 0.01, 40.0, "over-current trip, peak (hw trip 1.5x, >= 8 A)", M_IMAX),
+    ESC1_RW("m.psi_ref_wb", "Wb", 0.0, 1.0, "stator flux reference, 0 = MTPA", M_PSIREF),
+    ESC1_RW("enc.cpr", "-", 4.0, 65535.0, "encoder counts per revolution (4 x lines)", M_CPR),
+    ESC1_RO("b.fs_hz", "Hz", "PWM and control frequency", esc1_get_fs),
+    ESC1_RO("b.duty_max", "-", "largest leg duty (low-side current sampling window)",
+            esc1_get_duty_max),
+    ESC1_RO("b.hw_trip_a", "A", "hardware over-current threshold (comparators)", esc1_get_hw_trip),
+    ESC1_RO("b.temp_c", "C", "board temperature (NTC, linear model)", esc1_get_temp),
+    ESC1_RO("b.trip", "-", "trip latch: 1 over-current, 2 system break, 4 board (temp)",
+            esc1_get_trip),
+    {{"b.temp_check", "-", "1 = board over-temperature trip on", 0.0, 1.0, false},
+     esc1_get_temp_check,
+     esc1_set_temp_check},
+};
+
+void esc1_params_attach(esc1_t *s)
+{
+    fw_link_set_params(&s->link, esc1_params, sizeof esc1_params / sizeof esc1_params[0], s);
+}
+
+int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
+{
+    if (fw_state(&s->fw) == FW_STATE_RUNNING) {
+        return CMD_E_STATE;
+    }
+    const double trip = esc1_hw_trip_a(s->hal.board, m);
+    if (encoder_cpr < 4u || encoder_cpr > 0xFFFFu) {
+        return CMD_E_RANGE;
+    }
+    const ctrl_machine_t old = s->machine;
+    const uint32_t old_cpr = s->encoder_cpr;
+    g4_nvic_disable(G4_IRQ_ADC1_2);
+    s->machine = *m;
+    s->encoder_cpr = encoder_cpr;
+    s->hal.info.encoder_counts_per_rev = encoder_cpr;
+    fw_config_default(&s->fc, &s->machine, s->fw.ctrl);
+    int rc = fw_init(&s->fw, &s->hal, &s->fc);
+    if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
+        rc = FW_ERANGE;
+    }
+    if (rc != FW_OK) {
+        /* The previous data worked: back to them. */
+        s->machine = old;
+        s->encoder_cpr = old_cpr;
+        s->hal.info.encoder_counts_per_rev = old_cpr;
+        fw_config_default(&s->fc, &s->machine, s->fw.ctrl);
+        (void)fw_init(&s->fw, &s->hal, &s->fc);
+        (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
+    } else {
+        s->link.speed_max_rpm = 1.2 * s->machine.speed_rated_rpm;
+    }
+    g4_nvic_enable(G4_IRQ_ADC1_2);
+    return rc == FW_OK ? CMD_OK : CMD_E_RANGE;
+}

@@ -1,0 +1,86 @@
+/* USART2 byte rings (esc1_uart.h). */
+#include "esc1_uart.h"
+
+#include <string.h>
+
+#include "board_esc1.h"
+#include "g4_core.h"
+#include "g4_periph.h"
+#include "g4_regs.h"
+
+int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud)
+{
+    memset(u, 0, sizeof *u);
+    uint32_t brr;
+    if (g4_usart_brr(f_pclk_hz, baud, &brr) != G4_OK) {
+        return G4_E_CONFIG;
+    }
+    /* A full ring drains in TX_SIZE x 10 bits / baud; wait at most that. */
+    u->tx_wait_cycles = (uint32_t)((uint64_t)f_pclk_hz * 10u * ESC1_UART_TX_SIZE / baud);
+    g4_gpio_config(g4_board_esc1.uart_tx, G4_PIN_AF, 0u);
+    g4_gpio_config(g4_board_esc1.uart_rx, G4_PIN_AF, 1u);
+    g4_usart2_init(brr);
+    return G4_OK;
+}
+
+int esc1_uart_getc(esc1_uart_t *u)
+{
+    const uint32_t t = u->rx_tail;
+    if (t == u->rx_head) {
+        return -1;
+    }
+    const int c = u->rx[t & (ESC1_UART_RX_SIZE - 1u)];
+    u->rx_tail = t + 1u;
+    return c;
+}
+
+void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len)
+{
+    for (size_t i = 0; i < len; i++) {
+        if (u->tx_head - u->tx_tail >= ESC1_UART_TX_SIZE) {
+            const uint32_t t0 = g4_cycles();
+            while (u->tx_head - u->tx_tail >= ESC1_UART_TX_SIZE) {
+                if (g4_cycles() - t0 > u->tx_wait_cycles) {
+                    u->tx_dropped += (uint32_t)(len - i);
+                    return;
+                }
+            }
+        }
+        u->tx[u->tx_head & (ESC1_UART_TX_SIZE - 1u)] = bytes[i];
+        u->tx_head++;
+        /* The interrupt sends while bytes are queued. */
+        g4_set(G4_USART2 + G4_USART_CR1, G4_USART_CR1_TXEIE);
+    }
+}
+
+void esc1_uart_puts(esc1_uart_t *u, const char *s)
+{
+    esc1_uart_write(u, (const uint8_t *)s, strlen(s));
+}
+
+void esc1_uart_irq(esc1_uart_t *u)
+{
+    const uint32_t isr = g4_rd(G4_USART2 + G4_USART_ISR);
+    if ((isr & (G4_USART_ISR_ORE | G4_USART_ISR_FE | G4_USART_ISR_NE)) != 0u) {
+        u->rx_errors++;
+        g4_wr(G4_USART2 + G4_USART_ICR, G4_USART_ICR_ORECF | G4_USART_ICR_FECF | G4_USART_ICR_NECF);
+    }
+    if ((isr & G4_USART_ISR_RXNE) != 0u) {
+        const uint8_t c = (uint8_t)g4_rd(G4_USART2 + G4_USART_RDR); /* clears RXNE */
+        if (u->rx_head - u->rx_tail < ESC1_UART_RX_SIZE) {
+            u->rx[u->rx_head & (ESC1_UART_RX_SIZE - 1u)] = c;
+            u->rx_head++;
+        } else {
+            u->rx_dropped++;
+        }
+    }
+    if ((isr & G4_USART_ISR_TXE) != 0u &&
+        (g4_rd(G4_USART2 + G4_USART_CR1) & G4_USART_CR1_TXEIE) != 0u) {
+        if (u->tx_tail != u->tx_head) {
+            g4_wr(G4_USART2 + G4_USART_TDR, u->tx[u->tx_tail & (ESC1_UART_TX_SIZE - 1u)]);
+            u->tx_tail++;
+        } else {
+            g4_clr(G4_USART2 + G4_USART_CR1, G4_USART_CR1_TXEIE);
+        }
+    }
+}

@@ -1,0 +1,38 @@
+/*
+ * USART2 of the B-G431B-ESC1 (ST-LINK virtual COM port): interrupt-driven
+ * byte rings between the USART interrupt and the main loop. The main loop
+ * owns the transmit side (whole lines and frames, PROTOCOL.md), the interrupt
+ * moves bytes.
+ */
+#ifndef FIRMWARE_APPS_ESC1_ESC1_UART_H
+#define FIRMWARE_APPS_ESC1_ESC1_UART_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define ESC1_UART_RX_SIZE 256u /* powers of two */
+#define ESC1_UART_TX_SIZE 1024u
+
+typedef struct {
+    uint8_t rx[ESC1_UART_RX_SIZE];
+    uint8_t tx[ESC1_UART_TX_SIZE];
+    volatile uint32_t rx_head, rx_tail; /* head: interrupt, tail: main loop */
+    volatile uint32_t tx_head, tx_tail; /* head: main loop, tail: interrupt */
+    volatile uint32_t rx_dropped, rx_errors;
+    uint32_t tx_dropped;
+    uint32_t tx_wait_cycles; /* longest wait for transmit space before dropping */
+} esc1_uart_t;
+
+/* Pins, USART2 8N1 at `baud` from PCLK1 = f_pclk_hz. Returns G4_OK or
+ * G4_E_CONFIG. */
+int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud);
+/* Next received byte, or -1. */
+int esc1_uart_getc(esc1_uart_t *u);
+/* Queues bytes; when the ring is full it waits for the interrupt to drain
+ * it, up to tx_wait_cycles, then drops the rest (counted). */
+void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len);
+void esc1_uart_puts(esc1_uart_t *u, const char *s);
+/* USART2 interrupt. */
+void esc1_uart_irq(esc1_uart_t *u);
+
+#endif /* FIRMWARE_APPS_ESC1_ESC1_UART_H */

@@ -1,0 +1,196 @@
+/* Timers: PWM time base, dead time, TIM1 PWM, TIM4 encoder (g4_tim.h). */
+#include "g4_tim.h"
+
+#include "g4_core.h"
+#include "g4_regs.h"
+
+int g4_pwm_timing(uint32_t f_tim_hz, uint32_t fs_hz, g4_pwm_timing_t *t)
+{
+    if (t == 0 || fs_hz == 0u || f_tim_hz < 4u * fs_hz) {
+        return G4_E_CONFIG;
+    }
+    for (uint32_t div = 1u; div <= 65536u; div++) {
+        const uint64_t den = 2ull * fs_hz * div;
+        if (f_tim_hz % den != 0u) {
+            continue;
+        }
+        const uint64_t arr = f_tim_hz / den;
+        if (arr <= 0xFFFFu && arr >= 2u) {
+            t->psc = div - 1u;
+            t->arr = (uint32_t)arr;
+            t->fs_hz = fs_hz;
+            return G4_OK;
+        }
+    }
+    return G4_E_CONFIG;
+}
+
+int g4_dtg_encode(uint32_t f_dts_hz, uint32_t dead_ns, uint8_t *dtg)
+{
+    if (dtg == 0 || f_dts_hz == 0u) {
+        return G4_E_CONFIG;
+    }
+    /* Requested dead time in t_DTS, rounded up. */
+    const uint64_t ticks = ((uint64_t)dead_ns * f_dts_hz + 999999999u) / 1000000000u;
+    if (ticks <= 127u) {
+        *dtg = (uint8_t)ticks;
+    } else if (ticks <= 254u) {
+        const uint64_t k = (ticks + 1u) / 2u; /* 64..127 steps of 2 t_DTS */
+        *dtg = (uint8_t)(0x80u | (uint32_t)(k - 64u));
+    } else if (ticks <= 504u) {
+        const uint64_t k = (ticks + 7u) / 8u; /* 32..63 steps of 8 t_DTS */
+        *dtg = (uint8_t)(0xC0u | (uint32_t)(k - 32u));
+    } else if (ticks <= 1008u) {
+        const uint64_t k = (ticks + 15u) / 16u; /* 32..63 steps of 16 t_DTS */
+        *dtg = (uint8_t)(0xE0u | (uint32_t)(k - 32u));
+    } else {
+        return G4_E_CONFIG;
+    }
+    return G4_OK;
+}
+
+uint32_t g4_dtg_ticks(uint8_t dtg)
+{
+    if ((dtg & 0x80u) == 0u) {
+        return dtg;
+    }
+    if ((dtg & 0xC0u) == 0x80u) {
+        return (64u + (dtg & 0x3Fu)) * 2u;
+    }
+    if ((dtg & 0xE0u) == 0xC0u) {
+        return (32u + (dtg & 0x1Fu)) * 8u;
+    }
+    return (32u + (dtg & 0x1Fu)) * 16u;
+}
+
+uint32_t g4_filter_cycles(uint32_t code)
+{
+    /* {sampling divider, N}; code 0 = no filter. */
+    static const uint8_t div[16] = {1, 1, 1, 1, 2, 2, 4, 4, 8, 8, 16, 16, 16, 32, 32, 32};
+    static const uint8_t n[16] = {0, 2, 4, 8, 6, 8, 6, 8, 6, 8, 5, 6, 8, 5, 6, 8};
+    code &= 0xFu;
+    return (uint32_t)div[code] * n[code];
+}
+
+void g4_tim1_pwm_init(const g4_tim1_cfg_t *c)
+{
+    const uintptr_t t = G4_TIM1;
+    g4_set(G4_RCC + G4_RCC_APB2ENR, G4_RCC_APB2ENR_TIM1EN);
+    /* Counter stopped, outputs off before anything else. */
+    g4_wr(t + G4_TIM_CR1, 0u);
+    g4_clr(t + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
+    g4_wr(t + G4_TIM_CR1, G4_TIM_CR1_CMS_CENTER1 | G4_TIM_CR1_ARPE);
+    g4_wr(t + G4_TIM_PSC, c->timing.psc);
+    g4_wr(t + G4_TIM_ARR, c->timing.arr);
+    /* RCR = 1 before the counter starts: the update event (compare preload
+     * transfer, TRGO2) on every second counter event, the overflow (peak). */
+    g4_wr(t + G4_TIM_RCR, 1u);
+    g4_wr(t + G4_TIM_CCMR1, G4_TIM_CCMR_OC_PWM1_PE(0u) | G4_TIM_CCMR_OC_PWM1_PE(1u));
+    g4_wr(t + G4_TIM_CCMR2, G4_TIM_CCMR_OC_PWM1_PE(0u));
+    g4_wr(t + G4_TIM_CCR1, 0u);
+    g4_wr(t + G4_TIM_CCR2, 0u);
+    g4_wr(t + G4_TIM_CCR3, 0u);
+    uint32_t ccer = 0u;
+    for (uint32_t ch = 1u; ch <= 3u; ch++) {
+        ccer |= G4_TIM_CCER_CCE(ch) | G4_TIM_CCER_CCNE(ch);
+        if (c->active_low) {
+            ccer |= G4_TIM_CCER_CCP(ch) | G4_TIM_CCER_CCNP(ch);
+        }
+    }
+    g4_wr(t + G4_TIM_CCER, ccer);
+    /* Idle levels 0 (OISx = OISxN = 0 = inactive), TRGO2 on update. */
+    g4_wr(t + G4_TIM_CR2, G4_TIM_CR2_MMS2_UPDATE);
+    /* Break: comparators only (no BKIN pin), polarity as is (BKCMPxP = 0). */
+    uint32_t af1 = 0u;
+    for (uint32_t n = 1u; n <= 4u; n++) {
+        if ((c->break_comps & (1u << n)) != 0u) {
+            af1 |= G4_TIM_AF1_BKCMPE(n);
+        }
+    }
+    g4_wr(t + G4_TIM_AF1, af1);
+    /* One write with MOE = 0: dead time, off-state selection, break enabled,
+     * active high, filtered, no automatic re-enable, no lock. */
+    g4_wr(t + G4_TIM_BDTR, (uint32_t)c->dtg | G4_TIM_BDTR_OSSI | G4_TIM_BDTR_OSSR |
+                               (af1 != 0u ? G4_TIM_BDTR_BKE : 0u) | G4_TIM_BDTR_BKP |
+                               G4_FIELD(c->bkf & 0xFu, G4_TIM_BDTR_BKF_POS));
+    /* Load the preload registers (PSC, ARR, RCR, CCRx) into the shadows. */
+    g4_wr(t + G4_TIM_EGR, G4_TIM_EGR_UG);
+    g4_wr(t + G4_TIM_SR, 0u);
+    g4_wr(t + G4_TIM_DIER, G4_TIM_DIER_BIE);
+    /* Core halted by a debugger: counter stopped, outputs disabled as by a
+     * break (RM0440 chapter 29, "Debug mode"). */
+    g4_set(G4_DBGMCU + G4_DBGMCU_APB2FZ, G4_DBGMCU_APB2FZ_TIM1_STOP);
+}
+
+int g4_tim1_start(const g4_pwm_timing_t *t, uint32_t f_cpu_hz)
+{
+    const uintptr_t b = G4_TIM1;
+    /* Two PWM periods in core cycles as time-out. */
+    const uint32_t timeout = (uint32_t)(2ull * f_cpu_hz / t->fs_hz);
+    /* TIMx_SR is rc_w0: writing ~flag clears that flag alone (a read-modify-
+     * write could clear a break flag raised in between). */
+    g4_wr(b + G4_TIM_SR, ~G4_TIM_SR_UIF);
+    g4_set(b + G4_TIM_CR1, G4_TIM_CR1_CEN);
+    if (!g4_wait_bits(b + G4_TIM_SR, G4_TIM_SR_UIF, G4_TIM_SR_UIF, timeout) ||
+        (g4_rd(b + G4_TIM_CR1) & G4_TIM_CR1_DIR) == 0u) {
+        g4_clr(b + G4_TIM_CR1, G4_TIM_CR1_CEN);
+        return G4_E_TIM;
+    }
+    g4_wr(b + G4_TIM_SR, ~G4_TIM_SR_UIF);
+    return G4_OK;
+}
+
+void g4_tim1_outputs(bool on)
+{
+    if (on) {
+        g4_set(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
+    } else {
+        g4_clr(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
+    }
+}
+
+void g4_tim1_gates_off_now(void)
+{
+    g4_wr(G4_TIM1 + G4_TIM_EGR, G4_TIM_EGR_BG);
+    g4_clr(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
+}
+
+void g4_tim4_encoder_init(uint32_t icf, bool index)
+{
+    const uintptr_t t = G4_TIM4;
+    g4_set(G4_RCC + G4_RCC_APB1ENR1, G4_RCC_APB1ENR1_TIM4EN);
+    g4_wr(t + G4_TIM_CR1, 0u);
+    g4_wr(t + G4_TIM_CCMR1, G4_TIM_CCMR_IC_DIRECT(0u, icf) | G4_TIM_CCMR_IC_DIRECT(1u, icf));
+    g4_wr(t + G4_TIM_CCMR2, index ? G4_TIM_CCMR_IC_DIRECT(0u, icf) : 0u);
+    /* CC1P = CC2P = 0: non-inverted; CC3E: capture on the index's rising edge. */
+    g4_wr(t + G4_TIM_CCER, index ? G4_TIM_CCER_CCE(3u) : 0u);
+    g4_wr(t + G4_TIM_SMCR, G4_TIM_SMCR_SMS_ENCODER3);
+    g4_wr(t + G4_TIM_PSC, 0u);
+    g4_wr(t + G4_TIM_ARR, 0xFFFFu);
+    g4_wr(t + G4_TIM_EGR, G4_TIM_EGR_UG);
+    g4_wr(t + G4_TIM_CNT, 0u);
+    g4_wr(t + G4_TIM_SR, 0u);
+    g4_wr(t + G4_TIM_CR1, G4_TIM_CR1_CEN);
+}
+
+static int32_t g4_s16(uint16_t u)
+{
+    return u <= 0x7FFFu ? (int32_t)u : (int32_t)u - 65536;
+}
+
+uint32_t g4_enc_extend(g4_enc_ext_t *e, uint16_t cnt)
+{
+    if (!e->primed) {
+        e->primed = true;
+        e->count = (uint32_t)g4_s16(cnt);
+    } else {
+        e->count += (uint32_t)g4_s16((uint16_t)(cnt - e->last));
+    }
+    e->last = cnt;
+    return e->count;
+}
+
+uint32_t g4_enc_at_capture(const g4_enc_ext_t *e, uint16_t cnt, uint16_t ccr)
+{
+    return e->count - (uint32_t)g4_s16((uint16_t)(cnt - ccr));
+}

@@ -1,0 +1,93 @@
+/*
+ * Timers of the STM32G4 (RM0440 chapter 29 "Advanced-control timers
+ * (TIM1/TIM8/TIM20)" and the general-purpose TIM2/TIM3/TIM4/TIM5 chapter):
+ * the PWM time base, the dead-time and filter encodings, TIM1 as a
+ * three-phase complementary PWM with break input, TIM4 as a quadrature
+ * encoder counter.
+ */
+#ifndef HAL_STM32G4_G4_TIM_H
+#define HAL_STM32G4_G4_TIM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+/* Centre-aligned time base: the counter runs 0 -> ARR -> 0, so one PWM period
+ * is 2 ARR (PSC + 1) timer clocks: f_PWM = f_TIM / (2 ARR (PSC + 1)). */
+typedef struct {
+    uint32_t psc;   /* TIMx_PSC (divider - 1) */
+    uint32_t arr;   /* TIMx_ARR = compare value for 100 % duty */
+    uint32_t fs_hz; /* f_PWM, exactly the requested one */
+} g4_pwm_timing_t;
+
+/* PSC = 0 when ARR fits 16 bits, else the smallest prescaler; the period must
+ * be a whole number of timer clocks (f_TIM divisible by 2 fs (PSC + 1)),
+ * otherwise G4_E_CONFIG (the control period would not be 1/fs exactly). */
+int g4_pwm_timing(uint32_t f_tim_hz, uint32_t fs_hz, g4_pwm_timing_t *t);
+
+/* Dead time, TIMx_BDTR.DTG[7:0] (t_DTS = 1/f_DTS, CKD = 0 so f_DTS = f_TIM):
+ *   DTG[7:5] = 0xx:  DT = DTG[7:0] x t_DTS                      0 .. 127 t_DTS
+ *   DTG[7:5] = 10x:  DT = (64 + DTG[5:0]) x 2 t_DTS            128 .. 254 t_DTS
+ *   DTG[7:5] = 110:  DT = (32 + DTG[4:0]) x 8 t_DTS            256 .. 504 t_DTS
+ *   DTG[7:5] = 111:  DT = (32 + DTG[4:0]) x 16 t_DTS           512 .. 1008 t_DTS
+ * The encoding never gives less than the requested time (rounded up to the
+ * range's step). G4_OK, or G4_E_CONFIG above 1008 t_DTS. */
+int g4_dtg_encode(uint32_t f_dts_hz, uint32_t dead_ns, uint8_t *dtg);
+/* Dead time of a DTG code, in t_DTS. */
+uint32_t g4_dtg_ticks(uint8_t dtg);
+
+/* Digital filter codes (TIMx_BDTR.BKF, TIMx_CCMRx.ICxF, same table): the
+ * delay of a code in f_DTS cycles (sampling divider x N events), e.g.
+ * 0011 = f_CK_INT, N = 8 -> 8; 1010 = f_DTS/16, N = 5 -> 80. */
+uint32_t g4_filter_cycles(uint32_t code);
+
+/* TIM1 as the inverter's PWM. */
+typedef struct {
+    g4_pwm_timing_t timing;
+    uint8_t dtg;         /* g4_dtg_encode */
+    uint8_t bkf;         /* break filter code */
+    uint8_t break_comps; /* bit n (1..4): COMPn output drives the break input */
+    bool active_low;     /* gate-driver inputs active low (CCxP = CCxNP = 1) */
+} g4_tim1_cfg_t;
+
+/* Configures TIM1 with the outputs safe and the counter stopped (RM0440
+ * chapter 29): centre-aligned mode 1, ARR preload, PWM mode 1 on CH1..3 with
+ * compare preload (new values act at the next update event), complementary
+ * outputs with dead time, idle state inactive (OISx = OISxN = 0, OSSI = OSSR
+ * = 1: with MOE = 0 all six outputs are driven to their inactive level, both
+ * switches of every leg off), break input from the comparators, filtered,
+ * active high, not automatic (AOE = 0: after a break the gates stay off until
+ * software sets MOE), TRGO2 = update event (the ADC trigger), repetition
+ * counter RCR = 1 written before the counter starts: one update event per PWM
+ * period, at the counter peak (overflow). MOE stays 0. Compare values 0. */
+void g4_tim1_pwm_init(const g4_tim1_cfg_t *c);
+/* Starts the counter; waits for an update event and checks that it fell at
+ * the counter peak (TIMx_CR1.DIR = 1, counting down, right after it).
+ * G4_OK or G4_E_TIM (then the counter is stopped again). */
+int g4_tim1_start(const g4_pwm_timing_t *t, uint32_t f_cpu_hz);
+/* MOE: the outputs follow the compare values (on) / inactive (off, at once). */
+void g4_tim1_outputs(bool on);
+/* Gates off from any context, fault handlers included: a software break
+ * (TIMx_EGR.BG clears MOE in hardware), then MOE cleared. */
+void g4_tim1_gates_off_now(void);
+
+/* TIM4 as quadrature counter (encoder mode 3: x4, counts on both edges of
+ * both channels), 16 bits free-running (ARR = 0xFFFF), input filter code
+ * `icf` on CH1/CH2; CH3 (index) captures the counter on its rising edge
+ * when `index` is set. */
+void g4_tim4_encoder_init(uint32_t icf, bool index);
+
+/* 16-bit hardware counter extended to the 32-bit count of hal.h: the signed
+ * 16-bit difference since the last read is added (valid while the encoder
+ * moves less than 32768 counts between two reads, i.e. below
+ * 32768 fs / cpr revolutions per second). The first read is sign-extended. */
+typedef struct {
+    uint32_t count; /* extended count */
+    uint16_t last;  /* last hardware value */
+    bool primed;
+} g4_enc_ext_t;
+uint32_t g4_enc_extend(g4_enc_ext_t *e, uint16_t cnt);
+/* Extended count at a capture taken by the hardware at `ccr` (16 bits), given
+ * the extended count at the present hardware value `cnt`. */
+uint32_t g4_enc_at_capture(const g4_enc_ext_t *e, uint16_t cnt, uint16_t ccr);
+
+#endif /* HAL_STM32G4_G4_TIM_H */

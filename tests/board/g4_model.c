@@ -1,0 +1,216 @@
+/* Register-level STM32G4 model for the HAL tests (g4_model.h). */
+#include "g4_model.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#define G4_DEFINE_ARRAY(N, n, addr, bytes) uint32_t g4_mem_##n[(bytes) / 4u];
+G4_PERIPHS(G4_DEFINE_ARRAY)
+#undef G4_DEFINE_ARRAY
+
+g4_model_t g4_model;
+
+typedef struct {
+    const char *name;
+    uintptr_t base;
+    uint32_t bytes;
+} g4_region_t;
+
+#define G4_REGION(N, n, addr, bytes) {#N, (uintptr_t)g4_mem_##n, (bytes)},
+static const g4_region_t g4_regions[] = {G4_PERIPHS(G4_REGION)};
+#undef G4_REGION
+#define G4_N_REGIONS (sizeof g4_regions / sizeof g4_regions[0])
+
+static uint32_t *g4_model_cell(uintptr_t reg)
+{
+    for (size_t i = 0; i < G4_N_REGIONS; i++) {
+        if (reg >= g4_regions[i].base && reg < g4_regions[i].base + g4_regions[i].bytes) {
+            return (uint32_t *)reg;
+        }
+    }
+    fprintf(stderr, "g4_model: access outside the peripheral arrays: %p\n", (void *)reg);
+    return NULL;
+}
+
+void g4_model_reset(void)
+{
+#define G4_CLEAR(N, n, addr, bytes) memset(g4_mem_##n, 0, sizeof g4_mem_##n);
+    G4_PERIPHS(G4_CLEAR)
+#undef G4_CLEAR
+    memset(&g4_model, 0, sizeof g4_model);
+    g4_model.adc_regular = 128u;
+    /* Reset values the HAL relies on: PWR_CR1.VOS = range 1, PWR_CR5.R1MODE = 1
+     * (boost off), ADC_CR.DEEPPWD = 1, ADC_CFGR.JQDIS = 1 (RM0440 reset values). */
+    g4_mem_pwr[G4_PWR_CR1 / 4u] = G4_PWR_CR1_VOS_RANGE1;
+    g4_mem_pwr[G4_PWR_CR5 / 4u] = G4_PWR_CR5_R1MODE;
+    g4_mem_adc1[G4_ADC_CR / 4u] = G4_ADC_CR_DEEPPWD;
+    g4_mem_adc2[G4_ADC_CR / 4u] = G4_ADC_CR_DEEPPWD;
+    g4_mem_adc1[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
+    g4_mem_adc2[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
+}
+
+const char *g4_model_name(uintptr_t reg)
+{
+    static char buf[4][32];
+    static unsigned k;
+    char *b = buf[k++ % 4u];
+    for (size_t i = 0; i < G4_N_REGIONS; i++) {
+        if (reg >= g4_regions[i].base && reg < g4_regions[i].base + g4_regions[i].bytes) {
+            (void)snprintf(b, 32, "%s+0x%02X", g4_regions[i].name,
+                           (unsigned)(reg - g4_regions[i].base));
+            return b;
+        }
+    }
+    return "?";
+}
+
+uint32_t g4_model_get(uintptr_t reg)
+{
+    uint32_t *c = g4_model_cell(reg);
+    return c != NULL ? *c : 0u;
+}
+
+void g4_model_put(uintptr_t reg, uint32_t value)
+{
+    uint32_t *c = g4_model_cell(reg);
+    if (c != NULL) {
+        *c = value;
+    }
+}
+
+int g4_model_find(uintptr_t reg, uint32_t mask, uint32_t want, int from)
+{
+    for (uint32_t i = from < 0 ? 0u : (uint32_t)from; i < g4_model.n_log; i++) {
+        if (g4_model.log[i].reg == reg && (g4_model.log[i].value & mask) == want) {
+            return (int)i;
+        }
+    }
+    return -1;
+}
+
+int g4_model_find_last(uintptr_t reg, uint32_t mask, uint32_t want)
+{
+    for (uint32_t i = g4_model.n_log; i-- > 0u;) {
+        if (g4_model.log[i].reg == reg && (g4_model.log[i].value & mask) == want) {
+            return (int)i;
+        }
+    }
+    return -1;
+}
+
+uint32_t g4_trace_read(uintptr_t reg)
+{
+    uint32_t *c = g4_model_cell(reg);
+    if (c == NULL) {
+        return 0u;
+    }
+    /* Time passes: every read of the cycle counter advances it. */
+    if (reg == G4_DWT + G4_DWT_CYCCNT) {
+        *c += 16u;
+    }
+    if (reg == G4_RCC + G4_RCC_CR) {
+        uint32_t v = *c & ~(G4_RCC_CR_HSERDY | G4_RCC_CR_PLLRDY);
+        if ((v & G4_RCC_CR_HSEON) != 0u && !g4_model.hse_broken) {
+            v |= G4_RCC_CR_HSERDY;
+        }
+        if ((v & G4_RCC_CR_PLLON) != 0u && (v & G4_RCC_CR_HSERDY) != 0u) {
+            v |= G4_RCC_CR_PLLRDY;
+        }
+        *c = v;
+    }
+    if (reg == G4_RCC + G4_RCC_CFGR) {
+        *c = (*c & ~G4_RCC_CFGR_SWS_MASK) | ((*c & G4_RCC_CFGR_SW_MASK) << 2);
+    }
+    if (reg == G4_DAC3 + G4_DAC_SR) {
+        const uint32_t cr = g4_mem_dac3[G4_DAC_CR / 4u];
+        *c = ((cr & G4_DAC_CR_EN1) != 0u ? G4_DAC_SR_DAC1RDY : 0u) |
+             ((cr & G4_DAC_CR_EN2) != 0u ? G4_DAC_SR_DAC2RDY : 0u);
+    }
+    if (reg == G4_TIM1 + G4_TIM_CR1) {
+        /* Right after an update the counter counts down if the update was at
+         * the peak (RCR written before the start: RM0440 chapter 29,
+         * repetition counter in centre-aligned mode). */
+        const bool peak = g4_model.rcr_before_cen && !g4_model.uev_at_valley;
+        *c = (*c & ~G4_TIM_CR1_DIR) | (peak ? G4_TIM_CR1_DIR : 0u);
+    }
+    if (reg == G4_TIM1 + G4_TIM_SR && (g4_mem_tim1[G4_TIM_CR1 / 4u] & G4_TIM_CR1_CEN) != 0u) {
+        *c |= G4_TIM_SR_UIF; /* the counter runs: updates come */
+    }
+    if (reg >= G4_COMP && reg < G4_COMP + 0x10u) {
+        *c = (*c & ~G4_COMP_CSR_VALUE) | (g4_model.comp_high ? G4_COMP_CSR_VALUE : 0u);
+    }
+    return *c;
+}
+
+void g4_trace_write(uintptr_t reg, uint32_t value)
+{
+    uint32_t *c = g4_model_cell(reg);
+    if (g4_model.n_log < G4_MODEL_LOG_MAX) {
+        g4_model.log[g4_model.n_log].reg = reg;
+        g4_model.log[g4_model.n_log].value = value;
+        g4_model.n_log++;
+    } else {
+        g4_model.log_overflow = true;
+    }
+    if (c == NULL) {
+        return;
+    }
+    /* ADC: ISR is write-1-to-clear; ADCAL ends at once; ADEN raises ADRDY;
+     * ADSTART converts at once (EOC, DR). */
+    uintptr_t adc = 0u;
+    if (reg >= G4_ADC1 && reg < G4_ADC1 + 0x100u) {
+        adc = G4_ADC1;
+    } else if (reg >= G4_ADC2 && reg < G4_ADC2 + 0x100u) {
+        adc = G4_ADC2;
+    }
+    if (adc != 0u && reg == adc + G4_ADC_ISR) {
+        *c &= ~value;
+        return;
+    }
+    if (adc != 0u && reg == adc + G4_ADC_CR) {
+        uint32_t *isr = (uint32_t *)(adc + G4_ADC_ISR);
+        const uint32_t v = (*c & (G4_ADC_CR_ADEN | G4_ADC_CR_JADSTART)) | value;
+        if ((value & G4_ADC_CR_ADEN) != 0u) {
+            *isr |= G4_ADC_ISR_ADRDY;
+        }
+        if ((value & G4_ADC_CR_ADSTART) != 0u) {
+            *isr |= G4_ADC_ISR_EOC | G4_ADC_ISR_EOS;
+            *(uint32_t *)(adc + G4_ADC_DR) = g4_model.adc_regular;
+        }
+        *c = v & ~(G4_ADC_CR_ADCAL | G4_ADC_CR_ADSTART);
+        return;
+    }
+    /* USART ICR clears ISR flags. */
+    if (reg == G4_USART2 + G4_USART_ICR) {
+        g4_mem_usart2[G4_USART_ISR / 4u] &= ~value;
+        return;
+    }
+    uintptr_t tb = 0u;
+    if (reg >= G4_TIM1 && reg < G4_TIM1 + 0x400u) {
+        tb = G4_TIM1;
+    } else if (reg >= G4_TIM4 && reg < G4_TIM4 + 0x400u) {
+        tb = G4_TIM4;
+    }
+    if (tb != 0u) {
+        if (reg == tb + G4_TIM_SR) {
+            *c &= value; /* rc_w0 */
+            return;
+        }
+        if (reg == tb + G4_TIM_EGR) {
+            if ((value & G4_TIM_EGR_BG) != 0u) {
+                /* Software break: MOE cleared by the hardware, BIF set. */
+                *(uint32_t *)(tb + G4_TIM_BDTR) &= ~G4_TIM_BDTR_MOE;
+                *(uint32_t *)(tb + G4_TIM_SR) |= G4_TIM_SR_BIF;
+            }
+            return;
+        }
+        if (tb == G4_TIM1 && reg == tb + G4_TIM_RCR) {
+            g4_model.rcr_written = true;
+        }
+        if (tb == G4_TIM1 && reg == tb + G4_TIM_CR1 && (value & G4_TIM_CR1_CEN) != 0u &&
+            (*c & G4_TIM_CR1_CEN) == 0u) {
+            g4_model.rcr_before_cen = g4_model.rcr_written;
+        }
+    }
+    *c = value;
+}

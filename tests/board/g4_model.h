@@ -1,0 +1,55 @@
+/*
+ * A register-level model of the STM32G4 peripherals the G4 HAL touches, for
+ * host (and QEMU) tests: the peripheral base addresses are arrays
+ * (G4_MEM_ARRAYS), every access goes through g4_trace_read / g4_trace_write
+ * (G4_REG_TRACE), which log the writes in order and model what the hardware
+ * does that the HAL waits for (ready flags, calibration end, write-1-to-clear
+ * and write-0-to-clear flags, the software break, the TIM1 update phase).
+ * The model is deliberately simple: it answers the HAL's polls, it does not
+ * convert or count.
+ */
+#ifndef TESTS_BOARD_G4_MODEL_H
+#define TESTS_BOARD_G4_MODEL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "g4_regs.h"
+
+#define G4_MODEL_LOG_MAX 4096u
+
+typedef struct {
+    uintptr_t reg;
+    uint32_t value; /* the value written (before the model's side effects) */
+} g4_write_t;
+
+typedef struct {
+    g4_write_t log[G4_MODEL_LOG_MAX];
+    uint32_t n_log;
+    bool log_overflow;
+    /* behaviour switches */
+    bool hse_broken;      /* HSERDY never rises */
+    bool uev_at_valley;   /* the TIM1 update falls at the counter valley */
+    uint16_t adc_regular; /* result of every regular conversion */
+    bool comp_high;       /* every comparator output high */
+    /* state the model keeps */
+    bool rcr_before_cen;
+    bool rcr_written;
+} g4_model_t;
+
+extern g4_model_t g4_model;
+
+/* Clears every register array, the log and the switches. */
+void g4_model_reset(void);
+/* Name of a register address ("TIM1+0x44") for messages. */
+const char *g4_model_name(uintptr_t reg);
+/* Index in the log of the first write to reg with (value & mask) == want at
+ * or after `from`; -1 if none. */
+int g4_model_find(uintptr_t reg, uint32_t mask, uint32_t want, int from);
+/* The same, last such write. */
+int g4_model_find_last(uintptr_t reg, uint32_t mask, uint32_t want);
+/* Current register content. */
+uint32_t g4_model_get(uintptr_t reg);
+void g4_model_put(uintptr_t reg, uint32_t value);
+
+#endif /* TESTS_BOARD_G4_MODEL_H */
