@@ -28,7 +28,10 @@ void g4_gpio_config(g4_pin_t p, g4_pin_mode_t mode, uint32_t pull)
     }
     if (mode == G4_PIN_OUTPUT || mode == G4_PIN_AF) {
         g4_clr(b + G4_GPIO_OTYPER, G4_BIT(p.pin));
-        g4_mod(b + G4_GPIO_OSPEEDR, 3u << sh2, 3u << sh2);
+        /* PC13..PC15 sit in the backup power domain: low speed only
+         * (datasheet DS12589, pin notes: <= 2 MHz, 30 pF, no current source). */
+        const uint32_t speed = (p.port == 2u && p.pin >= 13u) ? 0u : 3u;
+        g4_mod(b + G4_GPIO_OSPEEDR, 3u << sh2, speed << sh2);
     }
     g4_mod(b + G4_GPIO_PUPDR, 3u << sh2, (pull & 3u) << sh2);
     g4_mod(b + G4_GPIO_MODER, 3u << sh2, (uint32_t)mode << sh2);

@@ -186,8 +186,8 @@ static void test_init_analog_image(void)
 }
 
 /* Pins: TIM1 CH1/2/3 PA8/9/10 AF6, CH1N PC13 AF4, CH2N PA12 AF6, CH3N PB15
- * AF4 in AF mode (10); op-amp pins analog (11); encoder PB6/7/8 AF2; UCPD1
- * dead-battery pull-downs off (PWR_CR3 bit 14); hal.h description. */
+ * AF4 in AF mode (10), PC13 at low speed (backup domain pin); op-amp pins analog (11); encoder
+ * PB6/7/8 AF2; UCPD1 dead-battery pull-downs off (PWR_CR3 bit 14); hal.h description. */
 static void test_init_pins_and_info(void)
 {
     TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
@@ -198,6 +198,9 @@ static void test_init_pins_and_info(void)
     }
     TEST_ASSERT_EQUAL_UINT32(2u, pin_mode(G4_GPIOC, 13u));
     TEST_ASSERT_EQUAL_UINT32(4u, pin_af(G4_GPIOC, 13u));
+    /* PC13 (backup domain) at low speed, the other gate pins very high (11) */
+    TEST_ASSERT_EQUAL_UINT32(0u, (reg(G4_GPIOC + G4_GPIO_OSPEEDR) >> 26) & 3u);
+    TEST_ASSERT_EQUAL_UINT32(3u, (reg(G4_GPIOA + G4_GPIO_OSPEEDR) >> 16) & 3u);
     TEST_ASSERT_EQUAL_UINT32(2u, pin_mode(G4_GPIOB, 15u));
     TEST_ASSERT_EQUAL_UINT32(4u, pin_af(G4_GPIOB, 15u));
     const uint32_t an_a[6] = {0u, 1u, 2u, 3u, 5u, 6u};
