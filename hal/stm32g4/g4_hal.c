@@ -143,9 +143,7 @@ static int g4_hal_check(const g4_board_t *b, const g4_hal_cfg_t *c)
     return G4_OK;
 }
 
-/* PWM pins as outputs at the inactive level: both switches of each leg off
- * until TIM1 drives them. */
-static void g4_hal_pins_safe(const g4_board_t *b)
+void g4_hal_gate_pins_safe(const g4_board_t *b)
 {
     for (unsigned x = 0; x < 3u; x++) {
         g4_gpio_write(b->pwm_high[x], b->gate_active_low);
@@ -211,7 +209,7 @@ int g4_hal_init(hal_t *h, const g4_board_t *b, const g4_hal_cfg_t *c)
     }
 
     /* 1. Gates: pins driven inactive before anything else. */
-    g4_hal_pins_safe(b);
+    g4_hal_gate_pins_safe(b);
     if (b->ucpd_dead_battery_off) {
         g4_set(G4_RCC + G4_RCC_APB1ENR1, G4_RCC_APB1ENR1_PWREN);
         g4_set(G4_PWR + G4_PWR_CR3, G4_PWR_CR3_UCPD1_DBDIS);

@@ -85,6 +85,11 @@ int g4_hal_set_trip_current(hal_t *h, double trip_a);
  * window takes more than a quarter of the period. */
 int g4_hal_cmp_max(const g4_board_t *b, const g4_pwm_timing_t *t, uint32_t *cmp_max);
 
+/* The six gate pins as GPIO outputs at their inactive level (both switches
+ * of every leg off), taken from TIM1: init's first step, and the fault
+ * handlers' last. */
+void g4_hal_gate_pins_safe(const g4_board_t *b);
+
 /* From the interrupts (board application). */
 void g4_hal_adc_irq_ack(hal_t *h); /* clears the end-of-sequence flags */
 void g4_hal_break_irq(hal_t *h);   /* latches and clears the break flags */

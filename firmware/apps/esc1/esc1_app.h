@@ -53,7 +53,8 @@ double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m);
 
 /* Re-initialises the firmware with new machine data / encoder resolution
  * (drive not running; control interrupt masked meanwhile). On failure the
- * previous data are restored. Returns CMD_OK or a cmd_err_t code. */
+ * previous data are restored. Returns CMD_OK, CMD_E_STATE (running),
+ * CMD_E_RANGE (encoder counts) or CMD_E_FAILED (the core refused them). */
 int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
 
 /* The body of the ADC1_2 interrupt (end of the injected sequence): flags

@@ -58,13 +58,7 @@ void USART2_IRQHandler(void)
  * their inactive level as well (in case TIM1 itself is misconfigured). */
 void g4_board_fault_hook(void)
 {
-    const g4_board_t *b = &g4_board_esc1;
-    for (unsigned x = 0; x < 3u; x++) {
-        g4_gpio_write(b->pwm_high[x], b->gate_active_low);
-        g4_gpio_write(b->pwm_low[x], b->gate_active_low);
-        g4_gpio_config(b->pwm_high[x], G4_PIN_OUTPUT, 2u);
-        g4_gpio_config(b->pwm_low[x], G4_PIN_OUTPUT, 2u);
-    }
+    g4_hal_gate_pins_safe(&g4_board_esc1);
 }
 
 static void esc1_write(void *ctx, const uint8_t *bytes, size_t len)

@@ -279,5 +279,7 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
         s->link.speed_max_rpm = 1.2 * s->machine.speed_rated_rpm;
     }
     g4_nvic_enable(G4_IRQ_ADC1_2);
-    return rc == FW_OK ? CMD_OK : CMD_E_RANGE;
+    /* In its range but refused by the core (e.g. a per-unit value outside its
+     * Q format): "err 10 failed", the previous data in force. */
+    return rc == FW_OK ? CMD_OK : CMD_E_FAILED;
 }
