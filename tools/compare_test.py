@@ -1,0 +1,88 @@
+#!/usr/bin/python3
+"""The report of tools/compare.py in its reduced configuration (--fast).
+
+usage: compare_test.py SIM_BINARY
+Runs compare.py --fast with the given simulator into a temporary folder and
+checks the report: it opens with Findings (the sources' claims beside the
+measurements, with verdicts; trips; steady-state errors), has the comparison
+at equal switching frequency with a Pareto plot (a PNG whose name contains
+"pareto") and a conclusion, marks the reversal n/a where it was never
+commanded, and every image it links exists.
+"""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SIM = None
+
+
+class ReportTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        r = subprocess.run([sys.executable, os.path.join(HERE, "compare.py"), "--fast", "--sim",
+                            SIM, "--out", cls.tmp.name], capture_output=True, text=True,
+                           timeout=600)
+        cls.rc, cls.out, cls.err = r.returncode, r.stdout, r.stderr
+        path = os.path.join(cls.tmp.name, "report.md")
+        cls.md = open(path).read() if os.path.exists(path) else ""
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_ran(self):
+        self.assertEqual(self.rc, 0, self.err)
+        self.assertTrue(self.md)
+
+    def test_findings_first(self):
+        h2 = re.findall(r"^## (.+)$", self.md, re.M)
+        self.assertGreater(len(h2), 3)
+        self.assertEqual(h2[0], "Findings")
+        rows = re.findall(r"^\| (.+?) \| (.+?) \| .+? \| .+? \| \*\*(reproduced|direction only|"
+                          r"not reproduced)\*\* \| .+ \|$", self.md, re.M)
+        self.assertGreaterEqual(len(rows), 10)
+        self.assertIn("### Trips", self.md)
+        self.assertIn("### Steady-state torque errors above 5 % of T_ref", self.md)
+
+    def test_pareto(self):
+        self.assertIn("## Comparison at equal switching frequency", self.md)
+        links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", self.md)
+        pareto = [p for p in links if "pareto" in p]
+        self.assertTrue(pareto, links)
+        for p in pareto:
+            with open(os.path.join(self.tmp.name, p), "rb") as fh:
+                self.assertEqual(fh.read(8), b"\x89PNG\r\n\x1a\n")
+        self.assertRegex(self.md, r"\*\*Conclusion\.\*\* At 750 r/min and f_av = \d+ kHz the "
+                                  r"lowest torque ripple is \w+'s")
+
+    def test_images_exist(self):
+        for p in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", self.md):
+            self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, p)), p)
+
+    def test_reversal_not_commanded_is_na(self):
+        # --fast runs the dynamic test for 40 ms: most controllers never reach
+        # 1500 r/min, so their reversal indices must read n/a, not "no".
+        sec = self.md[self.md.find("## Dynamic test"):]
+        sec = sec[:sec.find("\n## ", 5)]
+        rows = [[c.strip() for c in ln.strip("|").split("|")]
+                for ln in sec.splitlines() if ln.startswith("| ") and not ln.startswith("| contr")]
+        self.assertTrue(rows)
+        na = [r for r in rows if r[3] == "n/a"]
+        self.assertTrue(na, sec)
+        for r in na:
+            self.assertEqual((r[2], r[4], r[6], r[7]), ("n/a",) * 4, r)
+        for r in rows:
+            if r[3] != "n/a":
+                self.assertIn(r[7], ("yes", "**no**"), r)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) < 2:
+        sys.exit("usage: compare_test.py SIM_BINARY")
+    SIM = sys.argv.pop(1)
+    unittest.main(verbosity=2)
