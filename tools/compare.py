@@ -674,6 +674,25 @@ def notes(S, names):
                 errs.append(f"**{n} at {rpm} r/min**: T_sse {e:+.3f} N·m "
                             f"({100 * e / LOAD_NM:+.0f} % of T_ref; mean torque "
                             f"{m['torque_mean_nm']:.3f} N·m): {cause}")
+    # The fs sweep and the dynamic test: every trip, grouped per controller and speed.
+    for n in names:
+        for rpm in SPEEDS_USED:
+            bad = []
+            for fs in SWEEP_FS_USED:
+                r = RESULTS.get(("sweep", n, rpm, fs), {})
+                m = r.get("m")
+                if m is not None and m.get("fault") != "none":
+                    bad.append(f"{fs / 1e3:g} kHz ({m['fault']})")
+            if bad:
+                cause = CAUSE.get((n, rpm, "trip"), "cause not analysed in this report")
+                if len(bad) == len(SWEEP_FS_USED) and (n, rpm, "trip") in CAUSE:
+                    cause = "the same voltage limit at every fs"
+                trips.append(f"fs sweep, **{n} at {rpm} r/min**: {', '.join(bad)}: {cause}")
+        m = RESULTS.get(("dynamic", n), {}).get("m")
+        if m is not None and m.get("fault") != "none":
+            trips.append(f"dynamic test, **{n}**: {m['fault']} at t = "
+                         f"{fmt(m.get('fault_time_s'), '{:.4f}')} s: cause not analysed in this "
+                         "report")
     return trips, errs
 
 
@@ -791,6 +810,7 @@ def main():
                 print(f"  {k}/{len(jobs)} done", flush=True)
     sim_wall = time.time() - t_sim
 
+    RESULTS.update(results)
     S = {(n, r): results.get(("steady", n, r), {}).get("m") for n in names for r in SPEEDS_USED}
     # ---- dynamic ----
     dyn = {}
@@ -1076,6 +1096,7 @@ def equal_fav_conclusion(results, names):
 
 SPEEDS_USED = SPEEDS
 SWEEP_FS_USED = SWEEP_FS
+RESULTS = {}  # every run of this report, for the notes
 
 if __name__ == "__main__":
     sys.exit(main())

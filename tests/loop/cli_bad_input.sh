@@ -159,6 +159,17 @@ if grep -Eq "^centre +0/1 +\{0, 1\} +1 " <<<"$out" && grep -Eq "^lambda +1 +\[0.
 else
   echo "FAIL: --list-tunables m2ptfc: $out"; fails=$((fails + 1))
 fi
+# Speed mode prints the speed against its reference; a rotor at standstill has no
+# fundamental: THD n/a.
+out="$("$sim" --machine "$m" --controller bst --free --speed-ref-rpm 300 --duration 0.05 2>&1)"
+grep -Eq "speed mode: reference 300.0 r/min, window mean [0-9.]+ r/min, at the end [0-9.]+ r/min" <<<"$out" ||
+  { echo "FAIL: speed mode output: $out"; fails=$((fails + 1)); }
+out="$("$sim" --machine "$m" --controller bst --free --torque-ref 0 --duration 0.02 --metrics "$tmp/still.json" 2>&1)"
+if grep -q "THD_I n/a" <<<"$out" && grep -q '"thd_i_pct": null,' "$tmp/still.json"; then
+  echo "ok: THD undefined at standstill"
+else
+  echo "FAIL: THD at standstill: $out"; fails=$((fails + 1))
+fi
 # --help states the default metrics window the run uses, and the exit codes.
 "$sim" --help | grep -q -- "--window START:END.*default duration/3 : duration" &&
   "$sim" --help | grep -q "3 the drive" || { echo "FAIL: --help"; fails=$((fails + 1)); }
