@@ -41,7 +41,7 @@ typedef struct {
     q24_t kp;              /* rad per pu torque, Q24 */
     int32_t ki;            /* rad per (pu torque * sample), Q30 */
     int64_t integ;         /* integrator, rad, Q40 */
-    q24_t inv_ts;          /* 1 / Ts_pu, Q24 */
+    int32_t inv_ts;        /* 1 / Ts_pu, Q16 (Ts_pu >= 1e-3: up to 1000) */
     uint8_t ff;            /* omega_e Ts feed-forward on */
     uint8_t limited;       /* last voltage limited by the hexagon */
     q24_t dd;              /* last Delta delta, rad Q24 (telemetry/tests) */

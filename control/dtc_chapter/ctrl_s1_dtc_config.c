@@ -66,17 +66,17 @@ static void s1_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->tilt = S1_TILT_DEFAULT;
 }
 
-/* SI / base -> Q24 pu in [0, 127). */
-static int s1_q24(double si, double base, q24_t *out)
+/* SI / base -> Q24 pu in [0, 127) (named refusal). */
+static int s1_q24(const ctrl_setup_t *su, const char *quantity, double si, double base, q24_t *out)
 {
-    return ctrl_q24_from_si(si, base, 0.0, 127.0, out);
+    return ctrl_setup_q24(su, quantity, si, base, 0.0, 127.0, out);
 }
 
 /* Flux reference: tunable, else params->psi_ref, else psi_pm. */
 static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_setup_t *su, q24_t *out)
 {
     if (c->psi_ref > 0.0) {
-        return s1_q24(c->psi_ref, su->bases->psi_wb, out);
+        return s1_q24(su, "psi_ref / flux base", c->psi_ref, su->bases->psi_wb, out);
     }
     const ctrl_params_t *p = su->params;
     *out = p->psi_ref > 0 ? p->psi_ref : p->psi_pm;
@@ -87,9 +87,9 @@ static int s1_psi_ref(const ctrl_s1_cfg_t *c, const ctrl_setup_t *su, q24_t *out
  * S1 §3.3). */
 static int s1_bands(const ctrl_s1_cfg_t *c, const ctrl_setup_t *su, q24_t *ht, q24_t *hp)
 {
-    int rc = s1_q24(c->h_t, su->bases->torque_nm, ht);
+    int rc = s1_q24(su, "h_T / torque base", c->h_t, su->bases->torque_nm, ht);
     if (rc == CTRL_OK) {
-        rc = s1_q24(c->h_psi, su->bases->psi_wb, hp);
+        rc = s1_q24(su, "h_psi / flux base", c->h_psi, su->bases->psi_wb, hp);
     }
     return rc;
 }
@@ -131,8 +131,8 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
     }
     int rc = s1_psi_ref(c, su, &s->psi_ref);
     const double ts = ctrl_q24_to_double(p->ts);
-    if (rc == CTRL_OK && (!(ts > 0.0) || 1.0 / ts >= 127.0)) {
-        rc = CTRL_ERANGE; /* 1/Ts does not fit Q24 */
+    if (rc == CTRL_OK && (!(ts > 0.0) || 1.0 / ts >= 32767.0)) {
+        rc = CTRL_ERANGE; /* 1/Ts does not fit Q16 */
     }
     if (rc != CTRL_OK) {
         memset(s, 0, sizeof *s);
@@ -144,7 +144,7 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
         memset(s, 0, sizeof *s);
         return CTRL_ERANGE;
     }
-    s->inv_ts = ctrl_q24_from_double(1.0 / ts);
+    s->inv_ts = (int32_t)llround(65536.0 / ts);
     s->ff = (uint8_t)(c->omega_ff >= 0.5);
     ctrl_svm_dtc_reset(s);
     return CTRL_OK;
@@ -198,14 +198,15 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
     q24_t efs = 0;
     int rc = s1_bands(c, su, &ht, &hp);
     if (rc == CTRL_OK && c->e_fs > 0.0) {
-        rc = s1_q24(c->e_fs, su->bases->torque_nm, &efs);
+        rc = s1_q24(su, "e_fs / torque base", c->e_fs, su->bases->torque_nm, &efs);
     } else if (rc == CTRL_OK) {
         /* One level step (0.2 Vdc/sqrt(3)) turns the flux by 0.2 Ts Vdc/(sqrt(3) psi_pm)
          * per period; at delta = 0 dT/d delta = psi_pm^2 / Lq (pu, from S1(7)), so
-         * the torque moves by 0.2 ts / (sqrt(3) lq) pu per period and level step.
-         * e_fs = 5 x that: one level step corrects one level's error width in one
-         * period (loop gain 1 of the level quantiser). */
-        const double e = ctrl_q24_to_double(p->ts) / (sqrt(3.0) * ctrl_q24_to_double(p->lq));
+         * the torque moves by 0.2 Ts Vdc psi_pm / (sqrt(3) Lq) pu per period and
+         * level step. e_fs = 5 x that: one level step corrects one level's error
+         * width in one period (loop gain 1 of the level quantiser). */
+        const double e = ctrl_q24_to_double(p->ts) * ctrl_q24_to_double(p->vdc_nom) *
+                         ctrl_q24_to_double(p->psi_pm) / (CTRL_SQRT3 * ctrl_q24_to_double(p->lq));
         rc = (isfinite(e) && e > 0.0 && e < 127.0) ? CTRL_OK : CTRL_ERANGE;
         efs = ctrl_q24_from_double(rc == CTRL_OK ? e : 0.0);
     }

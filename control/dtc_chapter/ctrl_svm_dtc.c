@@ -63,8 +63,10 @@ void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const q24_t tx = fx_mul(psi_ref, fx_sub(fx_mul(cs, ux), fx_mul(sn, uy)));
     const q24_t ty = fx_mul(psi_ref, fx_add(fx_mul(sn, ux), fx_mul(cs, uy)));
     /* S1(19)-(20): V = (psi_target - psi) / Ts + Rs i. */
-    q24_t va = fx_add(fx_mul(fx_sub(tx, nx->psi_alpha), s->inv_ts), fx_mul(p->rs, nx->i_alpha));
-    q24_t vb = fx_add(fx_mul(fx_sub(ty, nx->psi_beta), s->inv_ts), fx_mul(p->rs, nx->i_beta));
+    q24_t va =
+        fx_add(fx_mul_qn(fx_sub(tx, nx->psi_alpha), s->inv_ts, 16u), fx_mul(p->rs, nx->i_alpha));
+    q24_t vb =
+        fx_add(fx_mul_qn(fx_sub(ty, nx->psi_beta), s->inv_ts, 16u), fx_mul(p->rs, nx->i_beta));
     s->v_alpha = va;
     s->v_beta = vb;
     out->plan.n_seg = 0u; /* leg duties (ctrl_types.h) */

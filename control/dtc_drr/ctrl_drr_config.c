@@ -104,10 +104,11 @@ double ctrl_drr_ema_cutoff_hz(double lambda, double fs_hz)
            acos((lambda * lambda + 2.0 * lambda - 2.0) / (2.0 * lambda - 2.0));
 }
 
-/* A per-unit value into Q24 when it lies in [lo, hi], else CTRL_ERANGE. */
-static int drr_q24(double pu, double lo, double hi, q24_t *out)
+/* A per-unit value into Q24 when it lies in [lo, hi], else CTRL_ERANGE (named). */
+static int drr_q24(const ctrl_setup_t *su, const char *quantity, double pu, double lo, double hi,
+                   q24_t *out)
 {
-    return ctrl_q24_from_si(pu, 1.0, lo, hi, out);
+    return ctrl_setup_q24(su, quantity, pu, 1.0, lo, hi, out);
 }
 
 /* ---------------- drr ---------------- */
@@ -159,12 +160,13 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
     const double w_rn_pu = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs) / b.w_rad_s;
     const double a_pu = a_nm / b.torque_nm;
     const double kb_pu = b_nm / b.torque_nm / w_rn_pu; /* B / w_rn in pu */
-    rc = drr_q24(a_pu, 1e-6, DRR_PU_MAX, &s->a);
+    rc = drr_q24(su, "DRR A (5.9)", a_pu, 1e-6, DRR_PU_MAX, &s->a);
     if (rc == CTRL_OK) {
-        rc = drr_q24(kb_pu, 0.0, DRR_PU_MAX, &s->kb);
+        rc = drr_q24(su, "DRR B / w_rn (5.10)", kb_pu, 0.0, DRR_PU_MAX, &s->kb);
     }
     if (rc == CTRL_OK) {
-        rc = drr_q24(CTRL_SQRT3 * a_pu, 0.0, 2.0 * DRR_PU_MAX, &s->sqrt3_a);
+        rc = drr_q24(su, "DRR sqrt(3) A (5.13)", CTRL_SQRT3 * a_pu, 0.0, 2.0 * DRR_PU_MAX,
+                     &s->sqrt3_a);
     }
     if (rc != CTRL_OK) {
         return rc;
@@ -183,15 +185,20 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
         s->dc_fixed = -FX_ONE;
         s->dc_max = -FX_ONE;
     }
-    rc = drr_q24(c->lambda, 0.0, 1.0, &s->lambda);
-    if (rc != CTRL_OK || s->lambda <= 0) {
-        return CTRL_ERANGE;
+    rc = drr_q24(su, "DRR lambda (5.4)", c->lambda, 0.0, 1.0, &s->lambda);
+    if (rc == CTRL_OK && s->lambda <= 0) {
+        rc = ctrl_setup_refuse(su, CTRL_ERANGE, "DRR lambda (5.4)", "", c->lambda, 1.0 / 16777216.0,
+                               1.0);
+    }
+    if (rc != CTRL_OK) {
+        return rc;
     }
     /* Delta psi_max ~ sqrt(3) Vdc Ts / 3 (from (4.13), §5.3.5) */
     const double dpsi = c->dpsi_max_wb > 0.0 ? c->dpsi_max_wb : CTRL_SQRT3 * m->vdc_v * ts / 3.0;
-    rc = drr_q24(0.5 * dpsi / b.psi_wb, 0.0, DRR_PU_MAX, &s->half_dpsi);
+    rc = drr_q24(su, "DRR dpsi_max / 2", 0.5 * dpsi / b.psi_wb, 0.0, DRR_PU_MAX, &s->half_dpsi);
     if (rc == CTRL_OK) {
-        rc = drr_q24(c->gamma_max_nm / b.torque_nm, 0.0, DRR_PU_MAX, &s->gamma_max);
+        rc = drr_q24(su, "DRR gamma_max", c->gamma_max_nm / b.torque_nm, 0.0, DRR_PU_MAX,
+                     &s->gamma_max);
     }
     if (rc != CTRL_OK) {
         return rc;
@@ -269,36 +276,41 @@ static int base_init(void *state, const void *cfg, const ctrl_setup_t *su,
     s->kind = (uint8_t)kind;
     switch (kind) {
     case CTRL_DRR_BASE_D1:
-        rc = drr_q24(b.torque_nm / c->c_t_nm, 0.0, lim, &s->inv_ct);
+        rc = drr_q24(su, "D1 1 / C_T", b.torque_nm / c->c_t_nm, 0.0, lim, &s->inv_ct);
         if (rc == CTRL_OK) {
-            rc = drr_q24(b.psi_wb / c->c_psi_wb, 0.0, lim, &s->inv_cpsi);
+            rc = drr_q24(su, "D1 1 / C_psi", b.psi_wb / c->c_psi_wb, 0.0, lim, &s->inv_cpsi);
         }
         break;
     case CTRL_DRR_BASE_D2: {
         /* K_b w with w in r/min (mechanical): w_rpm = w_pu w_base 60 / (2 pi p) */
         const double rpm_per_pu = ctrl_elec_to_rpm(b.w_rad_s, p->pole_pairs);
-        rc = drr_q24(c->k_a_nm / b.torque_nm, 0.0, DRR_PU_MAX, &s->ka);
+        rc = drr_q24(su, "D2 K_a", c->k_a_nm / b.torque_nm, 0.0, DRR_PU_MAX, &s->ka);
         if (rc == CTRL_OK) {
-            rc = drr_q24(c->k_b_nm_rpm * rpm_per_pu / b.torque_nm, 0.0, DRR_PU_MAX, &s->kb);
+            rc = drr_q24(su, "D2 K_b", c->k_b_nm_rpm * rpm_per_pu / b.torque_nm, 0.0, DRR_PU_MAX,
+                         &s->kb);
         }
         break;
     }
     case CTRL_DRR_BASE_PI:
-        rc = drr_q24(c->kp * b.torque_nm, 0.0, lim, &s->kp);
+        rc = drr_q24(su, "D_PI K_P", c->kp * b.torque_nm, 0.0, lim, &s->kp);
         if (rc == CTRL_OK) {
-            rc = drr_q24(c->ki * b.torque_nm / (double)p->fs_hz, 0.0, lim, &s->ki_ts);
+            rc = drr_q24(su, "D_PI K_I Ts", c->ki * b.torque_nm / (double)p->fs_hz, 0.0, lim,
+                         &s->ki_ts);
         }
         if (rc == CTRL_OK) {
             /* 3 |w| psi_pm / (2 Vdc) in pu of w: 1.5 psi_pm / Vdc (nominal DC link) */
-            rc = drr_q24(1.5 * ctrl_q24_to_double(p->psi_pm) / ctrl_q24_to_double(p->vdc_nom), 0.0,
+            rc = drr_q24(su, "D_PI feed-forward 3 psi_pm / (2 Vdc)",
+                         1.5 * ctrl_q24_to_double(p->psi_pm) / ctrl_q24_to_double(p->vdc_nom), 0.0,
                          lim, &s->ff);
         }
         break;
     case CTRL_DRR_BASE_DF:
         s->rms = c->rms >= 0.5 ? 1u : 0u;
-        rc = drr_q24(ctrl_q24_to_double(p->ts) * ctrl_q24_to_double(p->inv_ld), 0.0, lim, &s->ts_l);
+        rc = drr_q24(su, "D_f Ts / Ls", ctrl_q24_to_double(p->ts) * ctrl_q24_to_double(p->inv_ld),
+                     0.0, lim, &s->ts_l);
         if (rc == CTRL_OK) {
-            rc = drr_q24(ctrl_q24_to_double(p->rs) * ctrl_q24_to_double(p->inv_ld), 0.0, lim,
+            rc = drr_q24(su, "D_f Rs / Ls",
+                         ctrl_q24_to_double(p->rs) * ctrl_q24_to_double(p->inv_ld), 0.0, lim,
                          &s->rs_l);
         }
         break;

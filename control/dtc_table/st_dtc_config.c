@@ -64,8 +64,10 @@ static int st_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su, st
     }
     q24_t h_t;
     q24_t h_psi;
-    if (ctrl_q24_from_si(c->h_t, su->bases->torque_nm, 0.0, ST_PU_MAX, &h_t) != CTRL_OK ||
-        ctrl_q24_from_si(c->h_psi, su->bases->psi_wb, 0.0, ST_PU_MAX, &h_psi) != CTRL_OK) {
+    if (ctrl_setup_q24(su, "h_T / torque base", c->h_t, su->bases->torque_nm, 0.0, ST_PU_MAX,
+                       &h_t) != CTRL_OK ||
+        ctrl_setup_q24(su, "h_psi / flux base", c->h_psi, su->bases->psi_wb, 0.0, ST_PU_MAX,
+                       &h_psi) != CTRL_OK) {
         return CTRL_ERANGE;
     }
     s->kind = (uint8_t)kind;
@@ -109,8 +111,8 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     if (rc != CTRL_OK) {
         return rc;
     }
-    if (ctrl_q24_from_si(c->dt_step, su->bases->torque_nm, 0.0, ST_PU_MAX, &s->logic.dt_step) !=
-        CTRL_OK) {
+    if (ctrl_setup_q24(su, "dT_step / torque base", c->dt_step, su->bases->torque_nm, 0.0,
+                       ST_PU_MAX, &s->logic.dt_step) != CTRL_OK) {
         return CTRL_ERANGE;
     }
     st_fst_reset(s);

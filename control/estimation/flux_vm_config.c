@@ -6,7 +6,6 @@
 #include "flux_vm.h"
 #include "flux_vm_config.h"
 
-
 int ctrl_flux_vm_gain(const ctrl_params_t *p, double fc_hz, q24_t *k_corr)
 {
     if (p == NULL || k_corr == NULL || p->fs_hz == 0u || !isfinite(fc_hz) || fc_hz <= 0.0) {

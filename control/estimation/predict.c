@@ -78,7 +78,7 @@ void ctrl_predict_flux(const ctrl_params_t *p, const ctrl_mstate_t *now, q24_t v
     /* (5.15): psi + Ts v - Ts Rs i, both products in one rounding; psi 2^24
      * is a multiple of 2^24, so rounding the whole sum once equals psi plus
      * the rounded increment, saturated once. ctrl_params_init keeps Ts <= 1 pu
-     * and Rs <= 100 pu, so |Ts v| and |Ts Rs i| are < 2^62 and the sum < 2^63. */
+     * and Ts Rs <= 1 pu, so |Ts v| and |Ts Rs i| are < 2^55 and the sum < 2^57. */
     const int64_t da = (int64_t)p->ts * v_alpha - (int64_t)p->ts_rs * now->i_alpha;
     const int64_t db = (int64_t)p->ts * v_beta - (int64_t)p->ts_rs * now->i_beta;
     *psi_alpha = fx_round_sat((int64_t)now->psi_alpha * FX_ONE + da, FX_QBITS);

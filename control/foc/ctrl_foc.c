@@ -14,6 +14,7 @@
 #include "vectors.h"
 
 #define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
+#define FOC_KP_QBITS 20u
 #define FOC_KI_QBITS 30u
 
 void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d,
@@ -31,7 +32,8 @@ void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q2
 
 q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
 {
-    return fx_add(fx_mul(pi->kp, err), fx_sat32(fx_rshift64_round(pi->integ, FOC_INTEG_SHIFT)));
+    return fx_add(fx_mul_qn(err, pi->kp, FOC_KP_QBITS),
+                  fx_sat32(fx_rshift64_round(pi->integ, FOC_INTEG_SHIFT)));
 }
 
 void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
@@ -41,8 +43,8 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
     }
     /* err Q24 * ki_ts Q30 = Q54 -> Q40; |product| < 2^62. */
     const int64_t inc = fx_rshift64_round((int64_t)err * pi->ki_ts, FOC_KI_QBITS - FOC_INTEG_SHIFT);
-    const int64_t lim = (int64_t)FX_ONE * ((int64_t)1 << FOC_INTEG_SHIFT); /* 1 pu */
-    int64_t i = pi->integ + inc; /* |integ| <= 2^40, |inc| < 2^48 */
+    const int64_t lim = pi->lim;
+    int64_t i = pi->integ + inc; /* |integ| <= 2^45 (lim <= 32 pu), |inc| < 2^48 */
     i = i > lim ? lim : (i < -lim ? -lim : i);
     pi->integ = i;
 }

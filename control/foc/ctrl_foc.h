@@ -8,7 +8,7 @@
  * foc: d and q current PI with decoupling feed-forward (S1(1)),
  *   v_d = -omega psi_q + Kp_d e_d + I_d,  v_q = omega psi_d + Kp_q e_q + I_q,
  * gains Kp = L wc, Ki = R wc (default wc = 2 pi fs / 20), conditional
- * integration, integrators within +-1 pu; feedback on the k+1 prediction,
+ * integration, integrators within +-Vdc (nominal); feedback on the k+1 prediction,
  * inverse Park at theta(k+1) + omega Ts / 2; output: leg duties by SVPWM
  * (svpwm.h), over-modulation limited onto the hexagon.
  * foc_hyst: per phase, e_x = i_x,ref - i_x at k+1; leg high if e_x >= h_i, low
@@ -25,9 +25,10 @@
 
 /* One current PI (Q formats at the fields). */
 typedef struct {
-    q24_t kp;      /* V pu per A pu, Q24 */
+    int32_t kp;    /* V pu per A pu, Q20 (up to 2047: Kp ~ L wc / w_base grows with fs) */
     int32_t ki_ts; /* Ki Ts, V pu per (A pu * period), Q30 */
-    int64_t integ; /* integrator, V pu, Q40 */
+    int64_t integ; /* integrator, V pu, Q40, within +-lim */
+    int64_t lim;   /* the integrator's limit, the nominal DC link, Q40 */
 } ctrl_foc_pi_t;
 
 /* Torque -> current references (both controllers). */
@@ -55,7 +56,7 @@ q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err);
 
 /* Integrator update after the limiter: integrates Ki Ts err unless limited and
  * err has the sign of the axis output v (it would drive further into the limit).
- * The integrator is kept within +-1 pu. */
+ * The integrator is kept within +-pi->lim. */
 void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited);
 
 extern const ctrl_desc_t ctrl_desc_foc;

@@ -56,7 +56,7 @@ static int foc_iref_init(ctrl_foc_iref_t *r, const ctrl_params_t *p, int mtpa)
     r->mtpa = (uint8_t)(mtpa && p->salient && p->lq > p->ld);
     const double t_max =
         ctrl_q24_to_double(p->psi_pm) * ctrl_q24_to_double(p->current_max); /* (3.10) */
-    return ctrl_q24_from_si(t_max, 1.0, 0.0, 127.0, &r->t_max);
+    return ctrl_q24_from_si(t_max, 1.0, 0.0, 127.0, &r->t_max); /* < 16 pu: params' range */
 }
 
 static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l_pu, double wc,
@@ -70,10 +70,16 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     /* Kp = L wc (pu: L_pu * wc / w_base, w_base = ts_pu * fs); Ki Ts = R wc Ts. */
     const double kp = kp_si > 0.0 ? kp_si / r_base : l_pu * (wc / fs) / ts_pu;
     const double ki_ts = ki_si > 0.0 ? ki_si / r_base / fs : r_pu * wc / fs;
-    if (!isfinite(kp) || !isfinite(ki_ts) || kp >= 127.0 || ki_ts >= 1.99) {
-        return CTRL_ERANGE;
+    if (!isfinite(kp) || !(kp >= 0.0) || kp >= 2047.0) {
+        return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Kp / (r_base)", "pu", kp, 0.0,
+                                 2047.0);
     }
-    pi->kp = ctrl_q24_from_double(kp);
+    if (!isfinite(ki_ts) || !(ki_ts >= 0.0) || ki_ts >= 1.99) {
+        return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Ki Ts / (r_base)", "pu", ki_ts, 0.0,
+                                 1.99);
+    }
+    pi->kp = (int32_t)llround(kp * 1048576.0);          /* Q20 */
+    pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << 16); /* Q40 */
     pi->ki_ts = (int32_t)llround(ki_ts * 1073741824.0);
     pi->integ = 0;
     return CTRL_OK;
@@ -104,7 +110,7 @@ static int foc_init_common(void *state, const void *cfg, const ctrl_setup_t *su,
         rc = foc_pi_config(&s->pi_q, c->kp_q, c->ki_q, ctrl_q24_to_double(p->lq), wc, su);
     }
     if (rc == CTRL_OK) {
-        rc = ctrl_q24_from_si(c->h_i, su->bases->i_a, 0.0, 127.0, &s->h_i);
+        rc = ctrl_setup_q24(su, "h_i / current base", c->h_i, su->bases->i_a, 0.0, 127.0, &s->h_i);
     }
     if (rc != CTRL_OK) {
         memset(s, 0, sizeof *s);

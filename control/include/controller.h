@@ -35,6 +35,7 @@ typedef struct {
     const ctrl_machine_t *machine;
     const ctrl_bases_t *bases;
     const ctrl_params_t *params;
+    ctrl_diag_t *diag; /* optional (NULL): why init refused, see ctrl_setup_refuse */
 } ctrl_setup_t;
 
 /*
@@ -111,6 +112,18 @@ void ctrl_step(const ctrl_desc_t *d, void *state, const ctrl_ctx_t *ctx, ctrl_ou
  * CTRL_ENOENT for an unknown name, CTRL_EINVAL for a value out of range or not finite. */
 int ctrl_tunable_set(const ctrl_desc_t *d, void *cfg, const char *name, double value);
 int ctrl_tunable_get(const ctrl_desc_t *d, const void *cfg, const char *name, double *value);
+
+/* For init functions (controller_config.c): record in setup->diag (if any)
+ * why a value was refused — the quantity, its value, the accepted range — and
+ * return code. */
+int ctrl_setup_refuse(const ctrl_setup_t *setup, int code, const char *quantity, const char *unit,
+                      double value, double lo, double hi);
+
+/* ctrl_q24_from_si (ctrl_params.h) for init functions: si / base into *out
+ * when inside [lo_pu, hi_pu], else CTRL_ERANGE with the quantity (in pu),
+ * its value and the range in setup->diag. */
+int ctrl_setup_q24(const ctrl_setup_t *setup, const char *quantity, double si, double base,
+                   double lo_pu, double hi_pu, q24_t *out);
 
 /* Every field listed in t[0..n) of cfg is finite and inside [min, max]:
  * CTRL_OK, else CTRL_EINVAL (also for NULL t or cfg with n > 0). For init

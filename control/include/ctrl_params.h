@@ -1,15 +1,19 @@
 /*
  * Machine parameters: SI data-sheet values in, fixed-point per-unit out.
  *
- * Per-unit bases (chosen so the flux equations need no scaling):
- *   psi_base = psi_pm                   [Wb]    -> psi_pm = 1 pu
- *   v_base   = Vdc (nominal DC link)    [V]     -> |V_1..6| = 2/3 pu at nominal Vdc
- *   w_base   = v_base / psi_base        [rad/s electrical] -> d(psi)/dt = v in pu
- *   t_base   = 1 / w_base               [s]     (pu time)
- *   i_base   = psi_base / Ld            [A]     -> Ld = 1 pu
- *   l_base   = Ld, r_base = v_base / i_base
- *   T_base   = 1.5 * p * psi_base * i_base [N*m] -> Te = psi x i in pu (3.6)
- * The SI value of 1 pu of each is kept in ctrl_bases_t (configuration only).
+ * Per-unit bases (docs/fixed-point.md): from the machine, so that the
+ * formats hold from sub-milliweber drone motors to the 80 kW IPMSM:
+ *   psi_base = psi_pm                        [Wb]
+ *   w_base   = rated electrical speed        [rad/s]  -> rated speed = 1 pu
+ *   t_base   = 1 / w_base                    [s]
+ *   v_base   = psi_base w_base               [V]      -> d(psi)/dt = v in pu
+ *   l_base   = Ld, i_base = psi_base / l_base [A]
+ *   r_base   = v_base / i_base = w_base l_base [ohm]
+ *   T_base   = 1.5 p psi_base i_base         [N*m]    -> Te = psi x i in pu (3.6)
+ * so Ts in pu is the angle one period turns at rated speed, and the DC link
+ * in pu its ratio to the rated back-EMF (not 1). Per-period code uses the
+ * fields of ctrl_params_t and assumes no base value. The SI value of 1 pu of
+ * each quantity is kept in ctrl_bases_t (configuration only).
  *
  * ctrl_params_init() lives in ctrl_params_config.c: the only place (with the
  * other *_config.c files) where floating point is allowed in control/.
@@ -17,6 +21,7 @@
 #ifndef CONTROL_CTRL_PARAMS_H
 #define CONTROL_CTRL_PARAMS_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "fx.h"
@@ -43,8 +48,11 @@ typedef struct {
 } ctrl_bases_t;
 
 #define CTRL_MTPA_N 64                  /* segments of the IPMSM MTPA table */
-#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (README) */
-#define CTRL_DANGLE_SHIFT 28u           /* fractional bits of dangle_to_omega */
+#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (docs/algorithms.md) */
+#define CTRL_DANGLE_SHIFT 26u           /* fractional bits of dangle_to_omega */
+/* Range of Ts in pu, the angle one period turns at rated speed (rad). */
+#define CTRL_TS_PU_MIN 1.0e-3
+#define CTRL_TS_PU_MAX 1.0
 
 /* Fixed-point parameters used per sample; all q24_t fields are Q24 per-unit. */
 typedef struct {
@@ -53,10 +61,10 @@ typedef struct {
     q24_t ts;             /* control period Ts, pu time (Ts * w_base) */
     q24_t rs;             /* stator resistance, pu */
     q24_t ts_rs;          /* Ts * Rs, pu (precomputed product) */
-    q24_t ld, lq;         /* pu (ld == FX_ONE by the choice of base) */
+    q24_t ld, lq;         /* pu */
     q24_t inv_ld, inv_lq; /* 1/Ld, 1/Lq, pu */
-    q24_t psi_pm;         /* pu (== FX_ONE) */
-    q24_t vdc_nom;        /* nominal DC link, pu (== FX_ONE) */
+    q24_t psi_pm;         /* pu */
+    q24_t vdc_nom;        /* nominal DC link, pu (its ratio to the rated back-EMF) */
     q24_t torque_rated;   /* pu */
     q24_t speed_rated_e;  /* rated electrical speed, pu */
     q24_t current_rated;  /* pu */
@@ -68,8 +76,8 @@ typedef struct {
      * omega_to_dangle = round(Ts_pu / (2 pi) * 2^32); then
      * dtheta = round(omega_q24 * omega_to_dangle / 2^24) (ctrl_angle_step()). */
     int32_t omega_to_dangle;
-    /* Inverse, Q28 (CTRL_DANGLE_SHIFT): omega_q24 = round(dtheta * dangle_to_omega
-     * / 2^28) for a signed angle difference dtheta (angle units per period). */
+    /* Inverse, Q26 (CTRL_DANGLE_SHIFT): omega_q24 = round(dtheta * dangle_to_omega
+     * / 2^26) for a signed angle difference dtheta (angle units per period). */
     int32_t dangle_to_omega;
     /* First-order low-pass (EMA) coefficient of the encoder speed, Q24:
      * 1 - exp(-2 pi fc Ts), fc = CTRL_SPEED_LPF_HZ_DEFAULT unless changed with
@@ -97,13 +105,33 @@ typedef struct {
 #define CTRL_ERANGE (-2) /* a parameter does not fit the Q format */
 #define CTRL_ENOENT (-3) /* unknown name */
 
+/* Why a configuration was refused: the quantity, its value and the range the
+ * core accepts (for a derived quantity, the data it follows from). */
+typedef struct {
+    int code;             /* CTRL_OK, CTRL_EINVAL (SI datum), CTRL_ERANGE (per-unit range) */
+    const char *quantity; /* e.g. "psi_pm_wb", "rated electrical speed x Ts" */
+    const char *unit;     /* "Wb", "rad per period", "" for a ratio */
+    double value, min, max;
+    const char *depends; /* the SI data a derived quantity follows from, or NULL */
+} ctrl_diag_t;
+
 /*
  * Validate the machine data and compute bases and fixed-point parameters for a
- * control frequency. Returns CTRL_OK, or CTRL_EINVAL / CTRL_ERANGE with *p left
- * zeroed. Either output pointer may not be NULL.
+ * control frequency. Returns CTRL_OK, or CTRL_EINVAL (an SI datum missing, not
+ * finite, non-positive or beyond a unit-mistake limit) / CTRL_ERANGE (a
+ * per-unit value outside the core's formats) with *p and *bases zeroed;
+ * ctrl_params_init_diag also says why in *why (may be NULL).
  */
 int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m,
                      uint32_t fs_hz);
+int ctrl_params_init_diag(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m,
+                          uint32_t fs_hz, ctrl_diag_t *why);
+
+/* The diagnosis as one line, e.g. "rated electrical speed x Ts = 1.47 rad per
+ * period is outside the range the core takes, [0.001, 1] rad per period (from
+ * speed_rated_rpm, pole_pairs, fs_hz)" ("ok" for CTRL_OK); returns its length
+ * (truncated to cap - 1). */
+size_t ctrl_diag_format(const ctrl_diag_t *d, char *buf, size_t cap);
 
 /* A per-unit value -> Q24, rounded half away from zero, saturated (NaN: 0). */
 q24_t ctrl_q24_from_double(double pu);

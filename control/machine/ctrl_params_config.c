@@ -7,6 +7,7 @@
  * T_base = 1.5 p psi_base i_base.
  */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "ctrl_params.h"
@@ -58,11 +59,6 @@ int ctrl_q24_from_si(double si, double base, double lo_pu, double hi_pu, q24_t *
     }
     *out = ctrl_q24_from_double(pu);
     return CTRL_OK;
-}
-
-static int pos_finite(double x, double lim)
-{
-    return isfinite(x) && x > 0.0 && x <= lim;
 }
 
 static int fits(double pu)
@@ -138,58 +134,116 @@ static int mtpa_table(ctrl_params_t *p, double ld, double lq, double psi_pm, dou
     return CTRL_OK;
 }
 
-static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_t *m,
-                          uint32_t fs_hz)
+/* Record why a value was refused (quantity, value, accepted range) and return code. */
+static int refuse(ctrl_diag_t *d, int code, const char *quantity, const char *unit, double value,
+                  double lo, double hi, const char *depends)
 {
-    if (m->pole_pairs < 1 || m->pole_pairs > LIM_POLE_PAIRS || fs_hz == 0u || fs_hz > LIM_FS_HZ) {
-        return CTRL_EINVAL;
+    if (d != NULL) {
+        d->code = code;
+        d->quantity = quantity;
+        d->unit = unit;
+        d->value = value;
+        d->min = lo;
+        d->max = hi;
+        d->depends = depends;
     }
-    /* Rs = 0 (an ideal, lossless machine) is accepted; negative is not. */
-    if (!isfinite(m->rs_ohm) || m->rs_ohm < 0.0 || m->rs_ohm > LIM_R_OHM ||
-        !pos_finite(m->ld_h, LIM_L_H) || !pos_finite(m->lq_h, LIM_L_H) ||
-        !pos_finite(m->psi_pm_wb, LIM_PSI_WB) || !pos_finite(m->vdc_v, LIM_VDC_V) ||
-        !pos_finite(m->inertia_kgm2, LIM_J) || !pos_finite(m->torque_rated_nm, LIM_TORQUE_NM) ||
-        !pos_finite(m->speed_rated_rpm, LIM_SPEED_RPM) ||
-        !pos_finite(m->current_rated_a, LIM_CURRENT_A) ||
-        !pos_finite(m->current_max_a, LIM_CURRENT_A) || m->current_max_a < m->current_rated_a ||
-        !isfinite(m->psi_ref_wb) || m->psi_ref_wb < 0.0 || m->psi_ref_wb > LIM_PSI_WB) {
-        return CTRL_EINVAL;
+    return code;
+}
+
+/* An SI datum: finite and inside [lo, hi] (lo itself excluded when open). */
+static int si_ok(double x, double lo, double hi, int open)
+{
+    return isfinite(x) && (open ? x > lo : x >= lo) && x <= hi;
+}
+
+static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_t *m,
+                          uint32_t fs_hz, ctrl_diag_t *d)
+{
+    /* ---- SI data: finite, positive, below limits that only catch unit mistakes ---- */
+    if (m->pole_pairs < 1 || m->pole_pairs > LIM_POLE_PAIRS) {
+        return refuse(d, CTRL_EINVAL, "pole_pairs", "", (double)m->pole_pairs, 1.0,
+                      (double)LIM_POLE_PAIRS, NULL);
     }
-
-    b->psi_wb = m->psi_pm_wb;
-    b->v_v = m->vdc_v;
-    b->w_rad_s = b->v_v / b->psi_wb;
-    b->t_s = 1.0 / b->w_rad_s;
-    b->i_a = b->psi_wb / m->ld_h;
-    b->l_h = m->ld_h;
-    b->r_ohm = b->v_v / b->i_a;
-    b->torque_nm = 1.5 * (double)m->pole_pairs * b->psi_wb * b->i_a;
-
-    const double ts = 1.0 / ((double)fs_hz * b->t_s);
-    const double rs = m->rs_ohm / b->r_ohm;
-    const double lq = m->lq_h / b->l_h;
-    const double w_rated = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs);
-    const double vals[] = {
-        ts,
-        rs,
-        ts * rs,
-        lq,
-        1.0 / lq,
-        m->torque_rated_nm / b->torque_nm,
-        w_rated / b->w_rad_s,
-        m->current_rated_a / b->i_a,
-        m->current_max_a / b->i_a,
-        m->psi_ref_wb / b->psi_wb,
+    if (fs_hz == 0u || fs_hz > LIM_FS_HZ) {
+        return refuse(d, CTRL_EINVAL, "fs_hz", "Hz", (double)fs_hz, 1.0, (double)LIM_FS_HZ, NULL);
+    }
+    const struct {
+        const char *name, *unit;
+        double value, lo, hi;
+        int open;
+    } si[] = {
+        /* Rs = 0 (an ideal, lossless machine) is accepted. */
+        {"rs_ohm", "ohm", m->rs_ohm, 0.0, LIM_R_OHM, 0},
+        {"ld_h", "H", m->ld_h, 0.0, LIM_L_H, 1},
+        {"lq_h", "H", m->lq_h, 0.0, LIM_L_H, 1},
+        {"psi_pm_wb", "Wb", m->psi_pm_wb, 0.0, LIM_PSI_WB, 1},
+        {"vdc_v", "V", m->vdc_v, 0.0, LIM_VDC_V, 1},
+        {"inertia_kgm2", "kg*m^2", m->inertia_kgm2, 0.0, LIM_J, 1},
+        {"torque_rated_nm", "N*m", m->torque_rated_nm, 0.0, LIM_TORQUE_NM, 1},
+        {"speed_rated_rpm", "r/min", m->speed_rated_rpm, 0.0, LIM_SPEED_RPM, 1},
+        {"current_rated_a", "A", m->current_rated_a, 0.0, LIM_CURRENT_A, 1},
+        {"current_max_a", "A", m->current_max_a, m->current_rated_a, LIM_CURRENT_A, 0},
+        {"psi_ref_wb", "Wb", m->psi_ref_wb, 0.0, LIM_PSI_WB, 0},
     };
-    for (size_t i = 0; i < sizeof vals / sizeof vals[0]; i++) {
-        if (!fits(vals[i])) {
-            return CTRL_ERANGE;
+    for (size_t k = 0; k < sizeof si / sizeof si[0]; k++) {
+        if (!si_ok(si[k].value, si[k].lo, si[k].hi, si[k].open)) {
+            return refuse(d, CTRL_EINVAL, si[k].name, si[k].unit, si[k].value, si[k].lo, si[k].hi,
+                          NULL);
         }
     }
-    /* One period must turn at most one radian at 1 pu speed (Euler step of
-     * (5.15) and omega_to_dangle < 2^31). */
-    if (ts > 1.0) {
-        return CTRL_ERANGE;
+
+    /* ---- bases (ctrl_params.h) ---- */
+    const double w_rated = ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs);
+    b->psi_wb = m->psi_pm_wb;
+    b->w_rad_s = w_rated;
+    b->t_s = 1.0 / b->w_rad_s;
+    b->v_v = b->psi_wb * b->w_rad_s;
+    b->l_h = m->ld_h;
+    b->i_a = b->psi_wb / b->l_h;
+    b->r_ohm = b->w_rad_s * b->l_h;
+    b->torque_nm = 1.5 * (double)m->pole_pairs * b->psi_wb * b->i_a;
+
+    /* ---- the per-unit values and the ranges the core's formats take ---- */
+    const double ts = 1.0 / ((double)fs_hz * b->t_s);
+    const double ld = m->ld_h / b->l_h;
+    const double lq = m->lq_h / b->l_h;
+    const double psi_pm = m->psi_pm_wb / b->psi_wb;
+    const double rs = m->rs_ohm / b->r_ohm;
+    const double vdc = m->vdc_v / b->v_v;
+    const double i_max = m->current_max_a / b->i_a;
+    const double psi_at_imax = (psi_pm + fmax(ld, lq) * i_max) / psi_pm;
+    const struct {
+        const char *name, *unit;
+        double value, lo, hi;
+        const char *depends;
+    } pu[] = {
+        /* One period turns the rotor by at most one radian at rated speed; at
+         * least CTRL_TS_PU_MIN keeps dangle_to_omega in its Q26 format. */
+        {"rated electrical speed x Ts", "rad per period", ts, CTRL_TS_PU_MIN, CTRL_TS_PU_MAX,
+         "speed_rated_rpm, pole_pairs, fs_hz"},
+        /* Forward Euler of the resistive drop in the prediction (5.15). */
+        {"Ts Rs / Ld", "", ts * rs, 0.0, 1.0, "rs_ohm, ld_h, fs_hz"},
+        {"Lq / Ld", "", lq / ld, 0.125, 8.0, "ld_h, lq_h"},
+        {"vdc_v / rated back-EMF (psi_pm x rated electrical speed)", "", vdc, 1.0 / 64.0, 32.0,
+         "vdc_v, psi_pm_wb, speed_rated_rpm, pole_pairs"},
+        {"current_max_a / (psi_pm_wb / ld_h)", "", i_max, 1.0 / 256.0, 16.0,
+         "current_max_a, psi_pm_wb, ld_h"},
+        {"flux linkage at current_max / psi_pm", "", psi_at_imax, 1.0, 32.0,
+         "psi_pm_wb, ld_h, lq_h, current_max_a"},
+        {"Rs / (rated electrical speed x Ld)", "", rs, 0.0, FIT_MAX,
+         "rs_ohm, ld_h, speed_rated_rpm, pole_pairs"},
+        {"torque_rated_nm / torque base", "", m->torque_rated_nm / b->torque_nm, FIT_MIN_NONZERO,
+         FIT_MAX, "torque_rated_nm, pole_pairs, psi_pm_wb, ld_h"},
+        {"current_rated_a / (psi_pm_wb / ld_h)", "", m->current_rated_a / b->i_a, FIT_MIN_NONZERO,
+         FIT_MAX, "current_rated_a, psi_pm_wb, ld_h"},
+        {"psi_ref_wb / psi_pm_wb", "", m->psi_ref_wb / b->psi_wb, 0.0, FIT_MAX,
+         "psi_ref_wb, psi_pm_wb"},
+    };
+    for (size_t k = 0; k < sizeof pu / sizeof pu[0]; k++) {
+        if (!(pu[k].value >= pu[k].lo && pu[k].value <= pu[k].hi)) {
+            return refuse(d, CTRL_ERANGE, pu[k].name, pu[k].unit, pu[k].value, pu[k].lo, pu[k].hi,
+                          pu[k].depends);
+        }
     }
 
     p->fs_hz = fs_hz;
@@ -197,57 +251,90 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     p->ts = ctrl_q24_from_double(ts);
     p->rs = ctrl_q24_from_double(rs);
     p->ts_rs = ctrl_q24_from_double(ts * rs);
-    p->ld = FX_ONE;
+    p->ld = ctrl_q24_from_double(ld);
     p->lq = ctrl_q24_from_double(lq);
-    p->inv_ld = FX_ONE;
+    p->inv_ld = ctrl_q24_from_double(1.0 / ld);
     p->inv_lq = ctrl_q24_from_double(1.0 / lq);
-    p->psi_pm = FX_ONE;
-    p->vdc_nom = FX_ONE;
-    p->torque_rated = ctrl_q24_from_double(vals[5]);
-    p->speed_rated_e = ctrl_q24_from_double(vals[6]);
-    p->current_rated = ctrl_q24_from_double(vals[7]);
-    p->current_max = ctrl_q24_from_double(vals[8]);
-    p->psi_ref = ctrl_q24_from_double(vals[9]);
+    p->psi_pm = ctrl_q24_from_double(psi_pm);
+    p->inv_psi_pm = ctrl_q24_from_double(1.0 / psi_pm);
+    p->vdc_nom = ctrl_q24_from_double(vdc);
+    p->torque_rated = ctrl_q24_from_double(m->torque_rated_nm / b->torque_nm);
+    p->speed_rated_e = ctrl_q24_from_double(w_rated / b->w_rad_s);
+    p->current_rated = ctrl_q24_from_double(m->current_rated_a / b->i_a);
+    p->current_max = ctrl_q24_from_double(i_max);
+    p->psi_ref = ctrl_q24_from_double(m->psi_ref_wb / b->psi_wb);
     /* Saliency below 1e-6 is numerical noise: treat as SPMSM (4.15). */
-    p->salient = fabs(lq - 1.0) > 1.0e-6 ? 1u : 0u;
+    p->salient = fabs(lq / ld - 1.0) > 1.0e-6 ? 1u : 0u;
 
-    /* Angle per period at 1 pu speed: Ts_pu rad = Ts_pu / (2 pi) turns. */
+    /* Angle per period at 1 pu speed: Ts_pu rad = Ts_pu / (2 pi) turns, and
+     * the inverse coefficient in Q26 (CTRL_DANGLE_SHIFT): an int32_t for
+     * Ts_pu >= CTRL_TS_PU_MIN, >= 2^20 significant for Ts_pu <= 1.5. */
     const double k_ang = ts / CTRL_TWO_PI * 4294967296.0;
     p->omega_to_dangle = (int32_t)llround(k_ang);
-    /* Inverse: omega_q24 = dtheta * 2^24 / k_ang, coefficient in Q28 (fixed
-     * shift: cheap on the target). It must fit an int32_t (Ts_pu >= 0.0031)
-     * and keep >= 20 significant bits (Ts_pu <= 1 gives >= 2^22). */
-    const double inv = ldexp(16777216.0 / k_ang, (int)CTRL_DANGLE_SHIFT);
-    if (!(inv < 2147483647.0) || inv < 1048576.0) {
-        return CTRL_ERANGE;
-    }
-    p->dangle_to_omega = (int32_t)llround(inv);
+    p->dangle_to_omega = (int32_t)llround(ldexp(16777216.0 / k_ang, (int)CTRL_DANGLE_SHIFT));
 
     if (ctrl_params_set_speed_lpf(p, CTRL_SPEED_LPF_HZ_DEFAULT) != CTRL_OK &&
         ctrl_params_set_speed_lpf(p, 0.25 * (double)fs_hz) != CTRL_OK) {
-        return CTRL_ERANGE;
+        return refuse(d, CTRL_ERANGE, "speed filter coefficient", "", 0.0, 0.0, 1.0, "fs_hz");
     }
 
-    p->mtpa_k = ctrl_q24_from_double(lq); /* Lq / psi_pm, psi_pm = 1 pu */
-    p->inv_psi_pm = FX_ONE;               /* psi_pm = 1 pu */
-    /* SPMSM: the same table from the closed forms (dL = 0), for tools. */
-    return mtpa_table(p, 1.0, p->salient != 0u ? lq : 1.0, 1.0, vals[8]);
+    p->mtpa_k = ctrl_q24_from_double(lq / psi_pm); /* (4.15): Lq / psi_pm */
+    /* The MTPA table (for the SPMSM from the closed forms, dL = 0, for tools). */
+    const int rc = mtpa_table(p, ld, p->salient != 0u ? lq : ld, psi_pm, i_max);
+    if (rc != CTRL_OK) {
+        return refuse(d, rc, "MTPA torque at current_max", "pu", 0.0, 0.002, FIT_MAX,
+                      "current_max_a, psi_pm_wb, ld_h, lq_h");
+    }
+    return CTRL_OK;
 }
 
-int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m, uint32_t fs_hz)
+int ctrl_params_init_diag(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m,
+                          uint32_t fs_hz, ctrl_diag_t *why)
 {
+    if (why != NULL) {
+        memset(why, 0, sizeof *why);
+    }
     if (p == NULL || bases == NULL) {
-        return CTRL_EINVAL;
+        return refuse(why, CTRL_EINVAL, "output pointer", "", 0.0, 0.0, 0.0, NULL);
     }
     memset(p, 0, sizeof *p);
     memset(bases, 0, sizeof *bases);
     if (m == NULL) {
-        return CTRL_EINVAL;
+        return refuse(why, CTRL_EINVAL, "machine", "", 0.0, 0.0, 0.0, NULL);
     }
-    const int rc = params_compute(p, bases, m, fs_hz);
+    const int rc = params_compute(p, bases, m, fs_hz, why);
     if (rc != CTRL_OK) {
         memset(p, 0, sizeof *p);
         memset(bases, 0, sizeof *bases);
     }
     return rc;
+}
+
+int ctrl_params_init(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_machine_t *m, uint32_t fs_hz)
+{
+    return ctrl_params_init_diag(p, bases, m, fs_hz, NULL);
+}
+
+size_t ctrl_diag_format(const ctrl_diag_t *d, char *buf, size_t cap)
+{
+    if (buf == NULL || cap == 0u) {
+        return 0u;
+    }
+    int n;
+    if (d == NULL || d->code == CTRL_OK || d->quantity == NULL) {
+        n = snprintf(buf, cap, "ok");
+    } else if (d->min == 0.0 && d->max == 0.0) {
+        n = snprintf(buf, cap, "%s missing", d->quantity);
+    } else {
+        const char *u = d->unit != NULL && d->unit[0] != '\0' ? " " : "";
+        const char *un = d->unit != NULL ? d->unit : "";
+        n = snprintf(buf, cap,
+                     "%s = %.6g%s%s is outside the range the core takes, [%.6g, %.6g]%s%s",
+                     d->quantity, d->value, u, un, d->min, d->max, u, un);
+        if (n >= 0 && (size_t)n < cap && d->depends != NULL) {
+            const int k = snprintf(buf + n, cap - (size_t)n, " (from %s)", d->depends);
+            n = k < 0 ? n : n + k;
+        }
+    }
+    return n < 0 ? 0u : ((size_t)n < cap ? (size_t)n : cap - 1u);
 }

@@ -39,7 +39,8 @@ static int m2_init(void *state, const void *cfg, const ctrl_setup_t *setup)
     }
     int rc = ctrl_mpc_model_init(&s->model, &c->model, setup);
     if (rc == CTRL_OK) {
-        rc = ctrl_q24_from_si(c->eps_psi, setup->bases->psi_wb, 0.0, 127.0, &s->eps_psi);
+        rc = ctrl_setup_q24(setup, "eps_psi / flux base", c->eps_psi, setup->bases->psi_wb, 0.0,
+                            127.0, &s->eps_psi);
     }
     if (rc != CTRL_OK) {
         return rc;

@@ -52,7 +52,7 @@ static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
     /* Ts V1 = Ts 2/3 Vdc on alpha; in the rotor frame Ts|V| e^{-j th2}:
      * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
      * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
-    const q24_t mv = fx_mul_nosat(m->ts_v, fx_clamp(est->vdc, 0, CTRL_MPC_VDC_CLAMP));
+    const q24_t mv = fx_mul_nosat(m->ts_v, fx_clamp(est->vdc, 0, m->vdc_max));
     const q24_t c1 = fx_dot_nosat(c, s, FX_Q24_HALF, FX_Q24_SQRT3_2);
     const q24_t s1 = fx_dot_nosat(s, -c, FX_Q24_HALF, FX_Q24_SQRT3_2);
     w[0] = fx_mul_nosat(mv, c);

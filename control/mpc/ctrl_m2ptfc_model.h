@@ -25,15 +25,17 @@
 
 /* Model constants, computed once from the machine (ctrl_m2ptfc_model_config.c). */
 typedef struct {
-    q24_t a;     /* psi_pm / Ld, Q24 pu (1.0 with the project's bases) */
-    q24_t b;     /* 1/Lq - 1/Ld, Q24 pu (0 for an SPMSM, < 0 for an IPMSM) */
-    q24_t ts_rs; /* Ts Rs, Q24 pu */
-    q24_t ts_v;  /* Ts * 2/3: |V_i| Ts per pu of DC link, Q24 pu */
+    q24_t a;       /* psi_pm / Ld, Q24 pu */
+    q24_t b;       /* 1/Lq - 1/Ld, Q24 pu (0 for an SPMSM, < 0 for an IPMSM) */
+    q24_t ts_rs;   /* Ts Rs, Q24 pu */
+    q24_t ts_v;    /* Ts * 2/3: |V_i| Ts per pu of DC link, Q24 pu */
+    q24_t vdc_max; /* DC-link clamp of the basis, 2 x nominal, Q24 pu
+                    * (ts_v vdc_max <= CTRL_MPC_TSV_MAX) */
 } ctrl_mpc_model_t;
 
 /* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
  * bounds the fast arithmetic below relies on): |d0|, |q0| <= 8 sqrt(2) pu
- * (psi0 clamped to +-8 pu per alpha/beta component), |wd|, |wq| <= 1 pu. */
+ * (psi0 clamped to +-8 pu per alpha/beta component), |wd|, |wq| <= 16 pu. */
 typedef struct {
     q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
     q24_t wd[6], wq[6]; /* Ts V_1 .. Ts V_6 in the same frame (index i - 1), Q24 pu */
@@ -56,11 +58,11 @@ typedef struct {
 
 /* Model limits checked by ctrl_mpc_model_init (CTRL_ERANGE outside). */
 #define CTRL_MPC_AB_MAX (2 * FX_ONE)    /* |a|, |b| <= 2 pu */
-#define CTRL_MPC_TS_V_MAX (FX_ONE / 2)  /* Ts 2/3 <= 0.5 pu */
+#define CTRL_MPC_TSV_MAX (16 * FX_ONE)  /* |Ts V_i| at the DC-link clamp <= 16 pu */
 #define CTRL_MPC_TS_RS_MAX FX_ONE       /* Ts Rs <= 1 pu */
 #define CTRL_MPC_PSI_CLAMP (8 * FX_ONE) /* psi0 components, pu */
 #define CTRL_MPC_I_CLAMP (64 * FX_ONE)  /* i(k+1) components, pu */
-#define CTRL_MPC_VDC_CLAMP (2 * FX_ONE) /* DC link, pu */
+#define CTRL_MPC_PSI_MAX 7.0            /* |psi| at current_max, pu: inside the clamp */
 
 /* Candidate trace of the last step (for tests and telemetry). */
 #define CTRL_MPC_TRACE_MAX 17
@@ -149,7 +151,7 @@ static inline void ctrl_mpc_vec_dq(const ctrl_mpc_basis_t *b, uint8_t i, q24_t *
 }
 
 /* Ts V_i (i = 1..6) from a ctrl_mpc_basis3_t: V_i for i <= 3, else -V_{i-3}
- * (equal to ctrl_mpc_vec_dq of the full basis; |w| <= 1 pu, no overflow). */
+ * (equal to ctrl_mpc_vec_dq of the full basis; |w| <= 16 pu, no overflow). */
 static inline void ctrl_mpc_vec3_dq(const ctrl_mpc_basis3_t *b, uint8_t i, q24_t *vd, q24_t *vq)
 {
     if (i > 3u) {
@@ -162,8 +164,8 @@ static inline void ctrl_mpc_vec3_dq(const ctrl_mpc_basis3_t *b, uint8_t i, q24_t
 }
 
 /* Te = psi_q (a + b psi_d), (3.6)/(6.11) with (6.12) in the rotor frame, for a
- * flux of the basis' range (|psi_d| <= 16 pu): b psi_d < 2^55; the last
- * product saturates. */
+ * flux of the basis' range (|psi_d| <= 28 pu): |b psi_d| < 2^55 (|b| <= 2 pu);
+ * the last product saturates. */
 static inline q24_t ctrl_mpc_torque(const ctrl_mpc_model_t *m, q24_t psi_d, q24_t psi_q)
 {
     return fx_mul(psi_q, m->a + fx_mul_nosat(m->b, psi_d));
@@ -197,7 +199,7 @@ static inline q24_t ctrl_mpc_ref_amp(const ctrl_mpc_basis_t *b, q24_t psi)
 }
 
 /* Flux of a candidate: psi0 + D Ts V, rotor frame, for 0 <= duty <= FX_ONE
- * and (vd, vq) from ctrl_mpc_vec_dq (or 0): |psi| components <= 12.4 pu. */
+ * and (vd, vq) from ctrl_mpc_vec_dq (or 0): |psi| components <= 27.4 pu. */
 static inline void ctrl_mpc_flux(const ctrl_mpc_basis_t *b, q24_t vd, q24_t vq, q24_t duty,
                                  q24_t *psi_d, q24_t *psi_q)
 {

@@ -39,7 +39,9 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
         model_ratio(c->psi_pm_wb, CTRL_MPC_LPSI_MODEL_MAX, mc->psi_pm_wb, &k_psi) != CTRL_OK) {
         return CTRL_EINVAL;
     }
-    const double ts = ctrl_q24_to_double(params->ts);
+    /* Ts in pu from the SI data (not the rounded params->ts: one rounding of
+     * Ts 2/3 and Ts Rs instead of two). */
+    const double ts = setup->bases->w_rad_s / (double)params->fs_hz;
     const double rs = ctrl_q24_to_double(params->rs) * k_rs;
     const double inv_ld = ctrl_q24_to_double(params->inv_ld) / k_ld;
     const double inv_lq = ctrl_q24_to_double(params->inv_lq) / k_lq;
@@ -51,17 +53,38 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
     const double b = inv_lq - inv_ld;
     const double ts_rs = ts * rs;
     const double ts_v = ts * 2.0 / 3.0;
+    const double vdc_max = 2.0 * ctrl_q24_to_double(params->vdc_nom);
+    /* |psi| on |i| = current_max is at most |(psi_pm + Ld i_max, Lq i_max)|. */
+    const double i_max = ctrl_q24_to_double(params->current_max);
+    const double psi_max =
+        hypot(ctrl_q24_to_double(params->psi_pm) + i_max / inv_ld, i_max / inv_lq);
     /* Limits of the fast k+2 arithmetic (ctrl_m2ptfc_model.h). */
-    if (fabs(a) > ctrl_q24_to_double(CTRL_MPC_AB_MAX) ||
-        fabs(b) > ctrl_q24_to_double(CTRL_MPC_AB_MAX) ||
-        ts_rs > ctrl_q24_to_double(CTRL_MPC_TS_RS_MAX) ||
-        ts_v > ctrl_q24_to_double(CTRL_MPC_TS_V_MAX)) {
-        return CTRL_ERANGE;
+    const double ab_max = ctrl_q24_to_double(CTRL_MPC_AB_MAX);
+    if (fabs(a) > ab_max) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, "prediction model psi_pm / Ld", "pu", a, 0.0,
+                                 ab_max);
+    }
+    if (fabs(b) > ab_max) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, "prediction model 1/Lq - 1/Ld", "pu", b,
+                                 -ab_max, ab_max);
+    }
+    if (ts_rs > ctrl_q24_to_double(CTRL_MPC_TS_RS_MAX)) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, "prediction model Ts Rs / Ld", "", ts_rs, 0.0,
+                                 ctrl_q24_to_double(CTRL_MPC_TS_RS_MAX));
+    }
+    if (ts_v * vdc_max > ctrl_q24_to_double(CTRL_MPC_TSV_MAX)) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, "flux step 2/3 x 2 Vdc Ts / psi_pm", "",
+                                 ts_v * vdc_max, 0.0, ctrl_q24_to_double(CTRL_MPC_TSV_MAX));
+    }
+    if (psi_max > CTRL_MPC_PSI_MAX) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, "flux at current_max / psi_pm", "", psi_max,
+                                 1.0, CTRL_MPC_PSI_MAX);
     }
     m->a = ctrl_q24_from_double(a);
     m->b = ctrl_q24_from_double(b);
     m->ts_rs = ctrl_q24_from_double(ts_rs);
     m->ts_v = ctrl_q24_from_double(ts_v);
+    m->vdc_max = ctrl_q24_from_double(vdc_max);
     return CTRL_OK;
 }
 
@@ -74,7 +97,8 @@ int ctrl_mpc_zeta_pu(const ctrl_setup_t *setup, double zeta, q24_t *out)
         zeta = setup->machine->torque_rated_nm / setup->machine->psi_pm_wb; /* §6.5 */
     }
     /* (T/T_base) = zeta_pu (psi/psi_base) */
-    return ctrl_q24_from_si(zeta * setup->bases->psi_wb, setup->bases->torque_nm, 0.0, 127.0, out);
+    return ctrl_setup_q24(setup, "zeta x flux base / torque base", zeta * setup->bases->psi_wb,
+                          setup->bases->torque_nm, 0.0, 127.0, out);
 }
 
 void ctrl_mpc_wcfg_default(void *cfg, const ctrl_machine_t *machine)

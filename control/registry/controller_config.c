@@ -75,3 +75,28 @@ int ctrl_tunables_check(const ctrl_tunable_t *t, size_t n, const void *cfg)
     }
     return CTRL_OK;
 }
+
+int ctrl_setup_refuse(const ctrl_setup_t *setup, int code, const char *quantity, const char *unit,
+                      double value, double lo, double hi)
+{
+    if (setup != NULL && setup->diag != NULL) {
+        ctrl_diag_t *d = setup->diag;
+        d->code = code;
+        d->quantity = quantity;
+        d->unit = unit;
+        d->value = value;
+        d->min = lo;
+        d->max = hi;
+        d->depends = NULL;
+    }
+    return code;
+}
+
+int ctrl_setup_q24(const ctrl_setup_t *setup, const char *quantity, double si, double base,
+                   double lo_pu, double hi_pu, q24_t *out)
+{
+    if (ctrl_q24_from_si(si, base, lo_pu, hi_pu, out) != CTRL_OK) {
+        return ctrl_setup_refuse(setup, CTRL_ERANGE, quantity, "pu", si / base, lo_pu, hi_pu);
+    }
+    return CTRL_OK;
+}

@@ -14,7 +14,6 @@
 #include "speed_pi.h"
 #include "speed_pi_config.h"
 
-
 /* Normalise a positive gain g to a mantissa in [2^30, 2^31) and a shift in
  * [1, max_shift]; a gain needing more than max_shift fractional bits keeps
  * max_shift (fewer significant bits; reported as ERANGE if it rounds to 0). */

@@ -175,6 +175,7 @@ typedef struct {
     bool busy; /* re-entry flag */
     uint32_t period;
     fw_telemetry_t tm;
+    ctrl_diag_t why; /* why the core refused the last configuration (fw_explain) */
 } fw_t;
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),
@@ -186,6 +187,10 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
  * and protections; gates off, state boot. Returns FW_OK or FW_E*. */
 int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg);
 const char *fw_strerror(int code);
+/* The quantity, value and accepted range behind the last refusal of fw_init,
+ * fw_select_controller or fw_tunable_set (when the core said why; else "ok"),
+ * as one line (ctrl_diag_format). */
+size_t fw_explain(const fw_t *fw, char *buf, size_t cap);
 
 /* The PWM-period interrupt. */
 void fw_isr(fw_t *fw);

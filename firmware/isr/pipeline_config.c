@@ -36,6 +36,14 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->overspeed_rpm = 0.0;
 }
 
+size_t fw_explain(const fw_t *fw, char *buf, size_t cap)
+{
+    if (fw == NULL || fw->why.code == CTRL_OK) {
+        return ctrl_diag_format(NULL, buf, cap);
+    }
+    return ctrl_diag_format(&fw->why, buf, cap);
+}
+
 const char *fw_strerror(int code)
 {
     switch (code) {
@@ -82,7 +90,8 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         cfg->calib_samples == 0u || cfg->calib_samples > 65536u) {
         return FW_EINVAL;
     }
-    if (ctrl_params_init(&fw->params, &fw->bases, cfg->machine, in->pwm_freq_hz) != CTRL_OK) {
+    if (ctrl_params_init_diag(&fw->params, &fw->bases, cfg->machine, in->pwm_freq_hz, &fw->why) !=
+        CTRL_OK) {
         return FW_EINVAL;
     }
     if ((uint64_t)in->encoder_counts_per_rev * (uint64_t)fw->params.pole_pairs >
@@ -194,7 +203,8 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
         unsigned char bytes[CTRL_STATE_MAX];
     } st;
     memset(&st, 0, sizeof st);
-    const ctrl_setup_t setup = {fw->machine, &fw->bases, &fw->params};
+    memset(&fw->why, 0, sizeof fw->why);
+    const ctrl_setup_t setup = {fw->machine, &fw->bases, &fw->params, &fw->why};
     if (ctrl_init(d, st.bytes, cfg, &setup) != CTRL_OK) {
         return FW_ECTRL;
     }

@@ -202,8 +202,8 @@ static void test_foc_reference(void)
     rig_init("foc", &ini_thesis_spmsm);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     const double ts = q(rig.params.ts);
-    const double kp_d = q(s->pi_d.kp);
-    const double kp_q = q(s->pi_q.kp);
+    const double kp_d = s->pi_d.kp / 1048576.0; /* Q20 */
+    const double kp_q = s->pi_q.kp / 1048576.0;
     std::mt19937_64 rng(3);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     double worst = 0.0;

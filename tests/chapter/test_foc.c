@@ -89,7 +89,9 @@ static void test_iref(void)
 
 static void test_pi_antiwindup(void)
 {
-    ctrl_foc_pi_t pi = {ctrl_q24_from_double(1.3), (int32_t)(0.02 * 1073741824.0), 0};
+    /* Kp 1.3 (Q20), Ki Ts 0.02 (Q30), integrator limit 1 pu (Q40). */
+    ctrl_foc_pi_t pi = {(int32_t)(1.3 * 1048576.0), (int32_t)(0.02 * 1073741824.0), 0,
+                        (int64_t)1 << 40};
     const q24_t e = FX_ONE / 10;
     /* Not limited: integrates Ki Ts e = 0.002 pu per step. */
     ctrl_foc_pi_update(&pi, e, FX_ONE, 0u);
@@ -274,7 +276,7 @@ static void test_config_errors(void)
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "Kp_q", 10.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(rig.d, rig.state, rig.cfg, &rig.su));
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 10.0 / rig.bases.r_ohm, q(s->pi_q.kp));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 10.0 / rig.bases.r_ohm, s->pi_q.kp / 1048576.0);
 }
 
 int main(void)

@@ -190,8 +190,10 @@ static void test_step_geometry(void)
                     ctrl_legs_voltage(&o.legs, rig.est.vdc, &va, &vb);
                     const double m = (l + 1) / 5.0;
                     const double vmag = hypot(q(va), q(vb));
-                    /* Amplitude m Vdc/sqrt(3) within one point of |V_k| (2/3 / 20). */
-                    TEST_ASSERT_DOUBLE_WITHIN(2.0 / 3.0 / 20.0 + 1e-6, m / sqrt(3.0), vmag);
+                    /* Amplitude m Vdc/sqrt(3) within one point of |V_k| (2/3 Vdc / 20). */
+                    const double vdc = q(rig.est.vdc);
+                    TEST_ASSERT_DOUBLE_WITHIN(2.0 / 3.0 * vdc / 20.0 + 1e-6, m * vdc / sqrt(3.0),
+                                              vmag);
                     /* Direction: along the flux tangent (forward if tau), tilted
                      * towards the flux-increasing side if phi: radial and
                      * tangential components by sign, the angle from the tangent

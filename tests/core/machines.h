@@ -44,4 +44,46 @@ static inline ctrl_machine_t machine_chapter_ipmsm(void)
     return m;
 }
 
+/*
+ * Corner cases of the range the core takes (docs/fixed-point.md, "Range"):
+ * small motors at the low end of flux linkage, inductance and resistance
+ * (0.3 mWb, 10 uH, 20 mOhm: a drone motor of about 2300 rpm/V), on an 8 V and
+ * a 60 V DC link, with the rated speed the sampling frequency allows (at most
+ * one radian per period at rated speed).
+ */
+static inline ctrl_machine_t machine_small_8v(void)
+{
+    const ctrl_machine_t m = {"small_8v", 7,     0.02,    10e-6, 10e-6, 0.3e-3, 8.0,
+                              1e-6,       0.063, 18000.0, 20.0,  40.0,  0.0};
+    return m;
+}
+
+static inline ctrl_machine_t machine_small_60v(void)
+{
+    ctrl_machine_t m = machine_small_8v();
+    m.name = "small_60v";
+    m.vdc_v = 60.0;
+    return m;
+}
+
+/* The same motor with 4 pole pairs and a lower rated speed: usable at 10 kHz. */
+static inline ctrl_machine_t machine_small_10khz(void)
+{
+    ctrl_machine_t m = machine_small_8v();
+    m.name = "small_10khz";
+    m.pole_pairs = 4;
+    m.torque_rated_nm = 0.036;
+    m.speed_rated_rpm = 10000.0;
+    return m;
+}
+
+/* The thesis SPMSM on a 1000 V DC link (8.4 x its rated back-EMF). */
+static inline ctrl_machine_t machine_spmsm_1000v(void)
+{
+    ctrl_machine_t m = machine_thesis_spmsm();
+    m.name = "spmsm_1000v";
+    m.vdc_v = 1000.0;
+    return m;
+}
+
 #endif /* TESTS_CORE_MACHINES_H */

@@ -1,10 +1,13 @@
 /*
  * Double-precision reference of the control core (C++17, Eigen 3), driven with
  * the same randomised inputs as the fixed-point code over the whole operating
- * range: three machines (thesis SPMSM, 80 kW IPMSM, chapter IPMSM) at 10 and
- * 20 kHz, current vectors of any direction up to current_max (motoring and
- * braking), both rotation directions up to 1.2x rated speed, any rotor angle,
- * every voltage vector with any duty and DC link 0.9..1.1 pu.
+ * range: the thesis SPMSM, the 80 kW IPMSM and the chapter IPMSM at 10 and
+ * 20 kHz, and the corner cases of the range the core takes (machines.h: a
+ * 0.3 mWb / 10 uH / 20 mOhm motor on 8 V and 60 V at 20 and 40 kHz, with
+ * 4 pole pairs at 10, 20 and 40 kHz, the SPMSM on 1000 V), current vectors of
+ * any direction up to current_max (motoring and braking), both rotation
+ * directions up to 1.2x rated speed, any rotor angle, every voltage vector
+ * with any duty and the DC link within +-10 % of nominal.
  *
  * Equations (reference side, all in double, parameters from the SI data):
  *   Clarke (3.3), Park (3.7), current model (3.9), torque (3.10)/(3.6),
@@ -12,7 +15,7 @@
  *   prediction (5.15)/(6.10)-(6.12) generalised to Ld != Lq, MTPA (4.15).
  *
  * Each comparison is asserted against the error bound derived from the Q
- * formats (control/README.md, "Error budget"); the bound is evaluated per
+ * formats (docs/error-budget.md); the bound is evaluated per
  * sample from the magnitudes involved. The worst measured errors are printed.
  */
 #include <Eigen/Dense>
@@ -63,16 +66,20 @@ q24_t q(double x)
     return ctrl_q24_from_double(x);
 }
 
-// Exact per-unit model of one machine (from the SI data, not from ctrl_params_t).
+// Exact per-unit model of one machine (from the SI data and the bases of
+// docs/fixed-point.md, not from ctrl_params_t): psi_base = psi_pm, w_base =
+// the rated electrical speed, v_base = psi_base w_base, l_base = Ld.
 struct RefMachine {
-    double ts, rs, lq; // pu (ld = psi_pm = 1 by the bases)
+    double ts, rs, lq, vdc; // pu (ld = psi_pm = 1 by the bases)
     RefMachine(const ctrl_machine_t &m, uint32_t fs)
     {
-        const double wb = m.vdc_v / m.psi_pm_wb;
+        const double wb = m.pole_pairs * m.speed_rated_rpm * 2 * kPi / 60.0;
+        const double vb = m.psi_pm_wb * wb;
         const double ib = m.psi_pm_wb / m.ld_h;
         ts = wb / fs;
-        rs = m.rs_ohm / (m.vdc_v / ib);
+        rs = m.rs_ohm / (vb / ib);
         lq = m.lq_h / m.ld_h;
+        vdc = m.vdc_v / vb;
     }
 };
 
@@ -201,8 +208,7 @@ void run_machine(const ctrl_machine_t &mach, uint32_t fs, int n, std::mt19937_64
     const RefMachine rm(mach, fs);
     std::uniform_real_distribution<double> u01(0.0, 1.0);
     const double imax = mach.current_max_a / (mach.psi_pm_wb / mach.ld_h);
-    const double wmax = 1.2 * mach.pole_pairs * mach.speed_rated_rpm * 2 * kPi / 60.0 /
-                        (mach.vdc_v / mach.psi_pm_wb);
+    const double wmax = 1.2; // rated speed = 1 pu
     // parameter quantisation (0.5 LSB each, ld / inv_ld / psi_pm exact)
     const double lq_q = d(p.lq), inv_lq_q = d(p.inv_lq);
     TEST_ASSERT_TRUE(std::fabs(lq_q - rm.lq) <= 0.5 * L && std::fabs(d(p.ts) - rm.ts) <= 0.5 * L);
@@ -216,7 +222,7 @@ void run_machine(const ctrl_machine_t &mach, uint32_t fs, int n, std::mt19937_64
         const fx_angle_t th_q = static_cast<fx_angle_t>(gen());
         const double th = th_q * (2 * kPi / 4294967296.0);
         const q24_t w_q = q(wmax * (2 * u01(gen) - 1));
-        const q24_t vdc_q = q(0.9 + 0.2 * u01(gen));
+        const q24_t vdc_q = q(rm.vdc * (0.9 + 0.2 * u01(gen)));
         ctrl_plan_t plan;
         const uint8_t vec = static_cast<uint8_t>(gen() % 8u);
         if (gen() % 2u) {
@@ -361,6 +367,16 @@ void test_reference_all_machines()
         run_machine(m, 10000u, 10000, gen);
         run_machine(m, 20000u, 10000, gen);
     }
+    // corner cases of the range (machines.h), at the rates their rated speed allows
+    const ctrl_machine_t s8 = machine_small_8v(), s60 = machine_small_60v(),
+                         s10 = machine_small_10khz(), h = machine_spmsm_1000v();
+    run_machine(s8, 20000u, 4000, gen);
+    run_machine(s8, 40000u, 4000, gen);
+    run_machine(s60, 20000u, 4000, gen);
+    run_machine(s60, 40000u, 4000, gen);
+    run_machine(s10, 10000u, 4000, gen);
+    run_machine(s10, 40000u, 4000, gen);
+    run_machine(h, 10000u, 4000, gen);
     // the random drive covered all four quadrants of Fig. 3.9
     for (long c : quadrant_count)
         TEST_ASSERT_TRUE(c > 5000);

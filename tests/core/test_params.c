@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "controller.h"
@@ -48,29 +49,35 @@ static void test_bases_spmsm(void)
     ctrl_params_t p;
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
-    const double wb = 220.0 / 0.09427;
+    /* Bases (ctrl_params.h): psi_pm, the rated electrical speed, V = psi w, Ld. */
+    const double wb = 4 * 3000 * 2 * PI / 60;
+    const double vb = 0.09427 * wb;
     const double ib = 0.09427 / 6.552e-3;
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * wb, wb, b.w_rad_s);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1.0 / wb, b.t_s);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * wb, wb, b.w_rad_s);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 1.0 / wb, b.t_s);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * vb, vb, b.v_v);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12 * ib, ib, b.i_a);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1.5 * 4 * 0.09427 * ib, b.torque_nm);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 220.0 / ib, b.r_ohm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, vb / ib, b.r_ohm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, wb * 6.552e-3, b.r_ohm); /* w_base l_base */
+    /* the per-unit values follow from the data, none is assumed */
     TEST_ASSERT_EQUAL_INT32(FX_ONE, p.ld);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, p.lq);
     TEST_ASSERT_EQUAL_INT32(FX_ONE, p.psi_pm);
-    TEST_ASSERT_EQUAL_INT32(FX_ONE, p.vdc_nom);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, p.inv_psi_pm);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, p.speed_rated_e);
     TEST_ASSERT_EQUAL_UINT8(0u, p.salient);
     /* each Q24 field is the rounded pu value: error <= 0.5 LSB */
-    TEST_ASSERT_TRUE(fabs(d(p.ts) - wb * 1e-4) <= 0.5 * LSB);
-    TEST_ASSERT_TRUE(fabs(d(p.rs) - 0.901 / (220.0 / ib)) <= 0.5 * LSB);
-    TEST_ASSERT_TRUE(fabs(d(p.ts_rs) - wb * 1e-4 * 0.901 / (220.0 / ib)) <= 0.5 * LSB);
-    TEST_ASSERT_TRUE(fabs(d(p.speed_rated_e) - 4 * 3000 * 2 * PI / 60 / wb) <= 0.5 * LSB);
+    TEST_ASSERT_TRUE(fabs(d(p.vdc_nom) - 220.0 / vb) <= 0.5 * LSB); /* 1.857: DC link / EMF */
+    TEST_ASSERT_TRUE(fabs(d(p.ts) - wb * 1e-4) <= 0.5 * LSB); /* rad per period at rated speed */
+    TEST_ASSERT_TRUE(fabs(d(p.rs) - 0.901 / (vb / ib)) <= 0.5 * LSB);
+    TEST_ASSERT_TRUE(fabs(d(p.ts_rs) - 1e-4 * 0.901 / 6.552e-3) <= 0.5 * LSB); /* Ts / tau */
     TEST_ASSERT_TRUE(fabs(d(p.current_max) - 8.4 / ib) <= 0.5 * LSB);
-    /* Thesis SPMSM: omega_e psi_pm at 3000 r/min = 118.5 V (0.5386 pu of Vdc) */
-    TEST_ASSERT_DOUBLE_WITHIN(0.05, 118.5, d(p.speed_rated_e) * b.v_v);
+    /* Thesis SPMSM: omega_e psi_pm at 3000 r/min = 118.5 V: the voltage base */
+    TEST_ASSERT_DOUBLE_WITHIN(0.05, 118.5, b.v_v);
     /* angle increment per period: Ts_pu / (2 pi) turns, integer rounding */
     TEST_ASSERT_DOUBLE_WITHIN(0.5, wb * 1e-4 / (2 * PI) * 4294967296.0, (double)p.omega_to_dangle);
-    /* inverse: dtheta * m / 2^28 = dtheta * 2^24 / k_ang, m rounded (0.5 / 2^28) */
+    /* inverse: dtheta * m / 2^26 = dtheta * 2^24 / k_ang, m rounded (0.5 / 2^26) */
     const double inv = ldexp((double)p.dangle_to_omega, -(int)CTRL_DANGLE_SHIFT);
     const double inv_exact = 16777216.0 / (wb * 1e-4 / (2 * PI) * 4294967296.0);
     TEST_ASSERT_DOUBLE_WITHIN(ldexp(0.5, -(int)CTRL_DANGLE_SHIFT) + inv_exact * 1e-15, inv_exact,
@@ -143,21 +150,154 @@ static void test_reject_bad_machines(void)
     BAD(psi_ref_wb, -0.1, CTRL_EINVAL);
     BAD(pole_pairs, 0, CTRL_EINVAL);
     BAD(pole_pairs, 1000, CTRL_EINVAL);
-    /* plausible SI, but the per-unit value does not fit Q24 (|x| <= 100 pu
-     * with 2^-16 pu minimum): ERANGE */
-    BAD(lq_h, 6.552, CTRL_ERANGE); /* Lq / Ld = 1000 */
-    BAD(ld_h, 5.0, CTRL_ERANGE);   /* i_base = 19 mA: 8.4 A is 445 pu */
-    BAD(current_max_a, 5000.0, CTRL_ERANGE);
-    BAD(rs_ohm, 1e-7, CTRL_ERANGE); /* 6.5e-9 pu: no resolution */
+    /* plausible SI, but a per-unit value outside the core's formats: ERANGE */
+    BAD(lq_h, 6.552, CTRL_ERANGE);              /* Lq / Ld = 1000 */
+    BAD(ld_h, 5.0, CTRL_ERANGE);                /* Lq / Ld = 0.0013 */
+    BAD(current_max_a, 5000.0, CTRL_ERANGE);    /* 348 x psi_pm / Ld */
+    BAD(rs_ohm, 100.0, CTRL_ERANGE);            /* Ts Rs / Ld = 1.5: Euler of (5.15) */
+    BAD(vdc_v, 5000.0, CTRL_ERANGE);            /* 42 x the rated back-EMF */
+    BAD(speed_rated_rpm, 30000.0, CTRL_ERANGE); /* 1.26 rad per period at 10 kHz */
+    BAD(speed_rated_rpm, 20.0, CTRL_ERANGE);    /* 8.4e-4 rad per period */
 #undef BAD
-    /* 100 Hz sampling: 23 rad per period at 1 pu speed */
+    /* 100 Hz sampling: 12.6 rad per period at rated speed */
     expect_reject(&spm, 100u, CTRL_ERANGE);
+    /* a tiny resistance is no problem (its drop is a correction term) */
+    m = spm;
+    m.rs_ohm = 1e-7;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &m, 10000u));
     expect_reject(&spm, 100000000u, CTRL_EINVAL);
     /* an ideal lossless machine is accepted */
     m = spm;
     m.rs_ohm = 0.0;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &m, 10000u));
     TEST_ASSERT_EQUAL_INT32(0, p.rs);
+}
+
+/* A refusal names the quantity, its value and the accepted range. */
+static void expect_diag(const ctrl_machine_t *m, uint32_t fs, int code, const char *quantity,
+                        double value)
+{
+    ctrl_params_t p;
+    ctrl_bases_t b;
+    ctrl_diag_t why;
+    TEST_ASSERT_EQUAL_INT(code, ctrl_params_init_diag(&p, &b, m, fs, &why));
+    TEST_ASSERT_EQUAL_INT(code, why.code);
+    TEST_ASSERT_EQUAL_STRING(quantity, why.quantity);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * fabs(value) + 1e-12, value, why.value);
+    TEST_ASSERT_TRUE(why.value < why.min || why.value > why.max);
+    char msg[256];
+    const size_t n = ctrl_diag_format(&why, msg, sizeof msg);
+    TEST_ASSERT_TRUE(n > 0u && n < sizeof msg);
+    TEST_ASSERT_NOT_NULL(strstr(msg, quantity));
+    TEST_ASSERT_NOT_NULL(strstr(msg, "outside the range the core takes"));
+    char num[32];
+    snprintf(num, sizeof num, "[%.6g, %.6g]", why.min, why.max);
+    TEST_ASSERT_NOT_NULL(strstr(msg, num));
+    /* a buffer too short for the line: truncated, terminated */
+    char shortbuf[16];
+    TEST_ASSERT_EQUAL_UINT(sizeof shortbuf - 1u, ctrl_diag_format(&why, shortbuf, sizeof shortbuf));
+    TEST_ASSERT_EQUAL_UINT(sizeof shortbuf - 1u, strlen(shortbuf));
+}
+
+static void test_refusals_explained(void)
+{
+    const ctrl_machine_t spm = machine_thesis_spmsm();
+    ctrl_machine_t m = spm;
+    m.psi_pm_wb = -1e-3;
+    expect_diag(&m, 10000u, CTRL_EINVAL, "psi_pm_wb", -1e-3);
+    m = spm;
+    m.ld_h = NAN;
+    ctrl_params_t p;
+    ctrl_bases_t b;
+    ctrl_diag_t why;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_init_diag(&p, &b, &m, 10000u, &why));
+    TEST_ASSERT_EQUAL_STRING("ld_h", why.quantity);
+    m = spm;
+    m.speed_rated_rpm = 30000.0; /* 12.57 rad/s x 10000 rpm / ... = 1.257 rad per period */
+    expect_diag(&m, 10000u, CTRL_ERANGE, "rated electrical speed x Ts",
+                30000.0 / 60.0 * 2.0 * PI * 4.0 * 1e-4);
+    expect_diag(&spm, 500u, CTRL_ERANGE, "rated electrical speed x Ts",
+                3000.0 / 60.0 * 2.0 * PI * 4.0 / 500.0);
+    m = spm;
+    m.vdc_v = 5000.0;
+    expect_diag(&m, 10000u, CTRL_ERANGE, "vdc_v / rated back-EMF (psi_pm x rated electrical speed)",
+                5000.0 / (0.09427 * 3000.0 / 60.0 * 2.0 * PI * 4.0));
+    m = spm;
+    m.rs_ohm = 100.0;
+    expect_diag(&m, 10000u, CTRL_ERANGE, "Ts Rs / Ld", 1e-4 * 100.0 / 6.552e-3);
+    m = spm;
+    m.pole_pairs = 0;
+    expect_diag(&m, 10000u, CTRL_EINVAL, "pole_pairs", 0.0);
+    /* the dependent data are named with a derived quantity */
+    m = spm;
+    m.speed_rated_rpm = 30000.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_ERANGE, ctrl_params_init_diag(&p, &b, &m, 10000u, &why));
+    char msg[256];
+    ctrl_diag_format(&why, msg, sizeof msg);
+    TEST_ASSERT_NOT_NULL(strstr(msg, "speed_rated_rpm"));
+    TEST_ASSERT_NOT_NULL(strstr(msg, "fs_hz"));
+    /* accepted: "ok" */
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init_diag(&p, &b, &spm, 10000u, &why));
+    ctrl_diag_format(&why, msg, sizeof msg);
+    TEST_ASSERT_EQUAL_STRING("ok", msg);
+}
+
+/* The range of the brief: psi_pm from 0.3 mWb, L from 10 uH, R from 20 mOhm,
+ * Vdc 8-60 V and 540 V, fs 10-40 kHz. The machines (machines.h) at the
+ * sampling frequencies their rated speed allows are accepted by the core and
+ * by every registered controller (defaults); where one period would turn the
+ * rotor by more than one radian at rated speed the refusal says so. */
+static void test_range_corner_machines(void)
+{
+    const struct {
+        ctrl_machine_t m;
+        uint32_t fs_min; /* below: refused, "rated electrical speed x Ts" */
+    } cases[] = {
+        {machine_small_8v(), 20000u},       {machine_small_60v(), 20000u},
+        {machine_small_10khz(), 10000u},    {machine_spmsm_1000v(), 10000u},
+        {machine_thesis_ipmsm80(), 10000u}, {machine_thesis_spmsm(), 10000u},
+        {machine_chapter_ipmsm(), 10000u},
+    };
+    static const uint32_t fss[3] = {10000u, 20000u, 40000u};
+    static _Alignas(16) unsigned char cfg[CTRL_CFG_MAX];
+    static _Alignas(16) unsigned char st[CTRL_STATE_MAX];
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        for (size_t f = 0; f < 3; f++) {
+            ctrl_params_t p;
+            ctrl_bases_t b;
+            ctrl_diag_t why;
+            const int rc = ctrl_params_init_diag(&p, &b, &cases[k].m, fss[f], &why);
+            char msg[256];
+            ctrl_diag_format(&why, msg, sizeof msg);
+            if (fss[f] < cases[k].fs_min) {
+                TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_ERANGE, rc, cases[k].m.name);
+                TEST_ASSERT_EQUAL_STRING("rated electrical speed x Ts", why.quantity);
+                continue;
+            }
+            TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_OK, rc, msg);
+            const ctrl_setup_t su = {&cases[k].m, &b, &p, &why};
+            for (size_t i = 0; i < ctrl_count(); i++) {
+                const ctrl_desc_t *d = ctrl_at(i);
+                TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_cfg_default(d, cfg, &cases[k].m));
+                memset(&why, 0, sizeof why);
+                const int ci = ctrl_init(d, st, cfg, &su);
+                if (ci != CTRL_OK) {
+                    /* A controller may have a narrower range than the core
+                     * (its own arithmetic), but says which quantity is out;
+                     * the proposed controllers take every corner case. */
+                    char text[320];
+                    ctrl_diag_format(&why, msg, sizeof msg);
+                    snprintf(text, sizeof text, "%s on %s at %u Hz: %s", d->name, cases[k].m.name,
+                             (unsigned)fss[f], msg);
+                    TEST_ASSERT_NOT_NULL_MESSAGE(why.quantity, text);
+                    TEST_ASSERT_TRUE_MESSAGE(why.value < why.min || why.value > why.max, text);
+                    TEST_ASSERT_TRUE_MESSAGE(
+                        strcmp(d->name, "m2ptfc") != 0 && strcmp(d->name, "fst") != 0, text);
+                    TEST_MESSAGE(text);
+                }
+            }
+        }
+    }
 }
 
 static void test_q24_conversion(void)
@@ -312,22 +452,24 @@ static void test_speed_pi(void)
         const double expect = (kp_pu + n * ki_pu) * d(e);
         TEST_ASSERT_TRUE(fabs(d(u) - expect) <= 1.0 * LSB + expect * 1e-8);
     }
-    /* Saturation and anti-windup: a large error pins the output at the limit
-     * and the integrator never exceeds it; when the error reverses, the output
+    /* Saturation and anti-windup: a large error drives the output to the limit
+     * (conditional integration stops within one integration step of it) and
+     * the integrator never exceeds it; when the error reverses, the output
      * leaves the limit at once (no wind-up to unwind). */
     const q24_t lim = pi.out_max;
     TEST_ASSERT_TRUE(fabs(d(lim) - 2.4 / b.torque_nm) <= 0.5 * LSB);
     for (int n = 0; n < 20000; n++) {
         u = ctrl_speed_pi_step(&pi, FX_ONE, 0);
     }
-    TEST_ASSERT_EQUAL_INT32(lim, u);
+    const double step_lsb = ki_pu * 16777216.0 + 1.0; /* one integration step of 1 pu */
+    TEST_ASSERT_TRUE(u <= lim && (double)(lim - u) <= step_lsb);
     u = ctrl_speed_pi_step(&pi, -ctrl_q24_from_double(0.01), 0);
     TEST_ASSERT_TRUE(u < lim);
     ctrl_speed_pi_reset(&pi, 0);
     for (int n = 0; n < 20000; n++) {
         u = ctrl_speed_pi_step(&pi, -FX_ONE, 0);
     }
-    TEST_ASSERT_EQUAL_INT32(-lim, u);
+    TEST_ASSERT_TRUE(u >= -lim && (double)(u + lim) <= step_lsb);
     u = ctrl_speed_pi_step(&pi, FX_MAX, FX_MIN); /* extreme inputs: no overflow */
     TEST_ASSERT_EQUAL_INT32(lim, u);
     /* bumpless start */
@@ -399,6 +541,8 @@ int main(void)
     RUN_TEST(test_bases_spmsm);
     RUN_TEST(test_bases_ipmsm);
     RUN_TEST(test_reject_bad_machines);
+    RUN_TEST(test_refusals_explained);
+    RUN_TEST(test_range_corner_machines);
     RUN_TEST(test_q24_conversion);
     RUN_TEST(test_mtpa_oracle_spmsm);
     RUN_TEST(test_mtpa_ipmsm_table);

@@ -261,6 +261,18 @@ static void test_init_rejects(void)
     fw_config_default(&fc, NULL, &ol_desc);
     TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&fw, (hal_t *)&run.hal, &fc));
     TEST_ASSERT_NOT_NULL(fw_strerror(FW_ECTRL));
+    /* A machine the core cannot represent at this rate: refused, and
+     * fw_explain names the quantity, its value and the accepted range
+     * (60000 r/min, 4 pole pairs, 20 kHz: 1.26 rad per period at rated speed). */
+    ctrl_machine_t m = run.cfg.ctrl_machine;
+    m.speed_rated_rpm = 60000.0;
+    fw_config_default(&fc, &m, ctrl_find("bst"));
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&fw, (hal_t *)&run.hal, &fc));
+    char why[200];
+    TEST_ASSERT_TRUE(fw_explain(&fw, why, sizeof why) > 0u);
+    TEST_MESSAGE(why);
+    TEST_ASSERT_NOT_NULL(strstr(why, "rated electrical speed x Ts = 1.25664"));
+    TEST_ASSERT_NOT_NULL(strstr(why, "[0.001, 1]"));
 }
 
 int main(void)
