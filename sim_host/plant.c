@@ -275,7 +275,7 @@ static void leg_to_ab(const double v_leg[3], double *v_al, double *v_be)
 #define RK_N 7
 
 static int rk_deriv(const plant_t *p, const legs_t *l, double th, double w, const double y[RK_N],
-                    double dy[RK_N])
+                    double dy[RK_N], double v_ab[2])
 {
     double id, iq;
     const int rc = current_from_flux(p, y[0], y[1], &id, &iq);
@@ -287,6 +287,10 @@ static int rk_deriv(const plant_t *p, const legs_t *l, double th, double w, cons
     const double vdc = y[2];
     leg_voltages(p, l, vdc, i_abc, v_leg, &idc);
     leg_to_ab(v_leg, &v_al, &v_be);
+    if (v_ab != NULL) {
+        v_ab[0] = v_al;
+        v_ab[1] = v_be;
+    }
     const double c = cos(th), s = sin(th);
     const double vd = v_al * c + v_be * s;
     const double vq = -v_al * s + v_be * c;
@@ -322,20 +326,23 @@ static int rk4_interval(plant_t *p, const legs_t *l, double w, double dt)
     double y[RK_N] = {p->psi_d, p->psi_q, p->vdc, p->e_src_j, p->e_in_j, p->e_cu_j, p->e_mech_j};
     double th = p->theta_e;
     for (long k = 0; k < n; ++k) {
-        double k1[RK_N], k2[RK_N], k3[RK_N], k4[RK_N], yt[RK_N];
-        int rc = rk_deriv(p, l, th, w, y, k1);
+        double k1[RK_N], k2[RK_N], k3[RK_N], k4[RK_N], yt[RK_N], v_ab[2];
+        int rc = rk_deriv(p, l, th, w, y, k1, v_ab);
+        /* motor voltage integral: leg voltages of the sub-step's start */
+        p->v_int[0] += h * v_ab[0];
+        p->v_int[1] += h * v_ab[1];
         for (int j = 0; j < RK_N; ++j) {
             yt[j] = y[j] + 0.5 * h * k1[j];
         }
-        rc |= rk_deriv(p, l, th + 0.5 * h * w, w, yt, k2);
+        rc |= rk_deriv(p, l, th + 0.5 * h * w, w, yt, k2, NULL);
         for (int j = 0; j < RK_N; ++j) {
             yt[j] = y[j] + 0.5 * h * k2[j];
         }
-        rc |= rk_deriv(p, l, th + 0.5 * h * w, w, yt, k3);
+        rc |= rk_deriv(p, l, th + 0.5 * h * w, w, yt, k3, NULL);
         for (int j = 0; j < RK_N; ++j) {
             yt[j] = y[j] + h * k3[j];
         }
-        rc |= rk_deriv(p, l, th + h * w, w, yt, k4);
+        rc |= rk_deriv(p, l, th + h * w, w, yt, k4, NULL);
         if (rc != PLANT_OK) {
             return PLANT_ERANGE;
         }
@@ -432,6 +439,63 @@ typedef struct {
     double amp, omega_v, phase;
 } sine_in_t;
 
+/* Integral of the test source amp e^{j (omega_v t + phase)} over [t0, t0 + dt]. */
+static void sine_vint(plant_t *p, const sine_in_t *sine, double t0, double dt)
+{
+    const double a0 = sine->omega_v * t0 + sine->phase;
+    if (fabs(sine->omega_v * dt) < 1e-9) {
+        p->v_int[0] += sine->amp * cos(a0) * dt;
+        p->v_int[1] += sine->amp * sin(a0) * dt;
+        return;
+    }
+    const double a1 = a0 + sine->omega_v * dt;
+    /* integral e^{j a} dt = (e^{j a1} - e^{j a0}) / (j omega_v) */
+    p->v_int[0] += sine->amp * (sin(a1) - sin(a0)) / sine->omega_v;
+    p->v_int[1] += sine->amp * (cos(a0) - cos(a1)) / sine->omega_v;
+}
+
+/* Filter path: one piece at the step's held speed (the machine and the filter
+ * together, plant_filter.c); theta, t and the torque integral advance here,
+ * the speed at the step's end (step_end). */
+static int filter_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, double dt)
+{
+    const double pp = (double)p->cfg.pole_pairs;
+    const double w = p->step_wm * pp;
+    plant_filter_input_t in = {0, -w, 0.0, 0.0};
+    const double c = cos(p->theta_e), s = sin(p->theta_e);
+    if (sine != NULL && sine->active) {
+        const double ang = sine->omega_v * p->t + sine->phase;
+        const double va = sine->amp * cos(ang), vb = sine->amp * sin(ang);
+        in.wu = sine->omega_v - w;
+        in.w_d = va * c + vb * s;
+        in.w_q = -va * s + vb * c;
+    } else if (legs_driven(l)) {
+        const double vdc = p->vdc;
+        const double v_leg[3] = {l->s[0] ? vdc : 0.0, l->s[1] ? vdc : 0.0, l->s[2] ? vdc : 0.0};
+        double va, vb;
+        leg_to_ab(v_leg, &va, &vb);
+        in.w_d = va * c + vb * s;
+        in.w_q = -va * s + vb * c;
+    } else if (l->s[0] == PLANT_LEG_OFF && l->s[1] == PLANT_LEG_OFF && l->s[2] == PLANT_LEG_OFF) {
+        in.open = 1;
+    } else {
+        return PLANT_EINVAL; /* some legs off: only with dead time, refused with a filter */
+    }
+    double te_int = 0.0;
+    const int rc = plant_filter_piece(p, &in, w, dt, &te_int, p->v_int);
+    if (rc != PLANT_OK) {
+        return rc;
+    }
+    p->step_te_int += te_int;
+    plant_filter_motor_current(p, &p->id, &p->iq);
+    flux_from_current(p, p->id, p->iq, &p->psi_d, &p->psi_q);
+    p->theta_e = wrap_pi(p->theta_e + w * dt);
+    p->theta_m += p->step_wm * dt;
+    p->t += dt;
+    p->trig_n = 0;
+    return PLANT_OK;
+}
+
 /* Electrical integration over dt at constant omega_e = w (theta not advanced). */
 static int electrical_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, double w,
                             double t_off, double dt)
@@ -441,6 +505,7 @@ static int electrical_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, 
         const double ang = sine->omega_v * (p->t + t_off) + sine->phase;
         exact_setup(p, w, sine->omega_v - w, sine->amp * cos(ang), sine->amp * sin(ang),
                     cos(p->theta_e), sin(p->theta_e), &e);
+        sine_vint(p, sine, p->t + t_off, dt);
         return exact_interval(p, &e, dt);
     }
     if (use_exact(p, l)) {
@@ -448,6 +513,8 @@ static int electrical_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, 
         double v_leg[3] = {l->s[0] ? vdc : 0.0, l->s[1] ? vdc : 0.0, l->s[2] ? vdc : 0.0};
         double v_al, v_be;
         leg_to_ab(v_leg, &v_al, &v_be);
+        p->v_int[0] += v_al * dt;
+        p->v_int[1] += v_be * dt;
         if (p->trig_n == 0 || p->trig_n > 32 || p->trig_key != p->theta_e) {
             p->trig_c = cos(p->theta_e);
             p->trig_s = sin(p->theta_e);
@@ -474,6 +541,9 @@ static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, dou
 {
     if (dt <= 0.0) {
         return PLANT_OK;
+    }
+    if (p->flt.type != PLANT_FILTER_NONE) {
+        return filter_piece(p, l, sine, dt);
     }
     const double pp = (double)p->cfg.pole_pairs;
     int rc;
@@ -566,6 +636,10 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
         ok = c->fluxmap->n_d >= 2 && c->fluxmap->n_q >= 2 && c->fluxmap->psi_d != NULL &&
              c->fluxmap->psi_q != NULL;
     }
+    if (ok && c->filter.type != PLANT_FILTER_NONE) {
+        /* the filter path integrates the linear model exactly (plant_filter.h) */
+        ok = c->fluxmap == NULL && c->dc_cap_f == 0.0 && c->dead_time_s == 0.0 && c->v_fwd_v == 0.0;
+    }
     if (!ok) {
         return PLANT_EINVAL;
     }
@@ -586,6 +660,10 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
     for (int x = 0; x < 3; ++x) {
         p->dead_end[x] = -1.0;
     }
+    if (plant_filter_setup(p) != PLANT_OK) {
+        memset(p, 0, sizeof(*p));
+        return PLANT_EINVAL;
+    }
     return PLANT_OK;
 }
 
@@ -603,6 +681,8 @@ void plant_set_observer(plant_t *p, plant_observer_fn fn, void *ctx, double obs_
     p->obs = fn;
     p->obs_ctx = ctx;
     p->obs_dt = obs_dt;
+    p->v_int[0] = p->v_int[1] = 0.0;
+    p->v_int_t0 = p->t;
     p->obs_next = (int64_t)floor(p->t / obs_dt + 1e-9) + 1;
 }
 
@@ -651,12 +731,58 @@ static void effective_legs(const plant_t *p, legs_t *l)
 
 static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_in_t *sine);
 
+/* Filter path: one plant step of planned length len holds the electrical
+ * speed at the midpoint prediction (free mechanics) or the imposed speed, so
+ * that the combined linear system is time invariant over the step. Returns
+ * 1 if this call opened the step. */
+static int step_begin(plant_t *p, double len)
+{
+    if (p->flt.type == PLANT_FILTER_NONE || p->step_on) {
+        return 0;
+    }
+    p->step_on = 1;
+    p->step_t0 = p->t;
+    p->step_len = len;
+    p->step_wm0 = p->omega_m;
+    p->step_te_int = 0.0;
+    p->step_wm = p->omega_m;
+    if (p->cfg.mech == PLANT_MECH_FREE) {
+        const double J = p->cfg.inertia_kgm2, B = p->cfg.friction_nms;
+        p->step_wm += 0.5 * len * (plant_torque(p) - p->load_torque_nm - B * p->omega_m) / J;
+    }
+    return 1;
+}
+
+/* Close the step: the speed follows (3.15) with the step's mean torque. */
+static void step_end(plant_t *p, int opened)
+{
+    if (!opened) {
+        return;
+    }
+    p->step_on = 0;
+    const double dt = p->t - p->step_t0;
+    if (p->cfg.mech != PLANT_MECH_FREE || !(dt > 0.0)) {
+        return;
+    }
+    const double J = p->cfg.inertia_kgm2, B = p->cfg.friction_nms;
+    const double f = p->step_te_int / dt - p->load_torque_nm;
+    if (B > 0.0) {
+        const double a = exp(-B * dt / J);
+        p->omega_m = p->step_wm0 * a + f / B * (1.0 - a);
+    } else {
+        p->omega_m = p->step_wm0 + f * dt / J;
+    }
+}
+
 int plant_advance(plant_t *p, double dt, const uint8_t s[3])
 {
     if (p == NULL || s == NULL || !finite_nonneg(dt) || s[0] > 2u || s[1] > 2u || s[2] > 2u) {
         return PLANT_EINVAL;
     }
-    return advance_common(p, dt, s, NULL);
+    const int opened = step_begin(p, dt);
+    const int rc = advance_common(p, dt, s, NULL);
+    step_end(p, opened);
+    return rc;
 }
 
 int plant_advance_voltage_ab(plant_t *p, double dt, double v_amp, double omega_v, double phase)
@@ -667,7 +793,19 @@ int plant_advance_voltage_ab(plant_t *p, double dt, double v_amp, double omega_v
     }
     const sine_in_t sine = {1, v_amp, omega_v, phase};
     const uint8_t s[3] = {p->s[0], p->s[1], p->s[2]};
-    return advance_common(p, dt, s, &sine);
+    const int opened = step_begin(p, dt);
+    const int rc = advance_common(p, dt, s, &sine);
+    step_end(p, opened);
+    return rc;
+}
+
+/* Observer call at a grid instant; the motor-voltage integral restarts. */
+static void observe(plant_t *p)
+{
+    p->obs(p->obs_ctx, p);
+    p->obs_next++;
+    p->v_int[0] = p->v_int[1] = 0.0;
+    p->v_int_t0 = p->t;
 }
 
 static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_in_t *sine)
@@ -686,21 +824,33 @@ static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_
         p->s_valid = 1;
     }
     const double t_end = p->t + dt;
+    const double eps_end = PLANT_T_EPS * (1.0 + fabs(t_end));
     int guard = 0;
-    while (p->t < t_end - PLANT_T_EPS * (1.0 + fabs(t_end))) {
+    while (p->t < t_end - eps_end) {
         double t_next = t_end;
         int hit_obs = 0;
         if (p->obs != NULL) {
             const double t_obs = (double)p->obs_next * p->obs_dt;
-            if (t_obs <= t_next + PLANT_T_EPS * (1.0 + fabs(t_end))) {
+            if (t_obs <= t_next + eps_end) {
                 t_next = (t_obs < t_next) ? t_obs : t_next;
                 hit_obs = 1;
             }
+        }
+        /* the active filter's controller samples on its own grid */
+        const double t_flt = plant_filter_next_event(p);
+        int hit_flt = 0;
+        if (t_flt <= t_next + eps_end) {
+            if (t_flt < t_next - eps_end) {
+                hit_obs = 0;
+            }
+            t_next = (t_flt < t_next) ? t_flt : t_next;
+            hit_flt = 1;
         }
         for (int x = 0; x < 3; ++x) {
             if (p->dead_end[x] > p->t + PLANT_T_EPS && p->dead_end[x] < t_next) {
                 t_next = p->dead_end[x];
                 hit_obs = 0;
+                hit_flt = 0;
             }
         }
         legs_t l;
@@ -711,19 +861,23 @@ static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_
         }
         p->t = t_next; /* avoid drift of repeated sums */
         if (hit_obs) {
-            p->obs(p->obs_ctx, p);
-            p->obs_next++;
+            observe(p);
+        }
+        if (hit_flt) {
+            plant_filter_event(p);
         }
         if (++guard > 100000000) {
             return PLANT_ERANGE;
         }
     }
     p->t = t_end; /* the loop stops within rounding of t_end */
-    /* Observer instants that coincide with t_end within rounding. */
-    while (p->obs != NULL &&
-           (double)p->obs_next * p->obs_dt <= p->t + PLANT_T_EPS * (1.0 + fabs(p->t))) {
-        p->obs(p->obs_ctx, p);
-        p->obs_next++;
+    /* Observer and filter instants that coincide with t_end within rounding. */
+    const double eps_t = PLANT_T_EPS * (1.0 + fabs(p->t));
+    while (p->obs != NULL && (double)p->obs_next * p->obs_dt <= p->t + eps_t) {
+        observe(p);
+    }
+    while (plant_filter_next_event(p) <= p->t + eps_t) {
+        plant_filter_event(p);
     }
     return PLANT_OK;
 }
@@ -755,6 +909,7 @@ int plant_advance_period(plant_t *p, double T, const double duty[3])
         inst[j + 1] = v;
     }
     const double t0 = p->t;
+    const int opened = step_begin(p, T);
     for (int i = 0; i < 7; ++i) {
         const double a = inst[i], b = inst[i + 1];
         if (b - a <= 0.0) {
@@ -768,9 +923,11 @@ int plant_advance_period(plant_t *p, double T, const double duty[3])
         /* Integrate to the absolute instant t0 + b (no accumulated rounding). */
         const int rc = plant_advance(p, (t0 + b) - p->t, s);
         if (rc != PLANT_OK) {
+            step_end(p, opened);
             return rc;
         }
     }
+    step_end(p, opened);
     return PLANT_OK;
 }
 
@@ -835,6 +992,48 @@ double plant_omega_m(const plant_t *p)
 double plant_vdc(const plant_t *p)
 {
     return p->vdc;
+}
+
+static void ab_to_abc(double a, double b, double abc[3])
+{
+    abc[0] = a;
+    abc[1] = -0.5 * a + 0.5 * PLANT_SQRT3 * b;
+    abc[2] = -0.5 * a - 0.5 * PLANT_SQRT3 * b;
+}
+
+void plant_v_motor_abc(const plant_t *p, double v_abc[3])
+{
+    double ab[2];
+    if (p->flt.type != PLANT_FILTER_NONE) {
+        (void)plant_filter_probe(p, PLANT_FP_V_MOTOR, ab);
+    } else {
+        const double v_leg[3] = {p->s[0] == PLANT_LEG_HIGH ? p->vdc : 0.0,
+                                 p->s[1] == PLANT_LEG_HIGH ? p->vdc : 0.0,
+                                 p->s[2] == PLANT_LEG_HIGH ? p->vdc : 0.0};
+        leg_to_ab(v_leg, &ab[0], &ab[1]);
+    }
+    ab_to_abc(ab[0], ab[1], v_abc);
+}
+
+void plant_v_motor_mean_abc(const plant_t *p, double v_abc[3])
+{
+    const double dt = p->t - p->v_int_t0;
+    if (!(dt > 0.0)) {
+        plant_v_motor_abc(p, v_abc);
+        return;
+    }
+    ab_to_abc(p->v_int[0] / dt, p->v_int[1] / dt, v_abc);
+}
+
+void plant_i_inverter_abc(const plant_t *p, double i_abc[3])
+{
+    if (p->flt.type == PLANT_FILTER_NONE) {
+        plant_i_abc(p, i_abc);
+        return;
+    }
+    double ab[2];
+    (void)plant_filter_probe(p, PLANT_FP_I_INV, ab);
+    ab_to_abc(ab[0], ab[1], i_abc);
 }
 
 uint64_t plant_transitions(const plant_t *p)

@@ -33,6 +33,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "plant_filter.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -102,6 +104,14 @@ typedef struct {
     double rk4_step_s; /* sub-step of the RK4 path; default 0.5e-6 s */
     int track_energy;  /* 1: integrate the energy terms (plant_energy), costs
                           ~2x on the exact path (4-point Gauss-Legendre) */
+
+    /* Optional output filter between the inverter and the machine
+     * (plant_filter.h; type 0 = none). Needs the linear model: no flux map,
+     * stiff DC link, no dead time, no forward drop. With a filter the
+     * electrical speed is held over each plant step (one plant_advance_period
+     * or plant_advance call) at the midpoint prediction, and the speed is
+     * updated at the step's end with the step's mean torque. */
+    plant_filter_cfg_t filter;
 } plant_config_t;
 
 typedef struct plant plant_t;
@@ -142,6 +152,14 @@ struct plant {
     double e_cu_j;   /* copper loss, J: integral 1.5 Rs |i|^2 */
     double e_mech_j; /* electromagnetic -> mechanical, J: integral Te w_m */
     double e_src_j;  /* energy delivered by the DC source, J (= e_in_j when stiff) */
+    /* integral of the motor-terminal alpha-beta voltage since the last
+     * observer instant (plant_v_motor_mean_abc) */
+    double v_int[2];
+    double v_int_t0;
+    /* output filter (cfg.filter.type != PLANT_FILTER_NONE) and its step */
+    plant_filter_t flt;
+    int step_on;
+    double step_t0, step_len, step_wm0, step_wm, step_te_int;
 };
 
 /* Validate cfg and set the initial state. Returns PLANT_OK or PLANT_EINVAL
@@ -197,6 +215,30 @@ double plant_magnetic_energy(const plant_t *p);
  * loss, e_mech = integral Te * w_m. Balance: e_in = e_cu + e_mech + dW_mag. */
 void plant_energy(const plant_t *p, double *e_src_j, double *e_in_j, double *e_cu_j,
                   double *e_mech_j);
+
+/* Voltage at the motor terminals, phase to motor neutral: without a filter
+ * the inverter's phase voltages of the present leg states (ideal switches);
+ * with one the filter's output. */
+void plant_v_motor_abc(const plant_t *p, double v_abc[3]);
+/* Inside an observer callback: the mean motor-terminal phase voltages over
+ * the interval since the previous observer instant (exact for the
+ * piecewise-constant inverter voltage; open Newton-Cotes per piece with a
+ * filter). */
+void plant_v_motor_mean_abc(const plant_t *p, double v_abc[3]);
+/* Inverter output currents (= plant_i_abc without a filter). */
+void plant_i_inverter_abc(const plant_t *p, double i_abc[3]);
+
+/* Output filter (plant_filter.h). Each returns PLANT_EINVAL without one. */
+int plant_filter_stats(const plant_t *p, plant_filter_stats_t *st);
+int plant_filter_reset_peaks(plant_t *p);
+/* alpha-beta space vector of a filter quantity at the present instant. */
+int plant_filter_probe(const plant_t *p, int quantity, double ab[2]);
+/* Active filter: the drive's torque command, from which the reference
+ * generator takes i_sq by S1 (50) (held until the next call). */
+int plant_filter_set_torque_cmd(plant_t *p, double torque_nm);
+/* Tests: hold the half-bridge states (1 = upper capacitor, 0 = lower) and
+ * stop the hysteresis controller (sw == NULL: give control back). */
+int plant_filter_set_switches(plant_t *p, const uint8_t *sw);
 
 /* Flux maps: CSV "id_a,iq_a,psi_d_wb,psi_q_wb" (header line, then rows on a
  * full regular grid in any order). Returns PLANT_OK or PLANT_EINVAL with a
