@@ -19,6 +19,41 @@ void metrics_init(metrics_acc_t *m, metrics_sampling_t sampling, double f1_hz)
     m->f1_hz = (isfinite(f1_hz) && f1_hz > 0.0) ? f1_hz : 0.0;
     m->thd_fmax_hz = 10e3;
     m->trans_window_s = 0.0;
+    m->tq_min = INFINITY;
+    m->tq_max = -INFINITY;
+}
+
+/* Append (t, x) to a pair of growing arrays; 0 or -1 (out of memory). */
+static int push2(double **pt, double **px, size_t *n, size_t *cap, double t, double x)
+{
+    if (*n == *cap) {
+        const size_t c = *cap ? 2 * *cap : 4096;
+        double *nt = realloc(*pt, c * sizeof(double));
+        if (nt == NULL) {
+            return -1;
+        }
+        *pt = nt;
+        double *nx = realloc(*px, c * sizeof(double));
+        if (nx == NULL) {
+            return -1;
+        }
+        *px = nx;
+        *cap = c;
+    }
+    (*pt)[*n] = t;
+    (*px)[*n] = x;
+    (*n)++;
+    return 0;
+}
+
+void metrics_add_voltage(metrics_acc_t *m, double t, double v_mean)
+{
+    if (m == NULL || !(m->f1_hz > 0.0) || m->oom) {
+        return;
+    }
+    if (push2(&m->va_t, &m->va_v, &m->va_n, &m->va_cap, t, v_mean) != 0) {
+        m->oom = 1;
+    }
 }
 
 void metrics_add(metrics_acc_t *m, double t, double torque_nm, double torque_ref_nm,
@@ -41,26 +76,12 @@ void metrics_add(metrics_acc_t *m, double t, double torque_nm, double torque_ref
     m->psi_mean += dp / nn;
     m->psi_m2 += dp * (psi_amp_wb - m->psi_mean);
     m->err_sum += torque_ref_nm - torque_nm;
+    m->tq_min = fmin(m->tq_min, torque_nm);
+    m->tq_max = fmax(m->tq_max, torque_nm);
     if (m->f1_hz > 0.0 && !m->oom) {
-        if (m->ia_n == m->ia_cap) {
-            const size_t cap = m->ia_cap ? 2 * m->ia_cap : 4096;
-            double *nt = realloc(m->ia_t, cap * sizeof(double));
-            if (nt == NULL) {
-                m->oom = 1;
-                return;
-            }
-            m->ia_t = nt;
-            double *nv = realloc(m->ia_v, cap * sizeof(double));
-            if (nv == NULL) {
-                m->oom = 1;
-                return;
-            }
-            m->ia_v = nv;
-            m->ia_cap = cap;
+        if (push2(&m->ia_t, &m->ia_v, &m->ia_n, &m->ia_cap, t, i_a) != 0) {
+            m->oom = 1;
         }
-        m->ia_t[m->ia_n] = t;
-        m->ia_v[m->ia_n] = i_a;
-        m->ia_n++;
     }
 }
 
@@ -178,6 +199,95 @@ double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz,
     return 100.0 * sqrt(sum) / a1; /* (B.3) */
 }
 
+double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1_hz, double fmax_hz,
+                           int *n_harm, double *window_s, double *v1_amp)
+{
+    if (n_harm != NULL) {
+        *n_harm = 0;
+    }
+    if (window_s != NULL) {
+        *window_s = 0.0;
+    }
+    if (v1_amp != NULL) {
+        *v1_amp = NAN;
+    }
+    if (t == NULL || v == NULL || n < 3 || !(f1_hz > 0.0)) {
+        return NAN;
+    }
+    const double T1 = 1.0 / f1_hz;
+    const double span = t[n - 1] - t[0];
+    const double K = floor(span / T1 + 1e-9);
+    if (K < 1.0) {
+        return NAN;
+    }
+    const double t_end = t[0] + K * T1;
+    const double fs_mean = (double)(n - 1) / span;
+    double fm = (fmax_hz > 0.0) ? fmax_hz : 10e3;
+    if (fm > 0.5 * fs_mean) {
+        fm = 0.5 * fs_mean;
+    }
+    const int N = (int)floor(fm / f1_hz + 1e-9);
+    if (N < 2) {
+        return NAN;
+    }
+    double *re = calloc((size_t)N + 1, sizeof(double));
+    double *im = calloc((size_t)N + 1, sizeof(double));
+    if (re == NULL || im == NULL) {
+        free(re);
+        free(im);
+        return NAN;
+    }
+    const double w1 = 2.0 * METRICS_PI * f1_hz;
+    /* Interval j = [t[j-1], t[j]] holds the constant v[j]: integral of
+     * e^{-j k w1 (t - t0)} over it is (e^{-j k w1 (b - t0)} - e^{-j k w1 (a - t0)})
+     * / (-j k w1); the phasors of the ends by repeated multiplication. */
+    for (size_t j = 1; j < n && t[j - 1] < t_end; ++j) {
+        const double a = t[j - 1] - t[0];
+        const double b = (t[j] < t_end ? t[j] : t_end) - t[0];
+        const double ar = cos(w1 * a), ai = -sin(w1 * a);
+        const double br = cos(w1 * b), bi = -sin(w1 * b);
+        double zar = 1.0, zai = 0.0, zbr = 1.0, zbi = 0.0;
+        for (int k = 1; k <= N; ++k) {
+            double tmp = zar * ar - zai * ai;
+            zai = zar * ai + zai * ar;
+            zar = tmp;
+            tmp = zbr * br - zbi * bi;
+            zbi = zbr * bi + zbi * br;
+            zbr = tmp;
+            /* (zb - za) / (-j k w1) = j (zb - za) / (k w1) */
+            const double dr = zbr - zar, di = zbi - zai;
+            const double kw = (double)k * w1;
+            re[k] += v[j] * (-di / kw);
+            im[k] += v[j] * (dr / kw);
+        }
+    }
+    const double W = K * T1;
+    double a1 = 0.0, sum = 0.0;
+    for (int k = 1; k <= N; ++k) {
+        const double amp = 2.0 / W * hypot(re[k], im[k]);
+        if (k == 1) {
+            a1 = amp;
+        } else {
+            sum += amp * amp;
+        }
+    }
+    free(re);
+    free(im);
+    if (n_harm != NULL) {
+        *n_harm = N;
+    }
+    if (window_s != NULL) {
+        *window_s = W;
+    }
+    if (v1_amp != NULL) {
+        *v1_amp = a1;
+    }
+    if (!(a1 > 0.0)) {
+        return NAN;
+    }
+    return 100.0 * sqrt(sum) / a1;
+}
+
 int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
 {
     if (m == NULL || r == NULL) {
@@ -188,6 +298,9 @@ int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
     r->f_av_hz = NAN;
     r->thd_i_pct = NAN;
     r->i1_amp_a = NAN;
+    r->thd_v_pct = NAN;
+    r->v1_amp_v = NAN;
+    r->torque_pp_nm = NAN;
     if (m->n == 0 || m->oom) {
         r->torque_mean_nm = r->torque_ripple_nm = NAN;
         r->flux_mean_wb = r->flux_ripple_wb = r->torque_sse_nm = NAN;
@@ -198,6 +311,7 @@ int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
     r->window_s = m->t_last - m->t_first;
     r->torque_mean_nm = m->tq_mean;
     r->torque_ripple_nm = sqrt(m->tq_m2 / nn); /* (B.1), 1/m */
+    r->torque_pp_nm = m->tq_max - m->tq_min;
     r->flux_mean_wb = m->psi_mean;
     r->flux_ripple_wb = sqrt(m->psi_m2 / nn);
     r->torque_sse_nm = m->err_sum / nn; /* (B.2) */
@@ -210,6 +324,8 @@ int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
         if (!(r->i1_amp_a >= m->thd_i1_min_a)) {
             r->thd_i_pct = NAN; /* no fundamental to refer to (metrics.h) */
         }
+        r->thd_v_pct = metrics_thd_zoh_pct(m->va_t, m->va_v, m->va_n, m->f1_hz, m->thd_fmax_hz,
+                                           NULL, NULL, &r->v1_amp_v);
     }
     return 0;
 }
@@ -223,6 +339,10 @@ void metrics_free(metrics_acc_t *m)
     free(m->ia_v);
     m->ia_t = m->ia_v = NULL;
     m->ia_n = m->ia_cap = 0;
+    free(m->va_t);
+    free(m->va_v);
+    m->va_t = m->va_v = NULL;
+    m->va_n = m->va_cap = 0;
 }
 
 static void put_num(FILE *f, const char *key, double v, int last)
@@ -245,6 +365,7 @@ void metrics_write_json(FILE *f, const metrics_result_t *r)
     put_num(f, "window_s", r->window_s, 0);
     put_num(f, "torque_mean_nm", r->torque_mean_nm, 0);
     put_num(f, "torque_ripple_nm", r->torque_ripple_nm, 0);
+    put_num(f, "torque_ripple_pp_nm", r->torque_pp_nm, 0);
     put_num(f, "flux_mean_wb", r->flux_mean_wb, 0);
     put_num(f, "flux_ripple_wb", r->flux_ripple_wb, 0);
     put_num(f, "torque_sse_nm", r->torque_sse_nm, 0);
@@ -252,6 +373,8 @@ void metrics_write_json(FILE *f, const metrics_result_t *r)
     put_num(f, "thd_i_pct", r->thd_i_pct, 0);
     put_num(f, "thd_window_s", r->thd_window_s, 0);
     fprintf(f, "  \"thd_harmonics\": %d,\n", r->thd_harmonics);
+    put_num(f, "thd_v_pct", r->thd_v_pct, 0);
+    put_num(f, "v1_amp_v", r->v1_amp_v, 0);
     put_num(f, "i1_amp_a", r->i1_amp_a, 1);
     fprintf(f, "}\n");
 }

@@ -19,6 +19,13 @@
  * ripple, not distortion, and ran to ~1000 % at zero torque).
  * Samples are assumed uniformly spaced (the ripple figures are plain sample
  * statistics; THD uses the sample times).
+ * Also: the peak-to-peak torque ripple (max - min of the samples, as the book
+ * chapter quotes it) and THD_V of the motor-terminal phase voltage from the
+ * interval means the plant observer provides (plant_v_motor_mean_abc): the
+ * voltage is taken constant over each sample interval and its Fourier
+ * integrals are exact for that staircase (exact for the inverter's voltage
+ * when it switches on the sample grid; for a smooth voltage harmonic k is
+ * low by sinc(pi k f1 h), 1.6 % at 10 kHz with h = 10 us), harmonics as THD_I.
  */
 #ifndef SIM_HOST_METRICS_H
 #define SIM_HOST_METRICS_H
@@ -45,6 +52,10 @@ typedef struct {
     /* phase-a samples for THD (heap, grows) */
     double *ia_t, *ia_v;
     size_t ia_n, ia_cap;
+    /* motor-terminal phase-a voltage: interval ends and interval means */
+    double *va_t, *va_v;
+    size_t va_n, va_cap;
+    double tq_min, tq_max;
     int oom;
     /* transitions */
     uint64_t transitions;
@@ -63,6 +74,9 @@ typedef struct {
     double thd_window_s; /* the integer-period window used for THD */
     int thd_harmonics;   /* N */
     double i1_amp_a;     /* fundamental amplitude of i_a */
+    double torque_pp_nm; /* max - min of the torque samples */
+    double thd_v_pct;    /* THD of the motor phase voltage (NaN without voltage samples) */
+    double v1_amp_v;     /* its fundamental amplitude */
 } metrics_result_t;
 
 /* f1_hz: fundamental (electrical) frequency for THD, 0 to skip THD. */
@@ -70,6 +84,10 @@ void metrics_init(metrics_acc_t *m, metrics_sampling_t sampling, double f1_hz);
 /* One sample at time t. i_a is stored only when f1_hz > 0. */
 void metrics_add(metrics_acc_t *m, double t, double torque_nm, double torque_ref_nm,
                  double psi_amp_wb, double i_a);
+/* Motor-terminal phase-a voltage: its mean over the interval that ends at t
+ * (since the previous call; the first call only opens the first interval).
+ * Stored only when f1_hz > 0. */
+void metrics_add_voltage(metrics_acc_t *m, double t, double v_mean);
 /* Leg transitions of the three legs counted over a window of window_s seconds
  * (e.g. the difference of plant_transitions between the window's ends). */
 void metrics_set_transitions(metrics_acc_t *m, uint64_t transitions, double window_s);
@@ -84,6 +102,12 @@ void metrics_write_json(FILE *f, const metrics_result_t *r);
  * fundamental f1 (used by metrics_finish). Returns NaN if under one period. */
 double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz, double fmax_hz,
                        int *n_harm, double *window_s, double *i1_amp);
+
+/* THD (B.3) of a staircase: v[j] is the mean over [t[j-1], t[j]] (v[0] is
+ * unused), integrated exactly over the largest whole number of fundamental
+ * periods from t[0]. Harmonics 2..N, N f1 <= min(fmax, f_sample/2). */
+double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1_hz, double fmax_hz,
+                           int *n_harm, double *window_s, double *v1_amp);
 
 #ifdef __cplusplus
 }

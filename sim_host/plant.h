@@ -228,6 +228,8 @@ void plant_v_motor_mean_abc(const plant_t *p, double v_abc[3]);
 /* Inverter output currents (= plant_i_abc without a filter). */
 void plant_i_inverter_abc(const plant_t *p, double i_abc[3]);
 
+/* Name of branch b (PLANT_FB_*) of a filter type, NULL if none. */
+const char *plant_filter_branch_name(int type, int branch);
 /* Output filter (plant_filter.h). Each returns PLANT_EINVAL without one. */
 int plant_filter_stats(const plant_t *p, plant_filter_stats_t *st);
 int plant_filter_reset_peaks(plant_t *p);

@@ -729,6 +729,21 @@ void plant_filter_event(plant_t *p)
 
 /* ------------------------------------------------------- public API */
 
+const char *plant_filter_branch_name(int type, int branch)
+{
+    static const char *const passive[] = {"inverter", "motor",   "trap_l1c1", "trap_l2",
+                                          "trap_c2",  "trap_r1", "rlc_l3",    "rlc_shunt"};
+    static const char *const active[] = {"inverter", "motor", "pri_shunt", "transformer",
+                                         "sec_shunt"};
+    if (type == PLANT_FILTER_PASSIVE && branch >= 0 && branch < 8) {
+        return passive[branch];
+    }
+    if (type == PLANT_FILTER_ACTIVE && branch >= 0 && branch < 5) {
+        return active[branch];
+    }
+    return NULL;
+}
+
 int plant_filter_stats(const plant_t *p, plant_filter_stats_t *st)
 {
     if (p == NULL || st == NULL || p->flt.type == PLANT_FILTER_NONE) {

@@ -51,6 +51,31 @@ static const key_t_ k_keys[] = {
     {"speed_loop", "phase_margin_deg", K_REAL, 0, 20, 80, 0, 1.0, OFF(speed_pm_deg)},
     {"speed_loop", "kp_nm_s_per_rad", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(speed_kp)},
     {"speed_loop", "ki_nm_per_rad", K_REAL, 0, 0, 1e8, 0, 1.0, OFF(speed_ki)},
+    /* [filter]: the output filters of the book chapter (plant_filter.h) */
+    {"filter", "type", K_TEXT, 0, 0, 0, 0, 1.0, OFF(filter_type)},
+    {"filter", "current_sense", K_TEXT, 0, 0, 0, 0, 1.0, OFF(current_sense_text)},
+    {"filter", "trap_l1_uh", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.passive.l1_h)},
+    {"filter", "trap_c1_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.passive.c1_f)},
+    {"filter", "trap_r1_ohm", K_REAL, 0, 0, 1e9, 1, 1.0, OFF(filter.passive.r1_ohm)},
+    {"filter", "trap_l2_mh", K_REAL, 0, 0, 1e6, 1, 1e-3, OFF(filter.passive.l2_h)},
+    {"filter", "trap_c2_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.passive.c2_f)},
+    {"filter", "trap_r2_ohm", K_REAL, 0, 0, 1e9, 0, 1.0, OFF(filter.passive.r2_ohm)},
+    {"filter", "rlc_l3_mh", K_REAL, 0, 0, 1e6, 1, 1e-3, OFF(filter.passive.l3_h)},
+    {"filter", "rlc_r3s_ohm", K_REAL, 0, 0, 1e9, 0, 1.0, OFF(filter.passive.r3s_ohm)},
+    {"filter", "rlc_r3_ohm", K_REAL, 0, 0, 1e9, 1, 1.0, OFF(filter.passive.r3_ohm)},
+    {"filter", "rlc_c3_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.passive.c3_f)},
+    {"filter", "pri_l1_uh", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.active.l1_h)},
+    {"filter", "pri_c1_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.active.c1_f)},
+    {"filter", "pri_r1_ohm", K_REAL, 0, 0, 1e9, 1, 1.0, OFF(filter.active.r1_ohm)},
+    {"filter", "sec_l2_uh", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.active.l2_h)},
+    {"filter", "sec_c2_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.active.c2_f)},
+    {"filter", "sec_r2_ohm", K_REAL, 0, 0, 1e9, 1, 1.0, OFF(filter.active.r2_ohm)},
+    {"filter", "af_lf_mh", K_REAL, 0, 0, 1e6, 1, 1e-3, OFF(filter.active.lf_h)},
+    {"filter", "af_cf_uf", K_REAL, 0, 0, 1e9, 1, 1e-6, OFF(filter.active.cf_f)},
+    {"filter", "af_cf_initial_v", K_REAL, 0, 0, 1e5, 1, 1.0, OFF(filter.active.cf_v0_v)},
+    {"filter", "af_sample_hz", K_REAL, 0, 1e3, 1e8, 0, 1.0, OFF(filter.active.sample_hz)},
+    {"filter", "af_band_v", K_REAL, 0, 0, 1e4, 0, 1.0, OFF(filter.active.band_v)},
+    {"filter", "af_ref_cutoff_hz", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(filter.active.ref_cutoff_hz)},
 };
 #define N_KEYS (sizeof(k_keys) / sizeof(k_keys[0]))
 
@@ -163,6 +188,69 @@ static int header_check(FILE *f, char *bad, size_t badlen)
     return 0;
 }
 
+/* [filter]: the type decides which keys belong (all of its keys required,
+ * none of the other type's); the filter path needs the linear model. */
+static int filter_check(sim_machine_t *m, const unsigned char *seen, char *err, size_t errlen)
+{
+    int any = 0;
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        any |= seen[k] && strcmp(k_keys[k].section, "filter") == 0;
+    }
+    m->filter.type = PLANT_FILTER_NONE;
+    m->current_sense = SIM_SENSE_INVERTER;
+    if (!any) {
+        return 0;
+    }
+    const char *want = NULL; /* key prefix set of the type */
+    if (strcmp(m->filter_type, "passive") == 0) {
+        m->filter.type = PLANT_FILTER_PASSIVE;
+        want = "trap_ rlc_";
+    } else if (strcmp(m->filter_type, "active") == 0) {
+        m->filter.type = PLANT_FILTER_ACTIVE;
+        want = "pri_ sec_ af_";
+    } else {
+        snprintf(err, errlen, "[filter] type = '%s': expected passive or active", m->filter_type);
+        return -1;
+    }
+    if (m->current_sense_text[0] == '\0' || strcmp(m->current_sense_text, "inverter") == 0) {
+        m->current_sense = SIM_SENSE_INVERTER;
+    } else if (strcmp(m->current_sense_text, "motor") == 0) {
+        m->current_sense = SIM_SENSE_MOTOR;
+    } else {
+        snprintf(err, errlen, "[filter] current_sense = '%s': expected inverter or motor",
+                 m->current_sense_text);
+        return -1;
+    }
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        const key_t_ *K = &k_keys[k];
+        if (strcmp(K->section, "filter") != 0 || K->kind != K_REAL) {
+            continue;
+        }
+        const char *us = strchr(K->name, '_');
+        char prefix[8];
+        snprintf(prefix, sizeof prefix, "%.*s", (int)(us - K->name + 1), K->name);
+        const int mine = strstr(want, prefix) != NULL;
+        if (mine && !seen[k]) {
+            snprintf(err, errlen, "missing key %s in [filter] (type = %s)", K->name,
+                     m->filter_type);
+            return -1;
+        }
+        if (!mine && seen[k]) {
+            snprintf(err, errlen, "[filter] %s does not belong to a filter of type %s", K->name,
+                     m->filter_type);
+            return -1;
+        }
+    }
+    if (m->fluxmap_path[0] != '\0' || m->dead_time_s > 0.0 || m->v_fwd_v > 0.0 ||
+        m->dc_cap_f > 0.0) {
+        snprintf(err, errlen,
+                 "[filter] needs the linear model: no [fluxmap], dead_time_ns = 0, "
+                 "v_fwd_v = 0 and dc_cap_uf = 0 (the filter path is exact-linear)");
+        return -1;
+    }
+    return 0;
+}
+
 int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen)
 {
     char dummy[8];
@@ -247,6 +335,14 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
     }
     if (bad[0] != '\0') {
         snprintf(err, errlen, "%s: %s", path, bad);
+        memset(out, 0, sizeof(*out));
+        return -1;
+    }
+    if (filter_check(out, c.seen, err, errlen) != 0) {
+        /* err holds the key; prefix the file */
+        char tmp[256];
+        snprintf(tmp, sizeof tmp, "%s", err);
+        snprintf(err, errlen, "%s: %s", path, tmp);
         memset(out, 0, sizeof(*out));
         return -1;
     }

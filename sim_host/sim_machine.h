@@ -16,6 +16,18 @@
  *   [speed_loop] (optional, firmware/isr/speed_loop.h) bandwidth_hz,
  *               phase_margin_deg (the sizing from the inertia; 0 = defaults),
  *               or explicit gains kp_nm_s_per_rad, ki_nm_per_rad (mechanical)
+ *   [filter]    optional output filter (plant_filter.h; book chapter S1 §6):
+ *               type = passive | active, current_sense = inverter | motor
+ *               (optional, default inverter: where the drive's current
+ *               sensors sit), and every key of the type:
+ *               passive (S1 Table 5): trap_l1_uh trap_c1_uf trap_r1_ohm
+ *                 trap_l2_mh trap_c2_uf trap_r2_ohm rlc_l3_mh rlc_r3s_ohm (r3)
+ *                 rlc_r3_ohm rlc_c3_uf
+ *               active (S1 Table 6): pri_l1_uh pri_c1_uf pri_r1_ohm sec_l2_uh
+ *                 sec_c2_uf sec_r2_ohm af_lf_mh af_cf_uf af_cf_initial_v
+ *                 af_sample_hz af_band_v af_ref_cutoff_hz
+ *               A filter needs the linear model (no [fluxmap], no dead time,
+ *               forward drop or DC-link capacitor).
  * Unknown sections and unknown keys are REJECTED (a typo must not silently
  * fall back to a default). Values must be finite numbers in range.
  */
@@ -33,6 +45,12 @@ extern "C" {
 #define SIM_MACHINE_NAME_MAX 64
 #define SIM_MACHINE_PATH_MAX 512
 
+/* Where the drive's phase-current sensors sit (only differs with a filter). */
+typedef enum {
+    SIM_SENSE_INVERTER = 0, /* inverter output: shunts in the legs, as on a real board */
+    SIM_SENSE_MOTOR = 1     /* motor terminals */
+} sim_current_sense_t;
+
 typedef struct {
     char name[SIM_MACHINE_NAME_MAX];
     int pole_pairs;
@@ -46,6 +64,10 @@ typedef struct {
     double overspeed_rpm;                    /* 0 = firmware default */
     double speed_bw_hz, speed_pm_deg;        /* 0 = firmware defaults */
     double speed_kp, speed_ki;               /* explicit gains; 0 = sized */
+    plant_filter_cfg_t filter;               /* type NONE without [filter] */
+    sim_current_sense_t current_sense;
+    char filter_type[SIM_MACHINE_NAME_MAX];        /* [filter] type as written */
+    char current_sense_text[SIM_MACHINE_NAME_MAX]; /* [filter] current_sense as written */
 } sim_machine_t;
 
 /* Returns 0 on success; otherwise -1 and a message naming the key (and the

@@ -21,4 +21,5 @@ void sim_machine_to_plant(const sim_machine_t *m, plant_config_t *cfg)
     cfg->mech = PLANT_MECH_IMPOSED;
     cfg->inertia_kgm2 = m->inertia_kgm2;
     cfg->friction_nms = m->friction_nms;
+    cfg->filter = m->filter;
 }

@@ -77,6 +77,7 @@ hal_qemu_plant_t *hal_qemu_plant_init(const hal_qemu_plant_config_t *cfg, plant_
     c.enc_zero_count = cfg->enc_zero_count;
     c.trip_level_a = cfg->trip_level_a;
     c.seed = cfg->seed;
+    c.sense_motor_side = cfg->sense_motor_side;
     if (hal_sim_init(&hal_qemu_plant_instance, &c, plant) != HAL_SIM_OK) {
         return NULL;
     }

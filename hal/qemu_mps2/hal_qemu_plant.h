@@ -32,6 +32,7 @@ typedef struct {
     uint32_t enc_zero_count;
     double trip_level_a;
     uint64_t seed;
+    bool sense_motor_side;
 } hal_qemu_plant_config_t;
 
 /* hal_sim_config_default's values (hal_sim.h). */

@@ -98,7 +98,11 @@ static void hal_sim_sample(hal_t *h)
 {
     const hal_sim_config_t *c = &h->cfg;
     double i_abc[3];
-    plant_i_abc(h->plant, i_abc);
+    if (c->sense_motor_side) {
+        plant_i_abc(h->plant, i_abc);
+    } else {
+        plant_i_inverter_abc(h->plant, i_abc);
+    }
     i_abc[0] += h->short_i_a;
     i_abc[1] -= h->short_i_a;
 

@@ -25,7 +25,10 @@
  * through the diode bridge until the current dies. hal_gate_enable(true)
  * takes effect at the next period start, together with the compare values.
  *
- * ADC (12 bit by default): current channel count = mid + off + (1 + g) i / lsb
+ * ADC (12 bit by default): the phase currents are the inverter output currents
+ * (plant_i_inverter_abc, the shunts of a real board) or, with
+ * sense_motor_side, the motor currents; they differ only with a plant output
+ * filter. Current channel count = mid + off + (1 + g) i / lsb
  * + noise, lsb = 2 i_fullscale / 2^bits, mid = 2^(bits-1); DC-link channel
  * count = off + (1 + g) vdc / lsb_v + noise, lsb_v = vdc_fullscale / 2^bits;
  * rounded and clamped to [0, 2^bits - 1]. Noise: Gaussian, sigma in counts,
@@ -84,6 +87,9 @@ typedef struct {
     uint32_t enc_zero_count;     /* counter value at theta_m = 0 */
     double trip_level_a;         /* hardware comparator level, A; 0 = off */
     uint64_t seed;               /* PRNG seed for the ADC noise */
+    bool sense_motor_side;       /* currents sensed at the motor terminals instead of the
+                                    inverter output (the shunts of a real board); differs
+                                    only with a plant output filter; default false */
 } hal_sim_config_t;
 
 /* The back-end's handle (hal_t in hal.h). Fields are private. */

@@ -61,6 +61,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->auto_arm = true;
     c->kick_watchdog = true;
     engine_hal_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
+    c->hal.sense_motor_side = m->current_sense == SIM_SENSE_MOTOR;
 }
 
 static double sim_torque_ref_nm(const sim_run_t *r)
@@ -90,8 +91,11 @@ static void sim_observer(void *ctx, const plant_t *p)
     double i_abc[3];
     plant_i_abc(p, i_abc);
     const double tref = sim_torque_ref_nm(r);
+    double v_abc[3];
+    plant_v_motor_mean_abc(p, v_abc);
     if (t >= r->cfg.win_start_s && t <= r->cfg.win_end_s) {
         metrics_add(&r->m_plant, t, tq, tref, psi, i_abc[0]);
+        metrics_add_voltage(&r->m_plant, t, v_abc[0]);
         r->speed_sum_rpm += plant_omega_m(p) * 60.0 / (2.0 * SIM_PI);
         r->speed_n++;
     }
@@ -101,11 +105,15 @@ static void sim_observer(void *ctx, const plant_t *p)
         plant_i_dq(p, &id, &iq);
         const fw_telemetry_t *tm = fw_telemetry(&r->fw);
         const double load = r->cfg.free_mech ? plant_load_torque(p) : NAN;
+        double i_inv[3];
+        plant_i_inverter_abc(p, i_inv);
         fprintf(r->cfg.trace,
-                "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%u,%.6g,%.6g\n", t,
-                i_abc[0], i_abc[1], i_abc[2], id, iq, psi, tq,
+                "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%u,%.6g,%.6g,%.6g,%.6g,"
+                "%.6g,%.6g\n",
+                t, i_abc[0], i_abc[1], i_abc[2], id, iq, psi, tq,
                 plant_omega_m(p) * 60.0 / (2.0 * SIM_PI), tref, (unsigned)r->vec_now, r->duty_now,
-                (unsigned)tm->state, sim_run_speed_ref_now(r), load);
+                (unsigned)tm->state, sim_run_speed_ref_now(r), load, v_abc[0], v_abc[1], v_abc[2],
+                i_inv[0]);
     }
     r->obs_count++;
 }
@@ -174,6 +182,12 @@ static int sim_period_raw(sim_run_t *r)
     r->duty_now = on ? ctrl_q24_to_double(tm->duty) : 0.0;
     engine_hal_begin(&r->hal);
     fw_isr(&r->fw);
+    if (r->cfg.plant_machine.filter.type == PLANT_FILTER_ACTIVE) {
+        /* the active filter's reference generator follows the drive's torque
+         * setting, S1 (50) (0 while the drive is not running) */
+        (void)plant_filter_set_torque_cmd(
+            &r->plant, fw_state(&r->fw) == FW_STATE_RUNNING ? sim_torque_ref_nm(r) : 0.0);
+    }
     if (r->cfg.after_isr != NULL) {
         r->cfg.after_isr(r->cfg.after_isr_ctx);
     }
@@ -210,6 +224,14 @@ static void sim_arm(sim_run_t *r)
 }
 
 /* Leg transitions between the window start and t (period boundaries). */
+static void sim_filter_window_end(sim_run_t *r, double t)
+{
+    if (plant_filter_stats(&r->plant, &r->flt_w1) == PLANT_OK) {
+        r->flt_t1 = t;
+        r->flt_w1_set = true;
+    }
+}
+
 static void sim_count_transitions(sim_run_t *r, double t)
 {
     const uint64_t n = plant_transitions(&r->plant) - r->tr_win_start;
@@ -262,10 +284,15 @@ int sim_run_period(sim_run_t *r)
         r->win_started = true;
         r->tr_win_start = plant_transitions(&r->plant);
         r->t_win_start = t;
+        if (plant_filter_stats(&r->plant, &r->flt_w0) == PLANT_OK) {
+            (void)plant_filter_reset_peaks(&r->plant);
+            r->flt_t0 = t;
+        }
     }
     if (t >= r->cfg.win_end_s && r->win_started && !r->win_done) {
         r->win_done = true;
         sim_count_transitions(r, t);
+        sim_filter_window_end(r, t);
     }
     if (t >= r->cfg.win_start_s && t <= r->cfg.win_end_s) {
         double i_abc[3];
@@ -728,7 +755,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     r->obs_on = false;
     if (c->trace != NULL) {
         fprintf(c->trace, "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,"
-                          "speed_ref_rpm,load_nm\n");
+                          "speed_ref_rpm,load_nm,v_a,v_b,v_c,i_inv_a\n");
     }
     if (c->defer_start) {
         return 0; /* the caller runs the periods from boot on (sim_run_period) */
@@ -787,6 +814,7 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
 {
     if (!r->win_done && r->win_started) {
         sim_count_transitions(r, sim_run_time(r));
+        sim_filter_window_end(r, sim_run_time(r));
     }
     if (r->cfg.free_mech && !r->cfg.skip_thd) {
         const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : 0.0;
@@ -809,6 +837,36 @@ static void sim_json_num(FILE *f, const char *key, double v)
     } else {
         fprintf(f, "  \"%s\": null,\n", key);
     }
+}
+
+/* "filter": {...} over the metrics window: type, current sensing, losses,
+ * per-phase RMS and peak of each branch current, the active filter's
+ * capacitor range and half-bridge switching frequency (per leg). */
+static void sim_write_filter_json(FILE *f, const sim_run_t *r)
+{
+    const plant_filter_stats_t *a = &r->flt_w0, *b = &r->flt_w1;
+    const double w = r->flt_t1 - r->flt_t0;
+    if (r->cfg.plant_machine.filter.type == PLANT_FILTER_NONE || !r->flt_w1_set || !(w > 0.0)) {
+        return;
+    }
+    fprintf(f, "  \"filter\": {\n    \"type\": \"%s\",\n    \"current_sense\": \"%s\",\n",
+            b->type == PLANT_FILTER_PASSIVE ? "passive" : "active",
+            r->cfg.hal.sense_motor_side ? "motor" : "inverter");
+    fprintf(f, "    \"loss_w\": %.6g,\n", (b->e_loss_j - a->e_loss_j) / w);
+    fprintf(f, "    \"branches\": {");
+    for (int k = 0; k < b->n_branches; ++k) {
+        const double rms = sqrt(fmax(0.5 * (b->i2_int[k] - a->i2_int[k]) / w, 0.0));
+        fprintf(f, "%s\n      \"%s\": {\"i_rms_a\": %.6g, \"i_peak_a\": %.6g}", k ? "," : "",
+                plant_filter_branch_name(b->type, k), rms, b->i_peak[k]);
+    }
+    fprintf(f, "\n    }");
+    if (b->type == PLANT_FILTER_ACTIVE) {
+        fprintf(f, ",\n    \"af_cf_min_v\": %.6g,\n    \"af_cf_max_v\": %.6g", b->cf_min_v,
+                b->cf_max_v);
+        fprintf(f, ",\n    \"af_switching_hz\": %.6g",
+                (double)(b->af_transitions - a->af_transitions) / (2.0 * 3.0 * w));
+    }
+    fprintf(f, "\n  },\n");
 }
 
 void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
@@ -848,6 +906,10 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     sim_json_num(f, "f_av_hz", mp->f_av_hz);
     sim_json_num(f, "thd_i_pct", mp->thd_i_pct);
     sim_json_num(f, "i1_amp_a", mp->i1_amp_a);
+    sim_json_num(f, "torque_ripple_pp_nm", mp->torque_pp_nm);
+    sim_json_num(f, "thd_v_pct", mp->thd_v_pct);
+    sim_json_num(f, "v1_amp_v", mp->v1_amp_v);
+    sim_write_filter_json(f, r);
     sim_json_num(f, "torque_mean_ctrl_nm", mc->torque_mean_nm);
     sim_json_num(f, "torque_ripple_ctrl_nm", mc->torque_ripple_nm);
     sim_json_num(f, "flux_mean_ctrl_wb", mc->flux_mean_wb);

@@ -26,6 +26,13 @@
  *
  * Faults: with stop_on_fault the run ends in the period the firmware latched
  * a fault (fault_time_s, metrics over the samples before it).
+ *
+ * Output filter (machine [filter], sim_host/plant_filter.h): the firmware's
+ * current sensors sit at the inverter output or the motor terminals (the
+ * machine's current_sense, or cfg.hal.sense_motor_side); the active filter's
+ * reference generator gets the firmware's torque reference every period (its
+ * "control setting", S1 (50)); the metrics add the filter's losses, branch
+ * currents and the active filter's storage capacitors over the window.
  */
 #ifndef FIRMWARE_HOST_SIM_RUN_H
 #define FIRMWARE_HOST_SIM_RUN_H
@@ -117,6 +124,11 @@ typedef struct {
     double fault_time_s;            /* scenario time of the first fault, NaN if none */
     double scn_fired_s[SIM_SCN_MAX_EVENTS]; /* scenario time each event fired, NaN if not */
     unsigned char ctrl_cfg_buf[CTRL_CFG_MAX] __attribute__((aligned(16)));
+    /* output filter (plant_machine.filter): cumulative statistics at the
+     * window's start and end (losses, branch currents, AF capacitors) */
+    plant_filter_stats_t flt_w0, flt_w1;
+    double flt_t0, flt_t1;
+    bool flt_w1_set;
 } sim_run_t;
 
 /* Convert a machine file into the controller's machine description. */

@@ -41,7 +41,7 @@ typedef struct {
 /* Parsed values (one field per option, kind by k_opts). */
 typedef struct {
     const char *machine, *control_machine, *controller, *scenario, *trace, *metrics, *replay;
-    const char *list_tunables;
+    const char *list_tunables, *current_sense;
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
@@ -114,6 +114,9 @@ static const cli_opt_t k_opts[] = {
      "performance indices, settings and warnings (also printed to stdout)"},
     {"--set", "NAME=VALUE", K_SET, 0, 0, "", M_LOOP, NULL, NULL, F(sets),
      "controller tunable (repeatable; see --list-tunables NAME)"},
+    {"--current-sense", "WHERE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(current_sense),
+     "inverter | motor: where the drive's current sensors sit, with a machine [filter] "
+     "(default: the machine file's current_sense, else inverter)"},
     {"--continue-on-fault", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(continue_on_fault),
      "keep simulating after a fault (gates off) to the end; the exit status stays 3"},
     {"--list-controllers", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(list_controllers),
@@ -429,6 +432,9 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
             fmt_num(b[3], 32, "%.5f Wb", mp->flux_ripple_wb),
             fmt_num(b[4], 32, "%.4f N*m", mp->torque_sse_nm),
             fmt_num(b[5], 32, "%.0f Hz", mp->f_av_hz), fmt_num(b[6], 32, "%.2f %%", mp->thd_i_pct));
+    fprintf(f, "                      T_pp %s  THD_V %s (motor phase voltage)\n",
+            fmt_num(b[10], 32, "%.4f N*m", mp->torque_pp_nm),
+            fmt_num(b[11], 32, "%.2f %%", mp->thd_v_pct));
     fprintf(f, "  control instants:   T_mean %s  T_rip %s  psi_rip %s\n",
             fmt_num(b[7], 32, "%.4f N*m", mc->torque_mean_nm),
             fmt_num(b[8], 32, "%.4f N*m", mc->torque_ripple_nm),
@@ -535,6 +541,12 @@ int main(int argc, char **argv)
             return die("control machine file: %s", err);
         }
         sim_ctrl_machine_from(&cm, &cfg.ctrl_machine);
+    }
+    if (c.current_sense != NULL) {
+        if (strcmp(c.current_sense, "inverter") != 0 && strcmp(c.current_sense, "motor") != 0) {
+            return die("--current-sense '%s': expected inverter or motor", c.current_sense);
+        }
+        cfg.hal.sense_motor_side = strcmp(c.current_sense, "motor") == 0;
     }
     cfg.fs_hz = is_given(given, "--fs") ? (uint32_t)c.fs : d->fs_default_hz;
     cfg.free_mech = c.free_mech != 0;
