@@ -861,6 +861,8 @@ def main():
       "deviation of the torque, ψ_rip of |ψs|, T_sse = mean(T_ref − T), f_av = mean per-leg "
       "switching frequency, THD_I of phase a up to 10 kHz; from the plant's true signals on a "
       "Ts/10 grid. n/a: undefined (no fundamental, a trip, or not commanded).\n")
+    w("The book chapter's output filters (§6) on its IPMSM: [filters.md](filters.md) "
+      "(`tools/filters.py`).\n")
     w("## Findings\n")
     w("### The sources' claims beside the measurements\n")
     w("Verdicts: *reproduced* — same direction and a size within ±50 % of the claim (for "

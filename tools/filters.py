@@ -1,0 +1,447 @@
+#!/usr/bin/env -S /usr/bin/python3
+"""The book chapter's output filters (S1 §6) on the host simulator: out/filters.md.
+
+Chapter: A. A. Adam and K. Gulez, "Torque Control of PMSM and Associated Harmonic
+Ripples" (equations S1(n)). Machine files sim_host/machines/chapter_ipmsm.ini (S1
+Table 2), chapter_ipmsm_passive_filter.ini (S1 Table 5) and
+chapter_ipmsm_active_filter.ini (S1 Table 6); topology readings in sim_host/README.md.
+
+Runs (tools/sim, host-release), all at the chapter's operating point: free mechanics,
+load 2 N*m, speed loop at 70 rad/s (668.45 r/min), started at that speed, fs 10 kHz
+(Ts = 100 us), DURATION s simulated, indices over [SETTLE, DURATION] from the plant's
+true signals on the Ts/10 grid:
+  * HDTC without filter, with the passive and with the active filter (S1 §6.1.4,
+    §6.2.5): waveforms, current and voltage spectra, beside S1's numbers;
+  * FST, DRR and M2PTFC (thesis controllers) with the same filters;
+  * current sensors at the inverter output instead of the motor terminals;
+  * the active filter's storage capacitors over 0.6 s, and its pre-charge.
+usage: tools/filters.py [--out DIR] [--jobs N] [--seed N] [--duration S]
+"""
+import argparse
+import concurrent.futures as cf
+import json
+import os
+import subprocess
+import sys
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MDIR = os.path.join(ROOT, "sim_host", "machines")
+MACHINES = {
+    "none": "chapter_ipmsm.ini",
+    "passive": "chapter_ipmsm_passive_filter.ini",
+    "active": "chapter_ipmsm_active_filter.ini",
+}
+W_RPM = 70.0 * 60.0 / (2.0 * np.pi)  # 668.45 r/min
+CTRLS = ("hdtc", "fst", "drr", "m2ptfc")
+BANDS = ((0, 100), (100, 500), (500, 1500), (1500, 10000))
+# The hysteresis controllers' limit cycles are chaotic: the window's indices move by
+# 10-30 % with the ADC-noise seed; the tables give the mean over these seeds and
+# the range.
+SEEDS = [1, 2, 3, 4]
+
+
+def sim_binary():
+    r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"filters: tools/sim failed:\n{r.stderr}")
+    bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
+    return os.path.join(bdir, "firmware", "sim")
+
+
+def job(sim, runs, ctrl, filt, duration, settle, sense=None, machine=None, tag="",
+        trace=False, window=None, seed=1):
+    name = f"{ctrl}_{filt}{tag}" + (f"_s{seed}" if seed != SEEDS[0] else "")
+    base = os.path.join(runs, name)
+    mpath = machine or os.path.join(MDIR, MACHINES[filt])
+    w0, w1 = window or (settle, duration)
+    cmd = [sim, "--machine", mpath, "--controller", ctrl, "--fs", "10000", "--free",
+           "--speed-rpm", f"{W_RPM:.6f}", "--load-nm", "2", "--speed-ref-rpm", f"{W_RPM:.6f}",
+           "--duration", str(duration), "--window", f"{w0}:{w1}", "--metrics", base + ".json",
+           "--seed", str(seed)]
+    if sense:
+        cmd += ["--current-sense", sense]
+    if trace:
+        cmd += ["--trace", base + ".csv", "--trace-window", f"{settle}:{duration}"]
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        return name, None, r.stderr.strip()
+    with open(base + ".json") as f:
+        return name, json.load(f), None
+
+
+def spectrum(x, dt):
+    n = len(x)
+    a = np.abs(np.fft.rfft((x - x.mean()) * 1.0)) * 2.0 / n
+    return np.fft.rfftfreq(n, dt), a
+
+
+def band_rms(x, dt):
+    f, a = spectrum(x, dt)
+    return [float(np.sqrt(np.sum(a[(f >= lo) & (f < hi)] ** 2) / 2.0)) for lo, hi in BANDS]
+
+
+def load_trace(path):
+    d = np.genfromtxt(path, delimiter=",", names=True)
+    return np.atleast_1d(d)
+
+
+def fmt(x, p=3):
+    return "—" if x is None or (isinstance(x, float) and not np.isfinite(x)) else f"{x:.{p}f}"
+
+
+def s1_freq_plot(path):
+    """S1 (41)-(44) for Table 5 (the plant matches them to < 1e-5, tests/plant)."""
+    L1, C1, R1, L2, C2, R2 = 20e-6, 52e-6, 56e3, 30e-3, 5.1e-6, 2.2
+    L3, C3, R3, r3 = 30e-3, 12.5e-6, 128.0, 2.0
+    f = np.logspace(1, 5, 600)
+    w = 2 * np.pi * f
+    x1 = w * L1 - 1 / (w * C1)
+    z1 = x1 / (w * R1 * C2) + 1j * (x1 - 1 / (w * C2))
+    z2 = R1 - R1 * C2 * w * x1 + 1j * x1
+    z3 = R1 - R1 / (w * w * L1 * C2 - C2 / C1) - 1j / (w * C2)
+    zl2 = R2 + 1j * w * L2
+    z12 = z1 * zl2 / (z1 + zl2)
+    s = 1j * w
+    h44 = (R3 * C3 * s + 1) / (C3 * L3 * s * s + (r3 + R3) * C3 * s + 1)
+    fig, ax = plt.subplots(1, 2, figsize=(11, 3.8))
+    for z, lab in ((z2, "|Z2| (42)"), (z3, "|Z3| (43)"), (z12, "|Z12| = |Z1 ∥ (R2+sL2)|")):
+        ax[0].loglog(f, np.abs(z), label=lab)
+    ax[0].set_xlabel("Hz")
+    ax[0].set_ylabel("Ω")
+    ax[0].set_title("Trap filter, S1 Table 5")
+    ax[0].legend(fontsize=8)
+    ax[0].grid(True, which="both", alpha=0.3)
+    ax[1].loglog(f, np.abs(h44))
+    ax[1].axvline(1 / np.sqrt(L3 * C3) / (2 * np.pi), color="k", ls=":", lw=0.8)
+    ax[1].set_xlabel("Hz")
+    ax[1].set_title("RLC filter |V0/Vi| unloaded, S1 (44); ω_c (46) dotted")
+    ax[1].grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def wave_plot(traces, path, t_span=0.03):
+    fig, ax = plt.subplots(4, 3, figsize=(13, 9), sharex="col")
+    for c, (filt, d) in enumerate(traces.items()):
+        t = d["t"]
+        m = t >= t[-1] - t_span
+        tm = (t[m] - t[m][0]) * 1e3
+        ax[0, c].plot(tm, d["torque"][m], lw=0.7)
+        ax[0, c].plot(tm, d["torque_ref"][m], lw=0.7, color="k", alpha=0.5)
+        ax[0, c].set_title(f"HDTC, {filt}")
+        ax[1, c].plot(tm, d["i_a"][m], lw=0.7)
+        ax[2, c].plot(tm, (d["v_a"] - d["v_b"])[m], lw=0.5)
+        ax[3, c].plot(tm, d["v_a"][m], lw=0.5)
+        ax[3, c].set_xlabel("ms")
+    for r, lab in enumerate(("torque (N·m)", "i_a (A)", "v_ab motor (V)", "v_a motor (V)")):
+        ax[r, 0].set_ylabel(lab)
+    for a in ax.flat:
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def spectra_plot(traces, path):
+    fig, ax = plt.subplots(2, 1, figsize=(10, 6.5))
+    for filt, d in traces.items():
+        dt = d["t"][1] - d["t"][0]
+        f, a = spectrum(d["i_a"], dt)
+        ax[0].semilogy(f / 1e3, np.maximum(a, 1e-6), lw=0.6, label=filt)
+        f, a = spectrum(d["v_a"], dt)
+        ax[1].semilogy(f / 1e3, np.maximum(a, 1e-4), lw=0.6, label=filt)
+    ax[0].set_ylabel("|I_a| (A)")
+    ax[1].set_ylabel("|V_a| motor (V)")
+    for a in ax:
+        a.set_xlim(0, 10)
+        a.set_xlabel("kHz")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=8)
+    ax[0].set_title("HDTC, phase-a current and motor phase-voltage spectra (window)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(ROOT, "out"))
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--duration", type=float, default=0.25)
+    ap.add_argument("--settle", type=float, default=0.1)
+    ap.add_argument("--seed", type=int, default=1, help="first of the four ADC-noise seeds")
+    # tools/demo passes its options to both reports: ignore compare.py's own
+    a, _ = ap.parse_known_args()
+    SEEDS[:] = [a.seed + k for k in range(4)]
+    sim = sim_binary()
+    fdir = os.path.join(a.out, "filters")
+    runs = os.path.join(fdir, "runs")
+    os.makedirs(runs, exist_ok=True)
+    t0 = time.time()
+    D, S = a.duration, a.settle
+    jobs = []
+    for c in CTRLS:
+        for filt in MACHINES:
+            for sd in SEEDS:
+                jobs.append(dict(ctrl=c, filt=filt, trace=(c == "hdtc" and sd == SEEDS[0]), seed=sd))
+    for c in ("hdtc", "m2ptfc"):
+        for filt in ("passive", "active"):
+            jobs.append(dict(ctrl=c, filt=filt, sense="inverter", tag="_invsense"))
+    # active filter's capacitors: windows over 0.6 s
+    aw = [(0.0, 0.05), (0.1, 0.15), (0.2, 0.25), (0.3, 0.35), (0.4, 0.45), (0.55, 0.6)]
+    for k, w in enumerate(aw):
+        jobs.append(dict(ctrl="hdtc", filt="active", tag=f"_w{k}", window=w, dur=0.6))
+    # pre-charge of the storage capacitors (not in S1)
+    pre = (264, 400, 600)
+    with open(os.path.join(MDIR, MACHINES["active"])) as f:
+        ini = f.read()
+    for v in pre[1:]:
+        p = os.path.join(runs, f"active_cf{v}.ini")
+        with open(p, "w") as f:
+            f.write(ini.replace("af_cf_initial_v = 264", f"af_cf_initial_v = {v}"))
+        jobs.append(dict(ctrl="hdtc", filt="active", tag=f"_cf{v}", machine=p))
+    res, failed = {}, []
+    with cf.ThreadPoolExecutor(max_workers=max(1, a.jobs)) as ex:
+        futs = [ex.submit(job, sim, runs, j["ctrl"], j["filt"], j.get("dur", D), S,
+                          j.get("sense"), j.get("machine"), j.get("tag", ""), j.get("trace", False),
+                          j.get("window"), j.get("seed", SEEDS[0])) for j in jobs]
+        for fu in futs:
+            name, m, err = fu.result()
+            if m is None:
+                failed.append((name, err))
+            else:
+                res[name] = m
+    wall = time.time() - t0
+
+    def g(name, key):
+        m = res.get(name)
+        return None if m is None else m.get(key)
+
+    def gs(name, key):
+        """Values of a key over the seeds of a case."""
+        v = [g(name + (f"_s{sd}" if sd != SEEDS[0] else ""), key) for sd in SEEDS]
+        return [x for x in v if x is not None and np.isfinite(x)]
+
+    def mean(name, key):
+        v = gs(name, key)
+        return float(np.mean(v)) if v else None
+
+    def mr(name, key, p=3):
+        """mean (min–max) over the seeds."""
+        v = gs(name, key)
+        if not v:
+            return "—"
+        return f"{np.mean(v):.{p}f} ({min(v):.{p}f}–{max(v):.{p}f})"
+
+    traces = {}
+    for filt in MACHINES:
+        p = os.path.join(runs, f"hdtc_{filt}.csv")
+        if os.path.exists(p):
+            traces[filt] = load_trace(p)
+    s1_freq_plot(os.path.join(fdir, "s1_responses.png"))
+    if len(traces) == 3:
+        wave_plot(traces, os.path.join(fdir, "hdtc_waveforms.png"))
+        spectra_plot(traces, os.path.join(fdir, "hdtc_spectra.png"))
+
+    L = []
+    L.append("# Output filters of the book chapter (S1 §6) on the chapter IPMSM\n")
+    L.append(f"Generated by `tools/filters.py` ({len(jobs)} simulations, {wall:.0f} s wall). "
+             "Chapter: A. A. Adam and K. Gulez, *Torque Control of PMSM and Associated Harmonic "
+             "Ripples* (S1). Operating point of S1 §6.1.4 / §6.2.5: chapter IPMSM (S1 Table 2), "
+             "free mechanics, load 2 N·m, speed loop at 70 rad/s (668.45 r/min), fs 10 kHz "
+             f"(Ts 100 µs); {D} s simulated, indices over [{S}, {D}] s from the plant's true "
+             "signals on the Ts/10 grid: T p-p = max − min of the torque (S1 quotes peak to peak), "
+             "T std (REFERENCE §5), THD_I of i_a and THD_V of the motor phase voltage v_a "
+             "(harmonics 2..N up to 10 kHz of the measured fundamental). Current sensors at the "
+             "motor terminals as in S1's simulation unless marked. Filters: S1 Tables 5 and 6 in "
+             "the topologies read in `sim_host/README.md` (\"Output filters\"); the plant "
+             "integrates them exactly (matrix exponential, checked against Eigen to 1e-10 and "
+             "against S1 (41)–(47), (58) to 1e-5).\n")
+    n, p_, ac = "hdtc_none", "hdtc_passive", "hdtc_active"
+
+    def ratio(x, y):
+        return None if x is None or y is None or not y else x / y
+
+    L.append("## S1's numbers and ours (HDTC)\n")
+    L.append(f"Ours: mean (min–max) over the ADC-noise seeds {', '.join(map(str, SEEDS))}; the "
+             "ratio per seed.\n")
+    L.append("| quantity | S1 without | S1 with | ours without | ours with | ours with / without |")
+    L.append("|---|---|---|---|---|---|")
+    rows = [
+        ("passive: torque ripple p-p (N·m)", "1.4", "0.6", n, p_, "torque_ripple_pp_nm", 3),
+        ("passive: torque std (N·m)", "—", "—", n, p_, "torque_ripple_nm", 4),
+        ("passive: THD_I (%)", "≈ 3", "< 1.7", n, p_, "thd_i_pct", 2),
+        ("passive: THD_V motor phase (%)", "—", "—", n, p_, "thd_v_pct", 1),
+        ("active: torque ripple p-p (N·m)", "3.24 (±1.62)", "0.2 (±0.1)", n, ac,
+         "torque_ripple_pp_nm", 3),
+        ("active: torque std (N·m)", "—", "—", n, ac, "torque_ripple_nm", 4),
+        ("active: THD_V motor phase (%)", "≈ 79", "< 5", n, ac, "thd_v_pct", 1),
+        ("active: THD_I (%)", "—", "—", n, ac, "thd_i_pct", 2),
+    ]
+    for lab, s0, s1, a0, a1, key, pr in rows:
+        r = [x1 / x0 for x0, x1 in zip(gs(a0, key), gs(a1, key)) if x0]
+        rs = f"{np.mean(r):.2f} ({min(r):.2f}–{max(r):.2f})" if r else "—"
+        L.append(f"| {lab} | {s0} | {s1} | {mr(a0, key, pr)} | {mr(a1, key, pr)} | {rs} |")
+    L.append("")
+    L.append(
+        "Where and why they differ:\n\n"
+        "- **Unfiltered HDTC.** Our HDTC decides on the one-step prediction (`est->next`, "
+        "delay compensation), so its torque ripple (~0.7 N·m p-p) is half of S1 §6.1.4's 1.4 "
+        "and a fifth of S1 §6.2.5's ±1.62 N·m; its current distortion is larger than S1's "
+        "≈ 3 % (S1's spectra are figures; their harmonic range is not stated) and its motor "
+        "phase voltage is the two-level inverter waveform (THD_V ≈ 100 %, S1 ≈ 79 %).\n"
+        "- **Passive filter: the torque ripple does not drop.** The filter removes the torque "
+        "ripple above 1.5 kHz (table below, ≈ 0.15×) but the HDTC's torque loop now runs "
+        "through the filter: the RLC filter with the machine has a lightly damped mode at "
+        "≈ 0.5 kHz (eigenvalue −342 ± j3248 s⁻¹, ζ ≈ 0.1) and passes 0.55–0.86 of the "
+        "voltage between 0.5 and 1 kHz, and the hysteresis limit cycle moves there and "
+        "grows (500–1500 Hz band ≈ 2×). With Table 5's R1 = 56 kΩ the trap's branches to "
+        "the star point carry almost nothing; the trap acts as a capacitive path "
+        "L1–C1–C2 in parallel with R2–L2 (|Z12| ≈ 6 Ω at 5 kHz), so the RLC filter does "
+        "the filtering. THD_I falls to ≈ 0.7× (the issue's ≤ 0.8× holds in the mean, not "
+        "in every realisation, see the range), THD_V to ≈ 0.4×. S1's reported drop would "
+        "follow for a controller that does not react to the filter.\n"
+        "- **Active filter: the HF ripple vanishes, the low-frequency ripple stays.** The "
+        "motor voltage follows S1 (51)–(53) within the hysteresis band (THD_V 3–5 %, S1 "
+        "< 5 %), the torque ripple above 500 Hz drops to a few percent, and what remains is "
+        "below 500 Hz: S1's AF has no energy source, so while it holds the torque the HDTC "
+        "applies zero vectors and the storage capacitors supply the motor (they drain at "
+        "≈ the motor's 150 W, table below); as they fall below the ≈ 260 V the AF needs "
+        "(2/3 Vdc + |v*|) it loses track in parts of each electrical period, the speed loop "
+        "oscillates at the fundamental, and the torque ripple settles at ≈ 0.3–0.45× "
+        "instead of S1's 0.06× (the issue's ≤ 0.3× is not reached with the capacitors "
+        "pre-charged to Vdc; with 400–600 V it is, ≈ 0.23×, see below).\n")
+
+    L.append("### HDTC torque ripple by frequency band (RMS, N·m)\n")
+    L.append("| filter | " + " | ".join(f"{lo}–{hi} Hz" for lo, hi in BANDS) + " | total std |")
+    L.append("|---|" + "---|" * (len(BANDS) + 1))
+    for filt, d in traces.items():
+        dt = d["t"][1] - d["t"][0]
+        b = band_rms(d["torque"], dt)
+        L.append(f"| {filt} | " + " | ".join(f"{x:.4f}" for x in b) +
+                 f" | {d['torque'].std():.4f} |")
+    L.append("")
+    L.append("![HDTC waveforms](filters/hdtc_waveforms.png)\n")
+    L.append("Last 30 ms of the window: torque (reference in grey), phase current, line and "
+             "phase voltage at the motor terminals (means over each 10 µs grid step).\n")
+    L.append("![HDTC spectra](filters/hdtc_spectra.png)\n")
+
+    L.append("## Does a filter still pay with a low-ripple controller?\n")
+    L.append("Same operating point, each controller at fs 10 kHz with its defaults; filter "
+             "losses in the resistors, AF capacitors' lowest voltage in the window.\n")
+    L.append("| controller | filter | T p-p (N·m) | T std (N·m) | T std / unfiltered | THD_I (%) | "
+             "THD_V (%) | f_av (Hz) | filter loss (W) | AF C_F min (V) |")
+    L.append("|---|---|---|---|---|---|---|---|---|---|")
+    for c in CTRLS:
+        for filt in MACHINES:
+            nm = f"{c}_{filt}"
+            if not gs(nm, "torque_ripple_nm"):
+                L.append(f"| {c} | {filt} | (failed) ||||||||")
+                continue
+            rstd = ratio(mean(nm, "torque_ripple_nm"), mean(f"{c}_none", "torque_ripple_nm"))
+            flt = res.get(nm, {}).get("filter", {})
+            cfv = [res.get(nm + (f"_s{sd}" if sd != SEEDS[0] else ""), {}).get("filter", {})
+                   .get("af_cf_min_v") for sd in SEEDS]
+            cfv = [x for x in cfv if x is not None]
+            L.append(f"| {c} | {filt} | {mr(nm, 'torque_ripple_pp_nm')} | "
+                     f"{mr(nm, 'torque_ripple_nm', 4)} | {fmt(rstd, 2)} | "
+                     f"{mr(nm, 'thd_i_pct', 2)} | {fmt(mean(nm, 'thd_v_pct'), 1)} | "
+                     f"{fmt(mean(nm, 'f_av_hz'), 0)} | {fmt(flt.get('loss_w'), 1)} | "
+                     f"{fmt(min(cfv), 0) if cfv else '—'} |")
+    L.append("")
+    L.append(
+        "Conclusion: the passive filter pays for none of the controllers in torque ripple "
+        "(std 0.9–1.15× of the unfiltered run) and costs 15–60 W in its resistors "
+        "(R3 = 128 Ω carries the inverter's ripple current; the motor delivers 140 W); "
+        "what it does deliver is its stated purpose, S1 §6.1.2: a smoother motor voltage "
+        "(THD_V 3–5× lower). Unfiltered, DRR and M2PTFC already have the torque ripple "
+        "(≈ 0.22 N·m p-p) that HDTC reaches only with the active filter. The active filter "
+        "lowers every controller's ripple (HF ripple gone, THD_V < 5 %), but less the "
+        "better the controller (std ≈ 0.4× for HDTC and FST, ≈ 0.7× for DRR and M2PTFC), "
+        "and S1's AF needs an energy source or a capacitor-voltage loop to run longer "
+        "than its pre-charge lasts (below). For a low-ripple controller neither filter "
+        "pays in torque ripple for its cost; the passive one still pays where the motor "
+        "voltage's dv/dt and harmonics matter (cable, insulation, EMI).\n")
+
+    L.append("## Current sensors at the inverter output (a real board)\n")
+    L.append("A real board (e.g. the B-G431B-ESC1's leg shunts) measures the inverter output "
+             "currents. With a filter these contain the filter's shunt currents (RLC R3–C3 and "
+             "trap branches; the AF's R1–C1 and R2–C2): the current-model flux and torque "
+             "estimates (thesis (3.4), (3.10)) then see currents the machine does not carry, "
+             "at the fundamental (≈ 0.13 A of C3 at 22 Hz, ≈ 10 % of i_q) and at the "
+             "ripple frequencies.\n")
+    L.append("| controller | filter | sensing | T p-p (N·m) | T std (N·m) | THD_I (%) | T mean (N·m) |")
+    L.append("|---|---|---|---|---|---|---|")
+    for c in ("hdtc", "m2ptfc"):
+        for filt in ("passive", "active"):
+            for tag, lab in (("", "motor"), ("_invsense", "inverter")):
+                m = res.get(f"{c}_{filt}{tag}")
+                if m:
+                    L.append(f"| {c} | {filt} | {lab} | {fmt(m['torque_ripple_pp_nm'])} | "
+                             f"{fmt(m['torque_ripple_nm'], 4)} | {fmt(m['thd_i_pct'], 2)} | "
+                             f"{fmt(m['torque_mean_nm'], 3)} |")
+    L.append("")
+
+    L.append("## The active filter's storage capacitors\n")
+    L.append("S1 gives C_F = 200 µF and L_F = 200 mH but no pre-charge and no energy supply; "
+             "the machine file pre-charges each of the six capacitors to Vdc = 264 V (S1 (56) "
+             "sizes C_F for a swing of Vdc). HDTC, windows of one run of 0.6 s:\n")
+    L.append("| window (s) | T p-p (N·m) | T std (N·m) | THD_V (%) | C_F min (V) | C_F max (V) | "
+             "AF switching (Hz) |")
+    L.append("|---|---|---|---|---|---|---|")
+    for k, w in enumerate(aw):
+        m = res.get(f"hdtc_active_w{k}")
+        if m:
+            fl = m.get("filter", {})
+            L.append(f"| {w[0]}–{w[1]} | {fmt(m['torque_ripple_pp_nm'])} | "
+                     f"{fmt(m['torque_ripple_nm'], 4)} | {fmt(m['thd_v_pct'], 1)} | "
+                     f"{fmt(fl.get('af_cf_min_v'), 0)} | {fmt(fl.get('af_cf_max_v'), 0)} | "
+                     f"{fmt(fl.get('af_switching_hz'), 0)} |")
+    L.append("")
+    L.append("Pre-charge (not in S1; a sensitivity, not a setting of the shipped file):\n")
+    L.append("| C_F pre-charge (V) | T p-p (N·m) | T std (N·m) | T p-p / unfiltered | THD_V (%) | C_F min (V) |")
+    L.append("|---|---|---|---|---|---|")
+    for v in pre:
+        m = res.get("hdtc_active" if v == 264 else f"hdtc_active_cf{v}")
+        if m:
+            L.append(f"| {v} | {fmt(m['torque_ripple_pp_nm'])} | {fmt(m['torque_ripple_nm'], 4)} | "
+                     f"{fmt(ratio(m['torque_ripple_pp_nm'], g(n, 'torque_ripple_pp_nm')), 2)} | "
+                     f"{fmt(m['thd_v_pct'], 1)} | {fmt(m.get('filter', {}).get('af_cf_min_v'), 0)} |")
+    L.append("")
+    L.append("The capacitors lose ≈ 300 V/s: the AF supplies the motor while the HDTC, "
+             "seeing its torque and flux held, applies zero vectors. The AF's injected voltage "
+             "must bracket v_inv − v* (up to 2/3 Vdc + |v*| ≈ 260 V), so at a Vdc pre-charge "
+             "it is marginal from the start. A capacitor-voltage loop (the AF drawing its "
+             "losses and the motor's share from the inverter, as series active filters do) "
+             "is not in S1 and not modelled.\n")
+
+    L.append("## Filter frequency responses (S1 (41)–(46), Table 5)\n")
+    L.append("![S1 responses](filters/s1_responses.png)\n")
+    L.append("The plant's responses (sinusoidal steady state of the integrated plant) match "
+             "S1 (44), (47) and (58) to < 1e-6 and the Π elements (41)–(43) from the "
+             "two-port to < 1e-5 (`tests/plant/test_plant_filter.c`); S1 (45): R3 + r3 = "
+             "130 Ω > √(4 L3/C3) = 98 Ω; S1 (46): ω_c = 1633 rad/s (260 Hz).\n")
+    if failed:
+        L.append("## Failed runs\n")
+        for nm, err in failed:
+            L.append(f"- {nm}: `{err}`")
+    with open(os.path.join(a.out, "filters.md"), "w") as f:
+        f.write("\n".join(L) + "\n")
+    print(f"filters: {len(jobs)} simulations in {wall:.1f} s wall; report: "
+          f"{os.path.relpath(os.path.join(a.out, 'filters.md'), os.getcwd())}")
+    for nm, err in failed:
+        print(f"filters: FAILED {nm}: {err}", file=sys.stderr)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
