@@ -108,7 +108,7 @@ else
            torque_ref_requested_nm torque_ref_applied_nm warnings mode mechanics fault_time_s; do
     grep -q "\"$k\"" "$tmp/m.json" || { echo "FAIL: metrics key $k missing"; fails=$((fails + 1)); }
   done
-  head -n1 "$tmp/t.csv" | grep -q "^t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,speed_ref_rpm,load_nm$" ||
+  head -n1 "$tmp/t.csv" | grep -q "^t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,speed_ref_rpm,load_nm,v_a,v_b,v_c,i_inv_a$" ||
     { echo "FAIL: trace header"; fails=$((fails + 1)); }
   echo "ok: good run"
 fi
