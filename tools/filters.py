@@ -317,9 +317,9 @@ def main():
         "applies zero vectors and the storage capacitors supply the motor (they drain at "
         "≈ the motor's 150 W, table below); as they fall below the ≈ 260 V the AF needs "
         "(2/3 Vdc + |v*|) it loses track in parts of each electrical period, the speed loop "
-        "oscillates at the fundamental, and the torque ripple settles at ≈ 0.3–0.45× "
+        "oscillates at the fundamental, and the torque ripple settles at ≈ 0.35–0.45× "
         "instead of S1's 0.06× (the issue's ≤ 0.3× is not reached with the capacitors "
-        "pre-charged to Vdc; with 400–600 V it is, ≈ 0.23×, see below).\n")
+        "pre-charged to Vdc; with 400–600 V it is nearly, ≈ 0.25×, see below).\n")
 
     L.append("### HDTC torque ripple by frequency band (RMS, N·m)\n")
     L.append("| filter | " + " | ".join(f"{lo}–{hi} Hz" for lo, hi in BANDS) + " | total std |")
@@ -358,19 +358,27 @@ def main():
                      f"{fmt(mean(nm, 'f_av_hz'), 0)} | {fmt(flt.get('loss_w'), 1)} | "
                      f"{fmt(min(cfv), 0) if cfv else '—'} |")
     L.append("")
+    def std_ratios(filt, ctrls):
+        r = [ratio(mean(f"{c}_{filt}", "torque_ripple_nm"), mean(f"{c}_none", "torque_ripple_nm"))
+             for c in ctrls]
+        r = [x for x in r if x is not None]
+        return f"{min(r):.2f}–{max(r):.2f}" if r else "—"
+
     L.append(
         "Conclusion: the passive filter pays for none of the controllers in torque ripple "
-        "(std 0.9–1.15× of the unfiltered run) and costs 15–60 W in its resistors "
-        "(R3 = 128 Ω carries the inverter's ripple current; the motor delivers 140 W); "
-        "what it does deliver is its stated purpose, S1 §6.1.2: a smoother motor voltage "
-        "(THD_V 3–5× lower). Unfiltered, DRR and M2PTFC already have the torque ripple "
-        "(≈ 0.22 N·m p-p) that HDTC reaches only with the active filter. The active filter "
-        "lowers every controller's ripple (HF ripple gone, THD_V < 5 %), but less the "
-        "better the controller (std ≈ 0.4× for HDTC and FST, ≈ 0.7× for DRR and M2PTFC), "
-        "and S1's AF needs an energy source or a capacitor-voltage loop to run longer "
-        "than its pre-charge lasts (below). For a low-ripple controller neither filter "
-        "pays in torque ripple for its cost; the passive one still pays where the motor "
-        "voltage's dv/dt and harmonics matter (cable, insulation, EMI).\n")
+        f"(std {std_ratios('passive', CTRLS)}× of the unfiltered run, worst for the "
+        "low-ripple DRR and M2PTFC) and costs 15–60 W in its resistors (R3 = 128 Ω carries "
+        "the inverter's ripple current; the motor delivers 140 W); what it does deliver is "
+        "its stated purpose, S1 §6.1.2: a smoother motor voltage (THD_V 3–5× lower). "
+        "Unfiltered, DRR and M2PTFC already have less torque ripple than HDTC with the "
+        "active filter. The active filter lowers every controller's ripple (HF ripple "
+        "gone, THD_V < 5 %), but less the better the controller (std "
+        f"{std_ratios('active', ('hdtc', 'fst'))}× for HDTC and FST, "
+        f"{std_ratios('active', ('drr', 'm2ptfc'))}× for DRR and M2PTFC), and S1's AF needs "
+        "an energy source or a capacitor-voltage loop to run longer than its pre-charge "
+        "lasts (below). For a low-ripple controller neither filter pays in torque ripple for "
+        "its cost; the passive one still pays where the motor voltage's dv/dt and harmonics "
+        "matter (cable, insulation, EMI).\n")
 
     L.append("## Current sensors at the inverter output (a real board)\n")
     L.append("A real board (e.g. the B-G431B-ESC1's leg shunts) measures the inverter output "
