@@ -288,4 +288,8 @@ q24_t fx_mag(q24_t x, q24_t y);
 /* sin and cos of an angle in Q24; maximum error stated in control/README.md. */
 void fx_sincos(fx_angle_t angle, q24_t *sin_out, q24_t *cos_out);
 
+/* Angle of the vector (x, y) (any common scale), in [0, 2 pi) as fx_angle_t;
+ * (0, 0) gives 0. Error <= 1.4e-6 rad (docs/error-budget.md); fx_atan.c. */
+fx_angle_t fx_atan2(int32_t y, int32_t x);
+
 #endif /* CONTROL_FX_H */

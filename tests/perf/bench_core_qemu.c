@@ -28,6 +28,8 @@
 #include <string.h>
 
 #include "estimator.h"
+#include "flux_observer.h"
+#include "flux_observer_config.h"
 #include "fx.h"
 #include "machines.h"
 #include "mtpa.h"
@@ -65,6 +67,8 @@ static ctrl_params_t P;         /* thesis SPMSM, 10 kHz */
 static ctrl_params_t P_ipm;     /* 80 kW IPMSM, 10 kHz (MTPA table) */
 static ctrl_estimator_t E;      /* every output (CTRL_EST_ALL) */
 static ctrl_estimator_t E_lean; /* outputs = 0: no |psi|, no sector at k */
+static ctrl_fobs_t O_sl;        /* flux observer, sensorless, dead time compensated */
+static ctrl_fobs_t O_enc;       /* flux observer, encoder mode */
 static volatile int32_t sink;
 
 static uint32_t rng = 12345u;
@@ -116,6 +120,14 @@ static void make_inputs(void)
     ctrl_estimator_init(&E, &P);
     ctrl_estimator_init(&E_lean, &P);
     E_lean.outputs = 0u;
+    ctrl_fobs_config_t fc;
+    ctrl_fobs_config_default(&fc, &spm);
+    fc.dead_time_s = 1e-6;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_fobs_init(&O_sl, &P, &b, &fc, NULL));
+    fc.mode = CTRL_FOBS_ENCODER;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_fobs_init(&O_enc, &P, &b, &fc, NULL));
+    ctrl_fobs_reset(&O_sl, &P, 0u, 0, 0, 0);
+    ctrl_fobs_reset(&O_enc, &P, 0u, 0, 0, 0);
 }
 
 /* ---- wrappers: one call of the function under test on input k ---- */
@@ -243,6 +255,28 @@ __attribute__((noinline)) static void w_from_flux_noamp(int k)
     sink = o.torque;
 }
 
+__attribute__((noinline)) static void w_atan2(int k)
+{
+    sink = (int32_t)(fx_atan2(in[k].y, in[k].x) >> 1);
+}
+__attribute__((noinline)) static void w_fobs_voltage(int k)
+{
+    q24_t a;
+    q24_t b;
+    ctrl_fobs_voltage(&O_sl, &in[k].legs, in[k].vdc, in[k].ia, in[k].ib, &a, &b);
+    sink = a + b;
+}
+__attribute__((noinline)) static void w_fobs_sl(int k)
+{
+    sink =
+        (int32_t)(ctrl_fobs_update(&O_sl, &P, in[k].x, in[k].y, in[k].al, in[k].be, in[k].th) >> 1);
+}
+__attribute__((noinline)) static void w_fobs_enc(int k)
+{
+    sink = (int32_t)(ctrl_fobs_update(&O_enc, &P, in[k].x, in[k].y, in[k].al, in[k].be, in[k].th) >>
+                     1);
+}
+
 typedef struct {
     const char *name;
     bench_fn_t fn;
@@ -270,6 +304,10 @@ static const bench_t benches[] = {
     {"ctrl_mtpa_psi IPMSM", w_mtpa_ipm},
     {"ctrl_estimator_update", w_estimator},
     {"ctrl_estimator_update outputs=0", w_estimator_lean},
+    {"fx_atan2", w_atan2},
+    {"ctrl_fobs_voltage (dead time)", w_fobs_voltage},
+    {"ctrl_fobs_update sensorless", w_fobs_sl},
+    {"ctrl_fobs_update encoder", w_fobs_enc},
 };
 
 /* ---- measurement ---- */
@@ -347,7 +385,9 @@ static void test_core_counts(void)
         TEST_ASSERT_TRUE(mx < CEILING);
         TEST_ASSERT_TRUE(mn > 0u);
         /* determinism: the same input costs the same (estimator: same state) */
-        if (exact && benches[f].fn != w_estimator && benches[f].fn != w_estimator_lean) {
+        if (exact && benches[f].fn != w_estimator && benches[f].fn != w_estimator_lean &&
+            benches[f].fn != w_fobs_sl && benches[f].fn != w_fobs_enc &&
+            benches[f].fn != w_fobs_voltage) {
             TEST_ASSERT_EQUAL_UINT32(instr_of(benches[f].fn, 7), instr_of(benches[f].fn, 7));
         }
     }
