@@ -1,6 +1,5 @@
 /* Stator-flux observer: SI configuration -> fixed-point gains (configuration). */
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
 
 #include "ctrl_units.h"
@@ -22,12 +21,14 @@ void ctrl_fobs_config_default(ctrl_fobs_config_t *c, const ctrl_machine_t *m)
 
 /* value inside [lo, hi]? Otherwise fill *why. */
 static int fobs_in(double v, double lo, double hi, const char *q, const char *unit,
-                   ctrl_fobs_diag_t *why)
+                   ctrl_diag_t *why)
 {
     if (isfinite(v) && v >= lo && v <= hi) {
         return 1;
     }
     if (why != NULL) {
+        memset(why, 0, sizeof *why);
+        why->code = CTRL_EINVAL;
         why->quantity = q;
         why->unit = unit;
         why->value = v;
@@ -38,7 +39,7 @@ static int fobs_in(double v, double lo, double hi, const char *q, const char *un
 }
 
 int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b,
-                   const ctrl_fobs_config_t *c, ctrl_fobs_diag_t *why)
+                   const ctrl_fobs_config_t *c, ctrl_diag_t *why)
 {
     if (o == NULL || p == NULL || b == NULL || c == NULL || p->fs_hz == 0u) {
         return CTRL_EINVAL;
@@ -99,17 +100,4 @@ int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b
     n.primed = 0u;
     *o = n;
     return CTRL_OK;
-}
-
-size_t ctrl_fobs_diag_format(const ctrl_fobs_diag_t *d, char *buf, size_t cap)
-{
-    if (buf == NULL || cap == 0u) {
-        return 0u;
-    }
-    const int n = d == NULL || d->quantity == NULL
-                      ? snprintf(buf, cap, "ok")
-                      : snprintf(buf, cap, "%s = %g%s%s is outside [%g, %g]%s%s", d->quantity,
-                                 d->value, d->unit[0] ? " " : "", d->unit, d->min, d->max,
-                                 d->unit[0] ? " " : "", d->unit);
-    return n < 0 ? 0u : ((size_t)n < cap ? (size_t)n : cap - 1u);
 }

@@ -6,8 +6,6 @@
 #ifndef CONTROL_FLUX_OBSERVER_CONFIG_H
 #define CONTROL_FLUX_OBSERVER_CONFIG_H
 
-#include <stddef.h>
-
 #include "ctrl_params.h"
 #include "flux_observer.h"
 
@@ -24,13 +22,6 @@ typedef struct {
     double psi_speed_min; /* PM-flux estimate runs above this share of the rated speed */
 } ctrl_fobs_config_t;
 
-/* Why a configuration was refused: the quantity, its value and the range. */
-typedef struct {
-    const char *quantity; /* the ctrl_fobs_config_t field, e.g. "pll_hz" */
-    const char *unit;
-    double value, min, max;
-} ctrl_fobs_diag_t;
-
 /* Defaults for a machine (docs/algorithms.md, "Stator-flux observer"): sensorless,
  * k0 = 1 % and w_c = 5 % of the rated electrical speed, kappa = 0.5,
  * PLL 300 Hz, no inverter compensation (band 5 % of the rated current),
@@ -39,13 +30,10 @@ void ctrl_fobs_config_default(ctrl_fobs_config_t *c, const ctrl_machine_t *m);
 
 /* Validate c against the machine's fixed-point parameters and bases and set
  * the observer's gains; the state is cleared (not primed). Returns CTRL_OK,
- * or CTRL_EINVAL (a NULL pointer, a value outside its range: *why names it;
- * why may be NULL) with *o untouched. */
+ * or CTRL_EINVAL (a NULL pointer, or a value outside its range: *why names
+ * the ctrl_fobs_config_t field, its value and the range; why may be NULL;
+ * ctrl_diag_format words it) with *o untouched. */
 int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b,
-                   const ctrl_fobs_config_t *c, ctrl_fobs_diag_t *why);
-
-/* The diagnosis as one line ("pll_hz = 9000 Hz is outside [0.1, 795.8] Hz");
- * returns its length (truncated to cap - 1). */
-size_t ctrl_fobs_diag_format(const ctrl_fobs_diag_t *d, char *buf, size_t cap);
+                   const ctrl_fobs_config_t *c, ctrl_diag_t *why);
 
 #endif /* CONTROL_FLUX_OBSERVER_CONFIG_H */

@@ -198,12 +198,12 @@ int fobs_eval_run(const fobs_eval_cfg_t *c, fobs_eval_res_t *res, char *err, siz
         fc.dead_time_s = mach.dead_time_s;
         fc.v_fwd_v = mach.v_fwd_v;
     }
-    ctrl_fobs_diag_t why;
+    ctrl_diag_t why;
     memset(&why, 0, sizeof why);
     fc.mode = CTRL_FOBS_SENSORLESS;
     if (ctrl_fobs_init(&e.sl, &e.p, &run.fw.bases, &fc, &why) != CTRL_OK) {
         char msg[160];
-        (void)ctrl_fobs_diag_format(&why, msg, sizeof msg);
+        (void)ctrl_diag_format(&why, msg, sizeof msg);
         (void)snprintf(err, errlen, "observer configuration: %s", msg);
         sim_run_free(&run);
         return -1;

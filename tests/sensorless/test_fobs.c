@@ -121,7 +121,7 @@ static void fobs_default(ctrl_fobs_t *o, unsigned mode, const ctrl_params_t *p)
     ctrl_fobs_config_t c;
     ctrl_fobs_config_default(&c, &M);
     c.mode = mode;
-    ctrl_fobs_diag_t why;
+    ctrl_diag_t why;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_fobs_init(o, p, &B, &c, &why));
 }
 
@@ -562,14 +562,14 @@ static void test_config(void)
         memcpy((char *)&c + bad[i].off, &bad[i].bad, sizeof(double));
         ctrl_fobs_t o;
         memset(&o, 0x5A, sizeof o);
-        ctrl_fobs_diag_t why;
+        ctrl_diag_t why;
         memset(&why, 0, sizeof why);
         TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_fobs_init(&o, &P, &B, &c, &why));
         TEST_ASSERT_EQUAL_STRING(bad[i].name, why.quantity);
         TEST_ASSERT_TRUE(why.min <= why.max);
         TEST_ASSERT_EQUAL_UINT8(0x5Au, o.primed); /* untouched */
         char msg[128];
-        TEST_ASSERT_TRUE(ctrl_fobs_diag_format(&why, msg, sizeof msg) > 0u);
+        TEST_ASSERT_TRUE(ctrl_diag_format(&why, msg, sizeof msg) > 0u);
         TEST_ASSERT_NOT_NULL(strstr(msg, bad[i].name));
     }
     ctrl_fobs_config_t cm = c0;
