@@ -76,6 +76,9 @@ static const key_t_ k_keys[] = {
     {"filter", "af_sample_hz", K_REAL, 0, 1e3, 1e8, 0, 1.0, OFF(filter.active.sample_hz)},
     {"filter", "af_band_v", K_REAL, 0, 0, 1e4, 0, 1.0, OFF(filter.active.band_v)},
     {"filter", "af_ref_cutoff_hz", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(filter.active.ref_cutoff_hz)},
+    {"sensors", "encoder_lines", K_INT, 0, 1, 1e7, 0, 1.0, OFF(encoder_lines)},
+    {"sensors", "encoder_offset_deg", K_REAL, 0, -360, 360, 0, 1.0, OFF(encoder_offset_deg)},
+    {"sensors", "encoder_direction", K_INT, 0, -1, 1, 0, 1.0, OFF(encoder_direction)},
 };
 #define N_KEYS (sizeof(k_keys) / sizeof(k_keys[0]))
 
@@ -308,6 +311,16 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
             return -1;
         }
     }
+    /* Defaults of the optional [sensors] keys: today's aligned encoder. */
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        if (strcmp(k_keys[k].section, "sensors") == 0 && !c.seen[k]) {
+            if (strcmp(k_keys[k].name, "encoder_lines") == 0) {
+                out->encoder_lines = 2500;
+            } else if (strcmp(k_keys[k].name, "encoder_direction") == 0) {
+                out->encoder_direction = 1;
+            }
+        }
+    }
     /* Cross-field rules. */
     char bad[200] = "";
     if (!(out->current_max_a > out->current_rated_a)) {
@@ -327,6 +340,8 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
         snprintf(bad, sizeof bad,
                  "[speed_loop] give either the gains (kp_nm_s_per_rad, ki_nm_per_rad) or the "
                  "design (bandwidth_hz, phase_margin_deg), not both");
+    } else if (out->encoder_direction == 0) {
+        snprintf(bad, sizeof bad, "[sensors] encoder_direction must be 1 or -1 (got 0)");
     } else if (out->dead_time_s * out->fs_hz > 0.1) {
         snprintf(bad, sizeof bad,
                  "[inverter] dead_time_ns = %g exceeds 10 %% of the PWM period (<= %g ns at "

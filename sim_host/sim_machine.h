@@ -28,6 +28,11 @@
  *                 af_sample_hz af_band_v af_ref_cutoff_hz
  *               A filter needs the linear model (no [fluxmap], no dead time,
  *               forward drop or DC-link capacitor).
+ *   [sensors]   (optional) encoder_lines (lines per revolution, x4 counts;
+ *               default 2500), encoder_offset_deg (electrical angle of the d
+ *               axis where the encoder reads 0 and its index fires, i.e.
+ *               theta_e = offset + direction x count angle; default 0),
+ *               encoder_direction (1 or -1, default 1)
  * Unknown sections and unknown keys are REJECTED (a typo must not silently
  * fall back to a default). Values must be finite numbers in range.
  */
@@ -68,6 +73,9 @@ typedef struct {
     sim_current_sense_t current_sense;
     char filter_type[SIM_MACHINE_NAME_MAX];        /* [filter] type as written */
     char current_sense_text[SIM_MACHINE_NAME_MAX]; /* [filter] current_sense as written */
+    int encoder_lines;                       /* [sensors] */
+    double encoder_offset_deg;
+    int encoder_direction;
 } sim_machine_t;
 
 /* Returns 0 on success; otherwise -1 and a message naming the key (and the

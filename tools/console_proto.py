@@ -25,6 +25,7 @@ SIGNALS = [
     ("speed", "r/min"), ("speed_ref", "r/min"),
     ("vector", ""), ("duty", ""), ("vdc", "V"), ("theta", "rad"),
     ("sector", ""), ("state", ""), ("fault", ""), ("cycles", ""),
+    ("cm_step", ""), ("cm_progress", ""),
 ]
 
 

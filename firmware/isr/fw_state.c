@@ -43,7 +43,14 @@ bool fw_state_event(fw_state_t *s, fw_event_t ev, uint32_t fault_code)
     case FW_EV_ARM:
         return s->state == FW_STATE_READY ? fw_state_go(s, FW_STATE_RUNNING) : false;
     case FW_EV_DISARM:
-        return s->state == FW_STATE_RUNNING ? fw_state_go(s, FW_STATE_READY) : false;
+        /* Also stops commissioning. */
+        return s->state == FW_STATE_RUNNING || s->state == FW_STATE_COMMISSION
+                   ? fw_state_go(s, FW_STATE_READY)
+                   : false;
+    case FW_EV_CM_START:
+        return s->state == FW_STATE_READY ? fw_state_go(s, FW_STATE_COMMISSION) : false;
+    case FW_EV_CM_END:
+        return s->state == FW_STATE_COMMISSION ? fw_state_go(s, FW_STATE_READY) : false;
     case FW_EV_CLEAR:
         if (s->state != FW_STATE_FAULT) {
             return false;
@@ -75,6 +82,8 @@ const char *fw_state_name(fw_state_id_t st)
         return "running";
     case FW_STATE_FAULT:
         return "fault";
+    case FW_STATE_COMMISSION:
+        return "commission";
     default:
         return "?";
     }

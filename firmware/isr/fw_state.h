@@ -1,6 +1,7 @@
 /*
  * Drive state machine: boot -> ADC offset calibration -> ready -> running,
- * and fault from anywhere. Transitions happen only on commands (arm, disarm,
+ * ready -> commission (identification / bring-up steps, firmware/commission)
+ * -> ready, and fault from anywhere. Transitions happen only on commands (arm, disarm,
  * clear) or on events raised by the pipeline (calibration done, fault). A
  * fault latches until a clear command; the gates stay off in every state but
  * running. Pure logic: no HAL access here (the pipeline acts on the result).
@@ -12,11 +13,12 @@
 #include <stdint.h>
 
 typedef enum {
-    FW_STATE_BOOT = 0, /* after reset, nothing sampled yet */
-    FW_STATE_CALIB,    /* gates off, averaging ADC offsets */
-    FW_STATE_READY,    /* calibrated, gates off, waiting for arm */
-    FW_STATE_RUNNING,  /* gates on, controller in the loop */
-    FW_STATE_FAULT     /* gates off, latched until clear */
+    FW_STATE_BOOT = 0,  /* after reset, nothing sampled yet */
+    FW_STATE_CALIB,     /* gates off, averaging ADC offsets */
+    FW_STATE_READY,     /* calibrated, gates off, waiting for arm */
+    FW_STATE_RUNNING,   /* gates on, controller in the loop */
+    FW_STATE_FAULT,     /* gates off, latched until clear */
+    FW_STATE_COMMISSION /* a commissioning step drives the inverter (cm.h) */
 } fw_state_id_t;
 
 typedef enum {
@@ -25,7 +27,9 @@ typedef enum {
     FW_EV_ARM,        /* command: enable the gates and run */
     FW_EV_DISARM,     /* command: gates off, back to ready */
     FW_EV_FAULT,      /* a protection fired (any state) */
-    FW_EV_CLEAR       /* command: leave fault (only when no fault is active) */
+    FW_EV_CLEAR,      /* command: leave fault (only when no fault is active) */
+    FW_EV_CM_START,   /* command: start commissioning (from ready) */
+    FW_EV_CM_END      /* commissioning finished or stopped: back to ready */
 } fw_event_t;
 
 typedef struct {
@@ -50,7 +54,7 @@ bool fw_state_gates_allowed(const fw_state_t *s);
 /* fw_state_gates_allowed for a valid s, inlined into the interrupt. */
 static inline bool fw_state_gates_on(const fw_state_t *s)
 {
-    return s->state == FW_STATE_RUNNING;
+    return s->state == FW_STATE_RUNNING || s->state == FW_STATE_COMMISSION;
 }
 
 const char *fw_state_name(fw_state_id_t st);

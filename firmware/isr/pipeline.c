@@ -12,6 +12,10 @@ static void fw_fault_now(fw_t *fw, uint32_t code)
     /* Gates off before anything else, then latch the code. */
     hal_gate_enable(fw->hal, false);
     (void)fw_state_event(&fw->sm, FW_EV_FAULT, code);
+    if (fw->cm.active != 0u) {
+        cm_abort_fault(&fw->cm, code);
+    }
+    fw->cm_gates = 0u;
 }
 
 static void fw_pwm_off(fw_t *fw)
@@ -127,7 +131,10 @@ static void fw_encoder_track(fw_t *fw, uint32_t count)
 /* Encoder counter -> position modulo cpr -> electrical angle. */
 static inline fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc)
 {
-    const uint32_t count = enc->count;
+    /* Direction -1: the counter negated, (c ^ ~0) - ~0 = -c (mod 2^32). */
+    const uint32_t neg = fw->enc_neg;
+    const uint32_t count = (enc->count ^ neg) - neg;
+    const uint32_t index_count = (enc->index_count ^ neg) - neg;
     /* Usual period: the new position pos + delta stays in [0, cpr). With
      * delta in [-2^31, 2^31) and pos < cpr <= 2^31, pos + delta lies in that
      * range exactly when its value modulo 2^32 is below cpr (outside it, the
@@ -141,10 +148,10 @@ static inline fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc
         fw_encoder_track(fw, count);
     }
     /* A new index pulse marks position 0: re-synchronise. */
-    if (enc->index_seen && (enc->index_count != fw->enc_index_last || !fw->enc_index_valid)) {
-        fw->enc_index_last = enc->index_count;
+    if (enc->index_seen && (index_count != fw->enc_index_last || !fw->enc_index_valid)) {
+        fw->enc_index_last = index_count;
         fw->enc_index_valid = true;
-        fw->enc_pos = fw_mod_u32(count - enc->index_count, fw->enc_cpr);
+        fw->enc_pos = fw_mod_u32(count - index_count, fw->enc_cpr);
     }
     /* pos * p * 2^32 / cpr < p * 2^32: the low 32 bits are the angle modulo one
      * electrical turn (cpr * p < 2^31 checked at init). */
@@ -170,7 +177,22 @@ static void fw_apply_commands(fw_t *fw)
     }
     if (fw->req_disarm != 0u) {
         fw->req_disarm = 0u;
-        (void)fw_state_event(&fw->sm, FW_EV_DISARM, 0u);
+        const bool cm = fw->sm.state == FW_STATE_COMMISSION;
+        if (fw_state_event(&fw->sm, FW_EV_DISARM, 0u) && cm) {
+            /* Stop: the step ends, gates off now. */
+            cm_abort_stop(&fw->cm);
+            fw->cm_gates = 0u;
+            fw_pwm_off(fw);
+        }
+    }
+    if (fw->req_cm != 0u) {
+        fw->req_cm = 0u;
+        if (fw_state_event(&fw->sm, FW_EV_CM_START, 0u)) {
+            /* The steps enable the gates when they first drive the legs. */
+            fw->cm_gates = 0u;
+            fw_pwm_off(fw);
+            cm_begin(&fw->cm);
+        }
     }
     if (fw->req_arm != 0u) {
         fw->req_arm = 0u;
@@ -317,6 +339,80 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, const hal_adc_raw_t *
     }
 }
 
+/* ---- commissioning dispatch (firmware/commission; cm.h) ----
+ * The same conversion and protections as every state; the active step then
+ * decides the next period: gates off, leg duties, or the controller with a
+ * torque reference. A protection or a failed step ends it with the gates off
+ * (the step's reason stays in fw->cm.err, the fault latches). */
+static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
+                                 const hal_encoder_raw_t *enc)
+{
+    ctrl_meas_t *const m = &fw->tm.meas;
+    m->i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
+    m->i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
+    /* The step's record of the largest current sees a tripping sample too. */
+    fw->cm.i_peak = fx_max(fw->cm.i_peak, fx_max(fx_abs(m->i_a), fx_abs(m->i_b)));
+    uint32_t f = fw_protect_fast(fw, hal, m->i_a, m->i_b);
+    fw_measure_rest(fw, raw, enc, m);
+    if (f == FW_FAULT_NONE) {
+        f = fw_protect_slow(fw, m->vdc, enc->count);
+        if (f != FW_FAULT_NONE) {
+            fw_fault_now(fw, f);
+        }
+    }
+    fw->tm.vec = 0u;
+    fw->tm.duty = 0;
+    if (f != FW_FAULT_NONE) {
+        fw_pwm_off(fw); /* fw_fault_now ended the step */
+        return;
+    }
+    cm_in_t in;
+    in.i_a = m->i_a;
+    in.i_b = m->i_b;
+    in.i_c = fw->info.has_i_c ? fw_current_pu(raw->i_c, fw->off_q8[2], fw->gain_q30[2])
+                              : fx_neg(fx_add(m->i_a, m->i_b));
+    in.vdc = m->vdc;
+    in.theta = m->theta_e - fw->enc_offset;
+    in.omega_est = fw->estimate.omega_e;
+    in.torque_est = fw->estimate.now.torque;
+    cm_out_t out;
+    if (!cm_period(&fw->cm, &in, &out)) {
+        fw->cm_gates = 0u;
+        fw_pwm_off(fw);
+        if (fw->cm.err == CM_E_NONE) {
+            (void)fw_state_event(&fw->sm, FW_EV_CM_END, 0u);
+        } else {
+            fw_fault_now(fw, FW_FAULT_COMMISSION);
+        }
+        return;
+    }
+    if (out.mode == CM_OUT_OFF) {
+        fw->cm_gates = 0u;
+        fw_pwm_off(fw);
+        return;
+    }
+    if (fw->cm_gates == 0u) {
+        /* Effective at k+1, together with the compare values written now. */
+        fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
+        hal_gate_enable(hal, true);
+        fw->cm_gates = 1u;
+    }
+    if (out.mode == CM_OUT_CTRL) {
+        if (out.ctrl_reset != 0u) {
+            fw->ctrl->reset(fw->ctrl_state.bytes);
+            ctrl_estimator_reset(&fw->est);
+            fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
+        }
+        fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
+        fw->ref_mode = FW_REF_TORQUE;
+        fw_control(fw, hal, m);
+        return;
+    }
+    const ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
+    fw_pwm_out(fw, hal, &legs);
+    fw->applied = legs; /* acting in [k+1, k+2) */
+}
+
 /* Every other state (boot, calibration, ready, fault): gates off. */
 static void fw_period_idle(fw_t *fw, const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc)
 {
@@ -367,13 +463,15 @@ void fw_isr(fw_t *fw)
     hal_adc_read(hal, &raw);
     hal_encoder_read(hal, &enc);
 
-    if ((fw->req_clear | fw->req_disarm | fw->req_arm) != 0) {
+    if ((fw->req_clear | fw->req_disarm | fw->req_arm | fw->req_cm) != 0) {
         fw_apply_commands(fw);
     }
     /* Running: one predictable branch to the straight path; boot,
      * calibration, ready and fault take the general one. */
     if (fw->sm.state == FW_STATE_RUNNING) {
         fw_period_running(fw, hal, &raw, &enc);
+    } else if (fw->sm.state == FW_STATE_COMMISSION) {
+        fw_period_commission(fw, hal, &raw, &enc);
     } else {
         fw_period_idle(fw, &raw, &enc);
     }
@@ -386,7 +484,9 @@ void fw_isr(fw_t *fw)
     fw->tm.period = fw->period;
     fw->tm.state = (uint8_t)fw->sm.state;
     fw->tm.fault = (uint8_t)fw->sm.fault_code;
-    fw->tm.gates = fw_state_gates_on(&fw->sm) ? 1u : 0u;
+    fw->tm.gates = fw->sm.state == FW_STATE_RUNNING || fw->cm_gates != 0u ? 1u : 0u;
+    fw->tm.cm_step = fw->cm.step;
+    fw->tm.cm_progress = fw->cm.progress;
 
     /* Deadline: duration of this ISR against the period's cycle budget. */
     const uint32_t elapsed = hal_cycles(hal) - t0;

@@ -45,6 +45,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "cm.h"
+#include "cm_config.h"
 #include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_types.h"
@@ -79,13 +81,15 @@ typedef struct {
             fx_angle_t theta_e; /* electrical angle from the encoder */
         };
     };
-    q24_t psi_amp;    /* |psi_s| estimate at k, Q24 pu */
-    q24_t torque;     /* torque estimate at k, Q24 pu */
-    q24_t omega_e;    /* electrical speed estimate, Q24 pu */
-    q24_t torque_ref; /* torque reference used at k, Q24 pu */
-    q24_t duty;       /* on-time of segment 0, Q24 fraction */
-    q24_t legs[3];    /* leg duties written at k, Q24 fraction */
-    uint32_t cycles;  /* ISR duration measured with hal_cycles */
+    q24_t psi_amp;        /* |psi_s| estimate at k, Q24 pu */
+    q24_t torque;         /* torque estimate at k, Q24 pu */
+    q24_t omega_e;        /* electrical speed estimate, Q24 pu */
+    q24_t torque_ref;     /* torque reference used at k, Q24 pu */
+    q24_t duty;           /* on-time of segment 0, Q24 fraction */
+    q24_t legs[3];        /* leg duties written at k, Q24 fraction */
+    uint32_t cycles;      /* ISR duration measured with hal_cycles */
+    uint8_t cm_step;      /* commissioning step running (cm_step_id_t), 0 = none */
+    uint16_t cm_progress; /* its progress, per mille */
 } fw_telemetry_t;
 
 typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
@@ -99,6 +103,9 @@ typedef struct {
     uint32_t calib_samples;        /* ADC offset averaging (>= 1), default 256 */
     double adc_gain_corr[3];       /* per-channel current gain correction (~1.0) */
     fx_angle_t enc_offset;         /* electrical angle at encoder count 0 */
+    int8_t enc_direction;          /* +1: theta_e grows with the count; -1: falls */
+    uint32_t enc_cpr;              /* counts per revolution; 0 = hal_info's */
+    cm_config_t cm;                /* commissioning levels and times (cm_config.h) */
     /* Outer speed loop: sized from the machine (speed_loop.h) with this
      * bandwidth and phase margin (0 = the defaults there), unless explicit
      * gains are given (speed_kp or speed_ki > 0, in speed_unit). */
@@ -126,7 +133,10 @@ typedef struct {
     ctrl_params_t params;
     ctrl_bases_t bases;
     const ctrl_desc_t *ctrl;
-    const ctrl_machine_t *machine; /* the controller's machine (kept for re-selection) */
+    const ctrl_machine_t *machine; /* the controller's machine (&machine_own) */
+    ctrl_machine_t machine_own;    /* copy of the configured (or identified) machine */
+    fw_config_t cfg;               /* copy of the start-up configuration (pointers
+                                      machine and ctrl_cfg cleared) */
     union {
         max_align_t align;
         unsigned char bytes[CTRL_STATE_MAX];
@@ -170,8 +180,13 @@ typedef struct {
     bool enc_index_valid;    /* enc_index_last holds a latched index */
     uint32_t enc_index_last; /* counter value at the last index pulse */
     fx_angle_t enc_offset;
+    uint32_t enc_neg; /* 0, or all ones: the count is negated (direction -1) */
+    /* commissioning (firmware/commission): steps, results */
+    cm_t cm;
+    const char *cm_what; /* quantity the commissioning limits could not represent */
+    uint8_t cm_gates;    /* gates enabled by a commissioning step */
     /* commands from the main loop, applied at the next period start */
-    volatile uint8_t req_arm, req_disarm, req_clear;
+    volatile uint8_t req_arm, req_disarm, req_clear, req_cm;
     bool busy; /* re-entry flag */
     uint32_t period;
     fw_telemetry_t tm;
@@ -219,6 +234,27 @@ const fw_telemetry_t *fw_telemetry(const fw_t *fw);
 int fw_select_controller(fw_t *fw, const ctrl_desc_t *desc, const void *cfg);
 int fw_tunable_set(fw_t *fw, const char *name, double value);
 int fw_tunable_get(const fw_t *fw, const char *name, double *value);
+
+/*
+ * Commissioning (main loop; cm.h, docs/identification.md).
+ * fw_commission_start: run the steps in order (state ready, calibrated);
+ *   FW_EBUSY when not ready, FW_ENOENT when a step needs a result no earlier
+ *   step gives (*missing = the step to run first). The ISR enters state
+ *   COMMISSION at the next period (FW_ERANGE: the commissioning limits do not
+ *   fit this machine, fw->cm_what names the quantity); a failed step latches
+ *   FW_FAULT_COMMISSION
+ *   (gates off) with the reason in fw->cm.err; stop (fw_cmd_disarm) ends it.
+ * fw_commission_apply: the identified Rs, Ld, Lq, psi_pm, inertia and the
+ *   encoder offset/direction replace the configured ones (controller and
+ *   estimator re-initialised from the new machine; tunables back to their
+ *   defaults). State ready only (FW_EBUSY), FW_ERANGE if they do not fit.
+ * fw_commission_poll: applies a completed identification (ident run) once.
+ */
+int fw_commission_start(fw_t *fw, const uint8_t *steps, uint8_t n, uint8_t *missing);
+int fw_commission_apply(fw_t *fw);
+bool fw_commission_poll(fw_t *fw);
+/* Results in SI (direction absolute). */
+void fw_commission_results(const fw_t *fw, cm_si_t *out);
 
 /* Controller state block (for tests). */
 void *fw_ctrl_state(fw_t *fw);

@@ -25,6 +25,9 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->calib_samples = FW_CALIB_DEFAULT;
     c->adc_gain_corr[0] = c->adc_gain_corr[1] = c->adc_gain_corr[2] = 1.0;
     c->enc_offset = 0u;
+    c->enc_direction = 1;
+    c->enc_cpr = 0u;
+    cm_config_default(&c->cm);
     /* Speed PI sized at fw_init from the machine's inertia (speed_loop.h). */
     c->speed_bw_hz = 0.0;
     c->speed_pm_deg = 0.0;
@@ -73,36 +76,25 @@ static int32_t fw_q30(double x)
     return (int32_t)floor(x * 1073741824.0 + 0.5);
 }
 
-int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
+/* Everything that follows from the machine: per-unit parameters, estimator,
+ * controller, conversion gains, encoder scaling, protections, speed loop and
+ * the commissioning limits. fw_init (with the caller's controller
+ * configuration) and fw_commission_apply (cfg_default of the new machine)
+ * share it. */
+static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t *ctrl,
+                            const void *ctrl_cfg)
 {
-    if (fw == NULL || hal == NULL || cfg == NULL || cfg->machine == NULL || cfg->ctrl == NULL ||
-        cfg->ctrl->step == NULL || cfg->ctrl->init == NULL || cfg->ctrl->reset == NULL) {
-        return FW_EINVAL;
-    }
-    memset(fw, 0, sizeof *fw);
-    fw->hal = hal;
-    hal_gate_enable(hal, false);
-    hal_info_get(hal, &fw->info);
     const hal_info_t *in = &fw->info;
-    if (in->pwm_freq_hz == 0u || in->period_counts == 0u || in->adc_bits < 2u ||
-        in->adc_bits > 16u || !(in->adc_current_a_per_count > 0.0) ||
-        !(in->adc_vdc_v_per_count > 0.0) || in->encoder_counts_per_rev == 0u ||
-        cfg->calib_samples == 0u || cfg->calib_samples > 65536u) {
-        return FW_EINVAL;
-    }
-    if (ctrl_params_init_diag(&fw->params, &fw->bases, cfg->machine, in->pwm_freq_hz, &fw->why) !=
+    if (ctrl_params_init_diag(&fw->params, &fw->bases, fw->machine, in->pwm_freq_hz, &fw->why) !=
         CTRL_OK) {
         return FW_EINVAL;
     }
-    if ((uint64_t)in->encoder_counts_per_rev * (uint64_t)fw->params.pole_pairs >
-        (uint64_t)INT32_MAX) {
+    if ((uint64_t)fw->enc_cpr * (uint64_t)fw->params.pole_pairs > (uint64_t)INT32_MAX) {
         return FW_ERANGE;
     }
-
-    fw->machine = cfg->machine;
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
-    const int sel = fw_select_controller(fw, cfg->ctrl, cfg->ctrl_cfg);
+    const int sel = fw_select_controller(fw, ctrl, ctrl_cfg);
     if (sel != FW_OK) {
         return sel;
     }
@@ -122,28 +114,21 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     if (fw->vdc_gain_q30 <= 0) {
         return FW_ERANGE;
     }
-    fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
-    fw->pwm_n8 = in->period_counts < (1u << 24) ? in->period_counts << 8 : 0u;
-    fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
-    fw->calib_samples = cfg->calib_samples;
-    fw->enc_cpr = in->encoder_counts_per_rev;
     {
         const uint64_t num = (uint64_t)(uint32_t)fw->params.pole_pairs << 32;
         fw->enc_q32 = (uint32_t)((num / fw->enc_cpr) & 0xFFFFFFFFu);
         fw->enc_r = (uint32_t)(num % fw->enc_cpr);
     }
-    fw->enc_offset = cfg->enc_offset;
 
     fw_protect_cfg_t pc;
     /* Overspeed: FW_OVERSPEED_REL above the rated speed unless configured;
      * the speed reference is limited to the trip level / FW_OVERSPEED_REL. */
     fw->speed_info.overspeed_rpm = cfg->overspeed_rpm > 0.0
                                        ? cfg->overspeed_rpm
-                                       : FW_OVERSPEED_REL * cfg->machine->speed_rated_rpm;
+                                       : FW_OVERSPEED_REL * fw->machine->speed_rated_rpm;
     fw->speed_info.speed_ref_max_rpm = fw->speed_info.overspeed_rpm / FW_OVERSPEED_REL;
-    if (fw_protect_config(&pc, cfg->machine, &fw->bases, in->pwm_freq_hz,
-                          in->encoder_counts_per_rev, in->cycle_clock_hz,
-                          fw->speed_info.overspeed_rpm) != CTRL_OK) {
+    if (fw_protect_config(&pc, fw->machine, &fw->bases, in->pwm_freq_hz, fw->enc_cpr,
+                          in->cycle_clock_hz, fw->speed_info.overspeed_rpm) != CTRL_OK) {
         return FW_EINVAL;
     }
     if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
@@ -165,7 +150,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         const double lpf_hz = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)in->pwm_freq_hz
                                   ? CTRL_SPEED_LPF_HZ_DEFAULT
                                   : 0.45 * (double)in->pwm_freq_hz;
-        if (fw_speed_loop_design(&d, cfg->machine, loop_rate, lpf_hz, NULL, 0u) != CTRL_OK) {
+        if (fw_speed_loop_design(&d, fw->machine, loop_rate, lpf_hz, NULL, 0u) != CTRL_OK) {
             return FW_EINVAL;
         }
         kp = d.kp_nm_s_rad;
@@ -177,22 +162,152 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     }
     /* The gains in SI per mechanical rad/s for reports. */
     const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / CTRL_TWO_PI
-                           : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)cfg->machine->pole_pairs
+                           : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)fw->machine->pole_pairs
                                                                 : 1.0;
     si->kp_nm_s_rad = kp * per_rad;
     si->ki_nm_rad = ki * per_rad;
     if (!(cfg->speed_out_max_nm > 0.0) ||
-        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, cfg->machine->pole_pairs, kp, ki, unit,
+        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
                              cfg->speed_out_max_nm, in->pwm_freq_hz / fw->speed_div) != CTRL_OK) {
         return FW_ERANGE;
     }
 
     fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
     fw->torque_ref_min = fx_neg(fw->torque_ref_max);
+    /* Commissioning limits: a machine the steps cannot represent only
+     * disables commissioning (fw_commission_start names the quantity). */
+    fw->cm_what = NULL;
+    if (cm_configure(&fw->cm, &cfg->cm, &fw->params, &fw->bases, fw->machine, in, fw->enc_cpr,
+                     &fw->cm_what) != 0 &&
+        fw->cm_what == NULL) {
+        fw->cm_what = "commissioning configuration";
+    }
+    return FW_OK;
+}
+
+int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
+{
+    if (fw == NULL || hal == NULL || cfg == NULL || cfg->machine == NULL || cfg->ctrl == NULL ||
+        cfg->ctrl->step == NULL || cfg->ctrl->init == NULL || cfg->ctrl->reset == NULL) {
+        return FW_EINVAL;
+    }
+    memset(fw, 0, sizeof *fw);
+    fw->hal = hal;
+    hal_gate_enable(hal, false);
+    hal_info_get(hal, &fw->info);
+    const hal_info_t *in = &fw->info;
+    if (in->pwm_freq_hz == 0u || in->period_counts == 0u || in->adc_bits < 2u ||
+        in->adc_bits > 16u || !(in->adc_current_a_per_count > 0.0) ||
+        !(in->adc_vdc_v_per_count > 0.0) || in->encoder_counts_per_rev == 0u ||
+        cfg->calib_samples == 0u || cfg->calib_samples > 65536u ||
+        (cfg->enc_direction != 1 && cfg->enc_direction != -1)) {
+        return FW_EINVAL;
+    }
+    fw->machine_own = *cfg->machine;
+    fw->machine = &fw->machine_own;
+    fw->cfg = *cfg;
+    fw->cfg.machine = NULL;
+    fw->cfg.ctrl_cfg = NULL;
+    fw->enc_cpr = cfg->enc_cpr != 0u ? cfg->enc_cpr : in->encoder_counts_per_rev;
+    fw->enc_offset = cfg->enc_offset;
+    fw->enc_neg = cfg->enc_direction < 0 ? 0xFFFFFFFFu : 0u;
+    const int rc = fw_setup_machine(fw, cfg, cfg->ctrl, cfg->ctrl_cfg);
+    if (rc != FW_OK) {
+        return rc;
+    }
+    fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
+    fw->pwm_n8 = in->period_counts < (1u << 24) ? in->period_counts << 8 : 0u;
+    fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
+    fw->calib_samples = cfg->calib_samples;
     fw->ref_mode = FW_REF_TORQUE;
     memset(&fw->applied, 0, sizeof fw->applied);
     fw_state_init(&fw->sm);
     return FW_OK;
+}
+
+int fw_commission_start(fw_t *fw, const uint8_t *steps, uint8_t n, uint8_t *missing)
+{
+    if (fw == NULL || steps == NULL) {
+        return FW_EINVAL;
+    }
+    if (fw->sm.state != FW_STATE_READY || fw->req_cm != 0u) {
+        return FW_EBUSY;
+    }
+    if (fw->cm_what != NULL) {
+        return FW_ERANGE;
+    }
+    if (cm_prepare(&fw->cm, steps, n, missing) != CM_E_NONE) {
+        return FW_ENOENT;
+    }
+    fw->req_cm = 1u;
+    return FW_OK;
+}
+
+void fw_commission_results(const fw_t *fw, cm_si_t *out)
+{
+    if (fw != NULL && out != NULL) {
+        cm_results_si(&fw->cm, fw->enc_neg != 0u ? -1 : 1, (uint8_t)fw->params.pole_pairs,
+                      1.0 / (double)fw->info.pwm_freq_hz, out);
+    }
+}
+
+int fw_commission_apply(fw_t *fw)
+{
+    if (fw == NULL) {
+        return FW_EINVAL;
+    }
+    if (fw->sm.state != FW_STATE_READY) {
+        return FW_EBUSY;
+    }
+    cm_si_t r;
+    fw_commission_results(fw, &r);
+    ctrl_machine_t m = fw->machine_own;
+    if ((r.have & CM_HAVE_RS) != 0u) {
+        m.rs_ohm = r.rs_ohm;
+    }
+    if ((r.have & CM_HAVE_LDQ) != 0u) {
+        m.ld_h = r.ld_h;
+        m.lq_h = r.lq_h;
+    }
+    if ((r.have & CM_HAVE_FLUX) != 0u) {
+        m.psi_pm_wb = r.psi_wb;
+    }
+    if ((r.have & CM_HAVE_MECH) != 0u && isfinite(r.inertia_kgm2) && r.inertia_kgm2 > 0.0) {
+        m.inertia_kgm2 = r.inertia_kgm2;
+    }
+    const ctrl_machine_t old = fw->machine_own;
+    const fx_angle_t old_off = fw->enc_offset;
+    const uint32_t old_neg = fw->enc_neg;
+    const bool enc = (r.have & CM_HAVE_ENC) != 0u;
+    fw->machine_own = m;
+    if (enc) {
+        fw->enc_offset = fw->cm.res.enc_off;
+        fw->enc_neg = r.enc_dir < 0 ? 0xFFFFFFFFu : 0u;
+    }
+    const int rc = fw_setup_machine(fw, &fw->cfg, fw->ctrl, NULL);
+    if (rc != FW_OK) {
+        /* Back to the configuration that worked before. */
+        fw->machine_own = old;
+        fw->enc_offset = old_off;
+        fw->enc_neg = old_neg;
+        (void)fw_setup_machine(fw, &fw->cfg, fw->ctrl, NULL);
+        return rc;
+    }
+    cm_rebase(&fw->cm, &fw->bases, enc);
+    /* The encoder position restarts from the counter in the new direction. */
+    fw->enc_primed = false;
+    fw->enc_index_valid = false;
+    fw->cm.apply = 0u;
+    return FW_OK;
+}
+
+bool fw_commission_poll(fw_t *fw)
+{
+    if (fw == NULL || fw->cm.apply == 0u || fw->sm.state != FW_STATE_READY) {
+        return false;
+    }
+    fw->cm.apply = 0u;
+    return fw_commission_apply(fw) == FW_OK;
 }
 
 /* Initialise desc with cfg into the state block; keep both on success. */

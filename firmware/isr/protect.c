@@ -10,6 +10,7 @@ const char *fw_fault_name(uint32_t code)
         "none",          "overcurrent",  "hw_trip",  "dc_overvoltage", "dc_undervoltage",
         "encoder_stuck", "encoder_jump", "deadline", "watchdog",       "adc_calibration",
         "overspeed",
+        "commission",
     };
     return code < (uint32_t)FW_FAULT_COUNT ? names[code] : "unknown";
 }

@@ -59,7 +59,8 @@ enum {
     FW_FAULT_WATCHDOG = 8,     /* main loop stopped kicking */
     FW_FAULT_CALIB = 9,        /* ADC offset outside the plausible range */
     FW_FAULT_OVERSPEED = 10,   /* |speed| above the overspeed level */
-    FW_FAULT_COUNT = 11
+    FW_FAULT_COMMISSION = 11,  /* a commissioning step failed (cm_t.err names why) */
+    FW_FAULT_COUNT = 12
 };
 
 /* Overspeed level relative to the rated speed (protect.h, criteria above). */

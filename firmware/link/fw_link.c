@@ -1,6 +1,7 @@
 /* Serial link: cmd_ops_t on the pipeline, telemetry samples (see fw_link.h). */
 #include "fw_link.h"
 
+#include <stdio.h>
 #include <string.h>
 
 #include "controller.h"
@@ -203,11 +204,209 @@ static int op_telemetry_stop(void *ctx)
     return CMD_OK;
 }
 
+/* ---- commissioning (cm.h) ---- */
+
+/* The identification sequence ("ident run"). */
+static const uint8_t fw_link_ident_plan[] = {CM_STEP_VBUS, CM_STEP_PROBE, CM_STEP_ENCODER,
+                                             CM_STEP_RS,   CM_STEP_LDQ,   CM_STEP_FLUX};
+
+static bool op_cm_step_at(void *ctx, size_t index, const char **name, unsigned *kind)
+{
+    (void)ctx;
+    if (index + 1u >= (size_t)CM_STEP_COUNT) {
+        return false;
+    }
+    const uint8_t s = (uint8_t)(index + 1u);
+    *name = cm_step_name(s);
+    switch (s) {
+    case CM_STEP_VBUS:
+    case CM_STEP_ENCODER:
+        *kind = CMD_CM_IDENT | CMD_CM_BRINGUP;
+        break;
+    case CM_STEP_GATES:
+    case CM_STEP_SENSE:
+    case CM_STEP_RUN:
+        *kind = CMD_CM_BRINGUP;
+        break;
+    default:
+        *kind = CMD_CM_IDENT;
+        break;
+    }
+    return true;
+}
+
+static void op_cm_status(void *ctx, cmd_cm_status_t *st)
+{
+    const fw_t *fw = fw_link_of(ctx)->fw;
+    cm_outcome_t o;
+    cm_outcome(&fw->cm, &fw->bases, &o);
+    st->verdict = o.verdict;
+    st->step = o.step;
+    st->error = o.error;
+    st->n = o.n;
+    for (size_t k = 0; k < o.n && k < 3u; k++) {
+        st->label[k] = o.label[k];
+        st->value[k] = o.value[k];
+        st->unit[k] = o.unit[k];
+    }
+}
+
+/* The measured values, in SI, in a fixed order. */
+typedef struct {
+    const char *key, *unit;
+    double value;
+} fw_link_result_t;
+
+static size_t fw_link_results(const fw_t *fw, fw_link_result_t out[16])
+{
+    cm_si_t r;
+    fw_commission_results(fw, &r);
+    size_t n = 0;
+    if ((r.have & CM_HAVE_VBUS) != 0u) {
+        out[n++] = (fw_link_result_t){"vbus_v", "V", r.vbus_v};
+    }
+    if ((r.have & CM_HAVE_LPROBE) != 0u) {
+        out[n++] = (fw_link_result_t){"probe_l_mh", "mH", r.l_probe_h * 1e3};
+    }
+    if ((r.have & CM_HAVE_ENC) != 0u) {
+        out[n++] = (fw_link_result_t){"encoder_direction", "", (double)r.enc_dir};
+        out[n++] = (fw_link_result_t){"encoder_offset_deg", "deg", r.enc_offset_deg};
+        out[n++] = (fw_link_result_t){"encoder_counts", "", (double)r.enc_cpr};
+    }
+    if ((r.have & CM_HAVE_RS) != 0u) {
+        out[n++] = (fw_link_result_t){"rs_ohm", "Ohm", r.rs_ohm};
+        out[n++] = (fw_link_result_t){"inverter_error_v", "V", r.v_inv_v};
+        out[n++] = (fw_link_result_t){"unbalance", "", r.unbalance};
+    }
+    if ((r.have & CM_HAVE_LDQ) != 0u) {
+        out[n++] = (fw_link_result_t){"ld_mh", "mH", r.ld_h * 1e3};
+        out[n++] = (fw_link_result_t){"lq_mh", "mH", r.lq_h * 1e3};
+        out[n++] = (fw_link_result_t){"salient", "", r.salient ? 1.0 : 0.0};
+    }
+    if ((r.have & CM_HAVE_FLUX) != 0u) {
+        out[n++] = (fw_link_result_t){"psi_pm_wb", "Wb", r.psi_wb};
+    }
+    if ((r.have & CM_HAVE_MECH) != 0u && r.inertia_kgm2 > 0.0) {
+        out[n++] = (fw_link_result_t){"inertia_kgm2", "kg*m^2", r.inertia_kgm2};
+        out[n++] = (fw_link_result_t){"friction_nms", "N*m*s", r.friction_nms};
+    }
+    return n;
+}
+
+static bool op_cm_result_at(void *ctx, size_t index, const char **key, double *value,
+                            const char **unit)
+{
+    fw_link_result_t r[16];
+    const size_t n = fw_link_results(fw_link_of(ctx)->fw, r);
+    if (index >= n) {
+        return false;
+    }
+    *key = r[index].key;
+    *value = r[index].value;
+    *unit = r[index].unit;
+    return true;
+}
+
+static bool op_cm_ini_at(void *ctx, size_t index, cmd_cm_item_t *item)
+{
+    cm_si_t r;
+    fw_commission_results(fw_link_of(ctx)->fw, &r);
+    cm_item_t it;
+    if (!cm_fragment_item(&r, index, &it)) {
+        return false;
+    }
+    item->section = it.section;
+    item->key = it.key;
+    item->value = it.value;
+    item->integer = it.integer;
+    return true;
+}
+
+static int op_cm_start(void *ctx, const char *what, const char **detail)
+{
+    fw_link_t *l = fw_link_of(ctx);
+    fw_t *fw = l->fw;
+    uint8_t steps[CM_STEP_COUNT];
+    uint8_t n = 0;
+    const bool run = strcmp(what, "run") == 0;
+    if (run || strcmp(what, "resume") == 0) {
+        for (size_t i = 0; i < sizeof fw_link_ident_plan; i++) {
+            const uint8_t s = fw_link_ident_plan[i];
+            /* resume: from the first step whose results are not all there */
+            if (!run && n == 0u && (cm_step_gives(s) & ~fw->cm.res.have) == 0u) {
+                continue;
+            }
+            steps[n++] = s;
+        }
+        if (n == 0u) {
+            *detail = "nothing to resume";
+            return CMD_E_STATE;
+        }
+    } else {
+        const uint8_t s = cm_step_find(what);
+        if (s == CM_STEP_NONE) {
+            return CMD_E_NAME;
+        }
+        steps[n++] = s;
+    }
+    uint8_t missing = CM_STEP_NONE;
+    switch (fw_commission_start(fw, steps, n, &missing)) {
+    case FW_OK:
+        return CMD_OK;
+    case FW_ENOENT:
+        (void)snprintf(l->cm_detail, sizeof l->cm_detail, "needs %s", cm_step_name(missing));
+        *detail = l->cm_detail;
+        return CMD_E_STATE;
+    case FW_ERANGE:
+        (void)snprintf(l->cm_detail, sizeof l->cm_detail, "limit %s",
+                       fw->cm_what != NULL ? fw->cm_what : "?");
+        *detail = l->cm_detail;
+        return CMD_E_RANGE;
+    case FW_EBUSY:
+        *detail = "not ready";
+        return CMD_E_STATE;
+    default:
+        return CMD_E_FAILED;
+    }
+}
+
+static int op_cm_apply(void *ctx)
+{
+    fw_t *fw = fw_link_of(ctx)->fw;
+    if ((fw->cm.res.have & (CM_HAVE_RS | CM_HAVE_LDQ | CM_HAVE_FLUX | CM_HAVE_ENC)) == 0u) {
+        return CMD_E_STATE;
+    }
+    return fw_link_err(fw_commission_apply(fw));
+}
+
+static int op_stop(void *ctx)
+{
+    fw_cmd_disarm(fw_link_of(ctx)->fw);
+    return CMD_OK;
+}
+
 static const cmd_ops_t fw_link_ops = {
-    op_write,           op_get_status,        op_ctrl_at,   op_param_at,
-    op_param_get,       op_select_controller, op_arm,       op_disarm,
-    op_set_torque_ref,  op_set_speed_ref,     op_param_set, op_clear_fault,
-    op_telemetry_start, op_telemetry_stop,
+    op_write,
+    op_get_status,
+    op_ctrl_at,
+    op_param_at,
+    op_param_get,
+    op_select_controller,
+    op_arm,
+    op_disarm,
+    op_set_torque_ref,
+    op_set_speed_ref,
+    op_param_set,
+    op_clear_fault,
+    op_telemetry_start,
+    op_telemetry_stop,
+    op_cm_step_at,
+    op_cm_status,
+    op_cm_result_at,
+    op_cm_ini_at,
+    op_cm_start,
+    op_cm_apply,
+    op_stop,
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx)
@@ -272,12 +471,19 @@ void fw_link_isr(fw_link_t *l)
     s->state = (int32_t)tm->state;
     s->fault = (int32_t)tm->fault;
     s->cycles = (int32_t)(tm->cycles > (uint32_t)INT32_MAX ? (uint32_t)INT32_MAX : tm->cycles);
+    s->cm_step = (int32_t)tm->cm_step;
+    s->cm_progress = (int32_t)tm->cm_progress;
     l->q_head++;
 }
 
 void fw_link_poll(fw_link_t *l)
 {
-    if (l == NULL || l->write == NULL) {
+    if (l == NULL) {
+        return;
+    }
+    /* A completed identification is adopted here, in the main loop. */
+    (void)fw_commission_poll(l->fw);
+    if (l->write == NULL) {
         return;
     }
     uint8_t wire[TEL_WIRE_MAX];

@@ -46,6 +46,7 @@ typedef struct {
     uint32_t dropped;         /* samples lost to a full queue */
     uint8_t send_meta;
     double speed_max_rpm; /* |speed reference| limit (fw_speed_info_t: the rated speed) */
+    char cm_detail[48];   /* detail of the last refused commissioning start */
     fw_link_write_fn write;
     void *write_ctx;
     const fw_link_param_t *params; /* application parameters (fw_link_set_params) */

@@ -226,7 +226,7 @@ static bool cmd_param_find(cmd_t *c, cmd_tok_t name, cmd_param_info_t *info)
 static const char *const cmd_help_lines[] = {
     "help                          this list",
     "status                        drive state, controller, fault, speed, torque",
-    "arm | disarm                  enable / disable the gates and controller",
+    "arm | disarm | stop           enable / disable the gates (stop: any activity)",
     "ctrl list | ctrl select NAME  controllers (select only when disarmed)",
     "ref torque NM | ref speed RPM set the reference (and the control mode)",
     "param list | param get NAME | param set NAME VALUE",
@@ -234,6 +234,9 @@ static const char *const cmd_help_lines[] = {
     "tel list | tel stop           telemetry signals / stop streaming",
     "tel start SIG... [every N]    stream signals (or 'all') every Nth period",
     "echo on | echo off            echo typed characters",
+    "ident run | resume | step NAME motor identification (ident status)",
+    "ident status | result | ini | apply  progress, values, machine file",
+    "bringup NAME | bringup status  bench checks: vbus gates sense encoder run",
 };
 
 static void cmd_help(cmd_t *c)
@@ -670,6 +673,230 @@ static void cmd_echo(cmd_t *c, const cmd_tok_t *tok, size_t n)
     c->echo = on; /* after the response: the mode applies from the next byte */
 }
 
+/* ---- commissioning ---- */
+
+/* The step named tok if it is of `kind` (CMD_CM_*), else NULL. */
+static const char *cmd_cm_find(cmd_t *c, cmd_tok_t tok, unsigned kind)
+{
+    const char *name = NULL;
+    unsigned k = 0u;
+    for (size_t i = 0; i < 64u && c->ops->cm_step_at(c->ctx, i, &name, &k); i++) {
+        if (cmd_str_eq_tok(name, tok)) {
+            return (k & kind) != 0u ? name : NULL;
+        }
+    }
+    return NULL;
+}
+
+/* "ok <verdict> step=<s> [error=<e>] [<label>=<value>[<unit>]]..." */
+static void cmd_cm_status_line(cmd_t *c)
+{
+    cmd_cm_status_t st;
+    memset(&st, 0, sizeof st);
+    st.verdict = "idle";
+    st.step = "none";
+    st.error = "none";
+    c->ops->cm_status(c->ctx, &st);
+    cmd_ok_begin(c);
+    cmd_out_char(c, ' ');
+    cmd_out_str(c, st.verdict);
+    cmd_out_str(c, " step=");
+    cmd_out_str(c, st.step);
+    if (st.error != NULL && strcmp(st.error, "none") != 0) {
+        cmd_out_str(c, " error=");
+        cmd_out_str(c, st.error);
+    }
+    for (size_t k = 0; k < st.n && k < 3u; k++) {
+        cmd_out_char(c, ' ');
+        cmd_out_str(c, st.label[k]);
+        cmd_out_char(c, '=');
+        cmd_out_num(c, st.value[k]);
+        if (st.unit[k] != NULL && st.unit[k][0] != '\0') {
+            cmd_out_str(c, st.unit[k]);
+        }
+    }
+    cmd_out_flush(c);
+}
+
+/* Start `what` (validated); "ok <word> <what>" or the op's error. */
+static void cmd_cm_start(cmd_t *c, const char *word, const char *what)
+{
+    cmd_status_t st;
+    if (!cmd_status(c, &st)) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    if (st.fault != 0u) {
+        cmd_err(c, CMD_E_FAULT, st.fault_name);
+        return;
+    }
+    if (st.armed) {
+        cmd_err(c, CMD_E_STATE, "disarm first");
+        return;
+    }
+    const char *detail = NULL;
+    const int rc = c->ops->cm_start(c->ctx, what, &detail);
+    if (rc != CMD_OK) {
+        cmd_err(c, (rc > 0 && rc < (int)CMD_E_COUNT) ? rc : CMD_E_FAILED, detail);
+        return;
+    }
+    cmd_ok_begin(c);
+    cmd_out_char(c, ' ');
+    cmd_out_str(c, word);
+    cmd_out_char(c, ' ');
+    cmd_out_str(c, what);
+    cmd_out_flush(c);
+}
+
+/* Lines of the machine-file fragment: "[section]" whenever it changes. */
+static uint32_t cmd_cm_ini(cmd_t *c, bool print)
+{
+    cmd_cm_item_t it;
+    const char *sec = NULL;
+    uint32_t n = 0;
+    for (size_t i = 0; i < 64u && c->ops->cm_ini_at(c->ctx, i, &it); i++) {
+        if (sec == NULL || strcmp(sec, it.section) != 0) {
+            sec = it.section;
+            n++;
+            if (print) {
+                cmd_item_begin(c);
+                cmd_out_char(c, '[');
+                cmd_out_str(c, sec);
+                cmd_out_char(c, ']');
+                cmd_out_flush(c);
+            }
+        }
+        n++;
+        if (print) {
+            cmd_item_begin(c);
+            cmd_out_str(c, it.key);
+            cmd_out_str(c, " = ");
+            if (it.integer) {
+                const double a = it.value < 0.0 ? -it.value : it.value;
+                if (it.value < 0.0) {
+                    cmd_out_char(c, '-');
+                }
+                cmd_out_u32(c, (uint32_t)(a + 0.5));
+            } else {
+                cmd_out_num(c, it.value);
+            }
+            cmd_out_flush(c);
+        }
+    }
+    return n;
+}
+
+static void cmd_ident(cmd_t *c, const cmd_tok_t *tok, size_t n)
+{
+    static const char usage[] = "ident run|resume|step NAME|status|result|ini|apply";
+    if (c->ops->cm_step_at == NULL || c->ops->cm_status == NULL || c->ops->cm_start == NULL ||
+        c->ops->cm_result_at == NULL || c->ops->cm_ini_at == NULL || c->ops->cm_apply == NULL) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    if (n == 2 && (cmd_tok_is(tok[1], "run") || cmd_tok_is(tok[1], "resume"))) {
+        cmd_cm_start(c, "ident", cmd_tok_is(tok[1], "run") ? "run" : "resume");
+        return;
+    }
+    if (n == 3 && cmd_tok_is(tok[1], "step")) {
+        const char *name = cmd_cm_find(c, tok[2], CMD_CM_IDENT);
+        if (name == NULL) {
+            cmd_err(c, CMD_E_NAME, "vbus probe encoder rs ldq flux");
+            return;
+        }
+        cmd_cm_start(c, "ident", name);
+        return;
+    }
+    if (n == 2 && cmd_tok_is(tok[1], "status")) {
+        cmd_cm_status_line(c);
+        return;
+    }
+    if (n == 2 && cmd_tok_is(tok[1], "result")) {
+        const char *key = NULL;
+        const char *unit = NULL;
+        double v = 0.0;
+        uint32_t count = 0;
+        while (count < 64u && c->ops->cm_result_at(c->ctx, count, &key, &v, &unit)) {
+            count++;
+        }
+        cmd_ok_list(c, count);
+        for (uint32_t i = 0; i < count; i++) {
+            key = unit = NULL;
+            (void)c->ops->cm_result_at(c->ctx, i, &key, &v, &unit);
+            cmd_item_begin(c);
+            cmd_out_str(c, key);
+            cmd_out_char(c, ' ');
+            cmd_out_num(c, v);
+            cmd_out_char(c, ' ');
+            cmd_out_str(c, (unit == NULL || unit[0] == '\0') ? "-" : unit);
+            cmd_out_flush(c);
+        }
+        return;
+    }
+    if (n == 2 && cmd_tok_is(tok[1], "ini")) {
+        cmd_ok_list(c, cmd_cm_ini(c, false));
+        (void)cmd_cm_ini(c, true);
+        return;
+    }
+    if (n == 2 && cmd_tok_is(tok[1], "apply")) {
+        cmd_status_t st;
+        if (!cmd_status(c, &st)) {
+            cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+            return;
+        }
+        if (st.armed) {
+            cmd_err(c, CMD_E_STATE, "disarm first");
+            return;
+        }
+        if (cmd_op_ok(c, c->ops->cm_apply(c->ctx))) {
+            cmd_ok_begin(c);
+            cmd_out_str(c, " ident applied");
+            cmd_out_flush(c);
+        }
+        return;
+    }
+    cmd_err(c, CMD_E_ARGS, usage);
+}
+
+static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
+{
+    if (c->ops->cm_step_at == NULL || c->ops->cm_status == NULL || c->ops->cm_start == NULL) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    if (n != 2) {
+        cmd_err(c, CMD_E_ARGS, "bringup vbus|gates|sense|encoder|run|status");
+        return;
+    }
+    if (cmd_tok_is(tok[1], "status")) {
+        cmd_cm_status_line(c);
+        return;
+    }
+    const char *name = cmd_cm_find(c, tok[1], CMD_CM_BRINGUP);
+    if (name == NULL) {
+        cmd_err(c, CMD_E_NAME, "vbus gates sense encoder run");
+        return;
+    }
+    cmd_cm_start(c, "bringup", name);
+}
+
+static void cmd_stop(cmd_t *c, size_t n)
+{
+    if (n != 1) {
+        cmd_err(c, CMD_E_ARGS, "stop");
+        return;
+    }
+    if (c->ops->stop == NULL) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    if (cmd_op_ok(c, c->ops->stop(c->ctx))) {
+        cmd_ok_begin(c);
+        cmd_out_str(c, " stopped");
+        cmd_out_flush(c);
+    }
+}
+
 /* ---- line handling ---- */
 
 void cmd_init(cmd_t *c, const cmd_ops_t *ops, void *ctx)
@@ -759,6 +986,12 @@ void cmd_execute(cmd_t *c, const char *line, size_t len)
         cmd_tel(c, tok, n);
     } else if (cmd_tok_is(tok[0], "echo")) {
         cmd_echo(c, tok, n);
+    } else if (cmd_tok_is(tok[0], "ident")) {
+        cmd_ident(c, tok, n);
+    } else if (cmd_tok_is(tok[0], "bringup")) {
+        cmd_bringup(c, tok, n);
+    } else if (cmd_tok_is(tok[0], "stop")) {
+        cmd_stop(c, n);
     } else {
         cmd_err(c, CMD_E_UNKNOWN, "try help");
     }

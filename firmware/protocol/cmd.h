@@ -77,6 +77,27 @@ typedef struct {
     bool read_only;
 } cmd_param_info_t;
 
+#define CMD_CM_IDENT 1u   /* an identification step */
+#define CMD_CM_BRINGUP 2u /* a bench bring-up check */
+
+/* Commissioning status for "ident status" / "bringup status" (cm.h). */
+typedef struct {
+    const char *verdict; /* "idle", "running", "pass", "fail", "stopped" */
+    const char *step;    /* step concerned ("vbus", ...) */
+    const char *error;   /* error name ("none" on a pass) */
+    size_t n;            /* labelled numbers */
+    const char *label[3];
+    double value[3];
+    const char *unit[3];
+} cmd_cm_status_t;
+
+/* One item of the identified machine-file fragment ("ident ini"). */
+typedef struct {
+    const char *section, *key;
+    double value;
+    bool integer;
+} cmd_cm_item_t;
+
 /*
  * The firmware behind the interpreter. Every function receives the context
  * pointer given to cmd_init. State-changing ops return CMD_OK or a cmd_err_t
@@ -105,6 +126,24 @@ typedef struct {
     /* telemetry: mask of TEL_SIG_* bits (telemetry.h), send every Nth sample */
     int (*telemetry_start)(void *ctx, uint32_t mask, uint32_t decimation);
     int (*telemetry_stop)(void *ctx);
+    /* commissioning (PROTOCOL.md "Commissioning"); appended */
+    /* read-only: step names in order (vbus, probe, ...), false past the end;
+     * *kind: CMD_CM_IDENT ("ident step NAME") and/or CMD_CM_BRINGUP
+     * ("bringup NAME") */
+    bool (*cm_step_at)(void *ctx, size_t index, const char **name, unsigned *kind);
+    void (*cm_status)(void *ctx, cmd_cm_status_t *st);
+    /* identified values in SI ("ident result"), false past the end */
+    bool (*cm_result_at)(void *ctx, size_t index, const char **key, double *value,
+                         const char **unit);
+    bool (*cm_ini_at)(void *ctx, size_t index, cmd_cm_item_t *item);
+    /* state-changing: what = "run" (the whole identification), "resume" (its
+     * first step without a result onward) or a step name. On CMD_E_STATE the
+     * op may set *detail (e.g. "needs encoder"); it stays valid until the
+     * next op call. */
+    int (*cm_start)(void *ctx, const char *what, const char **detail);
+    int (*cm_apply)(void *ctx);
+    /* gates off now: ends commissioning or running */
+    int (*stop)(void *ctx);
 } cmd_ops_t;
 
 typedef struct {

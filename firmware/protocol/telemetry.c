@@ -31,6 +31,8 @@ static const tel_signal_t tel_signals[TEL_SIG_COUNT] = {
     TEL_SIG("state", "", "firmware state code", TEL_KIND_INTEGER, state),
     TEL_SIG("fault", "", "latched fault code", TEL_KIND_INTEGER, fault),
     TEL_SIG("cycles", "", "ISR execution time, CPU cycles", TEL_KIND_INTEGER, cycles),
+    TEL_SIG("cm_step", "", "commissioning step running (0 none)", TEL_KIND_INTEGER, cm_step),
+    TEL_SIG("cm_progress", "", "its progress, per mille", TEL_KIND_INTEGER, cm_progress),
 };
 
 const tel_signal_t *tel_signal_at(size_t index)

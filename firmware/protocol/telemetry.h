@@ -22,24 +22,26 @@
 
 /* Signal indices = bit numbers in the mask. Append only (PC tools use the numbers). */
 typedef enum {
-    TEL_SIG_I_A = 0,    /* phase current a */
-    TEL_SIG_I_B,        /* phase current b */
-    TEL_SIG_I_D,        /* d-axis current (estimate at k) */
-    TEL_SIG_I_Q,        /* q-axis current */
-    TEL_SIG_PSI,        /* stator-flux amplitude |psi_s| (4.3) */
-    TEL_SIG_PSI_REF,    /* flux reference in use */
-    TEL_SIG_TORQUE,     /* estimated torque (3.6) */
-    TEL_SIG_TORQUE_REF, /* torque reference */
-    TEL_SIG_SPEED,      /* electrical speed omega_e, shown as mechanical r/min */
-    TEL_SIG_SPEED_REF,  /* speed reference */
-    TEL_SIG_VECTOR,     /* selected voltage vector 0..7 (plan segment 0) */
-    TEL_SIG_DUTY,       /* duty of the selected vector (plan segment 0 duration) */
-    TEL_SIG_VDC,        /* DC-link voltage */
-    TEL_SIG_THETA,      /* rotor electrical angle */
-    TEL_SIG_SECTOR,     /* stator-flux sector 1..6 (4.5) */
-    TEL_SIG_STATE,      /* firmware state code (fw_state_id_t) */
-    TEL_SIG_FAULT,      /* latched fault code (FW_FAULT_*) */
-    TEL_SIG_CYCLES,     /* ISR execution time, CPU cycles */
+    TEL_SIG_I_A = 0,     /* phase current a */
+    TEL_SIG_I_B,         /* phase current b */
+    TEL_SIG_I_D,         /* d-axis current (estimate at k) */
+    TEL_SIG_I_Q,         /* q-axis current */
+    TEL_SIG_PSI,         /* stator-flux amplitude |psi_s| (4.3) */
+    TEL_SIG_PSI_REF,     /* flux reference in use */
+    TEL_SIG_TORQUE,      /* estimated torque (3.6) */
+    TEL_SIG_TORQUE_REF,  /* torque reference */
+    TEL_SIG_SPEED,       /* electrical speed omega_e, shown as mechanical r/min */
+    TEL_SIG_SPEED_REF,   /* speed reference */
+    TEL_SIG_VECTOR,      /* selected voltage vector 0..7 (plan segment 0) */
+    TEL_SIG_DUTY,        /* duty of the selected vector (plan segment 0 duration) */
+    TEL_SIG_VDC,         /* DC-link voltage */
+    TEL_SIG_THETA,       /* rotor electrical angle */
+    TEL_SIG_SECTOR,      /* stator-flux sector 1..6 (4.5) */
+    TEL_SIG_STATE,       /* firmware state code (fw_state_id_t) */
+    TEL_SIG_FAULT,       /* latched fault code (FW_FAULT_*) */
+    TEL_SIG_CYCLES,      /* ISR execution time, CPU cycles */
+    TEL_SIG_CM_STEP,     /* commissioning step running (cm_step_id_t, 0 none) */
+    TEL_SIG_CM_PROGRESS, /* its progress, per mille */
     TEL_SIG_COUNT
 } tel_sig_t;
 
@@ -54,7 +56,7 @@ typedef enum {
  *   vdc                  Q24 pu of the voltage base (V)
  *   duty                 Q24 fraction of the period (FX_ONE = 100 %)
  *   theta                theta_e >> 8: Q24 fraction of a turn, [0, 2^24)
- *   vector sector state fault cycles   plain integers
+ *   vector sector state fault cycles cm_step cm_progress   plain integers
  */
 typedef struct {
     uint32_t tick; /* control period index k (wraps), sent in every frame */
@@ -64,6 +66,7 @@ typedef struct {
     int32_t speed, speed_ref;
     int32_t vector, duty, vdc, theta, sector;
     int32_t state, fault, cycles;
+    int32_t cm_step, cm_progress;
 } tel_sample_t;
 
 /* How a raw value turns into SI. */

@@ -49,6 +49,9 @@ void hal_qemu_plant_config_default(hal_qemu_plant_config_t *cfg, uint32_t pwm_fr
     cfg->enc_lines = c.enc_lines;
     cfg->enc_index = c.enc_index;
     cfg->enc_zero_count = c.enc_zero_count;
+    cfg->enc_zero_rad = c.enc_zero_rad;
+    cfg->enc_dir = c.enc_dir;
+    cfg->adc_invert = c.adc_invert;
     cfg->trip_level_a = c.trip_level_a;
     cfg->seed = c.seed;
 }
@@ -75,6 +78,9 @@ hal_qemu_plant_t *hal_qemu_plant_init(const hal_qemu_plant_config_t *cfg, plant_
     c.enc_lines = cfg->enc_lines;
     c.enc_index = cfg->enc_index;
     c.enc_zero_count = cfg->enc_zero_count;
+    c.enc_zero_rad = cfg->enc_zero_rad;
+    c.enc_dir = cfg->enc_dir;
+    c.adc_invert = cfg->adc_invert;
     c.trip_level_a = cfg->trip_level_a;
     c.seed = cfg->seed;
     c.sense_motor_side = cfg->sense_motor_side;

@@ -30,6 +30,9 @@ typedef struct {
     uint32_t enc_lines;
     bool enc_index;
     uint32_t enc_zero_count;
+    double enc_zero_rad;
+    int8_t enc_dir;
+    uint8_t adc_invert;
     double trip_level_a;
     uint64_t seed;
     bool sense_motor_side;

@@ -25,6 +25,9 @@ void hal_sim_config_default(hal_sim_config_t *c, uint32_t pwm_freq_hz, double cu
     c->enc_lines = 2500u;
     c->enc_index = true;
     c->enc_zero_count = 0u;
+    c->enc_zero_rad = 0.0;
+    c->enc_dir = 1;
+    c->adc_invert = 0u;
     c->trip_level_a = 1.25 * current_max_a;
     c->seed = 1u;
 }
@@ -63,7 +66,7 @@ int hal_sim_init(hal_t *h, const hal_sim_config_t *cfg, plant_t *plant)
         !(cfg->vdc_fullscale_v > 0.0) || !(cfg->adc_noise_counts >= 0.0) ||
         !isfinite(cfg->i_fullscale_a) || !isfinite(cfg->vdc_fullscale_v) ||
         !isfinite(cfg->adc_noise_counts) || cfg->enc_lines == 0u || cfg->enc_lines > 100000000u ||
-        !(cfg->trip_level_a >= 0.0)) {
+        !(cfg->trip_level_a >= 0.0) || !isfinite(cfg->enc_zero_rad)) {
         return HAL_SIM_EINVAL;
     }
     for (int i = 0; i < 4; i++) {
@@ -110,8 +113,9 @@ static void hal_sim_sample(hal_t *h)
     const double lsb_i = 2.0 * c->i_fullscale_a / full;
     const double mid = full / 2.0;
     for (int x = 0; x < 3; x++) {
+        const double sense = ((c->adc_invert >> x) & 1u) != 0u ? -i_abc[x] : i_abc[x];
         const double cnt =
-            mid + c->adc_offset_counts[x] + (1.0 + c->adc_gain_err[x]) * i_abc[x] / lsb_i;
+            mid + c->adc_offset_counts[x] + (1.0 + c->adc_gain_err[x]) * sense / lsb_i;
         const uint16_t v = hal_sim_adc_count(h, cnt);
         if (x == 0) {
             h->adc.i_a = v;
@@ -135,7 +139,8 @@ static void hal_sim_sample(hal_t *h)
 
     /* Encoder from the unwrapped mechanical angle. */
     const uint32_t cpr = 4u * c->enc_lines;
-    const double theta_m = plant_theta_m(h->plant);
+    const double theta_m =
+        (c->enc_dir == -1 ? -1.0 : 1.0) * (plant_theta_m(h->plant) - c->enc_zero_rad);
     const double pos = floor(theta_m * (double)cpr / (2.0 * HAL_SIM_PI));
     const double turns = floor(theta_m / (2.0 * HAL_SIM_PI));
     /* pos modulo 2^32 without converting an out-of-range double. */
@@ -183,7 +188,7 @@ int hal_sim_period_end(hal_t *h)
         return PLANT_EINVAL;
     }
     int rc;
-    if (h->gates_on) {
+    if (h->gates_on && !h->motor_off) {
         double d[3];
         for (int x = 0; x < 3; x++) {
             const uint32_t cmp =
@@ -193,6 +198,10 @@ int hal_sim_period_end(hal_t *h)
         rc = plant_advance_period(h->plant, h->period_s, d);
         if (h->short_slope_a_s != 0.0) {
             h->short_i_a += h->short_slope_a_s * h->period_s;
+        }
+        if (h->short_l_h > 0.0) {
+            /* Mean line voltage a-b of the period over the short's inductance. */
+            h->short_i_a += (d[0] - d[1]) * plant_vdc(h->plant) * h->period_s / h->short_l_h;
         }
     } else {
         const uint8_t off[3] = {PLANT_LEG_OFF, PLANT_LEG_OFF, PLANT_LEG_OFF};
@@ -255,6 +264,23 @@ void hal_sim_inject_encoder_glitch(hal_t *h, int32_t counts)
     if (h != NULL) {
         /* Modulo-2^32 accumulation, done in unsigned arithmetic. */
         h->enc_glitch_total = (int32_t)(uint32_t)((uint32_t)h->enc_glitch_total + (uint32_t)counts);
+    }
+}
+
+void hal_sim_inject_motor_off(hal_t *h, bool off)
+{
+    if (h != NULL) {
+        h->motor_off = off;
+    }
+}
+
+void hal_sim_inject_winding_short(hal_t *h, double l_short_h)
+{
+    if (h != NULL && isfinite(l_short_h) && l_short_h >= 0.0) {
+        h->short_l_h = l_short_h;
+        if (l_short_h == 0.0) {
+            h->short_i_a = 0.0;
+        }
     }
 }
 

@@ -34,11 +34,14 @@
  * rounded and clamped to [0, 2^bits - 1]. Noise: Gaussian, sigma in counts,
  * from a seeded PRNG (splitmix64 + Box-Muller; no rand()).
  *
- * Encoder: lines per revolution x 4 counts, count = floor(theta_m cpr / 2 pi)
- * + zero_count (modulo 2^32). The counter is assumed aligned (zero_count at the
- * d axis on phase a, theta_e = 0), as after an alignment procedure. Optional
- * index at theta_m = 0 mod 2 pi: the counter value (spurious counts included)
- * is latched in index_count, detected at the period starts.
+ * Encoder: lines per revolution x 4 counts, count = floor(dir (theta_m -
+ * enc_zero_rad) cpr / 2 pi) + zero_count (modulo 2^32): the encoder reads
+ * zero_count where the rotor's mechanical angle is enc_zero_rad (electrical:
+ * p enc_zero_rad, the machine file's encoder_offset_deg) and counts down when
+ * enc_dir = -1. The defaults (0, +1) are an encoder aligned with the d axis
+ * on phase a. Optional index where dir (theta_m - enc_zero_rad) = 0 mod 2 pi:
+ * the counter value (spurious counts included) is latched in index_count,
+ * detected at the period starts.
  *
  * Cycle counter (hal_cycles): advances by cycle_clock_hz / pwm_freq_hz per
  * period, plus cycles_per_read on each read (so an ISR that reads it twice
@@ -58,6 +61,16 @@
  *  - encoder glitch: the counter jumps by n counts once (and keeps the offset,
  *    like spurious edges).
  *  - overrun: the next ISR's second hal_cycles read is late by n cycles.
+ *  - motor disconnected (open phases): the plant is advanced with every
+ *    switch open whatever the gates do, so no current flows (a machine at
+ *    rest with no current, as on a bench with the motor leads off).
+ *  - winding short between the a and b leads through an inductance l_s: a
+ *    fault current with di/dt = (v_a - v_b) / l_s (the period's mean leg
+ *    voltages from the active compare values) flows out of leg a and into
+ *    leg b, so the a and b current sensors see +i and -i; opening the gates
+ *    interrupts it. The plant's own currents are not affected.
+ * ADC channel polarity (adc_invert bit x): the current channel x reads the
+ * negated current (a sense resistor or op-amp wired the other way).
  */
 #ifndef HAL_SIM_HAL_SIM_H
 #define HAL_SIM_HAL_SIM_H
@@ -84,7 +97,10 @@ typedef struct {
     double adc_noise_counts;     /* Gaussian noise sigma, counts (>= 0) */
     uint32_t enc_lines;          /* lines per revolution (x4 counts), default 2500 */
     bool enc_index;              /* index pulse modelled */
-    uint32_t enc_zero_count;     /* counter value at theta_m = 0 */
+    uint32_t enc_zero_count;     /* counter value at theta_m = enc_zero_rad */
+    double enc_zero_rad;         /* mechanical angle where the encoder reads zero_count */
+    int8_t enc_dir;              /* -1: counts down as theta_m grows; else up */
+    uint8_t adc_invert;          /* bit x: current channel x negated */
     double trip_level_a;         /* hardware comparator level, A; 0 = off */
     uint64_t seed;               /* PRNG seed for the ADC noise */
     bool sense_motor_side;       /* currents sensed at the motor terminals instead of the
@@ -110,6 +126,8 @@ struct hal {
     uint32_t overrun_pending;
     uint32_t reads_this_period;
     /* injections */
+    bool motor_off;         /* motor disconnected */
+    double short_l_h;       /* winding short through this inductance; 0 = none */
     double short_slope_a_s; /* 0 = no short */
     double short_i_a;       /* present fault current, A */
     bool enc_stuck;
@@ -143,5 +161,7 @@ void hal_sim_inject_vdc(hal_t *h, double vdc_v);
 void hal_sim_inject_encoder_stuck(hal_t *h, bool stuck);
 void hal_sim_inject_encoder_glitch(hal_t *h, int32_t counts);
 void hal_sim_inject_overrun(hal_t *h, uint32_t cycles);
+void hal_sim_inject_motor_off(hal_t *h, bool off);
+void hal_sim_inject_winding_short(hal_t *h, double l_short_h);
 
 #endif /* HAL_SIM_HAL_SIM_H */

@@ -37,6 +37,13 @@ void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out)
     out->psi_ref_wb = m->psi_ref_wb;
 }
 
+void sim_run_ctrl_sensors_from(sim_run_cfg_t *c, const sim_machine_t *m)
+{
+    c->ctrl_enc_lines = m->encoder_lines;
+    c->ctrl_enc_offset_deg = m->encoder_offset_deg;
+    c->ctrl_enc_dir = m->encoder_direction;
+}
+
 void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl_desc_t *ctrl)
 {
     memset(c, 0, sizeof *c);
@@ -62,6 +69,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->kick_watchdog = true;
     engine_hal_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
     c->hal.sense_motor_side = m->current_sense == SIM_SENSE_MOTOR;
+    sim_run_ctrl_sensors_from(c, m);
 }
 
 static double sim_torque_ref_nm(const sim_run_t *r)
@@ -372,6 +380,14 @@ static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_co
         fc->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
     }
     fc->overspeed_rpm = c->overspeed_rpm;
+    /* The firmware's encoder configuration (the control machine's [sensors]). */
+    double off = fmod(c->ctrl_enc_offset_deg, 360.0);
+    off = off < 0.0 ? off + 360.0 : off;
+    double u = floor(off / 360.0 * 4294967296.0 + 0.5);
+    u = u >= 4294967296.0 ? u - 4294967296.0 : u;
+    fc->enc_offset = (fx_angle_t)(uint32_t)u;
+    fc->enc_direction = c->ctrl_enc_dir < 0 ? -1 : 1;
+    fc->enc_cpr = c->ctrl_enc_lines > 0 ? 4u * (uint32_t)c->ctrl_enc_lines : 0u;
 }
 
 #if !defined(ENGINE_PORT_QEMU)
@@ -649,6 +665,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     sim_machine_to_plant(&c->plant_machine, &pc);
     pc.mech = c->free_mech ? PLANT_MECH_FREE : PLANT_MECH_IMPOSED;
     pc.speed0_rpm = c->speed_rpm;
+    pc.theta0_e_rad = c->theta0_e_rad;
     /* The load is applied at the arm instant: a constant load torque on a free
      * rotor during the calibration (no motor torque) would spin it backwards. */
     pc.load_torque_nm = 0.0;
@@ -669,6 +686,13 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     c->hal.pwm_freq_hz = c->fs_hz;
     c->hal.seed = c->seed;
+    /* The plant's encoder: the simulated machine's [sensors]. */
+    if (c->plant_machine.encoder_lines > 0) {
+        c->hal.enc_lines = (uint32_t)c->plant_machine.encoder_lines;
+    }
+    c->hal.enc_zero_rad =
+        c->plant_machine.encoder_offset_deg * SIM_PI / 180.0 / (double)c->plant_machine.pole_pairs;
+    c->hal.enc_dir = c->plant_machine.encoder_direction < 0 ? -1 : 1;
     if (engine_hal_init(&r->hal, &c->hal, &r->plant) != 0) {
         return sim_err(err, errlen, "HAL simulation rejected its configuration");
     }

@@ -92,7 +92,13 @@ typedef struct {
     bool kick_watchdog;           /* kick after each ISR (default; a target's main loop does it) */
     void (*after_isr)(void *ctx); /* called right after fw_isr, may be NULL */
     void *after_isr_ctx;
-    bool skip_thd;            /* no THD (the QEMU images: its sums cost ~10^10 soft-float ops) */
+    bool skip_thd; /* no THD (the QEMU images: its sums cost ~10^10 soft-float ops) */
+    /* The firmware's encoder configuration (the control machine's [sensors];
+     * default: the plant machine's, i.e. a perfectly known encoder). */
+    int ctrl_enc_lines;
+    double ctrl_enc_offset_deg;
+    int ctrl_enc_dir;
+    double theta0_e_rad;      /* initial electrical rotor angle of the plant */
     sim_warnings_t *warnings; /* may be NULL (warnings printed only) */
 } sim_run_cfg_t;
 
@@ -133,6 +139,9 @@ typedef struct {
 
 /* Convert a machine file into the controller's machine description. */
 void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out);
+/* The control machine's encoder settings ([sensors]) into the run's firmware
+ * configuration. */
+void sim_run_ctrl_sensors_from(sim_run_cfg_t *c, const sim_machine_t *m);
 
 /* Defaults: fs = machine fs (the caller sets the controller's), dynamometer
  * at 0 r/min, torque mode 0 N*m, 0.3 s, window 0.1 s .. end, seed 1. */

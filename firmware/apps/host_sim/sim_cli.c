@@ -19,6 +19,7 @@
 
 #include "controller.h"
 #include "sim_diag.h"
+#include "sim_ident.h"
 #include "sim_replay.h"
 #include "sim_run.h"
 
@@ -32,7 +33,10 @@ enum {
 
 typedef enum { K_FLAG, K_REAL, K_UINT, K_TEXT, K_SPAN, K_SET } cli_kind_t;
 /* Which kind of run an option belongs to. */
-typedef enum { M_ANY, M_LOOP, M_REPLAY, M_INFO } cli_mode_t;
+typedef enum { M_ANY, M_LOOP, M_REPLAY, M_INFO, M_IDENT } cli_mode_t;
+/* Closed-loop options that also apply to --identify. */
+static const char *const k_ident_loop_opts[] = {"--control-machine", "--controller", "--seed",
+                                                "--metrics", "--trace-decimation"};
 
 typedef struct {
     double start, end;
@@ -42,6 +46,8 @@ typedef struct {
 typedef struct {
     const char *machine, *control_machine, *controller, *scenario, *trace, *metrics, *replay;
     const char *list_tunables, *current_sense;
+    const char *identify_out, *identify_steps, *inject;
+    int identify;
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
@@ -125,12 +131,21 @@ static const cli_opt_t k_opts[] = {
      "print each tunable of a controller: unit, range, default (for --machine)"},
     {"--replay", "FILE.csv", K_TEXT, 0, 0, "", M_REPLAY, "--trace", NULL, F(replay),
      "open loop: replay a switching sequence (needs --speed-rpm and --trace)"},
-    {"--theta0-elec", "RAD", K_REAL, -1000, 1000, "rad", M_REPLAY, "--replay", NULL, F(theta0),
-     "replay: initial electrical angle (default 0)"},
+    {"--theta0-elec", "RAD", K_REAL, -1000, 1000, "rad", M_ANY, NULL, NULL, F(theta0),
+     "replay, identify: initial electrical rotor angle (default 0)"},
     {"--id0", "A", K_REAL, -1e5, 1e5, "A", M_REPLAY, "--replay", NULL, F(id0),
      "replay: initial d current (default 0)"},
     {"--iq0", "A", K_REAL, -1e5, 1e5, "A", M_REPLAY, "--replay", NULL, F(iq0),
      "replay: initial q current (default 0)"},
+    {"--identify", NULL, K_FLAG, 0, 0, "", M_IDENT, NULL, NULL, F(identify),
+     "run the firmware's identification (free rotor, no load): Rs, Ld, Lq, psi_pm, encoder; "
+     "--metrics writes \"identified\" beside the truth"},
+    {"--identify-out", "FILE.ini", K_TEXT, 0, 0, "", M_IDENT, "--identify", NULL, F(identify_out),
+     "write the configured machine with the identified values"},
+    {"--identify-steps", "A,B,..", K_TEXT, 0, 0, "", M_IDENT, "--identify", NULL, F(identify_steps),
+     "only these steps: vbus probe encoder rs ldq flux gates sense run"},
+    {"--inject", "CASE", K_TEXT, 0, 0, "", M_IDENT, "--identify", NULL, F(inject),
+     "bad case: open (motor not connected), short (a-b leads), encoder_stuck, vbus_low"},
     {"--help", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(help), "this text"},
 };
 #undef F
@@ -162,6 +177,8 @@ static void usage(FILE *f)
     fprintf(f, "usage: sim --machine FILE --controller NAME [options]     closed loop\n"
                "       sim --machine FILE --replay FILE.csv --speed-rpm R --trace FILE   "
                "open loop\n"
+               "       sim --machine FILE --identify [--control-machine FILE] [--metrics F.json]"
+               "   identification\n"
                "       sim --list-controllers | --list-tunables NAME [--machine FILE]\n"
                "options:\n");
     for (size_t i = 0; i < N_OPTS; i++) {
@@ -312,10 +329,24 @@ static int is_given(const int *given, const char *name)
 static int cli_check(cli_t *c, const int *given)
 {
     const int replay = is_given(given, "--replay");
+    const int ident = is_given(given, "--identify");
     for (size_t i = 0; i < N_OPTS; i++) {
         const cli_opt_t *o = &k_opts[i];
         if (!given[i]) {
             continue;
+        }
+        if (ident && o->mode == M_LOOP) {
+            bool ok = false;
+            for (size_t k = 0; k < sizeof k_ident_loop_opts / sizeof k_ident_loop_opts[0]; k++) {
+                ok = ok || strcmp(o->name, k_ident_loop_opts[k]) == 0;
+            }
+            if (!ok) {
+                return die("--identify runs the commissioning sequence: %s does not apply to it",
+                           o->name);
+            }
+        }
+        if (ident && o->mode == M_REPLAY) {
+            return die("give either --identify or --replay, not both");
         }
         if (o->needs != NULL && !is_given(given, o->needs)) {
             return die("%s needs %s%s", o->name, o->needs,
@@ -338,6 +369,15 @@ static int cli_check(cli_t *c, const int *given)
             return die("--replay needs --speed-rpm");
         }
         return 0;
+    }
+    if (ident) {
+        if (is_given(given, "--speed-rpm")) {
+            return die("--identify starts from rest: --speed-rpm does not apply to it");
+        }
+        return 0;
+    }
+    if (is_given(given, "--theta0-elec")) {
+        return die("--theta0-elec belongs to --replay or --identify");
     }
     if (!is_given(given, "--window")) {
         c->window.start = c->duration / 3.0;
@@ -477,6 +517,126 @@ static int replay_main(const cli_t *c, const sim_machine_t *pm)
     return SIM_EXIT_OK;
 }
 
+/* Steps "a,b,c" -> step ids; returns the count or -1 (message printed). */
+static int parse_steps(const char *list, uint8_t *steps, size_t cap)
+{
+    size_t n = 0;
+    const char *p = list;
+    while (*p != '\0') {
+        const char *e = strchr(p, ',');
+        const size_t len = e != NULL ? (size_t)(e - p) : strlen(p);
+        char name[32];
+        if (len == 0u || len >= sizeof name || n >= cap) {
+            fprintf(stderr, "sim: error: --identify-steps '%s': expected NAME[,NAME...]\n", list);
+            return -1;
+        }
+        memcpy(name, p, len);
+        name[len] = '\0';
+        const uint8_t s = cm_step_find(name);
+        if (s == CM_STEP_NONE) {
+            fprintf(stderr,
+                    "sim: error: --identify-steps: unknown step '%s' (vbus probe encoder "
+                    "rs ldq flux gates sense run)\n",
+                    name);
+            return -1;
+        }
+        steps[n++] = s;
+        p += len;
+        if (*p == ',') {
+            p++;
+        }
+    }
+    return (int)n;
+}
+
+static int identify_main(const cli_t *c, const sim_machine_t *pm)
+{
+    const char *ctrl_machine_path = c->control_machine, *ctrl_name = c->controller;
+    const char *steps_arg = c->identify_steps, *inject = c->inject, *out_ini = c->identify_out;
+    const char *metrics_path = c->metrics;
+    const double theta0 = c->theta0, seed = c->seed;
+    char err[512];
+    static sim_machine_t cm;
+    cm = *pm;
+    if (ctrl_machine_path != NULL &&
+        sim_machine_load(ctrl_machine_path, &cm, err, sizeof err) != 0) {
+        return die("control machine file: %s", err);
+    }
+    const ctrl_desc_t *d = ctrl_name != NULL ? ctrl_find(ctrl_name) : ctrl_find("m2ptfc");
+    if (d == NULL) {
+        d = ctrl_at(0);
+    }
+    if (d == NULL) {
+        return die("unknown controller '%s' (see --list-controllers)", ctrl_name);
+    }
+    sim_bad_t bad = SIM_BAD_NONE;
+    if (inject != NULL) {
+        static const char *const names[SIM_BAD_COUNT] = {"none", "open", "short", "encoder_stuck",
+                                                         "vbus_low"};
+        bad = SIM_BAD_COUNT;
+        for (int k = 0; k < (int)SIM_BAD_COUNT; k++) {
+            if (strcmp(inject, names[k]) == 0) {
+                bad = (sim_bad_t)k;
+            }
+        }
+        if (bad == SIM_BAD_COUNT) {
+            return die("--inject '%s': expected open, short, encoder_stuck or vbus_low", inject);
+        }
+    }
+    uint8_t steps[CM_STEP_COUNT];
+    int n = (int)sim_ident_plan_n;
+    memcpy(steps, sim_ident_plan, sim_ident_plan_n);
+    if (steps_arg != NULL && (n = parse_steps(steps_arg, steps, sizeof steps)) < 0) {
+        return SIM_EXIT_USAGE;
+    }
+    FILE *tf = NULL;
+    if (c->trace != NULL && (tf = fopen(c->trace, "w")) == NULL) {
+        return die("cannot write trace file '%s': %s", c->trace, strerror(errno));
+    }
+    sim_ident_trace(tf, (uint32_t)c->decim);
+    static sim_run_t run;
+    if (sim_ident_setup(&run, pm, &cm, d, theta0, (uint64_t)seed, err, sizeof err) != 0) {
+        fprintf(stderr, "sim: error: %s\n", err);
+        if (tf != NULL) {
+            fclose(tf);
+        }
+        return SIM_EXIT_USAGE;
+    }
+    static sim_ident_t id;
+    if (sim_ident_run(&run, steps, (uint8_t)n, 30.0, bad, &id, err, sizeof err) != 0) {
+        fprintf(stderr, "sim: error: %s\n", err);
+        sim_run_free(&run);
+        if (tf != NULL) {
+            fclose(tf);
+        }
+        return SIM_EXIT_RUN;
+    }
+    sim_ident_print(stdout, &run, &id);
+    /* A step that ends in its named error is a fault of the drive (exit 3). */
+    int status = (id.finished && id.err == CM_E_NONE) ? SIM_EXIT_OK : SIM_EXIT_FAULT;
+    if (metrics_path != NULL) {
+        FILE *mf = fopen(metrics_path, "w");
+        if (mf == NULL) {
+            fprintf(stderr, "sim: error: cannot write metrics file '%s': %s\n", metrics_path,
+                    strerror(errno));
+            status = SIM_EXIT_RUN;
+        } else {
+            sim_ident_write_json(mf, &run, &id);
+            fclose(mf);
+        }
+    }
+    if (out_ini != NULL && sim_ident_write_ini(out_ini, &cm, &id, err, sizeof err) != 0) {
+        fprintf(stderr, "sim: error: %s: %s\n", out_ini, err);
+        status = SIM_EXIT_RUN;
+    }
+    sim_run_free(&run);
+    if (tf != NULL && fclose(tf) != 0) {
+        fprintf(stderr, "sim: error: writing the trace failed\n");
+        status = SIM_EXIT_RUN;
+    }
+    return status;
+}
+
 int main(int argc, char **argv)
 {
     static cli_t c;
@@ -523,6 +683,9 @@ int main(int argc, char **argv)
     if (c.replay != NULL) {
         return replay_main(&c, &pm);
     }
+    if (c.identify) {
+        return identify_main(&c, &pm);
+    }
 
     /* ---- closed loop: everything is checked before the run starts ---- */
     if (c.controller == NULL) {
@@ -541,6 +704,7 @@ int main(int argc, char **argv)
             return die("control machine file: %s", err);
         }
         sim_ctrl_machine_from(&cm, &cfg.ctrl_machine);
+        sim_run_ctrl_sensors_from(&cfg, &cm);
     }
     if (c.current_sense != NULL) {
         if (strcmp(c.current_sense, "inverter") != 0 && strcmp(c.current_sense, "motor") != 0) {

@@ -1,0 +1,103 @@
+/*
+ * Commissioning configuration (SI, read once) and the results in SI.
+ * Floating point here only: configuration and reporting, never per period.
+ */
+#ifndef FIRMWARE_COMMISSION_CM_CONFIG_H
+#define FIRMWARE_COMMISSION_CM_CONFIG_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cm.h"
+#include "ctrl_params.h"
+#include "hal.h"
+
+/* Test levels as fractions of the machine's ratings, times in seconds. */
+typedef struct {
+    double i_hold;             /* alignment, scan and bias current / rated (0.3) */
+    double i_rs1, i_rs2;       /* the two DC levels / rated (0.25, 0.5) */
+    double i_probe;            /* probe target / rated (0.1) */
+    double i_open;             /* probe: less at the largest pattern = open / rated (0.02) */
+    double i_acc;              /* accelerating q current / rated (0.5) */
+    double i_fd;               /* +-d current while coasting / rated (0.2) */
+    double i_sense;            /* sense pulse target / rated (0.2) */
+    double i_guard;            /* abort above this phase current / rated (1.0) */
+    double i_gate_max;         /* gate test: current meaning "load connected" / rated (0.05) */
+    double v_lim;              /* standstill voltage limit per axis / Vdc (0.25) */
+    double v_lim_run;          /* spinning voltage limit per axis / Vdc (0.4) */
+    double v_probe0;           /* first probe amplitude / Vdc (0.02) */
+    double vbus_min, vbus_max; /* test window / nominal Vdc (0.8, 1.2) */
+    double l_min_h, l_max_h;   /* plausible inductance (1 uH, 10 H) */
+    double loop_g;             /* current-loop crossover x Ts, rad (0.2) */
+    double damp_rad_s;         /* rotor damping rate Omega, rad/s electrical (30) */
+    double w_flux;             /* flux-step speed / rated (0.3) */
+    double w_guard;            /* abort above / rated (0.8) */
+    double w_settle;           /* at rest below / rated (0.01) */
+    double torque_run;         /* first run torque / rated (0.1) */
+    double unbalance_max;      /* (0.15) */
+    double sense_lo, sense_hi; /* (0.75, 1.3) */
+    double cpr_tol;            /* (0.03) */
+    double salient_min;        /* (0.05) */
+    double gate_duty;          /* (0.05) */
+    double scan_hz;            /* encoder scan, electrical turns per second (4) */
+    double t_vbus, t_ramp, t_settle, t_win, t_hold, t_hold_max, t_hf, t_scan_acc;
+    double t_flux_max, t_flux_win, t_run, t_gate;
+} cm_config_t;
+
+void cm_config_default(cm_config_t *c);
+
+/* Fill cm->par from the configuration, the drive's parameters and the
+ * hardware (results are kept). Returns 0, or -1 when a value does not fit
+ * its format (the name of the quantity in *what). */
+int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const ctrl_bases_t *b,
+                 const ctrl_machine_t *m, const hal_info_t *info, uint32_t enc_cpr,
+                 const char **what);
+
+/* Express the stored results in new bases (after the drive adopted new
+ * machine parameters); enc_adopted: the drive now counts in the identified
+ * direction (relative direction +1). */
+void cm_rebase(cm_t *cm, const ctrl_bases_t *nb, bool enc_adopted);
+
+/* The results in SI. enc_dir_cfg: the drive's configured direction (+1/-1). */
+typedef struct {
+    uint32_t have;
+    double vbus_v, i_off_a[3], i_noise_a[3];
+    double l_probe_h;
+    int enc_dir;           /* absolute direction (configured x measured) */
+    double enc_offset_deg; /* electrical, [0, 360) */
+    uint32_t enc_cpr;      /* measured counts per revolution (rounded) */
+    uint32_t enc_cpr_cfg;  /* configured (the measurement agreed with it) */
+    double unbalance;      /* fraction */
+    double rs_ohm, v_inv_v;
+    double ld_h, lq_h, ld_raw_h, lq_raw_h;
+    bool salient;
+    double psi_wb, psi_pos_wb, psi_neg_wb, omega_flux_rad_s;
+    double inertia_kgm2, friction_nms; /* NaN when not measured */
+} cm_si_t;
+
+void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double ts_s, cm_si_t *o);
+
+/* Item `index` (0..) of the machine-file fragment: section and key as in
+ * sim_host's machine files, the value in the file's unit (integer: print
+ * without decimals). Only measured values are listed. False past the end. */
+typedef struct {
+    const char *section, *key;
+    double value;
+    bool integer;
+} cm_item_t;
+bool cm_fragment_item(const cm_si_t *r, size_t index, cm_item_t *it);
+
+/* The last outcome: verdict ("running", "pass", "fail", "stopped", "idle"),
+ * the step it concerns, the error name ("none" on a pass) and up to three
+ * labelled numbers in SI. */
+typedef struct {
+    const char *verdict, *step, *error;
+    size_t n;
+    const char *label[3];
+    double value[3];
+    const char *unit[3];
+} cm_outcome_t;
+void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o);
+
+#endif /* FIRMWARE_COMMISSION_CM_CONFIG_H */

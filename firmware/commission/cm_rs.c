@@ -1,0 +1,165 @@
+/*
+ * Step "rs": stator resistance by DC injection at two current levels, along
+ * each phase's axis in turn, and the phase-balance check.
+ *
+ * Method (VESC and ODrive lock the field and take R = V / I at one current;
+ * here two levels and the slope, as the issue asks): the current is
+ * regulated along the axis of phase a (0 deg), then of phase b (120 deg),
+ * then of phase c (240 deg). On each axis the rotor is first pulled onto the
+ * field and let come to rest (cm_hold damps its swing), then the current is
+ * held at i_rs1 and at i_rs2 and over each window the applied voltage along
+ * the axis and the measured current are averaged. The inverter's error along
+ * the axis - dead time (Vdc t_d / Ts per leg) and the devices' forward drops
+ * - depends only on the signs of the phase currents, the same at both
+ * levels, so the slope
+ *     R_k = (V2 - V1) / (I2 - I1)
+ * is free of it; the intercept V1 - R_k I1 is that error (v_inv, reported
+ * for axis a). With the rotor at rest there is no back-EMF, and L di/dt
+ * averages out over a window of constant current.
+ * Rs is the mean of the three slopes. Phase balance: along phase x's axis
+ * the slope is (2 R_x + (R_y + R_z) / 2) / 3, so the slopes differ by half
+ * the differences of the phase resistances; unbalance = (max - min) / Rs
+ * above unbalance_max: unbalanced (one phase's resistance off by about
+ * twice that fraction).
+ * Verdicts: a slope <= 0: rs_range; the regulator at its voltage limit in a
+ * window: voltage_limit (resistance too high for the test current, or an
+ * open phase); the rotor not settling: enc_unsteady.
+ * The rotor ends aligned to phase c's axis (hold_angle).
+ */
+#include "cm_internal.h"
+
+enum { P_ALIGN, P_SETTLE1, P_WIN1, P_RAMP2, P_WIN2 };
+
+static const fx_angle_t cm_rs_axis[3] = {0u, 0x55555555u, 0xAAAAAAABu};
+
+/* Scratch: k[1] axis 0..2, a[0] start current of the align ramp, k[0]
+ * settled periods, s[0]/s[1] sum v / i of window 1, s[2]/s[3] of window 2,
+ * s[4] n1, s[5] n2; a[1..3] slopes of the axes, a[4] v_inv of axis a. */
+
+void cm_rs_begin(cm_t *cm)
+{
+    if (!cm->hold_valid) {
+        cm_pi_reset(&cm->pi_d, 0);
+        cm_pi_reset(&cm->pi_q, 0);
+        cm->x.a[0] = 0;
+    } else {
+        cm->x.a[0] = cm->hold_i;
+    }
+    cm->hold_angle = cm_rs_axis[0];
+    cm_pi_tune_dq(cm, cm_l_best(cm), cm_l_best(cm), cm->par.v_lim);
+}
+
+static void cm_rs_window(cm_t *cm, int64_t *sv, int64_t *si, int64_t *n)
+{
+    q24_t vd, vq, id, iq;
+    if (cm_acted(cm, cm->hold_angle, &vd, &vq)) {
+        cm_to_frame(cm->io.i_al, cm->io.i_be, cm->hold_angle, &id, &iq);
+        *sv += vd;
+        *si += id;
+        (*n)++;
+    }
+}
+
+/* Slope of the axis just measured; false (with the error set) if implausible. */
+static int cm_rs_axis_done(cm_t *cm)
+{
+    cm_scratch_t *x = &cm->x;
+    const q24_t v1 = cm_mean(x->s[0], (uint32_t)x->s[4]);
+    const q24_t i1 = cm_mean(x->s[1], (uint32_t)x->s[4]);
+    const q24_t v2 = cm_mean(x->s[2], (uint32_t)x->s[5]);
+    const q24_t i2 = cm_mean(x->s[3], (uint32_t)x->s[5]);
+    q24_t r = 0;
+    if (!cm_ratio((int64_t)v2 - v1, (int64_t)i2 - i1, &r) || r <= 0) {
+        return cm_fail(cm, CM_E_RS_RANGE, fx_sub(v2, v1), fx_sub(i2, i1), x->k[1]);
+    }
+    x->a[1 + x->k[1]] = r;
+    if (x->k[1] == 0) {
+        x->a[4] = fx_sub(v1, fx_mul(r, i1));
+    }
+    for (int k = 0; k < 6; k++) {
+        x->s[k] = 0;
+    }
+    return CM_RUN;
+}
+
+int cm_rs_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
+{
+    (void)in;
+    cm_scratch_t *x = &cm->x;
+    const cm_par_t *p = &cm->par;
+    const fx_angle_t h = cm->hold_angle;
+    cm->progress = (uint16_t)((uint32_t)x->k[1] * 333u + cm->phase * 66u);
+    switch (cm->phase) {
+    case P_ALIGN: {
+        const q24_t i = fx_add(x->a[0], cm_ramp(fx_sub(p->i_rs1, x->a[0]), cm->t, p->n_ramp));
+        cm_hold(cm, h, 0, i, 0, 0, out);
+        x->k[0] = cm_slip(cm) < p->w_settle ? x->k[0] + 1 : 0;
+        if (cm->t >= p->n_ramp && x->k[0] >= (int32_t)p->n_settle) {
+            cm->hold_valid = 1u;
+            cm_next(cm);
+        } else if (cm->t >= p->n_hold_max) {
+            return cm_fail(cm, CM_E_ENC_UNSTEADY, cm_slip(cm), p->w_settle, 0);
+        }
+        return CM_RUN;
+    }
+    case P_SETTLE1:
+        cm_hold(cm, h, 0, p->i_rs1, 0, 0, out);
+        if (cm->t >= p->n_settle) {
+            cm_next(cm);
+        }
+        return CM_RUN;
+    case P_WIN1:
+    case P_WIN2: {
+        const bool one = cm->phase == P_WIN1;
+        cm_hold(cm, h, 0, one ? p->i_rs1 : p->i_rs2, 0, 0, out);
+        if (cm->pi_d.sat) {
+            return cm_fail(cm, CM_E_VOLTAGE_LIMIT, one ? p->i_rs1 : p->i_rs2, p->v_lim, 0);
+        }
+        cm_rs_window(cm, &x->s[one ? 0 : 2], &x->s[one ? 1 : 3], &x->s[one ? 4 : 5]);
+        if (cm->t < p->n_win) {
+            return CM_RUN;
+        }
+        if (one) {
+            cm_next(cm);
+            return CM_RUN;
+        }
+        if (cm_rs_axis_done(cm) == CM_FAIL) {
+            return CM_FAIL;
+        }
+        if (x->k[1] < 2) {
+            /* Next axis: the field turns by 120 deg, the rotor follows. */
+            x->k[1]++;
+            cm->hold_angle = cm_rs_axis[x->k[1]];
+            x->a[0] = p->i_rs2;
+            x->k[0] = 0;
+            cm->phase = P_ALIGN;
+            cm->t = 0u;
+            return CM_RUN;
+        }
+        break;
+    }
+    case P_RAMP2:
+    default:
+        cm_hold(cm, h, 0, fx_add(p->i_rs1, cm_ramp(fx_sub(p->i_rs2, p->i_rs1), cm->t, p->n_ramp)),
+                0, 0, out);
+        if (cm->t >= p->n_ramp + p->n_settle) {
+            cm_next(cm);
+        }
+        return CM_RUN;
+    }
+    const q24_t r0 = x->a[1], r1 = x->a[2], r2 = x->a[3];
+    const q24_t rs = (q24_t)(((int64_t)r0 + r1 + r2) / 3);
+    const q24_t spread = fx_sub(fx_max(r0, fx_max(r1, r2)), fx_min(r0, fx_min(r1, r2)));
+    q24_t u = 0;
+    if (!cm_ratio(spread, rs, &u)) {
+        u = FX_MAX;
+    }
+    cm->res.rs = rs;
+    cm->res.v_inv = x->a[4];
+    cm->res.unbalance = u;
+    cm->res.have |= CM_HAVE_BALANCE;
+    if (u > p->unbalance_max) {
+        return cm_fail(cm, CM_E_UNBALANCED, u, p->unbalance_max, 0);
+    }
+    return CM_DONE;
+}
