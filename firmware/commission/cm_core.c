@@ -345,6 +345,25 @@ bool cm_ratio(int64_t num, int64_t den, q24_t *out)
     return true;
 }
 
+bool cm_muldiv(int64_t num, q24_t mul, int64_t den, q24_t *out)
+{
+    /* |num mul| must stay below 2^63 (checked, not assumed). */
+    const int64_t am = mul >= 0 ? (int64_t)mul : -(int64_t)mul;
+    const int64_t an = num >= 0 ? num : -num;
+    if (den == 0 || (am != 0 && an > INT64_MAX / am)) {
+        return false;
+    }
+    const int64_t p = an * am; /* |num mul| */
+    const int64_t ad = den > 0 ? den : -den;
+    const int64_t q = (p + ad / 2) / ad;
+    if (q > (int64_t)INT32_MAX) {
+        return false;
+    }
+    const bool neg = (num < 0) != (mul < 0) ? den > 0 : den < 0;
+    *out = neg ? -(q24_t)q : (q24_t)q;
+    return true;
+}
+
 q24_t cm_ramp(q24_t x, uint32_t t, uint32_t n)
 {
     if (n == 0u || t >= n) {
@@ -376,7 +395,9 @@ void cm_pi_tune(cm_pi_t *c, q24_t l_pu, q24_t ts, q24_t g, q24_t lim)
     /* kp = L g / Ts: the loop's crossover is g / Ts (rad/s pu) whatever R is;
      * ki per period = kp g / 4 puts the PI zero at a quarter of it. */
     q24_t kp = 0;
-    (void)cm_ratio((int64_t)fx_mul(l_pu, g), ts, &kp);
+    if (!cm_muldiv(l_pu, g, ts, &kp)) {
+        kp = 127 * FX_ONE; /* beyond any machine the core accepts */
+    }
     c->kp = kp;
     c->ki = fx_mul(kp, g) / 4;
     c->lim = lim;

@@ -94,6 +94,10 @@ bool cm_acted(const cm_t *cm, fx_angle_t ang, q24_t *vd, q24_t *vq);
 q24_t cm_mean(int64_t sum, uint32_t n);
 /* num / den in Q24 when it fits and den != 0; else false. */
 bool cm_ratio(int64_t num, int64_t den, q24_t *out);
+/* num x mul / den for Q24 num, mul and den (num a sum of up to 2^14 Q24
+ * values): round(num mul / den) as Q24 when it fits; else false. No
+ * intermediate ratio, so num / den may exceed the Q24 range. */
+bool cm_muldiv(int64_t num, q24_t mul, int64_t den, q24_t *out);
 /* Linear ramp from 0 to x over n periods (t = 0 .. n). */
 q24_t cm_ramp(q24_t x, uint32_t t, uint32_t n);
 

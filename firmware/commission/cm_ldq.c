@@ -48,9 +48,11 @@ void cm_ldq_begin(cm_t *cm)
     const q24_t l = cm_l_best(cm);
     cm_pi_tune_dq(cm, l, l, cm->par.v_lim);
     /* V_h = dI L / Ts with dI = i_hold / 8, at most 3/4 of the voltage limit. */
-    q24_t lt = 0;
-    (void)cm_ratio(l, cm->par.ts, &lt);
-    cm->x.a[1] = fx_min(fx_mul(cm->par.i_hold / 8, lt), cm->par.v_lim - cm->par.v_lim / 4);
+    q24_t vh = 0;
+    if (!cm_muldiv(cm->par.i_hold / 8, l, cm->par.ts, &vh)) {
+        vh = FX_MAX;
+    }
+    cm->x.a[1] = fx_min(vh, cm->par.v_lim - cm->par.v_lim / 4);
 }
 
 /* One demodulation sample along the rotor axis at angle ax. */
@@ -110,11 +112,10 @@ int cm_ldq_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     if (!last) {
         return CM_RUN;
     }
-    q24_t r = 0;
-    if (!cm_ratio(x->s[0], x->s[1], &r) || r <= 0) {
+    q24_t l = 0;
+    if (!cm_muldiv(x->s[0], p->ts, x->s[1], &l) || l <= 0) {
         return cm_fail(cm, CM_E_L_RANGE, 0, p->l_min, p->l_max);
     }
-    const q24_t l = fx_mul(r, p->ts);
     if (l < p->l_min || l > p->l_max) {
         return cm_fail(cm, CM_E_L_RANGE, l, p->l_min, p->l_max);
     }

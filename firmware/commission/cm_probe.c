@@ -69,9 +69,8 @@ int cm_probe_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     /* A current far beyond the target: stop driving (gates off), classify. */
     if (fx_abs(di) > 4 * cm->par.i_probe && p <= 3 * m + 1) {
         cm_out_off(cm, out);
-        q24_t r = 0;
-        (void)cm_ratio(j < m ? x->s[0] : fx_neg(fx_sat32(x->s[1])), fx_abs(di), &r);
-        const q24_t l = fx_mul(r, cm->par.ts);
+        q24_t l = 0;
+        (void)cm_muldiv(j < m ? x->s[0] : -x->s[1], cm->par.ts, fx_abs(di), &l);
         return cm_fail(cm, CM_E_SHORTED_PHASE, fx_abs(di), l, 0);
     }
     if (p < m) {
@@ -122,12 +121,11 @@ int cm_probe_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
         }
     }
     /* L = Ts sum(v) / di over segment 2 (volt-periods and a negative swing). */
-    q24_t r = 0;
+    q24_t l = 0;
     const q24_t swing = x->a[4];
-    if (!cm_ratio(x->s[1], swing, &r) || r <= 0) {
+    if (!cm_muldiv(x->s[1], cm->par.ts, swing, &l) || l <= 0) {
         return cm_fail(cm, CM_E_L_RANGE, 0, cm->par.l_min, cm->par.l_max);
     }
-    const q24_t l = fx_mul(r, cm->par.ts);
     if (l < cm->par.l_min) {
         return cm_fail(cm, CM_E_SHORTED_PHASE, d1, l, 0);
     }

@@ -44,11 +44,13 @@ void cm_sense_begin(cm_t *cm)
     /* m_p periods at V_p so that dI reaches about i_sense with L_min. */
     q24_t vp = p->v_lim - p->v_lim / 5;
     q24_t r = 0;
-    (void)cm_ratio(fx_mul(p->i_sense, x->a[4]), fx_mul(vp, p->ts), &r);
-    int32_t m = r / FX_ONE;
+    int32_t m = 64; /* a very large inductance: the longest pulse */
+    if (cm_ratio(fx_mul(p->i_sense, x->a[4]), fx_mul(vp, p->ts), &r)) {
+        m = r / FX_ONE;
+    }
     if (m < 1) {
         m = 1;
-        (void)cm_ratio(fx_mul(p->i_sense, x->a[4]), p->ts, &vp);
+        (void)cm_muldiv(p->i_sense, x->a[4], p->ts, &vp);
     }
     x->a[0] = vp;
     x->k[0] = m > 64 ? 64 : m;

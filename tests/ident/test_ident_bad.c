@@ -5,7 +5,7 @@
  * wrong (enc_cpr), DC link too low for the test (vbus_low). Also: stop in
  * the middle of a step (back to ready, gates off), a drive protection during
  * a step (fault), a step whose prerequisite is missing (refused), and the
- * bring-up checks' pass and fail answers.
+ * bring-up checks' pass and fail answers (gates, sense, first run).
  * Host closed loop (plant, hal/sim, firmware), thesis SPMSM, ideal inverter
  * (the exact plant path keeps these runs short), rotor at rest at 1 rad.
  */
@@ -208,6 +208,28 @@ static void test_bringup_sense(void)
     TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
 }
 
+/* Bring-up: the first closed-loop run passes with the right encoder
+ * settings and says "run_direction" with an offset 180 deg wrong (the torque
+ * turns the rotor the other way). */
+static void test_bringup_run(void)
+{
+    const uint8_t runs[] = {CM_STEP_RUN};
+    start(&spm, &spm);
+    ident(runs, 1, SIM_BAD_NONE, 2.0);
+    TEST_ASSERT_EQUAL_STRING("none", cm_err_name(id.err));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+    /* It gained a fifth of the rated speed (detail[0], pu electrical). */
+    TEST_ASSERT_TRUE(run.fw.cm.detail[0] >= run.fw.cm.par.w_rated / 5 - run.fw.cm.par.w_rated / 50);
+    sim_run_free(&run);
+
+    sim_machine_t wrong = spm;
+    wrong.encoder_offset_deg = 180.0;
+    start(&spm, &wrong);
+    ident(runs, 1, SIM_BAD_NONE, 2.0);
+    expect_fail(CM_E_RUN_DIRECTION, FW_FAULT_COMMISSION);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -221,5 +243,6 @@ int main(void)
     RUN_TEST(test_needs);
     RUN_TEST(test_bringup_gates);
     RUN_TEST(test_bringup_sense);
+    RUN_TEST(test_bringup_run);
     return UNITY_END();
 }
