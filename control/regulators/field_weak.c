@@ -1,0 +1,198 @@
+/*
+ * Field weakening, per-period part (integer-only). Equations and formats:
+ * field_weak.h.
+ */
+#include "field_weak.h"
+
+#include "mtpa.h"
+
+#define FW_NEWTON_STEPS 3 /* per call of ctrl_fieldweak_currents */
+
+void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
+{
+    s->vdc_acc = 0;
+    s->primed = 0u;
+    s->t_prev = 0;
+    s->psi_d = 0;
+}
+
+/* floor(sqrt(x)) of a Q48 value >= 0 as Q24 (x < 2^62: the result < 2^31). */
+static q24_t fw_sqrt48(int64_t x)
+{
+    if (x <= 0) {
+        return 0;
+    }
+    return (q24_t)fx_isqrt64((uint64_t)x);
+}
+
+static int64_t fw_sq48(q24_t x)
+{
+    return (int64_t)x * x; /* < 2^62 */
+}
+
+/* psi_d of the MTPV point on the flux circle psi (field_weak.h):
+ * -2 c2 psi^2 / (c1 + sqrt(c1^2 + 8 c2^2 psi^2)). */
+static q24_t fw_mtpv_psid(const ctrl_fieldweak_t *s, q24_t psi)
+{
+    const q24_t psi2 = fx_mul(psi, psi);
+    const int64_t rad = (int64_t)s->c1_sq * FX_ONE + (int64_t)s->c2_sq8 * psi2; /* Q48 */
+    return fx_neg(fx_div(fx_mul(fx_add(s->c2, s->c2), psi2), fx_add(s->c1, fw_sqrt48(rad))));
+}
+
+q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_t *limit)
+{
+    const int64_t psi2 = fw_sq48(psi);
+    const q24_t psid_v = fw_mtpv_psid(s, psi);
+    const q24_t psiq_v = fw_sqrt48(psi2 - fw_sq48(psid_v));
+    const q24_t t_v = fx_mul(psiq_v, fx_sub(s->c1, fx_mul(s->c2, psid_v)));
+    const q24_t id_v = fx_mul(fx_sub(psid_v, s->psi_pm), s->inv_ld);
+
+    /* On the flux ellipse |i|^2 = i_d^2 + (psi^2 - (Ld i_d + psi_pm)^2) / Lq^2
+     * is convex in i_d: largest at the left end -(psi + psi_pm)/Ld, smallest
+     * at i_d* = Ld psi_pm / (Lq^2 - Ld^2) or at the right end (psi - psi_pm)/Ld
+     * if that comes first. */
+    uint8_t lim = CTRL_FW_LIMIT_MTPV;
+    q24_t t = t_v;
+    const q24_t id_right = fx_mul(fx_sub(psi, s->psi_pm), s->inv_ld);
+    const q24_t id_left = fx_neg(fx_mul(fx_add(psi, s->psi_pm), s->inv_ld));
+    const q24_t id_min = fx_min(id_right, s->id_star);
+    const q24_t pd_min = fx_add(fx_mul(s->ld, id_min), s->psi_pm);
+    const int64_t i2_min =
+        fw_sq48(id_min) + fx_mul(fx_round_sat(psi2 - fw_sq48(pd_min), FX_QBITS), s->inv_lq2) *
+                              (int64_t)FX_ONE; /* Q48 */
+    if (i2_min > fw_sq48(s->i_max)) {
+        /* No point of the flux circle inside the current circle (above the
+         * speed the current limit reaches, or a fixed flux it cannot hold). */
+        t = 0;
+        lim = CTRL_FW_LIMIT_VOLTAGE;
+    } else if (fx_abs(id_left) > s->i_max) {
+        /* The circles meet: c = c0 - psi^2,
+         * i_d = -2c / (b + sqrt(b^2 + 4 (Lq^2 - Ld^2) c)); the arc i_d >= it
+         * is inside the current circle. */
+        const int64_t c48 = (int64_t)s->c0 * FX_ONE - psi2; /* Q48 */
+        const q24_t c = fx_round_sat(c48, FX_QBITS);
+        const int64_t disc = fw_sq48(s->b) + 4 * (int64_t)s->dl2 * c; /* Q48 */
+        const q24_t id_x = fx_neg(fx_div(fx_add(c, c), fx_add(s->b, fw_sqrt48(disc))));
+        if (id_v < id_x) {
+            /* MTPV lies outside the current circle: the intersection bounds T. */
+            const q24_t iq_x = fw_sqrt48(fw_sq48(s->i_max) - fw_sq48(id_x));
+            t = fx_mul(fx_add(s->psi_pm, fx_mul(s->ld_m_lq, id_x)), iq_x);
+            lim = CTRL_FW_LIMIT_VOLTAGE;
+        }
+    }
+    if (limit != 0) {
+        *limit = lim;
+    }
+    return fx_min(fx_max(t, 0), fx_mul(s->t_margin, t_v));
+}
+
+void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
+                         q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
+{
+    /* DC link: first-order low pass (the ADC's noise, not its dips: vdc_k is
+     * set for ~1 kHz). */
+    if (s->primed == 0u) {
+        s->vdc_acc = (int64_t)vdc * FX_ONE;
+        s->primed = 1u;
+    } else {
+        const q24_t vf = fx_round_sat(s->vdc_acc, FX_QBITS);
+        s->vdc_acc += (int64_t)fx_sub(vdc, vf) * s->vdc_k; /* |.| < 2^31 * 2^24 */
+    }
+    const q24_t vdc_f = fx_max(fx_round_sat(s->vdc_acc, FX_QBITS), 0);
+    out->vdc = vdc_f;
+
+    /* Flux the voltage allows: psi_max = sqrt(V^2 - (Rs I)^2 - 2 Rs w T) / |w|. */
+    const q24_t v = fx_mul_qn(vdc_f, s->v_frac, 30u);
+    int64_t x = fw_sq48(v) - s->rs_i2;
+    x -= (int64_t)s->two_rs * fx_mul(omega, s->t_prev); /* |.| < 2^62 */
+    const q24_t w = fx_abs(omega);
+    q24_t psi_max = s->psi_ceil;
+    if (w != 0) {
+        psi_max = fx_min(fx_div(fw_sqrt48(x), w), s->psi_ceil);
+    }
+    out->psi_max = psi_max;
+
+    /* Torque limit at the flux the controller will hold. */
+    const q24_t psi_fix = psi_cmd > 0 ? psi_cmd : p->psi_ref;
+    q24_t t_lim;
+    uint8_t lim;
+    if (psi_fix <= 0 && psi_max >= s->psi_mtpa) {
+        t_lim = s->t_mtpa;
+        lim = CTRL_FW_LIMIT_CURRENT;
+    } else {
+        const q24_t psi_lim = psi_fix > 0 ? fx_min(psi_fix, psi_max) : psi_max;
+        t_lim = ctrl_fieldweak_torque_at_flux(s, psi_lim, &lim);
+        if (psi_lim < psi_max) {
+            lim = CTRL_FW_LIMIT_FLUX; /* the fixed reference, not the voltage */
+        }
+    }
+    const q24_t t = fx_clamp(t_req, fx_neg(t_lim), t_lim);
+    const q24_t psi_own = ctrl_flux_ref(p, psi_cmd, t);
+    out->torque_max = t_lim;
+    out->torque = t;
+    out->psi_ref = fx_min(psi_own, psi_max);
+    out->limit = lim;
+    out->clipped = t != t_req ? 1u : 0u;
+    out->weakening = psi_max < psi_own ? 1u : 0u;
+    s->t_prev = t;
+}
+
+void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t t, q24_t psi_ref,
+                             q24_t *i_d, q24_t *i_q)
+{
+    q24_t md;
+    q24_t mq;
+    ctrl_mtpa_current(p, t, &md, &mq);
+    const q24_t psi_d = fx_add(fx_mul(p->ld, md), s->psi_pm);
+    if (psi_ref <= 0 || fx_mag(psi_d, fx_mul(p->lq, mq)) <= psi_ref) {
+        s->psi_d = psi_d; /* MTPA is within the voltage: where weakening starts */
+        *i_d = md;
+        *i_q = mq;
+        return;
+    }
+    /* On the flux circle psi, T(psi_d) = psi_q (c1 - c2 psi_d) falls strictly
+     * from T_mtpv at psi_d = psi_d,mtpv to 0 at psi_d = min(psi, c1/c2):
+     * bracketed Newton steps from the previous solution. */
+    const q24_t psi = psi_ref;
+    const int64_t psi2 = fw_sq48(psi);
+    const q24_t lo_v = fw_mtpv_psid(s, psi);
+    q24_t lo = lo_v;
+    q24_t hi = psi;
+    if (s->c2 > 0 && fx_mul(s->c2, psi) > s->c1) {
+        hi = fx_div(s->c1, s->c2);
+    }
+    const q24_t ta = fx_abs(t);
+    q24_t x = fx_clamp(s->psi_d, lo, hi);
+    for (int k = 0; k < FW_NEWTON_STEPS; k++) {
+        const q24_t pq = fw_sqrt48(psi2 - fw_sq48(x));
+        const q24_t kk = fx_sub(s->c1, fx_mul(s->c2, x));
+        const q24_t r = fx_sub(fx_mul(pq, kk), ta);
+        if (r > 0) {
+            lo = x; /* too much torque: psi_d must rise */
+        } else {
+            hi = x;
+        }
+        /* dT/dpsi_d = -(psi_d k + c2 psi_q^2) / psi_q: Newton step
+         * r psi_q / (psi_d k + c2 psi_q^2). */
+        const q24_t den = fx_add(fx_mul(x, kk), fx_mul(s->c2, fx_mul(pq, pq)));
+        q24_t xn = x;
+        if (den > 0) {
+            xn = fx_add(x, fx_div(fx_mul(r, pq), den));
+        }
+        if (den <= 0 || xn < lo || xn > hi) {
+            xn = fx_add(lo, fx_rshift32_round(fx_sub(hi, lo), 1u)); /* bisect */
+        }
+        x = xn;
+    }
+    s->psi_d = x;
+    const q24_t id = fx_mul(fx_sub(x, s->psi_pm), s->inv_ld);
+    /* i_q from the torque, T = (psi_pm + (Ld - Lq) i_d) i_q: exact in T even
+     * where psi_q = sqrt(psi^2 - psi_d^2) resolves a small torque poorly (near
+     * psi_d = psi one LSB of psi_d is sqrt(2 psi) LSB^(1/2) of psi_q); never
+     * beyond the flux circle (|t| above the arc's maximum: the MTPV point). */
+    const q24_t q_f = fx_mul(fw_sqrt48(psi2 - fw_sq48(x)), p->inv_lq);
+    const q24_t q_t = fx_div(ta, fx_add(s->psi_pm, fx_mul(s->ld_m_lq, id)));
+    const q24_t q = x == lo_v ? fx_min(q_t, q_f) : q_t;
+    *i_d = id;
+    *i_q = t < 0 ? fx_neg(q) : q;
+}

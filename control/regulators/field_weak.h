@@ -1,0 +1,129 @@
+/*
+ * Field weakening: the operating limits of one PWM period from the voltage
+ * available in it (integer-only; configuration in field_weak_config.h).
+ *
+ * Steady state of the dq model in pu (Te = psi x i, (3.6)), v = Rs i + j w psi:
+ *   |v|^2 = Rs^2 |i|^2 + w^2 |psi|^2 + 2 Rs w Te
+ * so with the usable phase-voltage amplitude V = k_mod Vdc / sqrt(3) (k_mod the
+ * modulation's limit, Vdc measured this period and low-pass filtered) the
+ * stator-flux amplitude the voltage allows at electrical speed w is
+ *   psi_max = sqrt(V^2 - (Rs I_max)^2 - 2 Rs w T) / |w|
+ * (T = the torque reference of the previous period: motoring, w T > 0, leaves
+ * less flux; braking more; I_max bounds the resistive term from above).
+ *
+ * Torque limit at the flux amplitude psi (psi = psi_max, or a fixed flux
+ * reference below it), for Lq >= Ld:
+ *   - MTPA mode and psi_max >= |psi_s| of MTPA at I_max: the current limit,
+ *     T_mtpa(I_max) (below base speed);
+ *   - otherwise the flux circle |psi_s| = psi in the current plane, an
+ *     ellipse (Ld i_d + psi_pm)^2 + (Lq i_q)^2 = psi^2, meets the current circle
+ *     |i| = I_max where
+ *       (Ld^2 - Lq^2) i_d^2 + 2 Ld psi_pm i_d + psi_pm^2 + Lq^2 I_max^2 - psi^2 = 0,
+ *     i_d = -2c / (b + sqrt(b^2 + 4 (Lq^2 - Ld^2) c)), b = 2 Ld psi_pm,
+ *     c = psi_pm^2 + Lq^2 I_max^2 - psi^2 (the root without cancellation);
+ *     the smaller root: |i|^2 on the ellipse is convex in i_d, so the arc
+ *     inside the current circle starts there (the circle holds no point of
+ *     the ellipse when even its least |i| exceeds I_max);
+ *   - the largest torque on the flux circle (MTPV), with c1 = psi_pm / Ld,
+ *     c2 = 1/Ld - 1/Lq: T = psi_q (c1 - c2 psi_d), maximal at
+ *       psi_d = -2 c2 psi^2 / (c1 + sqrt(c1^2 + 8 c2^2 psi^2))  (SPMSM: 0);
+ *   - T_lim = T_mtpv if the MTPV point lies inside the current circle (limit
+ *     "mtpv"), else the torque at the intersection (limit "voltage": current
+ *     circle and voltage ellipse), 0 if the flux circle has no point inside
+ *     the current circle, and never above torque_margin * T_mtpv: a
+ *     torque controller holding |psi_s| fixed loses the load angle at the
+ *     MTPV point (dT/d delta = 0) and the torque collapses.
+ * The flux reference is min(the controller's own (MTPA (4.15) / table, or the
+ * fixed reference), psi_max) for the limited torque; every function of it is
+ * continuous in speed, DC link and torque, so entering and leaving field
+ * weakening is smooth.
+ *
+ * Formats: every q24_t is Q24 pu (bases in ctrl_params.h); squares and sums
+ * of squares are formed in int64_t (Q48) and square-rooted exactly with
+ * fx_isqrt64 (floor); three fx_div per period (psi_max, the intersection,
+ * MTPV). Error budget: docs/error-budget.md, "Field weakening".
+ */
+#ifndef CONTROL_FIELD_WEAK_H
+#define CONTROL_FIELD_WEAK_H
+
+#include <stdint.h>
+
+#include "ctrl_params.h"
+#include "fx.h"
+
+/* What bounds the torque at this speed and DC link. */
+typedef enum {
+    CTRL_FW_LIMIT_CURRENT = 0, /* current circle (MTPA at I_max): below base speed */
+    CTRL_FW_LIMIT_VOLTAGE = 1, /* current circle and voltage ellipse: field weakening */
+    CTRL_FW_LIMIT_MTPV = 2,    /* voltage alone (MTPV, IPMSM with psi_pm/Ld < I_max) */
+    CTRL_FW_LIMIT_FLUX = 3,    /* a fixed flux reference below the voltage's limit */
+    CTRL_FW_LIMIT_COUNT = 4
+} ctrl_fw_limit_t;
+
+typedef struct {
+    /* configuration (field_weak_config.c) */
+    int32_t v_frac; /* usable phase-voltage amplitude per unit DC link, k_mod/sqrt(3), Q30 */
+    q24_t i_max;    /* current limit */
+    int64_t rs_i2;  /* (Rs I_max)^2, Q48 */
+    q24_t two_rs;   /* 2 Rs */
+    q24_t psi_pm, ld, ld_m_lq, inv_ld; /* psi_pm, Ld, Ld - Lq (<= 0), 1/Ld */
+    q24_t inv_lq2;                     /* 1/Lq^2 */
+    q24_t id_star;  /* Ld psi_pm / (Lq^2 - Ld^2): least |i| on a flux circle (FX_MAX: SPMSM) */
+    q24_t psi_mtpa; /* |psi_s| of MTPA at I_max */
+    q24_t t_mtpa;   /* torque of MTPA at I_max */
+    q24_t psi_ceil; /* psi_max at standstill (psi_pm + Lq I_max: more flux is never used) */
+    q24_t b;        /* 2 Ld psi_pm */
+    q24_t dl2;      /* Lq^2 - Ld^2 (>= 0) */
+    q24_t c0;       /* psi_pm^2 + Lq^2 I_max^2 */
+    q24_t c1, c2;   /* psi_pm / Ld, 1/Ld - 1/Lq (>= 0) */
+    q24_t c1_sq;    /* c1^2 */
+    q24_t c2_sq8;   /* 8 c2^2 */
+    q24_t t_margin; /* fraction of the MTPV torque allowed, Q24 in (0, 1] */
+    q24_t vdc_k;    /* DC-link EMA coefficient per period, Q24 */
+    /* state */
+    int64_t vdc_acc; /* filtered DC link, Q48 */
+    uint8_t primed;  /* vdc_acc holds a sample */
+    q24_t t_prev;    /* torque reference of the previous period (the Rs term) */
+    q24_t psi_d;     /* ctrl_fieldweak_currents: psi_d of the last solution */
+} ctrl_fieldweak_t;
+
+typedef struct {
+    q24_t vdc;         /* filtered DC link */
+    q24_t psi_max;     /* flux amplitude the voltage allows at this speed */
+    q24_t torque_max;  /* |torque| limit (> = 0) */
+    q24_t torque;      /* request clamped to +-torque_max */
+    q24_t psi_ref;     /* stator-flux amplitude reference for torque */
+    uint8_t limit;     /* ctrl_fw_limit_t: what bounds torque_max */
+    uint8_t clipped;   /* 1 when the request was larger than torque_max */
+    uint8_t weakening; /* 1 when psi_ref is below the controller's own reference */
+} ctrl_fieldweak_out_t;
+
+/* Clear the dynamic state (the next DC-link sample primes the filter). */
+void ctrl_fieldweak_reset(ctrl_fieldweak_t *s);
+
+/*
+ * One period: vdc the measured DC link, omega the electrical speed, t_req the
+ * torque request, psi_cmd a commanded flux amplitude (> 0) or 0 (then the
+ * machine's fixed reference p->psi_ref if > 0, else MTPA, ctrl_flux_ref).
+ */
+void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
+                         q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out);
+
+/* Torque limit and its kind at flux amplitude psi in field weakening (the
+ * flux-circle part above); for tests and tools. */
+q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_t *limit);
+
+/*
+ * Current references (FOC) for torque t at the flux reference psi_ref of
+ * ctrl_fieldweak_step: the MTPA currents (ctrl_mtpa_current) when their flux
+ * is within psi_ref, else the point of torque t on the flux circle psi_ref
+ * between MTPV and zero torque, where T = psi_q (c1 - c2 psi_d) falls
+ * strictly as psi_d rises: three bracketed Newton steps in psi_d per call
+ * from the previous call's solution (kept in s; bisection when a step leaves
+ * the bracket): i_d = (psi_d - psi_pm) / Ld, i_q = psi_q / Lq with the sign
+ * of t. |t| above the arc's maximum gives the MTPV point.
+ */
+void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t t, q24_t psi_ref,
+                             q24_t *i_d, q24_t *i_q);
+
+#endif /* CONTROL_FIELD_WEAK_H */
