@@ -47,6 +47,7 @@ static const key_t_ k_keys[] = {
     {"mechanics", "friction_nms", K_REAL, 0, 0, 1e6, 0, 1.0, OFF(friction_nms)},
     {"fluxmap", "file", K_PATH, 0, 0, 0, 0, 1.0, OFF(fluxmap_path)},
     {"rated", "overspeed_rpm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(overspeed_rpm)},
+    {"rated", "speed_max_rpm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(speed_max_rpm)},
     {"speed_loop", "bandwidth_hz", K_REAL, 0, 0, 1e4, 1, 1.0, OFF(speed_bw_hz)},
     {"speed_loop", "phase_margin_deg", K_REAL, 0, 20, 80, 0, 1.0, OFF(speed_pm_deg)},
     {"speed_loop", "kp_nm_s_per_rad", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(speed_kp)},
@@ -330,6 +331,12 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
                  out->current_max_a, out->current_rated_a);
     } else if (out->dc_cap_f > 0.0 && !(out->dc_src_r_ohm > 0.0)) {
         snprintf(bad, sizeof bad, "[inverter] dc_src_r_ohm is required (> 0) when dc_cap_uf > 0");
+    } else if (out->speed_max_rpm > 0.0 && !(out->speed_max_rpm >= out->speed_rated_rpm)) {
+        snprintf(
+            bad, sizeof bad,
+            "[rated] speed_max_rpm must be at least speed_rpm (speed_max_rpm = %g, speed_rpm = "
+            "%g)",
+            out->speed_max_rpm, out->speed_rated_rpm);
     } else if (out->overspeed_rpm > 0.0 && !(out->overspeed_rpm > out->speed_rated_rpm)) {
         snprintf(bad, sizeof bad,
                  "[rated] overspeed_rpm must exceed speed_rpm (overspeed_rpm = %g, speed_rpm = %g)",

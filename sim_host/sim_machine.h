@@ -9,7 +9,9 @@
  *   [inverter]  vdc_v, fs_hz (default control/PWM frequency),
  *               dead_time_ns (optional, 0), v_fwd_v (optional, 0),
  *               dc_cap_uf (optional, 0 = stiff), dc_src_r_ohm (optional, needed if dc_cap_uf > 0)
- *   [rated]     ... overspeed_rpm (optional, 0 = 1.05 x speed_rpm: the
+ *   [rated]     ... speed_max_rpm (optional, >= speed_rpm; 0 = the firmware's
+ *               default, where the back-EMF meets the DC link: fw_speed_max_rpm),
+ *               overspeed_rpm (optional, 0 = 1.05 x the maximum speed: the
  *               firmware's overspeed trip level)
  *   [mechanics] inertia_kgm2, friction_nms (optional, 0)
  *   [fluxmap]   file (optional, CSV path relative to the INI file's folder)
@@ -67,6 +69,7 @@ typedef struct {
     double inertia_kgm2, friction_nms;
     char fluxmap_path[SIM_MACHINE_PATH_MAX]; /* "" = none; resolved path */
     double overspeed_rpm;                    /* 0 = firmware default */
+    double speed_max_rpm;                    /* 0 = firmware default (fw_speed_max_rpm) */
     double speed_bw_hz, speed_pm_deg;        /* 0 = firmware defaults */
     double speed_kp, speed_ki;               /* explicit gains; 0 = sized */
     plant_filter_cfg_t filter;               /* type NONE without [filter] */

@@ -40,6 +40,9 @@ typedef struct {
     double current_rated_a; /* rated current (peak of the phase current) */
     double current_max_a;   /* over-current trip level (peak), > rated */
     double psi_ref_wb;      /* stator-flux reference; 0 = MTPA (4.15) */
+    double speed_max_rpm;   /* maximum mechanical speed (>= rated); 0 = the firmware's
+                               default, fw_speed_max_rpm (firmware/isr/protect.h); last
+                               so that positional initialisers need not name it */
 } ctrl_machine_t;
 
 /* SI value of 1 pu of each quantity (configuration and host tools only). */

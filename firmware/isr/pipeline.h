@@ -116,7 +116,8 @@ typedef struct {
                                 fw_torque_limit_nm (speed_loop.h) */
     uint32_t speed_loop_hz;  /* speed PI update rate (divides fs), default 1000;
                                 0 = every period */
-    double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x rated speed */
+    double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x the machine's
+                                maximum speed (fw_speed_max_rpm, protect.h) */
 } fw_config_t;
 
 /* The speed loop and speed limits in force (SI, for reports; set by fw_init). */
@@ -195,7 +196,7 @@ typedef struct {
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),
  * torque limit from the ratings (the rated torque, or less at a fixed flux
- * reference: fw_torque_limit_nm), overspeed at 1.05 x rated speed, 256 samples. */
+ * reference: fw_torque_limit_nm), overspeed at 1.05 x the maximum speed, 256 samples. */
 void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl);
 
 /* Bind the HAL, compute the fixed-point conversion, initialise the controller

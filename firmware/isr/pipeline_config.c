@@ -121,11 +121,15 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     }
 
     fw_protect_cfg_t pc;
-    /* Overspeed: FW_OVERSPEED_REL above the rated speed unless configured;
-     * the speed reference is limited to the trip level / FW_OVERSPEED_REL. */
-    fw->speed_info.overspeed_rpm = cfg->overspeed_rpm > 0.0
-                                       ? cfg->overspeed_rpm
-                                       : FW_OVERSPEED_REL * fw->machine->speed_rated_rpm;
+    /* Overspeed: FW_OVERSPEED_REL above the machine's maximum speed unless
+     * configured; the speed reference is limited to the trip level /
+     * FW_OVERSPEED_REL. */
+    const double n_max = fw_speed_max_rpm(fw->machine);
+    if (!(n_max > 0.0)) {
+        return FW_EINVAL; /* a declared maximum speed below the rated one */
+    }
+    fw->speed_info.overspeed_rpm =
+        cfg->overspeed_rpm > 0.0 ? cfg->overspeed_rpm : FW_OVERSPEED_REL * n_max;
     fw->speed_info.speed_ref_max_rpm = fw->speed_info.overspeed_rpm / FW_OVERSPEED_REL;
     if (fw_protect_config(&pc, fw->machine, &fw->bases, in->pwm_freq_hz, fw->enc_cpr,
                           in->cycle_clock_hz, fw->speed_info.overspeed_rpm) != CTRL_OK) {

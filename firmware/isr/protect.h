@@ -30,13 +30,12 @@
  *    loop (fw_watchdog_kick); more than wdg_periods periods without a kick
  *    is a fault.
  *  - overspeed: |estimated electrical speed| > omega_max, checked while
- *    running right after the estimator. Level: the machine's rated speed x
- *    FW_OVERSPEED_REL unless configured (fw_config_t.overspeed_rpm). A drive
- *    without field weakening has nothing to do above its rated speed; in
- *    torque mode with a light load the rotor accelerates until the back-EMF
- *    meets the DC link (3250 r/min for the thesis SPMSM at 220 V, 8 % above
- *    rated), which this catches. The speed-reference limit is the level /
- *    FW_OVERSPEED_REL (the rated speed by default).
+ *    running right after the estimator. Level: the machine's maximum speed
+ *    (fw_speed_max_rpm: declared, or where the back-EMF meets the DC link) x
+ *    FW_OVERSPEED_REL unless configured (fw_config_t.overspeed_rpm). In
+ *    torque mode with a light load the rotor accelerates until the torque
+ *    limit meets the load, which this catches. The speed-reference limit is
+ *    the level / FW_OVERSPEED_REL (the maximum speed by default).
  */
 #ifndef FIRMWARE_PROTECT_H
 #define FIRMWARE_PROTECT_H
@@ -63,8 +62,22 @@ enum {
     FW_FAULT_COUNT = 12
 };
 
-/* Overspeed level relative to the rated speed (protect.h, criteria above). */
+/* Overspeed level relative to the machine's maximum speed (criteria above). */
 #define FW_OVERSPEED_REL 1.05
+
+/*
+ * The machine's maximum mechanical speed (r/min): m->speed_max_rpm when
+ * declared (> 0), else the speed at which the magnets' line-to-line back-EMF
+ * reaches the DC link, sqrt(3) w_e psi_pm = Vdc, but at least the rated speed.
+ * Above that speed a fault that turns the gates off leaves the inverter's
+ * diodes rectifying the back-EMF into the DC link (uncontrolled generation:
+ * braking current and link overvoltage), so a drive must not go there unless
+ * the machine's data say it is built for it (field weakening keeps the
+ * terminal voltage down only while the gates are on). Thesis SPMSM: 3217
+ * r/min; 80 kW IPMSM: 3970 r/min; the machine files declare their range.
+ * Returns 0 for a declared value below the rated speed or not finite.
+ */
+double fw_speed_max_rpm(const ctrl_machine_t *m);
 
 /* Name of a fault code ("overcurrent", ...); "unknown" for others. */
 const char *fw_fault_name(uint32_t code);

@@ -16,6 +16,25 @@
 /* Least number of periods for the stuck check (noise immunity at high rates). */
 #define FW_ENC_STUCK_MIN_PERIODS 8.0
 
+double fw_speed_max_rpm(const ctrl_machine_t *m)
+{
+    if (m == NULL || !isfinite(m->speed_rated_rpm) || !(m->speed_rated_rpm > 0.0)) {
+        return 0.0;
+    }
+    if (m->speed_max_rpm != 0.0) {
+        return isfinite(m->speed_max_rpm) && m->speed_max_rpm >= m->speed_rated_rpm
+                   ? m->speed_max_rpm
+                   : 0.0;
+    }
+    double n = m->speed_rated_rpm;
+    if (m->psi_pm_wb > 0.0 && m->vdc_v > 0.0 && m->pole_pairs > 0) {
+        /* sqrt(3) w_e psi_pm = Vdc */
+        const double w_e = m->vdc_v / (sqrt(3.0) * m->psi_pm_wb);
+        n = fmax(n, w_e / (double)m->pole_pairs * 60.0 / (2.0 * CTRL_PI));
+    }
+    return n;
+}
+
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
                       uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
                       double overspeed_rpm)

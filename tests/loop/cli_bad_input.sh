@@ -78,9 +78,9 @@ expect_fail "fixed-point range named" "Lq = 0.3 mH is outside the accepted range
 expect_fail "fs below the Q format" "fs = 1000 Hz is outside the accepted range \(>= [0-9]+ Hz\)" --machine "$m" --controller bst --fs 1000
 expect_fail "speed bandwidth beyond the dead time" "speed loop: bandwidth 200 Hz is out of range \(0, [0-9.]+\) Hz" --machine "$mdir/thesis_ipmsm_80kw.ini" --controller m2ptfc --free --speed-ref-rpm 100 --speed-bw-hz 200
 expect_fail "sizing and gains together" "give either --speed-bw-hz or --speed-kp" --machine "$m" --controller bst --free --speed-ref-rpm 100 --speed-bw-hz 20 --speed-kp 1
-# A speed reference above the drive's limit (rated speed) warns.
-err="$("$sim" --machine "$m" --controller bst --free --speed-ref-rpm 3500 --duration 0.002 2>&1 >/dev/null)"
-grep -q "warning: speed reference 3500 r/min is outside the drive's speed limit \[-3000, 3000\] r/min (the overspeed trip is at 3150 r/min)" <<<"$err" ||
+# A speed reference above the drive's limit (the machine's maximum speed, 3750 r/min) warns.
+err="$("$sim" --machine "$m" --controller bst --free --speed-ref-rpm 4000 --duration 0.002 2>&1 >/dev/null)"
+grep -q "warning: speed reference 4000 r/min is outside the drive's speed limit \[-3750, 3750\] r/min (the overspeed trip is at 3937.5 r/min)" <<<"$err" ||
   { echo "FAIL: speed reference warning: $err"; fails=$((fails + 1)); }
 # An unwritable metrics path fails before the run: no trace row is written.
 out="$("$sim" --machine "$m" --controller bst --duration 0.01 --trace "$tmp/early.csv" \

@@ -9,9 +9,10 @@
  *    speed step 0 -> 1000 r/min: overshoot <= 10 % and within 2 % from 2 s on
  *    (issue 13; the SPMSM's fixed gains gave 1900 r/min and a 0.95 s limit
  *    cycle on this machine).
- *  - Thesis SPMSM in torque mode, free and unloaded, 1.8 N*m: the rotor
- *    accelerates until the back-EMF meets the DC link (~3250 r/min); the
- *    overspeed protection (1.05 x 3000 r/min) trips before that.
+ *  - Thesis SPMSM declared for at most 3000 r/min, in torque mode, free and
+ *    unloaded, 1.8 N*m: the rotor accelerates until the back-EMF meets the DC
+ *    link (~3250 r/min); the overspeed protection (1.05 x the maximum speed)
+ *    trips before that.
  */
 #include <complex.h>
 #include <math.h>
@@ -118,6 +119,7 @@ static void test_spmsm_runaway_trips_overspeed(void)
     sim_run_cfg_t c;
     loop_cfg(&c, "bst", 0.0, 1.8, 0.1, 0.09);
     c.free_mech = true;
+    c.ctrl_machine.speed_max_rpm = 3000.0; /* the file declares 3750 r/min */
     loop_start(&run, &c);
     double max_rpm = 0.0;
     while (sim_run_time(&run) < c.duration_s && fw_state(&run.fw) != FW_STATE_FAULT) {
@@ -134,11 +136,35 @@ static void test_spmsm_runaway_trips_overspeed(void)
     TEST_ASSERT_TRUE(max_rpm > level && max_rpm < 3250.0);
 }
 
+/* The maximum speed behind the overspeed level: declared, or where the
+ * magnets' line-to-line back-EMF meets the DC link (sqrt(3) w_e psi_pm = Vdc),
+ * at least the rated speed; a declared value below the rated speed is refused. */
+static void test_speed_max_default(void)
+{
+    ctrl_machine_t m;
+    sim_ctrl_machine_from(loop_spmsm(), &m);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 3750.0, fw_speed_max_rpm(&m)); /* the file's */
+    m.speed_max_rpm = 0.0;
+    const double n_emf = 220.0 / (sqrt(3.0) * 0.09427) / 4.0 * 60.0 / (2.0 * PI_D);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, n_emf, fw_speed_max_rpm(&m));
+    TEST_ASSERT_TRUE(n_emf > 3000.0 && n_emf < 3250.0); /* 3217 r/min */
+    m.vdc_v = 100.0; /* a link below the rated back-EMF: the rated speed */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 3000.0, fw_speed_max_rpm(&m));
+    m.speed_max_rpm = 2000.0; /* below the rated speed */
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, fw_speed_max_rpm(&m));
+    sim_run_cfg_t c;
+    loop_cfg(&c, "bst", 0.0, 0.0, 0.01, 0.0);
+    c.ctrl_machine.speed_max_rpm = 2000.0;
+    char err[256];
+    TEST_ASSERT_NOT_EQUAL(0, sim_run_init(&run, &c, err, sizeof err));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_design_meets_its_crossover_and_margin);
     RUN_TEST(test_ipmsm80_speed_step);
     RUN_TEST(test_spmsm_runaway_trips_overspeed);
+    RUN_TEST(test_speed_max_default);
     return UNITY_END();
 }

@@ -26,6 +26,7 @@ static const ctrl_machine_t ini_thesis_spmsm = {
     .current_rated_a = 4.2,
     .current_max_a = 10.5,
     .psi_ref_wb = 0.0,
+    .speed_max_rpm = 3750.0,
 };
 
 /* Thesis 80 kW IPMSM, Table 3.1 and section 6.5.1 (psi_s_ref 0.1837 Wb). */
@@ -43,6 +44,7 @@ static const ctrl_machine_t ini_thesis_ipmsm80 = {
     .current_rated_a = 400.0,
     .current_max_a = 800.0,
     .psi_ref_wb = 0.1837,
+    .speed_max_rpm = 6000.0,
 };
 
 /* Book-chapter IPMSM, S1 Table 2 (rated values: the project's assumption). */

@@ -147,6 +147,7 @@ static void check_mirror(const char *file, const ctrl_machine_t *c)
                           m.inertia_kgm2,
                           m.torque_rated_nm,
                           m.speed_rated_rpm,
+                          m.speed_max_rpm,
                           m.current_rated_a,
                           m.current_max_a,
                           m.psi_ref_wb};
@@ -158,6 +159,7 @@ static void check_mirror(const char *file, const ctrl_machine_t *c)
                           c->inertia_kgm2,
                           c->torque_rated_nm,
                           c->speed_rated_rpm,
+                          c->speed_max_rpm,
                           c->current_rated_a,
                           c->current_max_a,
                           c->psi_ref_wb};

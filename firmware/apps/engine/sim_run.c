@@ -32,6 +32,7 @@ void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out)
     out->inertia_kgm2 = m->inertia_kgm2;
     out->torque_rated_nm = m->torque_rated_nm;
     out->speed_rated_rpm = m->speed_rated_rpm;
+    out->speed_max_rpm = m->speed_max_rpm;
     out->current_rated_a = m->current_rated_a;
     out->current_max_a = m->current_max_a;
     out->psi_ref_wb = m->psi_ref_wb;

@@ -101,7 +101,7 @@ static const cli_opt_t k_opts[] = {
     {"--speed-ki", "K", K_REAL, 0, 1e12, "N*m/rad", M_LOOP, "--speed-kp", NULL, F(speed_ki),
      "explicit speed PI integral gain, per mechanical rad (default 0 with --speed-kp)"},
     {"--overspeed-rpm", "R", K_REAL, 1, 1e6, "r/min", M_LOOP, NULL, NULL, F(overspeed),
-     "overspeed trip level (default: machine file, else 1.05 x rated speed)"},
+     "overspeed trip level (default: machine file, else 1.05 x its maximum speed)"},
     {"--duration", "S", K_REAL, 1e-4, 100, "s", M_LOOP, NULL, NULL, F(duration),
      "simulated time after arm (default 0.3)"},
     {"--window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, NULL, NULL, F(window),
