@@ -1,0 +1,107 @@
+/* Sensorless angle: observer and forced-angle start-up (sensorless.h). */
+#include "sensorless.h"
+
+#include "predict.h"
+
+#define SL_QUARTER_TURN 0x40000000u /* 90 deg */
+
+void ctrl_sl_reset(ctrl_sl_t *s)
+{
+    s->mode = CTRL_SL_FORCED;
+    s->ramping = 0u;
+    s->count = 0u;
+    s->theta_f = s->theta0;
+    s->omega_f = 0;
+    s->obs.primed = 0u;
+    s->obs.kappa_ts = s->kappa_start;
+}
+
+/* omega_f one step towards target (at most ramp_dw). */
+static q24_t sl_ramp(q24_t omega_f, q24_t target, q24_t dw)
+{
+    if (omega_f < target) {
+        return fx_min(fx_add(omega_f, dw), target);
+    }
+    return fx_max(fx_sub(omega_f, dw), target);
+}
+
+/* The angle gamma of the rotor's d axis ahead of the forced d axis at which a
+ * current along the forced q axis that gives t_start in its own frame gives
+ * the torque T on the rotor: t_start cos(gamma) = T, gamma in [0, pi],
+ * = atan2(sqrt(t_start^2 - T^2), T) (T clamped to +-t_start). */
+static fx_angle_t sl_gamma(q24_t t_start, q24_t torque)
+{
+    const q24_t t = fx_clamp(torque, fx_neg(t_start), t_start);
+    const int64_t d = (int64_t)t_start * t_start - (int64_t)t * t; /* >= 0, < 2^62 */
+    const q24_t sn = (q24_t)fx_isqrt64((uint64_t)d);               /* <= t_start */
+    return fx_atan2(sn, t);
+}
+
+static void sl_forced_out(ctrl_sl_t *s, ctrl_sl_out_t *out)
+{
+    out->mode = CTRL_SL_FORCED;
+    out->theta = s->theta_f;
+    out->omega = s->omega_f;
+    out->torque_ref = s->t_start;
+}
+
+void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
+                    q24_t i_alpha, q24_t i_beta, q24_t speed_ref, q24_t torque_est,
+                    ctrl_sl_out_t *out)
+{
+    ctrl_fobs_t *const o = &s->obs;
+    const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
+    const q24_t w_obs = ctrl_fobs_omega(o);
+    out->handover = 0u;
+    out->theta_obs = th_obs;
+
+    if (s->mode == CTRL_SL_OBSERVER) {
+        out->mode = CTRL_SL_OBSERVER;
+        out->theta = th_obs;
+        out->omega = w_obs;
+        out->torque_ref = 0;
+        s->count = fx_abs(w_obs) < s->w_off ? s->count + 1u : 0u;
+        if (s->count < s->low_n) {
+            return;
+        }
+        /* Too slow for too long: the forced angle again, placed so that the
+         * torque stays what it was (t_start cos(gamma) = T^). */
+        s->mode = CTRL_SL_FORCED;
+        s->ramping = 1u;
+        s->count = 0u;
+        s->theta_f = th_obs - sl_gamma(s->t_start, torque_est);
+        s->omega_f = w_obs;
+        o->kappa_ts = s->kappa_start;
+    }
+
+    /* Forced: the ramp towards the speed reference, at most +-w_on. */
+    const q24_t target = fx_clamp(speed_ref, fx_neg(s->w_on), s->w_on);
+    if (s->ramping == 0u && (target != 0 || s->omega_f != 0)) {
+        /* The ramp starts: the observer from where an unloaded rotor lines up
+         * with the current (the forced q axis). Held at zero speed it waits:
+         * at rest it would only drift. */
+        ctrl_fobs_reset(o, p, s->theta_f + SL_QUARTER_TURN, s->omega_f, i_alpha, i_beta);
+        o->kappa_ts = s->kappa_start;
+        s->ramping = 1u;
+    }
+    sl_forced_out(s, out);
+    s->theta_f += ctrl_angle_step(p, s->omega_f);
+    const q24_t w_next = sl_ramp(s->omega_f, target, s->ramp_dw);
+    if ((w_next > 0 && s->omega_f < 0) || (w_next < 0 && s->omega_f > 0) ||
+        (w_next == 0 && s->omega_f != 0)) {
+        s->ramping = 0u; /* through or to zero: the observer restarts with the next ramp */
+    }
+    s->omega_f = w_next;
+    s->count = fx_abs(s->omega_f) >= s->w_on ? s->count + 1u : 0u;
+    if (s->count >= s->settle_n) {
+        /* Handover: the observer's angle from this period on. */
+        s->mode = CTRL_SL_OBSERVER;
+        s->count = 0u;
+        o->kappa_ts = s->kappa_ts;
+        out->mode = CTRL_SL_OBSERVER;
+        out->theta = th_obs;
+        out->omega = w_obs;
+        out->torque_ref = 0;
+        out->handover = 1u;
+    }
+}

@@ -1,0 +1,100 @@
+/* Sensorless angle: SI configuration -> fixed point (configuration only). */
+#include <math.h>
+#include <string.h>
+
+#include "ctrl_units.h"
+#include "sensorless.h"
+#include "sensorless_config.h"
+
+void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m)
+{
+    memset(c, 0, sizeof *c);
+    ctrl_fobs_config_default(&c->obs, m);
+    c->t_start_nm = 0.5 * m->torque_rated_nm;
+    c->ramp_rad_s2 = 0.25 * c->t_start_nm * (double)m->pole_pairs / m->inertia_kgm2;
+    c->w_on_frac = 0.05;
+    c->w_off_frac = 0.025;
+    c->low_s = 0.05;
+    const double w_on = c->w_on_frac * ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs);
+    c->settle_s = 6.0 / w_on;
+    c->kappa_start = 2.0;
+    c->theta0_rad = 0.0;
+}
+
+static int sl_in(double v, double lo, double hi, const char *q, const char *unit, ctrl_diag_t *why)
+{
+    if (isfinite(v) && v >= lo && v <= hi) {
+        return 1;
+    }
+    if (why != NULL) {
+        memset(why, 0, sizeof *why);
+        why->code = CTRL_EINVAL;
+        why->quantity = q;
+        why->unit = unit;
+        why->value = v;
+        why->min = lo;
+        why->max = hi;
+    }
+    return 0;
+}
+
+int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
+                 const ctrl_sl_config_t *c, ctrl_diag_t *why)
+{
+    if (s == NULL || p == NULL || b == NULL || c == NULL || p->fs_hz == 0u) {
+        return CTRL_EINVAL;
+    }
+    const double fs = (double)p->fs_hz;
+    const double t_max = (double)p->torque_rated * b->torque_nm / (double)FX_ONE * 2.0;
+    const double w_rated = (double)p->speed_rated_e * b->w_rad_s / (double)FX_ONE;
+    /* The ramp reaches the handover speed in at least 10 periods. */
+    const double w_on = c->w_on_frac * w_rated;
+    if (!sl_in(c->t_start_nm, 1e-6 * t_max, t_max, "t_start_nm", "N*m", why) ||
+        !sl_in(c->w_on_frac, 0.005, 0.5, "w_on_frac", "", why) ||
+        !sl_in(c->w_off_frac, 0.0, c->w_on_frac, "w_off_frac", "", why) ||
+        !sl_in(c->ramp_rad_s2, 1e-3 * w_on, 0.1 * w_on * fs, "ramp_rad_s2", "rad/s^2", why) ||
+        !sl_in(c->low_s, 1.0 / fs, 100.0, "low_s", "s", why) ||
+        !sl_in(c->settle_s, 1.0 / fs, 100.0, "settle_s", "s", why) ||
+        !sl_in(c->kappa_start, 0.0, 4.0, "kappa_start", "", why) ||
+        !sl_in(c->theta0_rad, -1e3, 1e3, "theta0_rad", "rad", why)) {
+        return CTRL_EINVAL;
+    }
+    ctrl_sl_t n;
+    memset(&n, 0, sizeof n);
+    ctrl_fobs_config_t oc = c->obs;
+    oc.mode = CTRL_FOBS_SENSORLESS;
+    /* kappa_start within what the observer accepts for kappa */
+    ctrl_fobs_config_t ks = oc;
+    ks.kappa = c->kappa_start;
+    ctrl_fobs_t tmp;
+    if (ctrl_fobs_init(&tmp, p, b, &ks, why) != CTRL_OK) {
+        if (why != NULL && why->quantity != NULL && strcmp(why->quantity, "kappa") == 0) {
+            why->quantity = "kappa_start";
+        }
+        return CTRL_EINVAL;
+    }
+    if (ctrl_fobs_init(&n.obs, p, b, &oc, why) != CTRL_OK) {
+        return CTRL_EINVAL;
+    }
+    n.kappa_ts = n.obs.kappa_ts;
+    n.kappa_start = tmp.kappa_ts;
+    n.t_start = ctrl_q24_from_double(c->t_start_nm / b->torque_nm);
+    n.ramp_dw = ctrl_q24_from_double(c->ramp_rad_s2 / fs / b->w_rad_s);
+    n.w_on = ctrl_q24_from_double(w_on / b->w_rad_s);
+    n.w_off = ctrl_q24_from_double(c->w_off_frac * w_rated / b->w_rad_s);
+    n.settle_n = (uint32_t)ceil(c->settle_s * fs);
+    n.low_n = (uint32_t)ceil(c->low_s * fs);
+    double th = fmod(c->theta0_rad, CTRL_TWO_PI);
+    if (th < 0.0) {
+        th += CTRL_TWO_PI;
+    }
+    n.theta0 =
+        (fx_angle_t)(uint32_t)fmin(floor(th / CTRL_TWO_PI * 4294967296.0 + 0.5), 4294967295.0);
+    if (n.t_start <= 0 || n.ramp_dw <= 0 || n.w_on <= 0) {
+        (void)sl_in(-1.0, 0.0, 0.0, n.t_start <= 0 ? "t_start_nm" : "ramp_rad_s2", "", why);
+        return CTRL_EINVAL;
+    }
+    *s = n;
+    ctrl_sl_reset(s);
+    return CTRL_OK;
+}

@@ -1,0 +1,42 @@
+/*
+ * Configuration side of the sensorless angle (sensorless.h): SI values
+ * (double) converted to its fixed-point settings. Included only by
+ * *_config.c files, tests and the firmware's configuration code.
+ */
+#ifndef CONTROL_SENSORLESS_CONFIG_H
+#define CONTROL_SENSORLESS_CONFIG_H
+
+#include "ctrl_params.h"
+#include "flux_observer_config.h"
+#include "sensorless.h"
+
+typedef struct {
+    ctrl_fobs_config_t obs; /* the observer (mode forced to sensorless) */
+    double t_start_nm;      /* torque reference while forced, N*m (> 0) */
+    double ramp_rad_s2;     /* forced speed ramp, electrical rad/s^2 (> 0) */
+    double w_on_frac;       /* handover speed, share of the rated speed */
+    double w_off_frac;      /* forced again under this share of the rated speed ... */
+    double low_s;           /* ... for this long, s */
+    double settle_s;        /* time at the handover speed before the handover, s */
+    double kappa_start;     /* observer gain while forced (obs.kappa afterwards) */
+    double theta0_rad;      /* forced angle at the start, electrical rad */
+} ctrl_sl_config_t;
+
+/*
+ * Defaults for a machine (docs/algorithms.md, "Sensorless start-up"):
+ * t_start = half the rated torque; the ramp a quarter of what t_start
+ * accelerates the bare rotor with (t_start p / (4 J)), leaving the rest for a
+ * load; handover at 5 % of the rated speed after 6 time constants of the
+ * observer at critical damping (kappa_start = 2: 6 / w_on); forced again
+ * under 2.5 % for 50 ms (the time a 10 % resistance error at rated current
+ * takes to turn the thesis SPMSM's flux by 10 deg).
+ */
+void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m);
+
+/* Validate and set everything (the observer through ctrl_fobs_init); the
+ * state is reset (ctrl_sl_reset). Returns CTRL_OK or CTRL_EINVAL with *why
+ * naming the field (why may be NULL) and *s untouched. */
+int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
+                 const ctrl_sl_config_t *c, ctrl_diag_t *why);
+
+#endif /* CONTROL_SENSORLESS_CONFIG_H */
