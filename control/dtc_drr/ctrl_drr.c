@@ -50,8 +50,11 @@ void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q2
     /* (5.13): C = 2 sqrt(3) A / (2 B |w| / w_rn - sqrt(3) A). The denominator
      * is < 0 below ~1.07 rated speed (thesis SPMSM) and crosses 0 above; it is
      * clamped to dc_max < 0, i.e. |C| <= CTRL_DRR_C_MAX. */
-    const q24_t w = fx_abs(drr_lim(omega_e));
-    const q24_t d = fx_sub(fx_lshift_sat(fx_mul(s->kb, w), 1u), s->sqrt3_a);
+    /* 2 B |w| / w_rn generalised to twice the magnitude of the zero-vector
+     * deviation with its resistive part, |kb w + rt| (s->rt = 0: the thesis). */
+    const q24_t z = s->rt == 0 ? fx_mul(s->kb, fx_abs(drr_lim(omega_e)))
+                               : fx_abs(fx_add(fx_mul(s->kb, drr_lim(omega_e)), drr_lim(s->rt)));
+    const q24_t d = fx_sub(fx_lshift_sat(z, 1u), s->sqrt3_a);
     *dc = fx_min(d, s->dc_max);
 }
 
@@ -130,7 +133,7 @@ q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24
      */
     const int64_t n48 = (int64_t)e * dc - ((int64_t)dc * 2 + cn) * g;
     const int64_t num = fx_rshift64_round(n48, FX_QBITS) * pamp;
-    const q24_t kbw = fx_mul(s->kb, w);
+    const q24_t kbw = fx_add(fx_mul(s->kb, w), drr_lim(s->rt)); /* zero-vector deviation */
     const int64_t d48 = (int64_t)s->a * cross - (int64_t)kbw * pamp;
     const int64_t cg = fx_rshift64_round((int64_t)cn * g, FX_QBITS);
     const int64_t den = fx_rshift64_round(d48, FX_QBITS) * dc - cg * pamp;
@@ -150,7 +153,7 @@ q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, 
     if (s == NULL) {
         return 0;
     }
-    const q24_t kbw = fx_mul(s->kb, drr_lim(omega_e));
+    const q24_t kbw = fx_add(fx_mul(s->kb, drr_lim(omega_e)), drr_lim(s->rt));
     if (vec < 1u || vec > 6u || psi_amp <= 0) {
         return fx_neg(kbw); /* zero vector: (5.16) third term */
     }
@@ -164,6 +167,7 @@ void ctrl_drr_reset(void *state)
 {
     ctrl_drr_state_t *s = state;
     s->gamma = 0;
+    s->rt = 0;
     s->dt_sel = 0;
     s->vec_sel = 0u;
     s->last_tvref = 0;
@@ -201,7 +205,8 @@ static q24_t drr_predict_516(const ctrl_drr_state_t *s, const ctrl_ctx_t *ctx)
         d = fx_clamp(s->last_duty, 0, FX_ONE);
         dt = s->dt_sel;
     }
-    const q24_t kbw = fx_mul(s->kb, drr_lim(ctx->est->omega_e));
+    const q24_t kbw = fx_add(fx_mul(s->kb, drr_lim(ctx->est->omega_e)),
+                             fx_mul(s->r_ts, drr_lim(ctx->est->now.torque)));
     const q24_t t = fx_add(ctx->est->now.torque, fx_mul(d, dt));
     return fx_sub(t, fx_mul(FX_ONE - d, kbw));
 }
@@ -212,6 +217,8 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t w = ctx->est->omega_e;
     const q24_t t_k1 = s->pred_516 != 0u ? drr_predict_516(s, ctx) : nx->torque;
+    /* Resistive zero-vector deviation (4.10) at the predicted torque. */
+    s->rt = fx_mul(s->r_ts, drr_lim(t_k1));
     const q24_t tref = ctx->ref->torque;
     const q24_t te = s->centre != 0u ? ctrl_drr_t_start(s, t_k1, w) : t_k1;
 

@@ -12,7 +12,11 @@
  *
  * Decisions on the k+1 prediction; torque at k+1 from the estimator's model
  * (tunable pred_516 = 1: (5.16)); with centre-aligned PWM (5.3) and (5.8)-(5.14)
- * are evaluated at the active-vector start (tunable centre, default 1). One
+ * are evaluated at the active-vector start (tunable centre, default 1). The
+ * zero-vector deviation of (5.6), (5.7), (5.13) and (5.16) is
+ * -(B/w_rn) w - (Rs Ts/Ls) T_e: the speed term of the thesis plus the resistive
+ * term of (4.10) that (5.10) drops ("T_e = 0"), s->rt = (Rs Ts/Ls) T_e of the
+ * sample (tunable rs_dt, default 1; 0 = the thesis' load-free model). One
  * division per period for the duty, one more for C gamma when C follows the
  * speed (5.13). Units: Q24 per-unit throughout; A (5.9) = (2/3) Vdc psi_pm Ts
  * / Ls, B (5.10) / w_rn = psi_pm^2 Ts / Ls in pu. Reasoning and measured
@@ -44,10 +48,12 @@ typedef struct {
     q24_t lambda;    /* (5.4), Q24 */
     q24_t half_dpsi; /* dpsi_max / 2, pu flux */
     q24_t gamma_max; /* pu torque; 0 = no limit */
+    q24_t r_ts;      /* Rs Ts / Ls, per period (Q24): resistive ZVV deviation; 0 = off */
     ctrl_vreplace_t vr;
     uint8_t pred_516;
     uint8_t centre; /* T_e taken at the active-vector start of a centre-aligned period */
     /* dynamic */
+    q24_t rt;        /* r_ts T_e of this sample, pu torque (set by ctrl_drr_step) */
     q24_t gamma;     /* EMA output gamma[k-1] -> gamma[k], pu torque (5.4) */
     q24_t dt_sel;    /* Delta T of the vector chosen at k-1 (for (5.16)), pu */
     uint8_t vec_sel; /* vector chosen at k-1 (0 after reset) */
@@ -105,7 +111,8 @@ void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q2
  * Optimised duty (5.14) of active vector vec (1..6) for the flux (psi_alpha,
  * psi_beta) of amplitude psi_amp, torque error t_err = T_vref - T_e, EMA
  * output gamma and electrical speed omega_e (all Q24 pu), with
- * Delta T = A (psi x v_hat) / |psi| - (B / w_rn) w  ((5.6)/(5.7): psi x v_hat =
+ * Delta T = A (psi x v_hat) / |psi| - (B / w_rn) w - s->rt  ((5.6)/(5.7), s->rt the
+ * resistive term of (4.10) set by ctrl_drr_step, 0 with rs_dt off: psi x v_hat =
  * |psi| |sin(theta_s - theta_v)| with the sign of the vector's family).
  * The branch (numerator/denominator pair) is chosen by the sign of t_err (5.8).
  * Result in [0, FX_ONE]; one fx_div. If the denominator has the sign opposite

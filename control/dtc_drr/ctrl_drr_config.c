@@ -18,6 +18,7 @@
 #define DRR_SIGMA_DEFAULT (10.0 * CTRL_PI / 180.0) /* §5.3.5, Fig. 5.9: sigma = 10 deg */
 #define DRR_SIGMA_MAX (CTRL_PI / 12.0)             /* (4.19) */
 #define DRR_PU_MAX 4.0                             /* A, B/w_rn must fit the per-sample clamps */
+#define DRR_RS_DT_REL 0.1 /* rs_dt default on when Rs i_rated >= 10 % of the rated back-EMF */
 
 /* Thesis baseline parameters (Table 5.1) for the thesis SPMSM (2.4 N*m, 3000 r/min). */
 #define DRR_THESIS_T_RATED 2.4
@@ -48,6 +49,10 @@ static const ctrl_tunable_t drr_tunables[] = {
     {"centre", "-",
      "1 = centre-aligned PWM: T_e at the active-vector start (Fig. 5.4); 0 = AVV first",
      offsetof(ctrl_drr_cfg_t, centre), 0.0, 1.0},
+    {"rs_dt", "-",
+     "1 = zero-vector deviation with the resistive term -(Rs Ts/Ls) T_e of (4.10); 0 = thesis "
+     "(5.6)/(5.7); default 1 when Rs i_rated >= 10 % of the rated back-EMF",
+     offsetof(ctrl_drr_cfg_t, rs_dt), 0.0, 1.0},
 };
 
 static const ctrl_tunable_t d1_tunables[] = {
@@ -130,6 +135,17 @@ static void drr_cfg_default(void *cfg, const ctrl_machine_t *m)
     c->pred_516 = 0.0;
     c->gamma_max_nm = 0.0;
     c->centre = 1.0; /* plan.h realises every plan centre-aligned */
+    /* §5.3.3 neglects the load's effect on the deviations "compared to that of
+     * the operating speed": at the rated point the resistive zero-vector
+     * deviation (Rs Ts/Ls) T_rated over B (5.10) is Rs i_rated / (w_rn psi_pm),
+     * the resistive drop over the back-EMF (thesis SPMSM 0.03). Kept when it
+     * is not small (a gimbal motor: 1.4). */
+    c->rs_dt = 0.0;
+    if (m != NULL &&
+        m->rs_ohm * m->current_rated_a >=
+            DRR_RS_DT_REL * ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs) * m->psi_pm_wb) {
+        c->rs_dt = 1.0;
+    }
 }
 
 static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
@@ -209,6 +225,8 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
     }
     s->pred_516 = c->pred_516 >= 0.5 ? 1u : 0u;
     s->centre = c->centre >= 0.5 ? 1u : 0u;
+    /* Rs Ts / Ls with Ls = Ld as in (5.9)-(5.10); <= 1 by the core's range. */
+    s->r_ts = c->rs_dt >= 0.5 ? fx_mul(p->ts_rs, p->inv_ld) : 0;
     ctrl_drr_reset(s);
     return CTRL_OK;
 }

@@ -22,6 +22,9 @@ typedef struct {
     double gamma_max_nm; /* |gamma| limit, N*m; 0 = none (thesis) */
     double centre;       /* 1: plans realised centre-aligned (plan.h, default): T_e is
                             shifted to the active-vector start; 0: active vector first */
+    double rs_dt;        /* 1: the zero-vector deviation includes -(Rs Ts/Ls) T_e of
+                            (4.10); 0: the thesis' load-free (5.6)/(5.7); default 1
+                            when Rs i_rated >= 10 % of w_rn psi_pm (ctrl_drr_config.c) */
 } ctrl_drr_cfg_t;
 
 /* ---------------- baselines: one SI configuration, each descriptor exposes its part ------ */

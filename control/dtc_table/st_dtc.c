@@ -98,6 +98,7 @@ void st_fst_reset(void *state)
 {
     st_fst_state_t *s = state;
     s->prev_vec = 0u;
+    s->g = 0;
     st_fst_logic_reset(&s->logic);
 }
 
@@ -108,9 +109,15 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
      * errors on the state predicted for k+1 (delay compensation). */
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t tref = ctx->ref->torque;
-    const q24_t t_err = fx_sub(tref, nx->torque);
+    const q24_t t_err = fx_sub(fx_add(tref, s->g), nx->torque); /* g = 0 when off */
     const q24_t psi_err = fx_sub(ctrl_flux_ref(ctx->params, ctx->ref->psi, tref), nx->psi_amp);
+    /* Step detection on the reference itself, not on T_vref. */
     const st_fst_mode_t mode = st_fst_logic_update(&s->logic, tref, t_err, ctx->est->omega_e);
+    if (mode != ST_FST_DYNAMIC) {
+        /* Integrate in steady state only (a step's error is the dynamics'). */
+        const q24_t inc = fx_mul(s->ki, fx_sub(tref, nx->torque));
+        s->g = fx_clamp(fx_add(s->g, inc), fx_neg(s->g_max), s->g_max);
+    }
     const uint8_t x = nx->sector;
     uint8_t n = st_lookup_fst(x, t_err >= 0, psi_err >= 0, mode);
     if (n != ST_ZVV) {

@@ -46,11 +46,20 @@ typedef struct {
     uint8_t terr_nonneg_prev; /* (T_err[k-1] >= 0) */
 } st_fst_logic_t;
 
-/* Runtime state of FST. */
+/* Runtime state of FST. Mean-torque-error integrator (off = the thesis' FST):
+ * the decisions use T_vref = T_ref + g, g += k_i (T_ref - T(k+1)) in the
+ * steady-state modes, |g| <= g_max. With one vector per period the torque is
+ * piecewise linear between the samples, so the mean of T_ref - T(k+1) over
+ * the samples is the mean torque error: the integrator removes the error
+ * (Delta T_active - |Delta T_zero|) / 2 that sign decisions leave when one
+ * period's torque step is not small (docs/algorithms.md, "FST"). */
 typedef struct {
     st_fst_logic_t logic;
     ctrl_vreplace_t vr;
     uint8_t prev_vec;
+    q24_t ki;    /* integrator gain per period (2 pi f_i Ts), Q24; 0 = off */
+    q24_t g_max; /* |g| limit: the rated torque, Q24 pu */
+    q24_t g;     /* integrator, Q24 pu torque */
 } st_fst_state_t;
 
 /* Clear the FST logic (flag 0, T_ref[k-1] = 0, T_err[k-1] >= 0), keep dt_step. */

@@ -18,6 +18,8 @@
 #define ST_PU_MAX 100.0                   /* bands and steps beyond 100 pu are unit mistakes */
 #define ST_SIGMA_DEFAULT (CTRL_PI / 12.0) /* §4.6.2 experiments */
 #define ST_SIGMA_MAX (CTRL_PI / 12.0)     /* (4.19) */
+#define ST_FI_HZ 50.0 /* integrator corner: the DRR EMA's (thesis §5.3.2, 1/20 of the bandwidth)  \
+                       */
 
 static const ctrl_tunable_t hyst_tunables[] = {
     {"h_T", "N*m", "torque hysteresis half band h_T (Fig. 4.2, Table 4.7: 2 % of T_rated)",
@@ -32,6 +34,10 @@ static const ctrl_tunable_t fst_tunables[] = {
     {"dT_step", "N*m",
      "reference-step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)",
      offsetof(st_fst_cfg_t, dt_step), 0.0, 1000.0},
+    {"f_i", "Hz",
+     "corner of the mean-torque-error integrator; 0 = off (thesis); default 50 Hz where one "
+     "20 kHz period moves the torque by >= T_rated, else 0",
+     offsetof(st_fst_cfg_t, f_i), 0.0, 1000.0},
 };
 
 static void st_hyst_cfg_default(void *cfg, const ctrl_machine_t *m)
@@ -44,13 +50,23 @@ static void st_hyst_cfg_default(void *cfg, const ctrl_machine_t *m)
     }
 }
 
+double st_fst_f_i_default(const ctrl_machine_t *m)
+{
+    if (m == NULL || !(m->ld_h > 0.0) || !(m->current_rated_a > 0.0)) {
+        return 0.0;
+    }
+    /* A (5.9) / T_rated = (p Vdc psi_pm Ts / Ls) / (1.5 p psi_pm i_rated) */
+    const double a_rel = m->vdc_v / ((double)ST_FS_HZ * 1.5 * m->ld_h * m->current_rated_a);
+    return a_rel >= 1.0 ? ST_FI_HZ : 0.0;
+}
+
 static void st_fst_cfg_default(void *cfg, const ctrl_machine_t *m)
 {
-    (void)m;
     st_fst_cfg_t *c = cfg;
     memset(c, 0, sizeof *c);
     c->sigma = ST_SIGMA_DEFAULT;
     c->dt_step = 0.0;
+    c->f_i = st_fst_f_i_default(m);
 }
 
 static int st_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su, st_kind_t kind)
@@ -115,6 +131,12 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
                        ST_PU_MAX, &s->logic.dt_step) != CTRL_OK) {
         return CTRL_ERANGE;
     }
+    /* k_i = 2 pi f_i Ts < 1 per period (a faster integrator is no mean). */
+    const double ki = 2.0 * CTRL_PI * c->f_i / (double)su->params->fs_hz;
+    if (ctrl_setup_q24(su, "FST 2 pi f_i Ts", ki, 1.0, 0.0, 0.5, &s->ki) != CTRL_OK) {
+        return CTRL_ERANGE;
+    }
+    s->g_max = su->params->torque_rated;
     st_fst_reset(s);
     return CTRL_OK;
 }

@@ -20,6 +20,14 @@ typedef struct {
     double sigma;   /* subsector width of (4.19), rad, [0, pi/12]; 0 = no replacement */
     double dt_step; /* |Delta T_ref| above which a reference step is detected, N*m;
                        0 = any change (thesis §4.5.3: Delta T_ref != 0) */
+    double f_i;     /* corner of the mean-torque-error integrator (st_dtc.h), Hz;
+                       0 = off (the thesis' FST); default: st_fst_f_i_default */
 } st_fst_cfg_t;
+
+/* Default f_i for a machine: 50 Hz when one 20 kHz period of an active vector
+ * at standstill moves the torque by at least the rated torque, A (5.9) =
+ * Vdc Ts / (1.5 Ld i_rated) >= 1 at Ts = 50 us (a 24 V drone motor: 2.4), else
+ * 0 (the thesis' machines: 0.07 .. 0.38). */
+double st_fst_f_i_default(const ctrl_machine_t *m);
 
 #endif /* CONTROL_ST_DTC_CONFIG_H */

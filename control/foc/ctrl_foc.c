@@ -15,7 +15,6 @@
 
 #define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
 #define FOC_KP_QBITS 20u
-#define FOC_KI_QBITS 30u
 
 void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d,
                    q24_t *i_q)
@@ -41,8 +40,8 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
     if (limited != 0u && fx_sign(err) * fx_sign(v) > 0) {
         return; /* conditional integration: hold while pushing into the limit */
     }
-    /* err Q24 * ki_ts Q30 = Q54 -> Q40; |product| < 2^62. */
-    const int64_t inc = fx_rshift64_round((int64_t)err * pi->ki_ts, FOC_KI_QBITS - FOC_INTEG_SHIFT);
+    /* err Q24 * ki_ts Q(ki_shift) -> Q40 (ki_shift 17..30); |product| < 2^62. */
+    const int64_t inc = fx_rshift64_round((int64_t)err * pi->ki_ts, pi->ki_shift - FOC_INTEG_SHIFT);
     const int64_t lim = pi->lim;
     int64_t i = pi->integ + inc; /* |integ| <= 2^45 (lim <= 32 pu), |inc| < 2^48 */
     i = i > lim ? lim : (i < -lim ? -lim : i);

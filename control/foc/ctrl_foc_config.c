@@ -13,9 +13,10 @@
 #include "ctrl_units.h"
 #include "estimator.h"
 
-#define FOC_FS_HZ 10000u   /* S1 §2: Ts = 100 us */
-#define FOC_WC_PER_FS 20.0 /* default wc = 2 pi fs / 20 */
-#define FOC_HI_REL 0.05    /* default foc_hyst band: 5 % of the rated current */
+#define FOC_FS_HZ 10000u      /* S1 §2: Ts = 100 us */
+#define FOC_WC_PER_FS 20.0    /* default wc = 2 pi fs / 20 */
+#define FOC_HI_REL 0.05       /* default foc_hyst band: 5 % of the rated current */
+#define FOC_KI_TS_MAX 16383.0 /* Ki Ts < 2^31 / 2^17 in Q17 */
 
 static const ctrl_tunable_t foc_tunables[] = {
     {"wc", "rad/s", "current-loop bandwidth for Kp = L wc, Ki = R wc; 0 = 2 pi fs/20",
@@ -74,13 +75,22 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
         return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Kp / (r_base)", "pu", kp, 0.0,
                                  2047.0);
     }
-    if (!isfinite(ki_ts) || !(ki_ts >= 0.0) || ki_ts >= 1.99) {
+    /* Ki Ts in Q(ki_shift): Q30 below 2 pu (every thesis machine), fewer bits
+     * above (Ki Ts = Rs wc Ts grows with Rs / r_base: a gimbal motor's Rs is
+     * ~26 r_base at its low rated speed); at least 17 (the update shifts by
+     * ki_shift - 16 >= 1). */
+    if (!isfinite(ki_ts) || !(ki_ts >= 0.0) || ki_ts >= FOC_KI_TS_MAX) {
         return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Ki Ts / (r_base)", "pu", ki_ts, 0.0,
-                                 1.99);
+                                 FOC_KI_TS_MAX);
+    }
+    unsigned ki_shift = 30u;
+    while (ki_shift > 17u && ki_ts * ldexp(1.0, (int)ki_shift) >= 2147483000.0) {
+        ki_shift--;
     }
     pi->kp = (int32_t)llround(kp * 1048576.0);          /* Q20 */
     pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << 16); /* Q40 */
-    pi->ki_ts = (int32_t)llround(ki_ts * 1073741824.0);
+    pi->ki_ts = (int32_t)llround(ldexp(ki_ts, (int)ki_shift));
+    pi->ki_shift = (uint8_t)ki_shift;
     pi->integ = 0;
     return CTRL_OK;
 }

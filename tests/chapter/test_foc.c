@@ -91,7 +91,7 @@ static void test_pi_antiwindup(void)
 {
     /* Kp 1.3 (Q20), Ki Ts 0.02 (Q30), integrator limit 1 pu (Q40). */
     ctrl_foc_pi_t pi = {(int32_t)(1.3 * 1048576.0), (int32_t)(0.02 * 1073741824.0), 0,
-                        (int64_t)1 << 40};
+                        (int64_t)1 << 40, 30u};
     const q24_t e = FX_ONE / 10;
     /* Not limited: integrates Ki Ts e = 0.002 pu per step. */
     ctrl_foc_pi_update(&pi, e, FX_ONE, 0u);
@@ -218,6 +218,39 @@ static void test_current_step_ipmsm_mtpa(void)
     check_step("IPMSM MTPA", 0.1, 0.015);
 }
 
+/* A gimbal motor (Rctimer GBM5208, sim_host/machines/gbm5208_gimbal.ini): Rs =
+ * 7.545 ohm is 25.6 r_base at its 120 r/min rated speed, so Ki Ts = Rs wc Ts =
+ * 25.6 x 2 pi / 20 = 8.05 pu, beyond Q30 (< 2): stored in Q27. The PI zero
+ * still cancels the (Euler) plant pole 1 - Ts Rs / Ld, so the designed loop
+ * holds: the same rise, no overshoot, no steady-state error. */
+static const ctrl_machine_t gimbal = {
+    "gbm5208_gimbal", 11,    7.545, 2.129e-3, 3.308e-3, 0.019655, 12.0,
+    5.6e-5,           0.162, 120.0, 0.5,      1.0,      0.0};
+
+static void test_current_step_gimbal(void)
+{
+    chapter_rig_init(&rig, "foc", &gimbal);
+    const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
+    const double r_pu = gimbal.rs_ohm / rig.bases.r_ohm;
+    const double ki_ts = r_pu * 2.0 * PI / 20.0;
+    TEST_ASSERT_DOUBLE_WITHIN(0.1, 25.6, r_pu);
+    TEST_ASSERT_EQUAL_UINT8(27, s->pi_q.ki_shift); /* 8.05 x 2^27 < 2^31 <= 8.05 x 2^28 */
+    TEST_ASSERT_DOUBLE_WITHIN(ki_ts * 1e-8, ki_ts, ldexp((double)s->pi_q.ki_ts, -27));
+    /* the thesis machines keep Q30 */
+    chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
+    TEST_ASSERT_EQUAL_UINT8(30, ((const ctrl_foc_state_t *)rig.state)->pi_q.ki_shift);
+    chapter_rig_init(&rig, "foc", &gimbal);
+    /* i_d = 0 (S1 Algorithm 1): MTPA's i_d at this small torque is 1e-3 pu, too
+     * small a step to time against the cross-coupling at speed. */
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "mtpa", 0.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(rig.d, rig.state, rig.cfg, &rig.su));
+    /* Linear region (Kp_q = Lq wc / w_base = 35 pu, hexagon radius ~2.5 pu):
+     * 0.04 pu torque (0.16 x rated; Kp e = 1.4 pu, Rs i = 1.0 pu) at standstill
+     * and at 0.5 pu speed (60 r/min). */
+    check_step("gimbal standstill", 0.0, 0.04);
+    check_step("gimbal 60 r/min", 0.5, 0.04);
+}
+
 static void test_saturation_recovery(void)
 {
     /* A step that saturates the voltage (Kp e = 1.35 pu > Vdc/sqrt 3): the
@@ -286,6 +319,7 @@ int main(void)
     RUN_TEST(test_pi_antiwindup);
     RUN_TEST(test_current_step_spmsm);
     RUN_TEST(test_current_step_ipmsm_mtpa);
+    RUN_TEST(test_current_step_gimbal);
     RUN_TEST(test_saturation_recovery);
     RUN_TEST(test_foc_hyst_decisions);
     RUN_TEST(test_config_errors);

@@ -191,15 +191,24 @@ DrrConst drr_const()
     return c;
 }
 
-void test_drr_vs_reference(void)
+void rs_dt_on(void *cfg)
 {
-    std::mt19937_64 rng(20261121u);
+    static_cast<ctrl_drr_cfg_t *>(cfg)->rs_dt = 1.0;
+}
+
+/* rs_dt = 1 adds the resistive zero-vector deviation (Rs Ts / Ls) T(k+1) of
+ * (4.10) to B w / w_rn in (5.6), (5.7), (5.13) (the thesis SPMSM's default is 0). */
+void run_drr_reference(bool rs_dt)
+{
+    std::mt19937_64 rng(rs_dt ? 20261122u : 20261121u);
     const DrrConst k = drr_const();
+    const double r_ts = rs_dt ? d(P.ts_rs) * d(P.inv_ld) : 0.0; // Rs Ts / Ld, pu
     const ctrl_desc_t *desc = ctrl_find("drr");
     Stats st;
     int fallback = 0;
     for (int i = 0; i < kSamples; i++) {
-        ctrl_drr_state_t *s = static_cast<ctrl_drr_state_t *>(make("drr", nullptr));
+        ctrl_drr_state_t *s =
+            static_cast<ctrl_drr_state_t *>(make("drr", rs_dt ? rs_dt_on : nullptr));
         Sample smp = random_sample(rng);
         std::uniform_real_distribution<double> u(-0.04, 0.04);
         s->gamma = q(u(rng));
@@ -218,8 +227,9 @@ void test_drr_vs_reference(void)
         const double t_k1 = d(nx.torque);
         const double tref = d(smp.ref.torque);
         const double w = d(smp.est.omega_e);
+        const double zr = r_ts * t_k1; // resistive zero-vector deviation (4.10)
         // (5.13), clamped to |C| <= 64
-        double dc = 2.0 * k.kb * std::fabs(w) - std::sqrt(3.0) * k.a;
+        double dc = 2.0 * std::fabs(k.kb * w + zr) - std::sqrt(3.0) * k.a;
         dc = std::min(dc, -2.0 * std::sqrt(3.0) * k.a / CTRL_DRR_C_MAX);
         const double C = 2.0 * std::sqrt(3.0) * k.a / dc;
         // centre-aligned period: torque at the active-vector start, (5.12) C gamma
@@ -247,7 +257,7 @@ void test_drr_vs_reference(void)
         }
         // (5.6)/(5.7): A |sin(theta_s - theta_v)| with the family's sign; (5.13); (5.14)
         const Vec2 v_hat = unit((vec - 1) * kPi / 3.0);
-        const double dT = k.a * cross(psi, v_hat) / psi.norm() - k.kb * w;
+        const double dT = k.a * cross(psi, v_hat) / psi.norm() - k.kb * w - zr;
         const double num = tv - te - (2.0 + C) * g;
         const double den = dT - C * g;
         const int want = terr >= 0 ? 1 : -1;
@@ -270,16 +280,19 @@ void test_drr_vs_reference(void)
         // T_start: (1-D)/2 rounding times C gamma, C gamma (rounding of cn gamma
         //   over |dc|, the division, dC), the product -> dte;
         //   it enters gamma through lambda and the error e directly.
-        const double dC =
-            std::fabs(C) * (kHalfLsb / (2 * std::sqrt(3.0) * k.a) + 4 * kHalfLsb / std::fabs(dc));
+        // rs_dt: r_ts T rounded (half LSB), r_ts quantised (half LSB times |T|):
+        //   2 more half-LSB in dc (twice z) and one in Delta T.
+        const double dzr = rs_dt ? kHalfLsb * (1.0 + std::fabs(t_k1)) : 0.0;
+        const double dC = std::fabs(C) * (kHalfLsb / (2 * std::sqrt(3.0) * k.a) +
+                                          (4 * kHalfLsb + 2 * dzr) / std::fabs(dc));
         const double dte = kHalfLsb * std::fabs(C * g_prev) +
                            0.5 * (std::fabs(g_prev) * dC + kHalfLsb / std::fabs(dc) + kHalfLsb) +
                            kHalfLsb;
         const double dg = 2 * kHalfLsb + k.lambda * dte;
         const double dN =
             (dg + dte) + std::fabs(2.0 + C) * dg + std::fabs(g) * dC + kHalfLsb / std::fabs(dc);
-        const double dD = (3.0 / pamp + 2.0) * kHalfLsb + std::fabs(C) * dg + std::fabs(g) * dC +
-                          kHalfLsb / pamp + kHalfLsb / std::fabs(dc);
+        const double dD = (3.0 / pamp + 2.0) * kHalfLsb + dzr + std::fabs(C) * dg +
+                          std::fabs(g) * dC + kHalfLsb / pamp + kHalfLsb / std::fabs(dc);
         const double bound = 2.0 * (dN + D * dD) / std::fabs(den) + kLsb;
 
         // boundary cases: decided by less than the rounding of the inputs
@@ -306,10 +319,20 @@ void test_drr_vs_reference(void)
         fallback += fb ? 1 : 0;
         st.add(err, bound);
     }
-    report("drr", st);
+    report(rs_dt ? "drr (rs_dt 1)" : "drr", st);
     char buf[120];
     std::snprintf(buf, sizeof buf, "drr: denominator-sign fallback D = 1 in %d samples", fallback);
     TEST_MESSAGE(buf);
+}
+
+void test_drr_vs_reference(void)
+{
+    run_drr_reference(false);
+}
+
+void test_drr_rs_dt_vs_reference(void)
+{
+    run_drr_reference(true);
 }
 
 // ---------------------------------------------------------------- baselines
@@ -472,6 +495,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_drr_vs_reference);
+    RUN_TEST(test_drr_rs_dt_vs_reference);
     RUN_TEST(test_d1_vs_reference);
     RUN_TEST(test_d2_vs_reference);
     RUN_TEST(test_pi_vs_reference);

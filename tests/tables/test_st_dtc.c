@@ -139,6 +139,8 @@ static void test_registry_and_defaults(void)
                 TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, t->max); /* (4.19) */
             } else if (strcmp(t->name, "dT_step") == 0) {
                 TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* Delta T_ref != 0 */
+            } else if (strcmp(t->name, "f_i") == 0) {
+                TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* the thesis' FST on its machine */
             } else {
                 TEST_FAIL_MESSAGE("unexpected tunable");
             }
@@ -504,6 +506,69 @@ static void test_fst_controller_replacement(void)
     }
 }
 
+/* The mean-torque-error integrator (f_i): its default from the machine, its
+ * gain 2 pi f_i Ts, integration of T_ref - T(k+1) in steady state only, the
+ * rated-torque clamp, and decisions on T_ref + g. */
+static void test_fst_integrator(void)
+{
+    /* Defaults: A (5.9) / T_rated = Vdc / (20 kHz 1.5 Ld i_rated): thesis SPMSM
+     * 0.27 -> off; a 24 V drone motor (26 uH, 13 A rated) 2.4 -> 50 Hz. */
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, st_fst_f_i_default(&SPMSM));
+    const ctrl_machine_t drone = {"mj5208", 7,     0.047,  26.0e-6, 45.8e-6, 2.5908e-3, 24.0,
+                                  5.6e-5,   0.354, 6000.0, 13.0,    22.5,    0.0};
+    TEST_ASSERT_EQUAL_DOUBLE(50.0, st_fst_f_i_default(&drone));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, st_fst_f_i_default(NULL));
+
+    rig_open("fst");
+    double v = -1.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(R.d, R.cfg, "f_i", &v));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, v);
+    const st_fst_state_t *f = (const st_fst_state_t *)R.state;
+    TEST_ASSERT_EQUAL_INT32(0, f->ki);
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "f_i", 100.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
+    const double ki = 2.0 * PI * 100.0 / 20000.0;
+    TEST_ASSERT_INT32_WITHIN(1, q24(ki), f->ki);
+    TEST_ASSERT_EQUAL_INT32(R.params.torque_rated, f->g_max);
+    /* outside the tunable's range: refused by name */
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "f_i", 2000.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "f_i", -1.0));
+
+    R.ref.psi = q24(1.05);
+    const double tref = 0.4;
+    R.ref.torque = q24(tref);
+    /* First sample: a reference step (dynamic mode): no integration. */
+    set_next(0.0, 1.04, tref - 0.05, 0.2);
+    (void)step();
+    TEST_ASSERT_EQUAL_INT32(0, f->g);
+    /* The torque crosses the reference: steady state, integrates -0.01. */
+    set_next(0.0, 1.04, tref + 0.01, 0.2);
+    (void)step();
+    TEST_ASSERT_INT32_WITHIN(2, q24(-0.01 * ki), f->g);
+    /* Steady, torque 0.01 above the reference for n samples: g = -(n+1) 0.01 ki;
+     * the decisions use T_ref + g, so a torque 0.001 above T_ref + g (below
+     * T_ref) is a decrease (zero vector in the steady forward column). */
+    for (int n = 0; n < 50; n++) {
+        (void)step();
+    }
+    const double g = -51.0 * 0.01 * ki;
+    TEST_ASSERT_INT32_WITHIN(60, q24(g), f->g);
+    set_next(0.0, 1.04, tref + g + 0.001, 0.2);
+    const uint8_t dec = step();
+    TEST_ASSERT_TRUE(dec == 0u || dec == 7u);
+    set_next(0.0, 1.04, tref + g - 0.001, 0.2);
+    TEST_ASSERT_TRUE(step() != 0u && R.applied.vec[0] != 7u); /* increase */
+    /* Clamped to the rated torque. */
+    set_next(0.0, 1.04, tref + 10.0, 0.2);
+    for (int n = 0; n < 20000; n++) {
+        (void)step();
+    }
+    TEST_ASSERT_EQUAL_INT32(fx_neg(R.params.torque_rated), f->g);
+    /* reset clears it */
+    R.d->reset(R.state);
+    TEST_ASSERT_EQUAL_INT32(0, f->g);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -518,6 +583,7 @@ int main(void)
     RUN_TEST(test_flux_reference);
     RUN_TEST(test_fst_logic_forward_step);
     RUN_TEST(test_fst_logic_braking_and_reversal);
+    RUN_TEST(test_fst_integrator);
     RUN_TEST(test_fst_logic_step_sample_and_threshold);
     RUN_TEST(test_fst_controller_all_states);
     RUN_TEST(test_fst_controller_replacement);
