@@ -42,8 +42,12 @@ typedef struct {
     double temp_c;   /* last board temperature (NaN: sensor open/short) */
 } esc1_t;
 
-/* The compiled-in machine: a small 12 V gimbal-class outrunner (see
- * esc1_params.c for its values and how to change them). */
+/* The compiled-in machine, generated at build time from a machine file
+ * (CMake cache PMSM_ESC1_MACHINE_INI, default sim_host/machines/
+ * gbm5208_gimbal.ini: the Rctimer GBM5208 gimbal motor on 12 V, 0.5 A rated,
+ * 1 A trip; tools/board/machine_c.py). Changed over the link with the m.*
+ * parameters (esc1_params.c). tests/board/test_esc1_machine.c checks it
+ * against the file, the board's ratings and the core's range. */
 extern const ctrl_machine_t esc1_default_machine;
 
 /* Hardware over-current threshold for a machine: 1.5 x current_max_a, at

@@ -5,7 +5,8 @@
  * every change re-initialises the firmware (state boot -> calibration ->
  * ready, controller tunables back to their defaults) and moves the hardware
  * over-current threshold with m.i_max_a. Nothing is stored across a reset:
- * after power-up the compiled-in machine below is active again.
+ * after power-up the compiled-in machine (esc1_default_machine, generated from
+ * its machine file: esc1_app.h) is active again.
  */
 #include <math.h>
 #include <string.h>
@@ -14,28 +15,6 @@
 #include "cmd.h"
 #include "esc1_app.h"
 #include "g4_core.h"
-
-/* The compiled-in machine: a typical 12 V gimbal-class outrunner (7 pole
- * pairs, a few ohms: at 12 V it cannot draw more than a few amperes, a safe
- * first motor for bring-up). Not one specific product: replace it with your
- * motor's data ("param set m.rs_ohm 0.12" ...; docs/bringup.md). Checked in
- * closed loop on the host plant (m2ptfc, foc, fst, drr at 400 r/min).
- * T_rated = 1.5 p psi I_rated = 1.5 x 7 x 3.6 mWb x 1.5 A = 0.057 N*m. */
-const ctrl_machine_t esc1_default_machine = {
-    .name = "esc1_default_gimbal",
-    .pole_pairs = 7,
-    .rs_ohm = 2.5,
-    .ld_h = 1.0e-3,
-    .lq_h = 1.0e-3,
-    .psi_pm_wb = 3.6e-3,
-    .vdc_v = 12.0,
-    .inertia_kgm2 = 2.0e-6,
-    .torque_rated_nm = 0.05,
-    .speed_rated_rpm = 2000.0,
-    .current_rated_a = 1.5,
-    .current_max_a = 3.0,
-    .psi_ref_wb = 0.0,
-};
 
 double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m)
 {
