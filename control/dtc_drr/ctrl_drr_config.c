@@ -139,7 +139,7 @@ static void drr_cfg_default(void *cfg, const ctrl_machine_t *m)
      * the operating speed": at the rated point the resistive zero-vector
      * deviation (Rs Ts/Ls) T_rated over B (5.10) is Rs i_rated / (w_rn psi_pm),
      * the resistive drop over the back-EMF (thesis SPMSM 0.03). Kept when it
-     * is not small (a gimbal motor: 1.4). */
+     * is not small (the GBM5208 gimbal motor: 0.53). */
     c->rs_dt = 0.0;
     if (m != NULL &&
         m->rs_ohm * m->current_rated_a >=

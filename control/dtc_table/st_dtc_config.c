@@ -18,8 +18,10 @@
 #define ST_PU_MAX 100.0                   /* bands and steps beyond 100 pu are unit mistakes */
 #define ST_SIGMA_DEFAULT (CTRL_PI / 12.0) /* §4.6.2 experiments */
 #define ST_SIGMA_MAX (CTRL_PI / 12.0)     /* (4.19) */
-#define ST_FI_HZ 50.0 /* integrator corner: the DRR EMA's (thesis §5.3.2, 1/20 of the bandwidth)  \
-                       */
+/* f_i default: the DRR EMA's corner (thesis §5.3.2, 1/20 of the bandwidth),
+ * where A (5.9) at 20 kHz is at least half the rated torque. */
+#define ST_FI_HZ 50.0
+#define ST_FI_A_REL 0.5
 
 static const ctrl_tunable_t hyst_tunables[] = {
     {"h_T", "N*m", "torque hysteresis half band h_T (Fig. 4.2, Table 4.7: 2 % of T_rated)",
@@ -36,7 +38,7 @@ static const ctrl_tunable_t fst_tunables[] = {
      offsetof(st_fst_cfg_t, dt_step), 0.0, 1000.0},
     {"f_i", "Hz",
      "corner of the mean-torque-error integrator; 0 = off (thesis); default 50 Hz where one "
-     "20 kHz period moves the torque by >= T_rated, else 0",
+     "20 kHz period moves the torque by >= T_rated / 2, else 0",
      offsetof(st_fst_cfg_t, f_i), 0.0, 1000.0},
 };
 
@@ -57,7 +59,7 @@ double st_fst_f_i_default(const ctrl_machine_t *m)
     }
     /* A (5.9) / T_rated = (p Vdc psi_pm Ts / Ls) / (1.5 p psi_pm i_rated) */
     const double a_rel = m->vdc_v / ((double)ST_FS_HZ * 1.5 * m->ld_h * m->current_rated_a);
-    return a_rel >= 1.0 ? ST_FI_HZ : 0.0;
+    return a_rel >= ST_FI_A_REL ? ST_FI_HZ : 0.0;
 }
 
 static void st_fst_cfg_default(void *cfg, const ctrl_machine_t *m)

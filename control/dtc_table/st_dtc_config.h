@@ -25,9 +25,11 @@ typedef struct {
 } st_fst_cfg_t;
 
 /* Default f_i for a machine: 50 Hz when one 20 kHz period of an active vector
- * at standstill moves the torque by at least the rated torque, A (5.9) =
- * Vdc Ts / (1.5 Ld i_rated) >= 1 at Ts = 50 us (a 24 V drone motor: 2.4), else
- * 0 (the thesis' machines: 0.07 .. 0.38). */
+ * at standstill moves the torque by at least half the rated torque, A (5.9) /
+ * T_rated = Vdc Ts / (1.5 Ld i_rated) >= 0.5 at Ts = 50 us (then the sign
+ * decisions leave an offset of the order of a quarter of the rated torque; the
+ * mj5208 drone motor: 2.4, the GBM5208 gimbal motor: 0.63), else 0 (the
+ * thesis' machines: 0.07 .. 0.27). */
 double st_fst_f_i_default(const ctrl_machine_t *m);
 
 #endif /* CONTROL_ST_DTC_CONFIG_H */

@@ -30,7 +30,7 @@ typedef struct {
     int64_t integ; /* integrator, V pu, Q40, within +-lim */
     int64_t lim;   /* the integrator's limit, the nominal DC link, Q40 */
     /* Fractional bits of ki_ts, 17..30: 30 while Ki Ts < 2 pu; fewer for a
-     * machine whose Rs is many r_base (a gimbal motor: Rs ~ 26 pu, Ki Ts ~ 8). */
+     * machine whose Rs is many r_base (a gimbal motor: Rs ~ 16 pu, Ki Ts ~ 5). */
     uint8_t ki_shift;
 } ctrl_foc_pi_t;
 

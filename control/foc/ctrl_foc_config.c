@@ -77,7 +77,7 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     }
     /* Ki Ts in Q(ki_shift): Q30 below 2 pu (every thesis machine), fewer bits
      * above (Ki Ts = Rs wc Ts grows with Rs / r_base: a gimbal motor's Rs is
-     * ~26 r_base at its low rated speed); at least 17 (the update shifts by
+     * ~16 r_base at its low rated speed); at least 17 (the update shifts by
      * ki_shift - 16 >= 1). */
     if (!isfinite(ki_ts) || !(ki_ts >= 0.0) || ki_ts >= FOC_KI_TS_MAX) {
         return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Ki Ts / (r_base)", "pu", ki_ts, 0.0,

@@ -14,11 +14,11 @@
  * (plant torque on the Ts/10 grid). m2ptfc, drr and foc at 20 kHz; the
  * switching table fst at 40 kHz (the issue allows tables up to 40 kHz).
  *
- * Sensors (hal/sim defaults unless named): ADC 12 bit, +-1.5 current_max full
- * scale (mj5208 +-33.75 A, 16.5 mA per count; GBM5208 +-1.5 A, 0.73 mA per
- * count), 0.5 count noise; a 14-bit absolute magnetic encoder as both motors
- * are usually fitted (moteus' AS5047P on the mj5208, AS5048A on gimbal
- * motors): 4096 lines x 4 = 16384 counts per turn.
+ * Sensors: the files' [sensors] (a 14-bit absolute magnetic encoder, 4096
+ * lines x 4 = 16384 counts per turn, as both motors are usually fitted:
+ * moteus' AS5047P on the mj5208, AS5048A on gimbal motors); hal/sim's ADC
+ * defaults: 12 bit, +-1.5 current_max full scale (mj5208 +-33.75 A, 16.5 mA
+ * per count; GBM5208 +-1.5 A, 0.73 mA per count), 0.5 count noise.
  */
 #include <math.h>
 #include <stdio.h>
@@ -30,7 +30,6 @@
 
 #define PI_D 3.14159265358979323846
 #define TSSE_REL 0.05
-#define ENC_LINES_14BIT 4096u
 
 static sim_run_t run;
 
@@ -71,7 +70,6 @@ static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double
     sim_run_config_default(&c, m, d);
     c.fs_hz = fs;
     c.hal.pwm_freq_hz = fs;
-    c.hal.enc_lines = ENC_LINES_14BIT;
     c.speed_rpm = 0.2 * no_load_rpm(m);
     c.torque_ref_nm = 0.5 * m->torque_rated_nm;
     c.duration_s = duration_s;
@@ -108,8 +106,9 @@ static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double
 static void test_mj5208_drone(void)
 {
     const sim_machine_t m = load("mj5208_drone.ini");
-    /* the file's data: Kv 304 r/min/V on 24 V */
+    /* the file's data: Kv 304 r/min/V on 24 V, the 14-bit encoder */
     TEST_ASSERT_DOUBLE_WITHIN(1.0, 304.0 * 24.0, no_load_rpm(&m));
+    TEST_ASSERT_EQUAL_INT(4096, m.encoder_lines);
     steady(&m, "m2ptfc", 20000u, 0.08, 0.03);
     steady(&m, "drr", 20000u, 0.08, 0.03);
     steady(&m, "foc", 20000u, 0.08, 0.03);
@@ -121,8 +120,9 @@ static void test_mj5208_drone(void)
 static void test_gbm5208_gimbal(void)
 {
     const sim_machine_t m = load("gbm5208_gimbal.ini");
-    /* the file's data: Kv 25.5 r/min/V on 12 V */
+    /* the file's data: Kv 25.5 r/min/V on 12 V, the 14-bit encoder */
     TEST_ASSERT_DOUBLE_WITHIN(0.1, 25.5 * 12.0, no_load_rpm(&m));
+    TEST_ASSERT_EQUAL_INT(4096, m.encoder_lines);
     steady(&m, "m2ptfc", 20000u, 0.2, 0.05);
     steady(&m, "drr", 20000u, 0.2, 0.05);
     steady(&m, "foc", 20000u, 0.2, 0.05);

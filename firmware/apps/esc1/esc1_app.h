@@ -44,7 +44,7 @@ typedef struct {
 
 /* The compiled-in machine, generated at build time from a machine file
  * (CMake cache PMSM_ESC1_MACHINE_INI, default sim_host/machines/
- * gbm5208_gimbal.ini: the Rctimer GBM5208 gimbal motor on 12 V, 0.5 A rated,
+ * gbm5208_gimbal.ini: the Rctimer GBM5208 gimbal motor on 12 V, 0.3 A rated,
  * 1 A trip; tools/board/machine_c.py). Changed over the link with the m.*
  * parameters (esc1_params.c). tests/board/test_esc1_machine.c checks it
  * against the file, the board's ratings and the core's range. */
