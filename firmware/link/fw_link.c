@@ -118,13 +118,25 @@ static int op_param_get(void *ctx, const char *name, double *value)
     return fw_link_err(fw_tunable_get(l->fw, name, value));
 }
 
+/* A configuration op's result; on a refusal the core's reason is kept for
+ * the "err 10 failed" detail (op_failed_detail). */
+static int fw_link_cfg_err(fw_link_t *l, int fw_rc)
+{
+    memset(&l->why, 0, sizeof l->why);
+    if (fw_rc != FW_OK) {
+        l->why = l->fw->why;
+    }
+    return fw_link_err(fw_rc);
+}
+
 static int op_select_controller(void *ctx, const char *name)
 {
     const ctrl_desc_t *d = ctrl_find(name);
     if (d == NULL) {
         return CMD_E_NAME;
     }
-    return fw_link_err(fw_select_controller(fw_link_of(ctx)->fw, d, NULL));
+    fw_link_t *l = fw_link_of(ctx);
+    return fw_link_cfg_err(l, fw_select_controller(l->fw, d, NULL));
 }
 
 static int op_arm(void *ctx)
@@ -172,9 +184,43 @@ static int op_param_set(void *ctx, const char *name, double value)
     fw_link_t *l = fw_link_of(ctx);
     const fw_link_param_t *p = fw_link_param(l, name);
     if (p != NULL) {
+        memset(&l->why, 0, sizeof l->why); /* the application sets it (fw_link_set_why) */
         return p->set != NULL ? p->set(l->params_ctx, value) : CMD_E_READONLY;
     }
-    return fw_link_err(fw_tunable_set(l->fw, name, value));
+    return fw_link_cfg_err(l, fw_tunable_set(l->fw, name, value));
+}
+
+void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why)
+{
+    if (l != NULL && why != NULL) {
+        l->why = *why;
+    }
+}
+
+/* The reason of the last refusal in one response line after "err 10 failed "
+ * (CMD_OUT_MAX - 16 characters): "<quantity> = <value> <unit> outside [<min>,
+ * <max>]", then the SI data it follows from when that fits. Consumed once. */
+static const char *op_failed_detail(void *ctx)
+{
+    fw_link_t *l = fw_link_of(ctx);
+    const ctrl_diag_t *d = &l->why;
+    if (d->code == CTRL_OK || d->quantity == NULL) {
+        return NULL;
+    }
+    const size_t cap = CMD_OUT_MAX - 16u;
+    char *t = l->why_text;
+    const char *u = d->unit != NULL && d->unit[0] != '\0' ? " " : "";
+    int n = snprintf(t, cap, "%s = %.4g%s%s outside [%.4g, %.4g]", d->quantity, d->value, u,
+                     d->unit != NULL ? d->unit : "", d->min, d->max);
+    if (d->min == 0.0 && d->max == 0.0) {
+        n = snprintf(t, cap, "%s missing", d->quantity);
+    }
+    if (n > 0 && (size_t)n < cap && d->depends != NULL &&
+        (size_t)n + strlen(d->depends) + 3u < cap) {
+        (void)snprintf(t + n, cap - (size_t)n, " (%s)", d->depends);
+    }
+    memset(&l->why, 0, sizeof l->why);
+    return t;
 }
 
 static int op_clear_fault(void *ctx)
@@ -407,6 +453,7 @@ static const cmd_ops_t fw_link_ops = {
     op_cm_start,
     op_cm_apply,
     op_stop,
+    op_failed_detail,
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx)

@@ -45,8 +45,10 @@ typedef struct {
     volatile uint32_t q_tail; /* written by the main loop */
     uint32_t dropped;         /* samples lost to a full queue */
     uint8_t send_meta;
-    double speed_max_rpm; /* |speed reference| limit (fw_speed_info_t: the rated speed) */
-    char cm_detail[48];   /* detail of the last refused commissioning start */
+    double speed_max_rpm;       /* |speed reference| limit (fw_speed_info_t: the rated speed) */
+    char cm_detail[48];         /* detail of the last refused commissioning start */
+    ctrl_diag_t why;            /* why the core refused the last configuration op (CTRL_OK: none) */
+    char why_text[CMD_OUT_MAX]; /* its "err 10 failed" detail */
     fw_link_write_fn write;
     void *write_ctx;
     const fw_link_param_t *params; /* application parameters (fw_link_set_params) */
@@ -57,6 +59,10 @@ typedef struct {
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
 /* Application parameters (after fw_link_init; the table must outlive the link). */
 void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, void *ctx);
+/* For an application parameter's set (main loop) that fails because the core
+ * refused the configuration: the reason (fw_t.why before the application
+ * restores its previous data), sent as the detail of "err 10 failed". */
+void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why);
 /* Main loop: one received byte. */
 void fw_link_rx(fw_link_t *l, uint8_t byte);
 /* ISR, after fw_isr: queue this period's telemetry sample when due. */

@@ -172,7 +172,12 @@ static bool cmd_op_ok(cmd_t *c, int rc)
     if (rc == CMD_OK) {
         return true;
     }
-    cmd_err(c, (rc > 0 && rc < (int)CMD_E_COUNT) ? rc : CMD_E_FAILED, NULL);
+    const int code = (rc > 0 && rc < (int)CMD_E_COUNT) ? rc : CMD_E_FAILED;
+    const char *detail = NULL;
+    if (code == CMD_E_FAILED && c->ops->failed_detail != NULL) {
+        detail = c->ops->failed_detail(c->ctx);
+    }
+    cmd_err(c, code, detail);
     return false;
 }
 

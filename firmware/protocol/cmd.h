@@ -144,6 +144,10 @@ typedef struct {
     int (*cm_apply)(void *ctx);
     /* gates off now: ends commissioning or running */
     int (*stop)(void *ctx);
+    /* optional: why the op that just returned CMD_E_FAILED failed (e.g. the
+     * quantity the control core refused, its value and its range), or NULL;
+     * appended to "err 10 failed" (cut at the line's end). Appended. */
+    const char *(*failed_detail)(void *ctx);
 } cmd_ops_t;
 
 typedef struct {

@@ -9,14 +9,22 @@
  *    current_peak_a 40 A) and the link's m.vdc_v range (>= 8 V);
  *  - the core takes it at the image's PWM frequency (ESC1_FS_HZ) and every
  *    registered controller accepts its default configuration for it (the
- *    board selects any of them with "ctrl select").
+ *    board selects any of them with "ctrl select");
+ *  - over the serial link (the image's application: board HAL on the register
+ *    model of g4_model.c, fw_init, fw_link, the m.* parameters of
+ *    esc1_params.c), machine data the core cannot represent are refused with
+ *    the quantity, its value and its range, and the previous data stay.
  */
+#include <stdio.h>
 #include <string.h>
 
 #include "board_esc1.h"
 #include "controller.h"
 #include "ctrl_params.h"
 #include "esc1_app.h"
+#include "g4_clock.h"
+#include "g4_core.h"
+#include "g4_model.h"
 #include "sim_machine.h"
 #include "unity.h"
 
@@ -98,11 +106,99 @@ static void test_core_and_every_controller_take_it(void)
     }
 }
 
+/* ---- the link on the board's code path ---- */
+
+static esc1_t esc;
+static char reply[4][160];
+static size_t n_reply;
+
+static void capture(void *ctx, const uint8_t *bytes, size_t len)
+{
+    (void)ctx;
+    static char line[160];
+    static size_t n;
+    for (size_t k = 0; k < len; k++) {
+        if (bytes[k] == '\n') {
+            line[n > 0 && line[n - 1] == '\r' ? n - 1 : n] = '\0';
+            if (n_reply < 4u) {
+                memcpy(reply[n_reply++], line, sizeof line);
+            }
+            n = 0;
+        } else if (n + 1u < sizeof line) {
+            line[n++] = (char)bytes[k];
+        }
+    }
+}
+
+static const char *command(const char *text)
+{
+    n_reply = 0;
+    for (const char *c = text; *c != '\0'; c++) {
+        fw_link_rx(&esc.link, (uint8_t)*c);
+    }
+    fw_link_rx(&esc.link, '\r');
+    fw_link_poll(&esc.link);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, n_reply, text);
+    return reply[0];
+}
+
+/* As esc1_main.c: board HAL, fw_init with the compiled-in motor, the link and
+ * its application parameters (on the register model, no interrupts). */
+static void esc1_start(void)
+{
+    g4_model_reset();
+    g4_cycle_counter_init();
+    memset(&esc, 0, sizeof esc);
+    const g4_board_t *b = &g4_board_esc1;
+    esc.machine = esc1_default_machine;
+    esc.encoder_cpr = ESC1_ENCODER_CPR;
+    esc.hc.fs_hz = ESC1_FS_HZ;
+    esc.hc.encoder_cpr = esc.encoder_cpr;
+    esc.hc.trip_current_a = esc1_hw_trip_a(b, &esc.machine);
+    TEST_ASSERT_EQUAL_INT(G4_OK, g4_clock_init(b->hse_hz, b->sysclk_hz));
+    TEST_ASSERT_EQUAL_INT(G4_OK, g4_hal_init(&esc.hal, b, &esc.hc));
+    fw_config_default(&esc.fc, &esc.machine, ctrl_find(ESC1_CTRL));
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_init(&esc.fw, &esc.hal, &esc.fc));
+    fw_link_init(&esc.link, &esc.fw, capture, NULL);
+    esc1_params_attach(&esc);
+}
+
+/* Neighbours of the compiled-in gimbal motor the core cannot represent at
+ * 20 kHz (docs/fixed-point.md, "The range the core takes"): each answer names
+ * the quantity, its value and the range; the motor's data stay. */
+static void test_link_refusal_names_quantity_value_range(void)
+{
+    esc1_start();
+    char want[160];
+    /* 15 r/min (inside the link's [10, 100000]): 11 x 15 x 2 pi / 60 x 50 us =
+     * 8.64e-4 rad per period < 0.001 */
+    TEST_ASSERT_EQUAL_STRING("err 10 failed rated electrical speed x Ts = 0.0008639 rad per period "
+                             "outside [0.001, 1]",
+                             command("param set m.n_rated_rpm 15"));
+    /* 0.3 mH: Ts Rs / Ld = 50 us x 7.545 / 0.3 mH = 1.258 > 1 */
+    TEST_ASSERT_EQUAL_STRING(
+        "err 10 failed Ts Rs / Ld = 1.258 outside [0, 1] (rs_ohm, ld_h, fs_hz)",
+        command("param set m.ld_h 0.0003"));
+    /* the previous data are in force */
+    snprintf(want, sizeof want, "ok m.n_rated_rpm %g r/min", esc1_default_machine.speed_rated_rpm);
+    TEST_ASSERT_EQUAL_STRING(want, command("param get m.n_rated_rpm"));
+    TEST_ASSERT_EQUAL_STRING("gbm5208_gimbal", esc.machine.name);
+    /* and the firmware runs with them and its controller (the restore used to
+     * lose the controller: fw_init had cleared fw_t before it was read) */
+    TEST_ASSERT_TRUE(esc.fw.ctrl != NULL);
+    TEST_ASSERT_EQUAL_STRING(ESC1_CTRL, esc.fw.ctrl->name);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_BOOT, fw_state(&esc.fw));
+    /* a value the core takes is taken, and a refusal after it has no stale reason */
+    TEST_ASSERT_EQUAL_STRING("ok m.n_rated_rpm 150", command("param set m.n_rated_rpm 150"));
+    TEST_ASSERT_EQUAL_STRING("err 4 range [10, 100000]", command("param set m.n_rated_rpm 1"));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_default_machine_is_the_file);
     RUN_TEST(test_default_machine_within_the_board);
     RUN_TEST(test_core_and_every_controller_take_it);
+    RUN_TEST(test_link_refusal_names_quantity_value_range);
     return UNITY_END();
 }

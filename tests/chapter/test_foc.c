@@ -223,15 +223,12 @@ static void test_current_step_ipmsm_mtpa(void)
  * 16.2 x 2 pi / 20 = 5.08 pu, beyond Q30 (< 2): stored in Q28. The PI zero
  * still cancels the (Euler) plant pole 1 - Ts Rs / Ld, so the designed loop
  * holds: the same rise, no overshoot, no steady-state error. */
-static const ctrl_machine_t gimbal = {
-    "gbm5208_gimbal", 11,     7.545, 2.129e-3, 3.308e-3, 0.019655, 12.0,
-    5.6e-5,           0.0973, 190.0, 0.3,      1.0,      0.0};
 
 static void test_current_step_gimbal(void)
 {
-    chapter_rig_init(&rig, "foc", &gimbal);
+    chapter_rig_init(&rig, "foc", &ini_gbm5208_gimbal);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
-    const double r_pu = gimbal.rs_ohm / rig.bases.r_ohm;
+    const double r_pu = ini_gbm5208_gimbal.rs_ohm / rig.bases.r_ohm;
     const double ki_ts = r_pu * 2.0 * PI / 20.0;
     TEST_ASSERT_DOUBLE_WITHIN(0.1, 16.2, r_pu);
     TEST_ASSERT_EQUAL_UINT8(28, s->pi_q.ki_shift); /* 5.08 x 2^28 < 2^31 <= 5.08 x 2^29 */
@@ -239,7 +236,7 @@ static void test_current_step_gimbal(void)
     /* the thesis machines keep Q30 */
     chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_UINT8(30, ((const ctrl_foc_state_t *)rig.state)->pi_q.ki_shift);
-    chapter_rig_init(&rig, "foc", &gimbal);
+    chapter_rig_init(&rig, "foc", &ini_gbm5208_gimbal);
     /* i_d = 0 (S1 Algorithm 1): MTPA's i_d at this small torque is 1e-3 pu, too
      * small a step to time against the cross-coupling at speed. */
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(rig.d, rig.cfg, "mtpa", 0.0));

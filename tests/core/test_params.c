@@ -242,6 +242,50 @@ static void test_refusals_explained(void)
     TEST_ASSERT_EQUAL_STRING("ok", msg);
 }
 
+/* The small motors of issue 12 (sim_host/machines/{mj5208_drone,
+ * gbm5208_gimbal}.ini) are taken at 10, 20 and 40 kHz; their neighbours just
+ * outside the core's range are refused with the quantity, its value and the
+ * range (the same diagnosis the simulator and the serial link print). */
+static void test_small_motor_neighbours(void)
+{
+    static const uint32_t fss[3] = {10000u, 20000u, 40000u};
+    ctrl_params_t p;
+    ctrl_bases_t b;
+    ctrl_diag_t why;
+    for (size_t f = 0; f < 3; f++) {
+        TEST_ASSERT_EQUAL_INT(CTRL_OK,
+                              ctrl_params_init_diag(&p, &b, &ini_mj5208_drone, fss[f], &why));
+        TEST_ASSERT_EQUAL_INT(CTRL_OK,
+                              ctrl_params_init_diag(&p, &b, &ini_gbm5208_gimbal, fss[f], &why));
+    }
+    /* a 40000 r/min rating on the drone motor: 7 x 40000 x 2 pi / 60 x 50 us */
+    ctrl_machine_t m = ini_mj5208_drone;
+    m.speed_rated_rpm = 40000.0;
+    expect_diag(&m, 20000u, CTRL_ERANGE, "rated electrical speed x Ts",
+                7.0 * 40000.0 / 60.0 * 2.0 * PI / 20000.0);
+    /* the gimbal motor rated at 15 r/min: 11 x 15 x 2 pi / 60 x 50 us < 0.001 */
+    m = ini_gbm5208_gimbal;
+    m.speed_rated_rpm = 15.0;
+    expect_diag(&m, 20000u, CTRL_ERANGE, "rated electrical speed x Ts",
+                11.0 * 15.0 / 60.0 * 2.0 * PI / 20000.0);
+    /* its winding with 0.3 mH: Ts Rs / Ld = 50 us x 7.545 / 0.3 mH */
+    m = ini_gbm5208_gimbal;
+    m.ld_h = 0.3e-3;
+    m.lq_h = 0.3e-3;
+    expect_diag(&m, 20000u, CTRL_ERANGE, "Ts Rs / Ld", 50e-6 * 7.545 / 0.3e-3);
+    /* on 60 V and rated at 20 r/min: the DC link is 132 rated back-EMFs */
+    m = ini_gbm5208_gimbal;
+    m.vdc_v = 60.0;
+    m.speed_rated_rpm = 20.0;
+    expect_diag(&m, 20000u, CTRL_ERANGE, "vdc_v / rated back-EMF (psi_pm x rated electrical speed)",
+                60.0 / (0.019655 * 20.0 / 60.0 * 2.0 * PI * 11.0));
+    /* the drone motor with a 2000 A trip: current_max / (psi_pm / Ld) = 20 > 16 */
+    m = ini_mj5208_drone;
+    m.current_max_a = 2000.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_ERANGE, ctrl_params_init_diag(&p, &b, &m, 20000u, &why));
+    TEST_ASSERT_TRUE(why.value > why.max);
+}
+
 /* The range of the brief: psi_pm from 0.3 mWb, L from 10 uH, R from 20 mOhm,
  * Vdc 8-60 V and 540 V, fs 10-40 kHz. The machines (machines.h) at the
  * sampling frequencies their rated speed allows are accepted by the core and
@@ -543,6 +587,7 @@ int main(void)
     RUN_TEST(test_reject_bad_machines);
     RUN_TEST(test_refusals_explained);
     RUN_TEST(test_range_corner_machines);
+    RUN_TEST(test_small_motor_neighbours);
     RUN_TEST(test_q24_conversion);
     RUN_TEST(test_mtpa_oracle_spmsm);
     RUN_TEST(test_mtpa_ipmsm_table);

@@ -98,6 +98,19 @@ static void test_commands_reach_the_pipeline(void)
     send("param get nosuch");
     TEST_ASSERT_EQUAL_INT(0, strncmp(out, "err 5", 5));
 
+    /* A configuration the controller cannot represent: the answer names the
+     * quantity, its value and its range (FOC: Kp in Q20 below 2048 pu; 20000
+     * V/A over r_base 8.233 ohm = 2429 pu), the configuration in force stays. */
+    send("ctrl select foc");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    send("param set Kp_q 20000");
+    TEST_ASSERT_EQUAL_STRING(
+        "err 10 failed current PI Kp / (r_base) = 2429 pu outside [0, 2047]\r\n", out);
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_get(&run.fw, "Kp_q", &v));
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* the default (0 = Lq wc) */
+    send("ctrl select bst");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+
     send("arm");
     TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
     periods(2);

@@ -1,6 +1,7 @@
 /*
  * The shipped machine files sim_host/machines/{thesis_spmsm,
- * thesis_ipmsm_80kw, chapter_ipmsm}.ini (REFERENCE.md section 2) as
+ * thesis_ipmsm_80kw, chapter_ipmsm, mj5208_drone, gbm5208_gimbal}.ini
+ * (REFERENCE.md section 2; the small motors of issue 12) as
  * ctrl_machine_t, for the unit tests that configure a controller without the
  * INI loader (also built for the QEMU target, no file access).
  * tests/plant/test_plant_files.c checks every field against the INI files.
@@ -61,6 +62,40 @@ static const ctrl_machine_t ini_chapter_ipmsm = {
     .speed_rated_rpm = 1000.0,
     .current_rated_a = 2.5,
     .current_max_a = 6.25,
+    .psi_ref_wb = 0.0,
+};
+
+/* mjbots mj5208 drone outrunner on 24 V (moteus mpat data; psi_pm from Kv 304). */
+static const ctrl_machine_t ini_mj5208_drone = {
+    .name = "mj5208_drone",
+    .pole_pairs = 7,
+    .rs_ohm = 0.047,
+    .ld_h = 26.0e-6,
+    .lq_h = 45.8e-6,
+    .psi_pm_wb = 2.5908e-3,
+    .vdc_v = 24.0,
+    .inertia_kgm2 = 5.6e-5,
+    .torque_rated_nm = 0.354,
+    .speed_rated_rpm = 6000.0,
+    .current_rated_a = 13.0,
+    .current_max_a = 22.5,
+    .psi_ref_wb = 0.0,
+};
+
+/* Rctimer GBM5208 gimbal motor on 12 V (moteus mpat data; psi_pm from Kv 25.5). */
+static const ctrl_machine_t ini_gbm5208_gimbal = {
+    .name = "gbm5208_gimbal",
+    .pole_pairs = 11,
+    .rs_ohm = 7.545,
+    .ld_h = 2.129e-3,
+    .lq_h = 3.308e-3,
+    .psi_pm_wb = 0.019655,
+    .vdc_v = 12.0,
+    .inertia_kgm2 = 5.6e-5,
+    .torque_rated_nm = 0.0973,
+    .speed_rated_rpm = 190.0,
+    .current_rated_a = 0.3,
+    .current_max_a = 1.0,
     .psi_ref_wb = 0.0,
 };
 

@@ -175,6 +175,8 @@ static void test_ini_mirror_header(void)
     check_mirror("thesis_spmsm.ini", &ini_thesis_spmsm);
     check_mirror("thesis_ipmsm_80kw.ini", &ini_thesis_ipmsm80);
     check_mirror("chapter_ipmsm.ini", &ini_chapter_ipmsm);
+    check_mirror("mj5208_drone.ini", &ini_mj5208_drone);
+    check_mirror("gbm5208_gimbal.ini", &ini_gbm5208_gimbal);
 }
 
 static void test_ini_bad_input(void)

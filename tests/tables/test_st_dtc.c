@@ -10,6 +10,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "../plant/ini_machines.h"
 #include "controller.h"
 #include "ctrl_params.h"
 #include "mtpa.h"
@@ -512,11 +513,12 @@ static void test_fst_controller_replacement(void)
 static void test_fst_integrator(void)
 {
     /* Defaults: A (5.9) / T_rated = Vdc / (20 kHz 1.5 Ld i_rated): thesis SPMSM
-     * 0.27 -> off; a 24 V drone motor (26 uH, 13 A rated) 2.4 -> 50 Hz. */
+     * 0.27 -> off; the mj5208 drone motor 2.4 and the GBM5208 gimbal motor
+     * 0.63 -> 50 Hz; the thesis 80 kW IPMSM 0.075 -> off. */
     TEST_ASSERT_EQUAL_DOUBLE(0.0, st_fst_f_i_default(&SPMSM));
-    const ctrl_machine_t drone = {"mj5208", 7,     0.047,  26.0e-6, 45.8e-6, 2.5908e-3, 24.0,
-                                  5.6e-5,   0.354, 6000.0, 13.0,    22.5,    0.0};
-    TEST_ASSERT_EQUAL_DOUBLE(50.0, st_fst_f_i_default(&drone));
+    TEST_ASSERT_EQUAL_DOUBLE(50.0, st_fst_f_i_default(&ini_mj5208_drone));
+    TEST_ASSERT_EQUAL_DOUBLE(50.0, st_fst_f_i_default(&ini_gbm5208_gimbal));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, st_fst_f_i_default(&ini_thesis_ipmsm80));
     TEST_ASSERT_EQUAL_DOUBLE(0.0, st_fst_f_i_default(NULL));
 
     rig_open("fst");

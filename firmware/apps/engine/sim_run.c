@@ -461,11 +461,15 @@ static int sim_trial_scaled(const sim_run_cfg_t *c, const sim_qty_t *q, double v
  * one unchanged (log-scale search over factors 2^+-16, then bisection to 0.1 %
  * of the boundary). Names the quantity, its value and the accepted range.
  */
-static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, size_t errlen)
+static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, const char *why, char *err,
+                               size_t errlen)
 {
     (void)snprintf(err, errlen,
                    "the firmware refuses this drive: %s (controller %s, machine %s, fs %u Hz)",
                    fw_strerror(fw_rc), c->ctrl->name, c->ctrl_machine.name, (unsigned)c->fs_hz);
+    if (strcmp(why, "ok") != 0) {
+        sim_appendf(err, errlen, ": %s", why); /* the core's diagnosis (fw_explain) */
+    }
     int found = 0;
     for (size_t k = 0; k < sizeof sim_qtys / sizeof sim_qtys[0]; k++) {
         const sim_qty_t *q = &sim_qtys[k];
@@ -529,10 +533,11 @@ static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, siz
 
 #else
 /* The QEMU port has one instance of the HAL models: no trial configurations. */
-static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, char *err, size_t errlen)
+static void sim_explain_reject(const sim_run_cfg_t *c, int fw_rc, const char *why, char *err,
+                               size_t errlen)
 {
-    (void)snprintf(err, errlen, "the firmware refuses this drive: %s (controller %s, fs %u Hz)",
-                   fw_strerror(fw_rc), c->ctrl->name, (unsigned)c->fs_hz);
+    (void)snprintf(err, errlen, "the firmware refuses this drive: %s (controller %s, fs %u Hz): %s",
+                   fw_strerror(fw_rc), c->ctrl->name, (unsigned)c->fs_hz, why);
 }
 #endif
 
@@ -721,7 +726,9 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     const int frc = fw_init(&r->fw, &r->hal, &fc);
     if (frc != FW_OK) {
-        sim_explain_reject(c, frc, err, errlen);
+        char why[200];
+        (void)fw_explain(&r->fw, why, sizeof why);
+        sim_explain_reject(c, frc, why, err, errlen);
         return -1;
     }
     r->torque_limit_nm = ctrl_q24_to_double(r->fw.torque_ref_max) * r->fw.bases.torque_nm;

@@ -237,21 +237,26 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
     }
     const ctrl_machine_t old = s->machine;
     const uint32_t old_cpr = s->encoder_cpr;
+    /* fw_init clears fw_t, so the controller in use is kept here for the
+     * restore (else a refused machine left the firmware without one). */
+    const ctrl_desc_t *ctrl = s->fw.ctrl;
     g4_nvic_disable(G4_IRQ_ADC1_2);
     s->machine = *m;
     s->encoder_cpr = encoder_cpr;
     s->hal.info.encoder_counts_per_rev = encoder_cpr;
-    fw_config_default(&s->fc, &s->machine, s->fw.ctrl);
+    fw_config_default(&s->fc, &s->machine, ctrl);
     int rc = fw_init(&s->fw, &s->hal, &s->fc);
     if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
         rc = FW_ERANGE;
     }
     if (rc != FW_OK) {
+        /* The core's reason for "err 10 failed", before the restore clears it. */
+        fw_link_set_why(&s->link, &s->fw.why);
         /* The previous data worked: back to them. */
         s->machine = old;
         s->encoder_cpr = old_cpr;
         s->hal.info.encoder_counts_per_rev = old_cpr;
-        fw_config_default(&s->fc, &s->machine, s->fw.ctrl);
+        fw_config_default(&s->fc, &s->machine, ctrl);
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
     } else {
@@ -259,6 +264,7 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
     }
     g4_nvic_enable(G4_IRQ_ADC1_2);
     /* In its range but refused by the core (e.g. a per-unit value outside its
-     * Q format): "err 10 failed", the previous data in force. */
+     * Q format): "err 10 failed <quantity> = <value> outside [<min>, <max>]",
+     * the previous data in force. */
     return rc == FW_OK ? CMD_OK : CMD_E_FAILED;
 }
