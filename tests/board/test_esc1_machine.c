@@ -57,7 +57,8 @@ static void test_default_machine_is_the_file(void)
                         m->speed_rated_rpm,
                         m->current_rated_a,
                         m->current_max_a,
-                        m->psi_ref_wb};
+                        m->psi_ref_wb,
+                        m->speed_max_rpm};
     const double b[] = {e->rs_ohm,
                         e->ld_h,
                         e->lq_h,
@@ -68,7 +69,8 @@ static void test_default_machine_is_the_file(void)
                         e->speed_rated_rpm,
                         e->current_rated_a,
                         e->current_max_a,
-                        e->psi_ref_wb};
+                        e->psi_ref_wb,
+                        e->speed_max_rpm};
     for (size_t k = 0; k < sizeof a / sizeof a[0]; k++) {
         TEST_ASSERT_EQUAL_MEMORY(&a[k], &b[k], sizeof a[k]);
     }

@@ -32,6 +32,7 @@ FIELDS = (
     ("rated", "current_a", "current_rated_a", 1.0, True),
     ("rated", "current_max_a", "current_max_a", 1.0, True),
     ("rated", "psi_ref_wb", "psi_ref_wb", 1.0, False),
+    ("rated", "speed_max_rpm", "speed_max_rpm", 1.0, False),
 )
 
 
