@@ -18,13 +18,18 @@
  * lines x 4 = 16384 counts per turn, as both motors are usually fitted:
  * moteus' AS5047P on the mj5208, AS5048A on gimbal motors); hal/sim's ADC
  * defaults: 12 bit, +-1.5 current_max full scale (mj5208 +-33.75 A, 16.5 mA
- * per count; GBM5208 +-1.5 A, 0.73 mA per count), 0.5 count noise.
+ * per count; GBM5208 +-1.5 A, 0.73 mA per count), 0.5 count noise; and the
+ * gimbal motor once more on the B-G431B-ESC1's own current scale (its default
+ * motor; board_esc1.c: 3 mOhm shunts, gain 64/7, 12-bit ADC on 3.3 V =
+ * 29.4 mA per count, so its half-rated 0.146 A is 5 counts).
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "board_esc1.h"
 #include "fw_state.h"
+#include "g4_adc.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -61,8 +66,8 @@ static double no_load_rpm(const sim_machine_t *m)
 }
 
 /* Dynamometer run at 20 % of the no-load speed, half the rated torque. */
-static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double duration_s,
-                   double win_start_s)
+static void steady_adc(const sim_machine_t *m, const char *ctrl, uint32_t fs, double duration_s,
+                       double win_start_s, double i_fullscale_a)
 {
     const ctrl_desc_t *d = ctrl_find(ctrl);
     TEST_ASSERT_NOT_NULL_MESSAGE(d, ctrl);
@@ -76,6 +81,9 @@ static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double
     c.win_start_s = win_start_s;
     c.win_end_s = duration_s;
     c.calib_samples = 64u;
+    if (i_fullscale_a > 0.0) {
+        c.hal.i_fullscale_a = i_fullscale_a;
+    }
     char err[256];
     if (sim_run_init(&run, &c, err, sizeof err) != 0) {
         TEST_FAIL_MESSAGE(err);
@@ -88,10 +96,10 @@ static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double
     TEST_ASSERT_EQUAL_INT(0, sim_run_metrics(&run, &mp, &mc));
     const double tref = c.torque_ref_nm;
     const double sse = tref - mp.torque_mean_nm;
-    printf("  %-15s %-6s %2u kHz %7.1f r/min  T_ref %.4f N*m  T_sse %+.5f N*m (%+.2f %%)  "
-           "T_rip %.5f N*m (%.1f %%)  f_av %5.0f Hz  fault %s\n",
-           m->name, ctrl, fs / 1000u, c.speed_rpm, tref, sse, 100.0 * sse / tref,
-           mp.torque_ripple_nm, 100.0 * mp.torque_ripple_nm / tref, mp.f_av_hz,
+    printf("  %-15s %-6s %2u kHz %7.1f r/min  ADC %5.1f mA/count  T_ref %.4f N*m  T_sse %+.5f N*m "
+           "(%+.2f %%)  T_rip %.5f N*m (%.1f %%)  f_av %5.0f Hz  fault %s\n",
+           m->name, ctrl, fs / 1000u, c.speed_rpm, 2e3 * c.hal.i_fullscale_a / 4096.0, tref, sse,
+           100.0 * sse / tref, mp.torque_ripple_nm, 100.0 * mp.torque_ripple_nm / tref, mp.f_av_hz,
            fw_fault_name(fw_fault(&run.fw)));
     char msg[200];
     snprintf(msg, sizeof msg, "%s %s: fault %s", m->name, ctrl, fw_fault_name(fw_fault(&run.fw)));
@@ -100,6 +108,12 @@ static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double
              tref);
     TEST_ASSERT_TRUE_MESSAGE(fabs(sse) <= TSSE_REL * tref, msg);
     sim_run_free(&run);
+}
+
+static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double duration_s,
+                   double win_start_s)
+{
+    steady_adc(m, ctrl, fs, duration_s, win_start_s, 0.0);
 }
 
 /* mj5208: f_e = 170 Hz at 1459 r/min; window 50 ms = 8.5 electrical turns. */
@@ -129,10 +143,26 @@ static void test_gbm5208_gimbal(void)
     steady(&m, "fst", 40000u, 0.2, 0.05);
 }
 
+/* The gimbal motor on the ESC1 board's current scale: +-(A per count) 2^11. */
+static void test_gbm5208_gimbal_esc1_current_scale(void)
+{
+    const sim_machine_t m = load("gbm5208_gimbal.ini");
+    const g4_board_t *b = &g4_board_esc1;
+    const double a_per_count =
+        b->vref / (double)G4_ADC_FULL_SCALE / (fabs(b->sense_gain) * b->shunt_ohm);
+    TEST_ASSERT_DOUBLE_WITHIN(0.5e-3, 29.4e-3, a_per_count);
+    const double fullscale = a_per_count * 2048.0;
+    steady_adc(&m, "m2ptfc", 20000u, 0.2, 0.05, fullscale);
+    steady_adc(&m, "drr", 20000u, 0.2, 0.05, fullscale);
+    steady_adc(&m, "foc", 20000u, 0.2, 0.05, fullscale);
+    steady_adc(&m, "fst", 40000u, 0.2, 0.05, fullscale);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_mj5208_drone);
     RUN_TEST(test_gbm5208_gimbal);
+    RUN_TEST(test_gbm5208_gimbal_esc1_current_scale);
     return UNITY_END();
 }
