@@ -28,6 +28,6 @@ void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const int tau = ctrl_hyst3_update(&s->torque, fx_sub(ctx->ref->torque, nx->torque));
     const uint8_t n = st_lookup_bst(nx->sector, phi, tau);
     const uint8_t v = n == ST_ZVV ? ctrl_zero_after(s->prev_vec) : n;
-    ctrl_plan_single(&out->plan, v);
+    ctrl_out_single(out, v);
     s->prev_vec = v;
 }

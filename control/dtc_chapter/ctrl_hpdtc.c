@@ -114,4 +114,12 @@ void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     p->dur[2] = d0 / 2;
     p->vec[3] = 7u;
     p->dur[3] = d0 - d0 / 2;
+    /* Its leg duties: a leg is on during the segments of the vectors that
+     * have it high, V7's half of the zero time included (d1 + d2 + d0 = 1). */
+    const uint32_t m1 = ctrl_vec_legs[k1];
+    const uint32_t m2 = ctrl_vec_legs[k2];
+    for (unsigned x = 0u; x < 3u; x++) {
+        out->legs.duty[x] =
+            p->dur[3] + (((m1 >> x) & 1u) != 0u ? d1 : 0) + (((m2 >> x) & 1u) != 0u ? d2 : 0);
+    }
 }

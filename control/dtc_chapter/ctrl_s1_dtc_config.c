@@ -240,7 +240,7 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return CTRL_OK;
 }
 
-#define S1_DESC(id, label, st, tun, initfn, resetfn, stepfn)                                       \
+#define S1_DESC(id, label, st, tun, initfn, resetfn, stepfn, est)                                  \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
         .name = #id,                                                                               \
         .title = label,                                                                            \
@@ -252,12 +252,15 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
         .init = initfn,                                                                            \
         .reset = resetfn,                                                                          \
         .step = stepfn,                                                                            \
-        .est_unused = CTRL_EST_SECTOR_NOW,                                                         \
+        .est_unused = CTRL_EST_ONLY(est),                                                          \
     }
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",
-        ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step);
+        ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step,
+        CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 sec. 4, S1(17)-(20))",
-        ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step);
+        ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step,
+        CTRL_EST_AMP_NEXT | CTRL_EST_PSI_AB_NEXT | CTRL_EST_I_AB_NEXT);
 S1_DESC(hpdtc, "HP-DTC, two adjacent vectors + 20-point timing table (S1 sec. 5, Table 4)",
-        ctrl_hpdtc_state_t, hpdtc_tunables, hpdtc_init, ctrl_hpdtc_reset, ctrl_hpdtc_step);
+        ctrl_hpdtc_state_t, hpdtc_tunables, hpdtc_init, ctrl_hpdtc_reset, ctrl_hpdtc_step,
+        CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);

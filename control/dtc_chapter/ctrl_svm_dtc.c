@@ -6,7 +6,6 @@
 
 #include "ctrl_s1_dtc.h"
 #include "plan.h"
-#include "predict.h"
 #include "svpwm.h"
 
 #define SVM_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
@@ -44,24 +43,26 @@ void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     s->dd = dd;
 
-    /* Unit vector of the present flux (lambda_s), no atan: psi / |psi|. */
-    q24_t ux;
-    q24_t uy;
-    if (nx->psi_amp >= SVM_PSI_MIN) {
-        ux = fx_div(nx->psi_alpha, nx->psi_amp);
-        uy = fx_div(nx->psi_beta, nx->psi_amp);
-    } else {
-        ux = nx->cos_theta; /* no flux yet: start from the magnet axis */
-        uy = nx->sin_theta;
-    }
-    /* psi_ref e^{j(lambda + dd)}: rotate u by dd (|dd| < pi/2 + |omega Ts|, the
-     * product dd * 2^32/(2 pi) fits 64 bits), scale by psi_ref. */
+    /* Target psi_ref e^{j(lambda + dd)}, lambda the angle of the present flux
+     * (no atan): the flux turned by dd and scaled by psi_ref / |psi| (one
+     * division); without usable flux the magnet axis at k+1 scaled by
+     * psi_ref. dd * 2^32/(2 pi) fits 64 bits; the angle wraps modulo a turn. */
     const int64_t ang = fx_rshift64_round((int64_t)dd * SVM_RAD_TO_ANGLE, FX_QBITS);
-    q24_t sn;
-    q24_t cs;
-    fx_sincos((fx_angle_t)(uint64_t)ang, &sn, &cs);
-    const q24_t tx = fx_mul(psi_ref, fx_sub(fx_mul(cs, ux), fx_mul(sn, uy)));
-    const q24_t ty = fx_mul(psi_ref, fx_add(fx_mul(sn, ux), fx_mul(cs, uy)));
+    int32_t rc;
+    int32_t rs;
+    fx_rot_q30(fx_u2i((uint32_t)(uint64_t)ang), &rc, &rs);
+    q24_t rx;
+    q24_t ry;
+    q24_t g;
+    if (nx->psi_amp >= SVM_PSI_MIN) {
+        fx_rotate(nx->psi_alpha, nx->psi_beta, rc, rs, &rx, &ry);
+        g = fx_div(psi_ref, nx->psi_amp);
+    } else {
+        fx_rotate(nx->cos_theta, nx->sin_theta, rc, rs, &rx, &ry);
+        g = psi_ref;
+    }
+    const q24_t tx = fx_mul(g, rx);
+    const q24_t ty = fx_mul(g, ry);
     /* S1(19)-(20): V = (psi_target - psi) / Ts + Rs i. */
     q24_t va =
         fx_add(fx_mul_qn(fx_sub(tx, nx->psi_alpha), s->inv_ts, 16u), fx_mul(p->rs, nx->i_alpha));

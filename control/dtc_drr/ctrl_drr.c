@@ -253,5 +253,5 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     s->last_psierr = psierr;
     s->last_duty = duty;
     /* Active vector for D Ts, then V0 after V1/V3/V5, V7 after V2/V4/V6 (§5.4). */
-    ctrl_plan_active_zero(&out->plan, vec, duty);
+    ctrl_out_active_zero(out, vec, duty);
 }

@@ -67,17 +67,15 @@ q24_t ctrl_drr_duty_df(const ctrl_drr_base_state_t *s, const ctrl_params_t *p,
     /* (4.10) in pu (T = psi_r x psi / Ls):
      *   Delta T[v] = Ts/Ls [ psi_r x v - Rs/Ls (psi_r x psi) - w (psi_r . psi) ]
      * so Delta T[0] = -Ts/Ls [ Rs/Ls psi_pm psi_s sin(delta) + w psi_pm psi_s cos(delta) ]
-     * and Delta T[x+n] - Delta T[0] = Ts/Ls (psi_r x v). */
-    const q24_t pra = fx_mul(p->psi_pm, m->cos_theta);
-    const q24_t prb = fx_mul(p->psi_pm, m->sin_theta);
-    const q24_t pa = base_lim(m->psi_alpha);
-    const q24_t pb = base_lim(m->psi_beta);
+     * and Delta T[x+n] - Delta T[0] = Ts/Ls (psi_r x v). psi_r = psi_pm on
+     * the d axis: psi_r x psi = psi_pm psi_q, psi_r . psi = psi_pm psi_d,
+     * psi_r x v = psi_pm v_q (rotor frame at k+1, m->sin/cos_theta). */
     q24_t va;
     q24_t vb;
     ctrl_vector_ab(vec, base_lim(vdc), &va, &vb);
-    const q24_t cr_v = fx_cross(pra, prb, va, vb);
-    const q24_t cr_p = fx_cross(pra, prb, pa, pb);
-    const q24_t dot_p = fx_dot(pra, prb, pa, pb);
+    const q24_t cr_v = fx_mul(p->psi_pm, fx_cross(m->cos_theta, m->sin_theta, va, vb));
+    const q24_t cr_p = fx_mul(p->psi_pm, base_lim(m->psi_q));
+    const q24_t dot_p = fx_mul(p->psi_pm, base_lim(m->psi_d));
     const q24_t w = base_lim(omega_e);
     const int64_t z48 = (int64_t)s->rs_l * cr_p + (int64_t)w * dot_p; /* < 2^57 */
     const q24_t dt0 = fx_neg(fx_mul(s->ts_l, fx_sat32(fx_rshift64_round(z48, FX_QBITS))));
@@ -145,5 +143,5 @@ void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     s->last_terr = terr;
     s->last_psierr = psierr;
     s->last_duty = duty;
-    ctrl_plan_active_zero(&out->plan, vec, duty);
+    ctrl_out_active_zero(out, vec, duty);
 }

@@ -243,7 +243,7 @@ const ctrl_desc_t ctrl_desc_drr = {
     .init = drr_init,
     .reset = ctrl_drr_reset,
     .step = ctrl_drr_step,
-    .est_unused = CTRL_EST_SECTOR_NOW, /* reads |psi| and the sector at k+1 only */
+    .est_unused = CTRL_EST_ONLY(CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT),
 };
 
 /* ---------------- baselines ---------------- */
@@ -367,7 +367,7 @@ static int df_init(void *state, const void *cfg, const ctrl_setup_t *su)
                      sizeof df_tunables / sizeof df_tunables[0]);
 }
 
-#define DRR_BASE_DESC(id, label, tun, initfn)                                                      \
+#define DRR_BASE_DESC(id, label, tun, initfn, est)                                                 \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
         .name = #id,                                                                               \
         .title = label,                                                                            \
@@ -379,14 +379,14 @@ static int df_init(void *state, const void *cfg, const ctrl_setup_t *su)
         .init = initfn,                                                                            \
         .reset = ctrl_drr_base_reset,                                                              \
         .step = ctrl_drr_base_step,                                                                \
-        .est_unused = CTRL_EST_SECTOR_NOW,                                                         \
+        .est_unused = CTRL_EST_ONLY(est),                                                          \
     }
 
 DRR_BASE_DESC(drr_d1, "DRR baseline D1: D = |T_err/C_T| + |psi_err/C_psi| (thesis (5.19))",
-              d1_tunables, d1_init);
+              d1_tunables, d1_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 DRR_BASE_DESC(drr_d2, "DRR baseline D2: speed-proportional deviation K_a, K_b (thesis (5.21))",
-              d2_tunables, d2_init);
+              d2_tunables, d2_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 DRR_BASE_DESC(drr_pi, "DRR baseline D_PI: back-EMF feed-forward + PI duty (thesis (5.20))",
-              pi_tunables, pi_init);
+              pi_tunables, pi_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 DRR_BASE_DESC(drr_df, "DRR baseline D_f / D_RMS with (4.10) deviations (thesis (5.17)-(5.18))",
-              df_tunables, df_init);
+              df_tunables, df_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT | CTRL_EST_SC_NEXT);

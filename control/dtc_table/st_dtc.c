@@ -14,10 +14,10 @@
 
 /* One vector for the whole period; a table "ZVV" becomes V0/V7 by the
  * previous vector so that one leg switches (§4.5.2). */
-static void st_emit(ctrl_plan_t *out, uint8_t *prev_vec, uint8_t n)
+static void st_emit(ctrl_out_t *out, uint8_t *prev_vec, uint8_t n)
 {
     const uint8_t v = (n == ST_ZVV) ? ctrl_zero_after(*prev_vec) : n;
-    ctrl_plan_single(out, v);
+    ctrl_out_single(out, v);
     *prev_vec = v;
 }
 
@@ -59,7 +59,7 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         n = ST_ZVV; /* corrupted state: apply no voltage */
         break;
     }
-    st_emit(&out->plan, &s->prev_vec, n);
+    st_emit(out, &s->prev_vec, n);
 }
 
 void st_fst_logic_reset(st_fst_logic_t *l)
@@ -123,5 +123,5 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     if (n != ST_ZVV) {
         n = ctrl_vreplace(&s->vr, n, x, nx->psi_alpha, nx->psi_beta); /* (4.19)-(4.21) */
     }
-    st_emit(&out->plan, &s->prev_vec, n);
+    st_emit(out, &s->prev_vec, n);
 }

@@ -143,7 +143,7 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return CTRL_OK;
 }
 
-#define ST_HYST_DESC(id, label, initfn)                                                            \
+#define ST_HYST_DESC(id, label, initfn, est)                                                       \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
         .name = #id,                                                                               \
         .title = label,                                                                            \
@@ -155,15 +155,18 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
         .init = initfn,                                                                            \
         .reset = st_hyst_reset,                                                                    \
         .step = st_hyst_step,                                                                      \
-        .est_unused = CTRL_EST_SECTOR_NOW,                                                         \
+        .est_unused = CTRL_EST_ONLY(est),                                                          \
     }
 
-ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init);
+ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init,
+             CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 /* MBST's speed limit at 220 V: docs/algorithms.md, "MBST". */
-ST_HYST_DESC(mbst, "ST-DTC, modified basic table, sectors (4.18) (thesis Table 4.3)", st_mbst_init);
-ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4.4)", st_ast_init);
+ST_HYST_DESC(mbst, "ST-DTC, modified basic table, sectors (4.18) (thesis Table 4.3)", st_mbst_init,
+             CTRL_EST_AMP_NEXT | CTRL_EST_PSI_AB_NEXT);
+ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4.4)", st_ast_init,
+             CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (Table 4.5)",
-             st_zst_init);
+             st_zst_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 
 const ctrl_desc_t ctrl_desc_fst = {
     .name = "fst",
@@ -176,5 +179,5 @@ const ctrl_desc_t ctrl_desc_fst = {
     .init = st_fst_init,
     .reset = st_fst_reset,
     .step = st_fst_step,
-    .est_unused = CTRL_EST_SECTOR_NOW,
+    .est_unused = CTRL_EST_ONLY(CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT),
 };

@@ -1,150 +1,217 @@
 /*
- * Per-period estimator: current-model flux (3.4)/(3.9), torque (3.6), speed
- * from encoder differences, and the k+1 prediction (5.15)/(6.10)-(6.12).
+ * Per-period estimator in the rotor frame (estimator.h): current model
+ * (3.9), torque (3.10), and the k+1 prediction (5.15)/(6.10)-(6.12) with one
+ * table sine/cosine per period.
  */
 #include "estimator.h"
 
+#include <string.h>
+
 #include "plan.h"
-#include "predict.h"
-#include "transforms.h"
 #include "vectors.h"
 
 void ctrl_estimator_init(ctrl_estimator_t *e, const ctrl_params_t *p)
 {
-    (void)p; /* every parameter is read from p at each update */
-    e->flux_source = CTRL_FLUX_CURRENT_MODEL;
+    e->src = &ctrl_angle_encoder;
     e->outputs = CTRL_EST_ALL;
-    ctrl_flux_vm_init(&e->vm, CTRL_VM_CORR_NONE, 0);
-    ctrl_estimator_reset(e);
+    memset(e->src_state.bytes, 0, sizeof e->src_state.bytes);
+    ctrl_estimator_reset(e, p);
 }
 
-void ctrl_estimator_reset(ctrl_estimator_t *e)
+void ctrl_estimator_reset(ctrl_estimator_t *e, const ctrl_params_t *p)
 {
-    e->theta_prev = 0u;
-    e->omega_acc = 0;
-    e->v_prev_alpha = 0;
-    e->v_prev_beta = 0;
-    e->primed = 0u;
-    ctrl_flux_vm_init(&e->vm, e->vm.mode, e->vm.k_corr);
+    memset(&e->in, 0, sizeof e->in);
+    e->src->reset(e->src_state.bytes, p);
 }
 
-/* Current model (3.9) without |psi| and the sector. Park (3.7) and its inverse
- * with fx_dot/fx_cross (one rounding each, saturated): i_d = c a + s b,
- * i_q = c b - s a; psi_alpha = c psi_d - s psi_q, psi_beta = s psi_d + c psi_q. */
-static void current_model(const ctrl_params_t *p, q24_t i_alpha, q24_t i_beta, fx_angle_t theta_e,
-                          q24_t sin_theta, q24_t cos_theta, ctrl_mstate_t *out)
+int ctrl_estimator_set_angle_src(ctrl_estimator_t *e, const ctrl_params_t *p,
+                                 const ctrl_angle_src_t *src)
 {
-    const q24_t i_d = fx_dot(cos_theta, sin_theta, i_alpha, i_beta);
-    const q24_t i_q = fx_cross(cos_theta, sin_theta, i_alpha, i_beta);
-    /* (3.9): psi_d = Ld i_d + psi_pm, psi_q = Lq i_q. */
-    const q24_t psi_d = fx_add(fx_mul(p->ld, i_d), p->psi_pm);
-    const q24_t psi_q = fx_mul(p->lq, i_q);
-    out->i_alpha = i_alpha;
-    out->i_beta = i_beta;
-    out->i_d = i_d;
-    out->i_q = i_q;
-    out->psi_d = psi_d;
-    out->psi_q = psi_q;
-    out->psi_alpha = fx_cross(cos_theta, sin_theta, psi_q, psi_d);
-    out->psi_beta = fx_dot(sin_theta, cos_theta, psi_d, psi_q);
-    out->torque = fx_cross(psi_d, psi_q, i_d, i_q); /* (3.10) */
-    out->theta_e = theta_e;
-    out->sin_theta = sin_theta;
-    out->cos_theta = cos_theta;
+    if (e == NULL || p == NULL || src == NULL || src->update == NULL || src->reset == NULL ||
+        src->state_size > CTRL_ANGLE_STATE_MAX) {
+        return CTRL_EINVAL;
+    }
+    e->src = src;
+    memset(e->src_state.bytes, 0, sizeof e->src_state.bytes);
+    ctrl_estimator_reset(e, p);
+    return CTRL_OK;
 }
 
-void ctrl_mstate_from_current(const ctrl_params_t *p, q24_t i_alpha, q24_t i_beta,
-                              fx_angle_t theta_e, q24_t sin_theta, q24_t cos_theta,
-                              ctrl_mstate_t *out)
+void *ctrl_estimator_angle_state(ctrl_estimator_t *e)
 {
-    current_model(p, i_alpha, i_beta, theta_e, sin_theta, cos_theta, out);
-    out->psi_amp = fx_mag(out->psi_d, out->psi_q);            /* (4.3), rotation-invariant */
-    out->sector = ctrl_sector(out->psi_alpha, out->psi_beta); /* (4.5) */
+    return e != NULL ? e->src_state.bytes : NULL;
 }
 
-/* State with the voltage-model flux and the measured current. */
-static void state_from_vm(const ctrl_estimator_t *e, ctrl_mstate_t *s)
+void ctrl_estimator_set_outputs(ctrl_estimator_t *e, unsigned outputs)
 {
-    q24_t pa;
-    q24_t pb;
-    ctrl_flux_vm_get(&e->vm, &pa, &pb);
-    s->psi_alpha = pa;
-    s->psi_beta = pb;
-    ctrl_park(pa, pb, s->sin_theta, s->cos_theta, &s->psi_d, &s->psi_q);
-    s->torque = fx_cross(pa, pb, s->i_alpha, s->i_beta); /* (3.6) */
+    if (outputs & CTRL_EST_SECTOR_NOW) {
+        outputs |= CTRL_EST_PSI_AB_NOW;
+    }
+    if (outputs & CTRL_EST_SECTOR_NEXT) {
+        outputs |= CTRL_EST_PSI_AB_NEXT;
+    }
+    if (outputs & CTRL_EST_I_AB_NEXT) {
+        outputs |= CTRL_EST_SC_NEXT;
+    }
+    e->outputs = (uint8_t)(outputs & CTRL_EST_ALL);
 }
 
-/* Signed angle difference in [-pi, pi) as an int32_t, without the
- * implementation-defined unsigned -> signed conversion. */
-static int32_t angle_diff(fx_angle_t a, fx_angle_t b)
+/* The optional outputs (estimator.h). (hd, hq): the predicted flux in the
+ * frame at theta(k), psi' of (5.15); its stator-frame image is psi(k+1). */
+static void estimator_options(unsigned outputs, q24_t hd, q24_t hq, ctrl_estimate_t *est)
 {
-    return fx_u2i(a - b);
+    ctrl_mstate_t *now = &est->now;
+    ctrl_mstate_t *nx = &est->next;
+    const q24_t s = now->sin_theta;
+    const q24_t c = now->cos_theta;
+    if (outputs & CTRL_EST_AMP_NOW) {
+        now->psi_amp = fx_mag(now->psi_d, now->psi_q); /* (4.3), rotation-invariant */
+    }
+    if (outputs & CTRL_EST_PSI_AB_NOW) {
+        now->psi_alpha = fx_cross(c, s, now->psi_q, now->psi_d); /* inverse Park */
+        now->psi_beta = fx_dot(s, c, now->psi_d, now->psi_q);
+        if (outputs & CTRL_EST_SECTOR_NOW) {
+            now->sector = ctrl_sector(now->psi_alpha, now->psi_beta); /* (4.5) */
+        }
+    }
+    if (outputs & CTRL_EST_AMP_NEXT) {
+        nx->psi_amp = fx_mag(hd, hq); /* = |psi(k+1)|, one rounding less */
+    }
+    if (outputs & CTRL_EST_PSI_AB_NEXT) {
+        /* |psi'| <= 91 pu (clamped), |(s, c)| <= 1: no saturation */
+        nx->psi_alpha = fx_cross_nosat(c, s, hq, hd);
+        nx->psi_beta = fx_dot_nosat(s, c, hd, hq);
+        if (outputs & CTRL_EST_SECTOR_NEXT) {
+            nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta);
+        }
+    }
+    if (outputs & CTRL_EST_SC_NEXT) {
+        /* theta(k+1) = theta(k) + delta: (s, c) turned by (rot_c, rot_s). */
+        const int32_t rc = est->rot_c;
+        const int32_t rs = est->rot_s;
+        const q24_t c1 = fx_round_nosat((int64_t)c * rc - (int64_t)s * rs, 30u);
+        const q24_t s1 = fx_round_nosat((int64_t)s * rc + (int64_t)c * rs, 30u);
+        nx->sin_theta = s1;
+        nx->cos_theta = c1;
+        if (outputs & CTRL_EST_I_AB_NEXT) {
+            nx->i_alpha = fx_cross(c1, s1, nx->i_q, nx->i_d);
+            nx->i_beta = fx_dot(s1, c1, nx->i_d, nx->i_q);
+        }
+    }
 }
+
+/* Range of the per-period arithmetic (estimator.h): phase currents within
+ * +-CTRL_EST_I_LIM, leg duties in [0, FX_ONE], the DC link in [0, 64 pu]. */
+#define EST_VDC_LIM ((q24_t)1 << 30) /* 64 pu */
+#define EST_PSI_LIM ((q24_t)1 << 30) /* 64 pu */
 
 void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ctrl_meas_t *m,
                            const ctrl_legs_t *applied, ctrl_estimate_t *est)
 {
-    q24_t i_alpha;
-    q24_t i_beta;
+    ctrl_mstate_t *now = &est->now;
+    ctrl_mstate_t *nx = &est->next;
+    /* Clarke (3.3): beta = (a + 2 b)/sqrt(3); |a|, |b| <= 2^29: |beta| <= 55.5 pu,
+     * the products < 2^60, no saturation. */
+    const q24_t i_a = fx_clamp(m->i_a, -CTRL_EST_I_LIM, CTRL_EST_I_LIM);
+    const q24_t i_b = fx_clamp(m->i_b, -CTRL_EST_I_LIM, CTRL_EST_I_LIM);
+    const q24_t i_alpha = i_a;
+    const q24_t i_beta =
+        fx_round_nosat((int64_t)i_a * FX_Q30_INV_SQRT3 + (int64_t)i_b * FX_Q30_2_SQRT3, 30u);
+    const q24_t vdc = fx_clamp(m->vdc, 0, EST_VDC_LIM);
+
+    /* theta(k), omega(k) from the angle source. */
+    ctrl_angle_in_t *in = &e->in;
+    in->theta_meas = m->theta_e;
+    in->i_alpha = i_alpha;
+    in->i_beta = i_beta;
+    in->vdc = vdc;
+    ctrl_angle_out_t ang;
+    if (e->src == &ctrl_angle_encoder) {
+        /* the usual source, called directly (inline) */
+        ctrl_angle_encoder_step((ctrl_angle_encoder_t *)(void *)e->src_state.bytes, p, m->theta_e,
+                                &ang);
+    } else {
+        e->src->update(e->src_state.bytes, p, in, &ang);
+    }
+    const fx_angle_t th = ang.theta;
+    const q24_t omega = ang.omega;
+
+    /* The one table sine/cosine of the period; the turn over the period. */
     q24_t s;
     q24_t c;
-    ctrl_clarke(m->i_a, m->i_b, &i_alpha, &i_beta);
-    fx_sincos(m->theta_e, &s, &c);
+    fx_sincos_inline(th, &s, &c);
+    const int32_t dth = fx_u2i(ctrl_angle_step(p, omega));
+    int32_t rc;
+    int32_t rs;
+    fx_rot_q30_inline(dth, &rc, &rs);
 
-    /* Speed: omega = dtheta / Ts (pu), then a first-order EMA kept in Q48 so
-     * that it settles to the input exactly (no dead band). |omega_acc| stays
-     * below 2^55 (an average of values < 2^31 in Q24 with 24 guard bits). */
-    if (e->primed != 0u) {
-        const int32_t dth = angle_diff(m->theta_e, e->theta_prev);
-        const q24_t raw = fx_round_sat((int64_t)dth * p->dangle_to_omega, CTRL_DANGLE_SHIFT);
-        const q24_t out = fx_round_sat(e->omega_acc, FX_QBITS);
-        const q24_t diff = fx_sub(raw, out);
-        e->omega_acc += (int64_t)diff * p->speed_lpf_k; /* |.| < 2^55 */
-    }
-    const q24_t omega = fx_round_sat(e->omega_acc, FX_QBITS);
+    /* k: Park (3.7) (|i| <= 64 pu: no saturation), current model (3.9),
+     * torque (3.10). */
+    const q24_t i_d = fx_dot_nosat(c, s, i_alpha, i_beta);
+    const q24_t i_q = fx_cross_nosat(c, s, i_alpha, i_beta);
+    const q24_t psi_d = fx_add(fx_mul(p->ld, i_d), p->psi_pm);
+    const q24_t psi_q = fx_mul(p->lq, i_q);
+    now->i_d = i_d;
+    now->i_q = i_q;
+    now->psi_d = psi_d;
+    now->psi_q = psi_q;
+    now->torque = fx_cross(psi_d, psi_q, i_d, i_q);
+    now->theta_e = th;
+    now->sin_theta = s;
+    now->cos_theta = c;
+    now->i_alpha = i_alpha;
+    now->i_beta = i_beta;
 
-    ctrl_mstate_t *now = &est->now;
-    current_model(p, i_alpha, i_beta, m->theta_e, s, c, now);
-    if (e->flux_source == CTRL_FLUX_VOLTAGE_MODEL) {
-        ctrl_flux_vm_update(&e->vm, p, e->v_prev_alpha, e->v_prev_beta, i_alpha, i_beta,
-                            now->psi_alpha, now->psi_beta);
-        state_from_vm(e, now);
+    /* (5.15) in the frame at theta(k): psi' = psi + Ts Vdc u - Ts Rs i, u the
+     * duties' voltage per unit of DC link turned into that frame. Ts Vdc <=
+     * 64 pu, |u| <= 2/3, Ts Rs <= 1 pu: the products fit without saturation;
+     * the sums saturate. */
+    q24_t hd = fx_sub(psi_d, fx_mul_nosat(p->ts_rs, i_d));
+    q24_t hq = fx_sub(psi_q, fx_mul_nosat(p->ts_rs, i_q));
+    if (applied != NULL) {
+        /* (4.4) averaged over the period: (2 d_a - d_b - d_c)/3 and
+         * (d_b - d_c)/sqrt(3), the duties in [0, 2^24]: exact in 32 bits. */
+        const int32_t da = (int32_t)ctrl_plan_dur(applied->duty[0]);
+        const int32_t db = (int32_t)ctrl_plan_dur(applied->duty[1]);
+        const int32_t dc = (int32_t)ctrl_plan_dur(applied->duty[2]);
+        const q24_t ua = fx_round_nosat((int64_t)(2 * da - db - dc) * FX_Q30_1_3, 30u);
+        const q24_t ub = fx_round_nosat((int64_t)(db - dc) * FX_Q30_INV_SQRT3, 30u);
+        const q24_t ts_vdc = fx_mul_nosat(p->ts, vdc);
+        hd = fx_add(hd, fx_mul_nosat(ts_vdc, fx_dot_nosat(c, s, ua, ub)));
+        hq = fx_add(hq, fx_mul_nosat(ts_vdc, fx_cross_nosat(c, s, ua, ub)));
+        if (e->src->uses_voltage != 0u) {
+            in->v_alpha = fx_mul_nosat(vdc, ua);
+            in->v_beta = fx_mul_nosat(vdc, ub);
+        }
+    } else {
+        in->v_alpha = 0;
+        in->v_beta = 0;
     }
-    /* (4.3) and (4.5) at k. Current model: the amplitude from the rotor-frame
-     * flux (rotation invariant, one rounding less than from alpha/beta);
-     * voltage model: from its alpha/beta flux. */
-    const unsigned outputs = e->outputs;
-    now->psi_amp = 0;
-    if ((outputs & CTRL_EST_AMP_NOW) != 0u) {
-        now->psi_amp = e->flux_source == CTRL_FLUX_VOLTAGE_MODEL
-                           ? fx_mag(now->psi_alpha, now->psi_beta)
-                           : fx_mag(now->psi_d, now->psi_q);
-    }
-    now->sector =
-        (outputs & CTRL_EST_SECTOR_NOW) != 0u ? ctrl_sector(now->psi_alpha, now->psi_beta) : 0u;
 
-    q24_t va = 0;
-    q24_t vb = 0;
-    if (applied != 0) {
-        ctrl_legs_voltage(applied, m->vdc, &va, &vb);
-    }
-    /* Prediction (5.15)/(6.10)-(6.12): flux, angle theta + omega Ts, state. */
-    q24_t pa;
-    q24_t pb;
-    ctrl_predict_flux(p, now, va, vb, &pa, &pb);
-    const fx_angle_t th1 = m->theta_e + ctrl_angle_step(p, omega);
-    q24_t s1;
-    q24_t c1;
-    fx_sincos(th1, &s1, &c1);
-    ctrl_mstate_from_flux_noamp(p, pa, pb, th1, s1, c1, &est->next);
-    if ((outputs & CTRL_EST_AMP_NEXT) != 0u) {
-        est->next.psi_amp = fx_mag(pa, pb);
-    }
+    /* k+1: the frame turned by delta = omega Ts, psi(k+1) = psi' e^{-j delta}
+     * (6.12); current (3.9) inverted, torque (3.10). psi' is taken within
+     * +-64 pu (EST_PSI_LIM; twice the flux the core's range allows at
+     * current_max): the turned flux and its stator-frame image stay below
+     * 91 pu, no saturation. */
+    hd = fx_clamp(hd, -EST_PSI_LIM, EST_PSI_LIM - 1);
+    hq = fx_clamp(hq, -EST_PSI_LIM, EST_PSI_LIM - 1);
+    const q24_t psi1_d = fx_round_nosat((int64_t)hd * rc + (int64_t)hq * rs, 30u);
+    const q24_t psi1_q = fx_round_nosat((int64_t)hq * rc - (int64_t)hd * rs, 30u);
+    const q24_t i1_d = fx_mul(fx_sub(psi1_d, p->psi_pm), p->inv_ld);
+    const q24_t i1_q = fx_mul(psi1_q, p->inv_lq);
+    nx->i_d = i1_d;
+    nx->i_q = i1_q;
+    nx->psi_d = psi1_d;
+    nx->psi_q = psi1_q;
+    nx->torque = fx_cross(psi1_d, psi1_q, i1_d, i1_q);
+    nx->theta_e = th + (fx_angle_t)dth;
 
     est->omega_e = omega;
-    est->vdc = m->vdc;
-    e->v_prev_alpha = va;
-    e->v_prev_beta = vb;
-    e->theta_prev = m->theta_e;
-    e->primed = 1u;
+    est->vdc = vdc;
+    est->dtheta = dth;
+    est->rot_c = rc;
+    est->rot_s = rs;
+    if (e->outputs != 0u) {
+        estimator_options(e->outputs, hd, hq, est);
+    }
 }

@@ -6,8 +6,8 @@
  */
 #include "flux_observer.h"
 
+#include "angle_source.h"
 #include "plan.h"
-#include "predict.h"
 #include "transforms.h"
 
 /* |flux| kept below 127 pu in Q48 so the Q24 view always fits an int32_t. */

@@ -13,8 +13,9 @@
  *                         psi += Ts (v - Rs i) + k (psi_cm - psi). Below the
  *                         corner the current model dominates, above it the
  *                         voltage model (complementary filter).
- * Not used by default: the estimator runs the current model (as the thesis
- * experiments do, §6.3.4); select it with ctrl_estimator_t.flux_source.
+ * Not in the estimator's path (it runs the current model from the angle
+ * source's theta, as the thesis experiments do, §6.3.4): a building block
+ * for a sensorless angle source (angle_source.h, uses_voltage).
  */
 #ifndef CONTROL_FLUX_VM_H
 #define CONTROL_FLUX_VM_H

@@ -1,7 +1,7 @@
 /* Sensorless angle: observer and forced-angle start-up (sensorless.h). */
 #include "sensorless.h"
 
-#include "predict.h"
+#include "angle_source.h"
 
 #define SL_QUARTER_TURN 0x40000000u /* 90 deg */
 

@@ -8,7 +8,6 @@
 
 #include "mtpa.h"
 #include "plan.h"
-#include "predict.h"
 #include "svpwm.h"
 #include "transforms.h"
 #include "vectors.h"
@@ -63,7 +62,6 @@ void ctrl_foc_reset(void *state)
 static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref, q24_t iq_ref,
                         ctrl_out_t *out)
 {
-    const ctrl_params_t *p = ctx->params;
     const ctrl_mstate_t *nx = &ctx->est->next; /* state at k+1: delay compensation */
     const q24_t w = ctx->est->omega_e;
     const q24_t e_d = fx_sub(id_ref, nx->i_d);
@@ -73,11 +71,17 @@ static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref
     const q24_t v_q = fx_add(fx_mul(w, nx->psi_d), ctrl_foc_pi_out(&s->pi_q, e_q));
     s->v_d = v_d;
     s->v_q = v_q;
-    /* Mean rotor angle over [k+1, k+2): theta(k+1) + omega Ts / 2. */
-    const fx_angle_t th = nx->theta_e + ctrl_angle_step(p, fx_rshift32_round(w, 1u));
-    q24_t sn;
+    /* Mean rotor angle over [k+1, k+2): theta(k+1) + omega Ts / 2 =
+     * theta(k) + 3/2 delta: the estimator's sine and cosine at k turned by
+     * 3/2 delta (formed in 64 bits, rounded, taken modulo one turn). */
+    const int64_t d15 = (int64_t)ctx->est->dtheta * 3;
+    int32_t rc;
+    int32_t rs;
+    fx_rot_q30(fx_u2i((uint32_t)(uint64_t)fx_rshift64_round(d15, 1u)), &rc, &rs);
+    const ctrl_mstate_t *now = &ctx->est->now;
     q24_t cs;
-    fx_sincos(th, &sn, &cs);
+    q24_t sn;
+    fx_rotate(now->cos_theta, now->sin_theta, rc, rs, &cs, &sn);
     q24_t va;
     q24_t vb;
     ctrl_inv_park(v_d, v_q, sn, cs, &va, &vb);
@@ -92,16 +96,18 @@ static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_r
                           ctrl_out_t *out)
 {
     const ctrl_mstate_t *nx = &ctx->est->next; /* currents at k+1 (delay compensation) */
-    q24_t ra;
-    q24_t rb;
-    ctrl_inv_park(id_ref, iq_ref, nx->sin_theta, nx->cos_theta, &ra, &rb);
-    q24_t ref[3];
-    q24_t mea[3];
-    ctrl_inv_clarke(ra, rb, &ref[0], &ref[1], &ref[2]);
-    ctrl_inv_clarke(nx->i_alpha, nx->i_beta, &mea[0], &mea[1], &mea[2]);
+    /* Phase errors i_ref - i(k+1): the rotor-frame error turned to the stator
+     * frame (inverse Park at theta(k+1)) and split into phases (inverse
+     * Clarke), both linear. */
+    q24_t ea;
+    q24_t eb;
+    ctrl_inv_park(fx_sub(id_ref, nx->i_d), fx_sub(iq_ref, nx->i_q), nx->sin_theta, nx->cos_theta,
+                  &ea, &eb);
+    q24_t err[3];
+    ctrl_inv_clarke(ea, eb, &err[0], &err[1], &err[2]);
     uint8_t legs = s->legs;
     for (unsigned x = 0u; x < 3u; x++) {
-        const q24_t e = fx_sub(ref[x], mea[x]);
+        const q24_t e = err[x];
         const uint8_t bit = (uint8_t)(1u << x);
         if (e >= s->h_i) {
             legs = (uint8_t)(legs | bit); /* current too low: leg high */
@@ -110,7 +116,7 @@ static void foc_hyst_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_r
         }
     }
     s->legs = legs;
-    ctrl_plan_single(&out->plan, ctrl_vec_of_legs[legs & 7u]);
+    ctrl_out_single(out, ctrl_vec_of_legs[legs & 7u]);
 }
 
 void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)

@@ -153,7 +153,7 @@ const ctrl_desc_t ctrl_desc_foc = {
     .init = foc_init,
     .reset = ctrl_foc_reset,
     .step = ctrl_foc_step,
-    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* currents, not |psi| or sectors */
+    .est_unused = CTRL_EST_ONLY(0u), /* rotor-frame currents and fluxes only */
 };
 
 const ctrl_desc_t ctrl_desc_foc_hyst = {
@@ -167,5 +167,5 @@ const ctrl_desc_t ctrl_desc_foc_hyst = {
     .init = foc_hyst_init,
     .reset = ctrl_foc_reset,
     .step = ctrl_foc_step,
-    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW, /* currents, not |psi| or sectors */
+    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT), /* the angle at k+1 */
 };

@@ -21,25 +21,31 @@ typedef struct {
     fx_angle_t theta_e; /* electrical rotor angle (d axis), from the encoder */
 } ctrl_meas_t;
 
-/* Machine state at one instant (measured at k, or predicted for k+1). */
+/* Machine state at one instant (measured at k, or predicted for k+1), rotor
+ * frame first. The stator-frame fields, the amplitude, the sector and the
+ * predicted sine and cosine are optional outputs of the estimator
+ * (estimator.h, CTRL_EST_*). */
 typedef struct {
-    q24_t i_alpha, i_beta;      /* stator current, pu */
-    q24_t i_d, i_q;             /* rotor frame, pu */
-    q24_t psi_alpha, psi_beta;  /* stator flux linkage, pu */
-    q24_t psi_d, psi_q;         /* rotor frame, pu */
-    q24_t psi_amp;              /* |psi_s|, pu (4.3) */
-    q24_t torque;               /* Te, pu: psi x i (3.6) */
+    q24_t i_d, i_q;             /* stator current, rotor frame, pu */
+    q24_t psi_d, psi_q;         /* stator flux linkage, rotor frame, pu */
+    q24_t torque;               /* Te, pu: psi x i (3.10) */
     fx_angle_t theta_e;         /* rotor electrical angle */
     q24_t sin_theta, cos_theta; /* of theta_e, Q24 */
+    q24_t i_alpha, i_beta;      /* stator current, stator frame, pu */
+    q24_t psi_alpha, psi_beta;  /* stator flux linkage, stator frame, pu */
+    q24_t psi_amp;              /* |psi_s|, pu (4.3) */
     uint8_t sector;             /* stator-flux sector 1..6 (4.5) */
 } ctrl_mstate_t;
 
 /* What the estimator hands every controller at sample k. */
 typedef struct {
-    ctrl_mstate_t now;  /* at sample k, from the measurements (3.4)/(4.1) */
-    ctrl_mstate_t next; /* predicted for k+1 with the plan applied in [k, k+1) (5.15) */
-    q24_t omega_e;      /* electrical speed, pu (filtered encoder difference) */
-    q24_t vdc;          /* DC link, pu */
+    ctrl_mstate_t now;    /* at sample k, from the measurements (3.4)/(4.1) */
+    ctrl_mstate_t next;   /* predicted for k+1 with the duties applied in [k, k+1) (5.15) */
+    q24_t omega_e;        /* electrical speed, pu (from the angle source) */
+    q24_t vdc;            /* DC link, pu */
+    int32_t dtheta;       /* omega_e Ts: the angle one period turns, fx_angle_t units, signed */
+    int32_t rot_c, rot_s; /* cos and sin of dtheta, Q30 (fx_rot_q30): the frame at
+                           * k+1 is the frame at k turned by dtheta */
 } ctrl_estimate_t;
 
 /* References from the outer loop / command interface. */
@@ -68,13 +74,14 @@ typedef struct {
     q24_t duty[3];
 } ctrl_legs_t;
 
-/* What a controller's step writes for [k+1, k+2): a switching plan (switching
- * tables, duty-ratio DTC, predictive control), whose leg duties ctrl_out_legs()
- * (plan.h) derives, or the leg duties themselves (space-vector modulation),
- * marked by plan.n_seg == 0. */
+/* What a controller's step writes for [k+1, k+2): the leg duties, always,
+ * and the switching plan they realise when it has one (switching tables,
+ * duty-ratio DTC, predictive control), for telemetry; plan.n_seg == 0 for
+ * space-vector modulation. plan.h: ctrl_out_plan() derives the duties of a
+ * plan, ctrl_out_single() and ctrl_out_active_zero() write both at once. */
 typedef struct {
-    ctrl_plan_t plan;
     ctrl_legs_t legs;
+    ctrl_plan_t plan;
 } ctrl_out_t;
 
 #endif /* CONTROL_CTRL_TYPES_H */

@@ -1,67 +1,92 @@
 /*
- * State estimator run once per control period (thesis §5.4, §6.3.4).
+ * State estimator run once per control period, in the rotor frame (thesis
+ * §5.4, §6.3.4; docs/architecture.md, "One period").
  *
- * At sample k, from the measured phase currents and the encoder angle:
- *   - current model (3.4)/(4.1), in the rotor frame (3.9):
- *       psi_d = Ld i_d + psi_pm, psi_q = Lq i_q (SPMSM and IPMSM);
- *   - torque (3.6) = psi x i, amplitude (4.3), sector (4.5);
- *   - electrical speed from the angle difference per period, low-pass filtered
- *     (first-order EMA with coefficient p->speed_lpf_k; the default cut-off is
- *     CTRL_SPEED_LPF_HZ_DEFAULT, see ctrl_params.h);
- *   - prediction to k+1 (5.15)/(6.10)-(6.12) with the period-average voltage of
- *     the leg duties applied during [k, k+1).
- * One fx_sincos for the measured angle and one for the predicted angle.
+ * At sample k:
+ *   - Clarke (3.3) of the measured currents; theta(k), omega(k) from the
+ *     angle source (angle_source.h: encoder by default);
+ *   - one fx_sincos(theta(k)); Park (3.7) of the current, current model
+ *     (3.9) psi_d = Ld i_d + psi_pm, psi_q = Lq i_q, torque (3.10);
+ *   - prediction to k+1 in the rotor frame, (5.15)/(6.10)-(6.12): the leg
+ *     duties acting in [k, k+1) as a voltage in the frame at theta(k),
+ *     psi' = psi + Ts v - Ts Rs i, then the frame turned by
+ *     delta = omega Ts: psi(k+1) = psi' e^{-j delta} (fx_rot_q30, no second
+ *     table look-up), i(k+1) from (3.9) inverted, torque (3.10).
+ * Stator-frame values, amplitudes and sectors only where a consumer reads
+ * them (CTRL_EST_* below).
  */
 #ifndef CONTROL_ESTIMATOR_H
 #define CONTROL_ESTIMATOR_H
 
+#include <stddef.h>
 #include <stdint.h>
 
+#include "angle_source.h"
 #include "ctrl_params.h"
 #include "ctrl_types.h"
-#include "flux_vm.h"
 #include "fx.h"
 
-/* Optional outputs (ctrl_estimator_t.outputs, a bit set = computed). The rest
- * of ctrl_estimate_t is always computed. A field not computed is set to 0
- * (psi_amp 0, sector 0 = "none"). Default CTRL_EST_ALL: clear bits only when no
- * consumer (controller, telemetry) reads the field; each square root costs
- * ~75 Cortex-M4 instructions, the sector ~20 (tests/perf). */
-#define CTRL_EST_AMP_NOW 0x01u    /* est->now.psi_amp (4.3) */
-#define CTRL_EST_AMP_NEXT 0x02u   /* est->next.psi_amp */
-#define CTRL_EST_SECTOR_NOW 0x04u /* est->now.sector (4.5); next.sector is always computed */
-#define CTRL_EST_ALL 0x07u
+/* Optional outputs (bit set = computed). Always computed: now and next
+ * i_d, i_q, psi_d, psi_q, torque, theta_e; now.sin_theta, now.cos_theta,
+ * now.i_alpha, now.i_beta; omega_e, vdc, dtheta, rot_c, rot_s. A field not
+ * computed is not written (it keeps the caller's value, zero from an
+ * initialised ctrl_estimate_t). Costs on a Cortex-M4: a square root ~60
+ * instructions, a sector ~20, a rotation ~10. */
+#define CTRL_EST_AMP_NOW 0x01u     /* now.psi_amp (4.3) */
+#define CTRL_EST_SECTOR_NOW 0x02u  /* now.sector (4.5), with now.psi_alpha/beta */
+#define CTRL_EST_PSI_AB_NOW 0x04u  /* now.psi_alpha, now.psi_beta */
+#define CTRL_EST_AMP_NEXT 0x08u    /* next.psi_amp */
+#define CTRL_EST_SECTOR_NEXT 0x10u /* next.sector, with next.psi_alpha/beta */
+#define CTRL_EST_PSI_AB_NEXT 0x20u /* next.psi_alpha, next.psi_beta */
+#define CTRL_EST_SC_NEXT 0x40u     /* next.sin_theta, next.cos_theta */
+#define CTRL_EST_I_AB_NEXT 0x80u   /* next.i_alpha, next.i_beta, with next sin/cos */
+#define CTRL_EST_ALL 0xFFu
+/* For a descriptor's est_unused (controller.h): it reads no optional output but x. */
+#define CTRL_EST_ONLY(x) ((uint8_t)(CTRL_EST_ALL & ~(unsigned)(x)))
 
-#define CTRL_FLUX_CURRENT_MODEL 0u /* default: (3.4) from the encoder angle */
-#define CTRL_FLUX_VOLTAGE_MODEL 1u /* flux_vm.h, drift-compensated */
+/* Range of the phase currents the estimator takes (beyond: taken as the
+ * limit): 32 pu, twice the largest trip level the core accepts
+ * (current_max <= 16 pu), so the over-current protection acts first; it
+ * bounds every product of the period (no saturation needed in the Park
+ * transform and the voltage terms). Leg duties are taken in [0, FX_ONE],
+ * the DC link in [0, 64 pu]. */
+#define CTRL_EST_I_LIM ((q24_t)1 << 29)
 
 typedef struct {
-    fx_angle_t theta_prev;           /* encoder angle at k-1 */
-    int64_t omega_acc;               /* filtered electrical speed, Q48 pu */
-    q24_t v_prev_alpha, v_prev_beta; /* average voltage applied during [k-1, k), Q24 pu */
-    uint8_t primed;                  /* 0 before the first update after reset */
-    uint8_t flux_source;             /* CTRL_FLUX_*; set after init, kept by reset */
-    ctrl_flux_vm_t vm;               /* voltage model (used if flux_source says so) */
-    uint8_t outputs;                 /* CTRL_EST_* optional outputs; init: CTRL_EST_ALL,
-                                      * set after init, kept by reset */
+    const ctrl_angle_src_t *src; /* angle source; init: ctrl_angle_encoder */
+    uint8_t outputs;             /* CTRL_EST_* (with what they imply), set by
+                                  * ctrl_estimator_set_outputs; init: all */
+    ctrl_angle_in_t in;          /* what the source sees; v_alpha, v_beta: the
+                                  * mean voltage of the last period (for a
+                                  * source with uses_voltage), Q24 pu */
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_ANGLE_STATE_MAX];
+    } src_state; /* the source's state */
 } ctrl_estimator_t;
 
-/* Current model, default flux source, every output, voltage model configured
- * without correction (call ctrl_flux_vm_init on e->vm to choose another). */
+/* Encoder angle source, every output. */
 void ctrl_estimator_init(ctrl_estimator_t *e, const ctrl_params_t *p);
 
-/* Forget the history (speed, previous angle, voltage model), keep the settings. */
-void ctrl_estimator_reset(ctrl_estimator_t *e);
+/* Forget the history (the source's, the last voltage); keep the settings. */
+void ctrl_estimator_reset(ctrl_estimator_t *e, const ctrl_params_t *p);
 
-/* Estimate at k and predict k+1; applied: the leg duties acting during [k, k+1)
- * (NULL: a zero vector). */
+/* Select the angle source (its state cleared and reset). Returns CTRL_OK,
+ * or CTRL_EINVAL (NULL, no update function, state larger than
+ * CTRL_ANGLE_STATE_MAX) with the previous source kept. */
+int ctrl_estimator_set_angle_src(ctrl_estimator_t *e, const ctrl_params_t *p,
+                                 const ctrl_angle_src_t *src);
+
+/* The selected source's state (e.g. for ctrl_angle_forced_set). */
+void *ctrl_estimator_angle_state(ctrl_estimator_t *e);
+
+/* Choose the optional outputs (CTRL_EST_*; a sector implies the stator-frame
+ * flux it is taken from, I_AB_NEXT the sine and cosine at k+1). */
+void ctrl_estimator_set_outputs(ctrl_estimator_t *e, unsigned outputs);
+
+/* Estimate at k and predict k+1; applied: the leg duties acting during
+ * [k, k+1) (NULL: a zero vector). */
 void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ctrl_meas_t *m,
                            const ctrl_legs_t *applied, ctrl_estimate_t *est);
-
-/* Current model (3.9) for a measured alpha/beta current at angle theta_e with
- * its sin/cos (Q24): fills every field of out. */
-void ctrl_mstate_from_current(const ctrl_params_t *p, q24_t i_alpha, q24_t i_beta,
-                              fx_angle_t theta_e, q24_t sin_theta, q24_t cos_theta,
-                              ctrl_mstate_t *out);
 
 #endif /* CONTROL_ESTIMATOR_H */

@@ -285,11 +285,109 @@ uint32_t fx_isqrt64(uint64_t x);
 /* |(x, y)| in Q24, saturated. */
 q24_t fx_mag(q24_t x, q24_t y);
 
-/* sin and cos of an angle in Q24; maximum error stated in control/README.md. */
+/* sin and cos of an angle in Q24: the nearest point of a Q30 quarter-wave
+ * table turned by the remainder; maximum error 0.5 LSB + 2e-9 = 3.2e-8
+ * (docs/fixed-point.md). Either output may be NULL. */
 void fx_sincos(fx_angle_t angle, q24_t *sin_out, q24_t *cos_out);
 
 /* Angle of the vector (x, y) (any common scale), in [0, 2 pi) as fx_angle_t;
  * (0, 0) gives 0. Error <= 1.4e-6 rad (docs/error-budget.md); fx_atan.c. */
 fx_angle_t fx_atan2(int32_t y, int32_t x);
+
+/* cos and sin of a signed angle step (fx_angle_t units, 2^32 = one turn) in
+ * Q30, for turning a frame by the angle one period turns: error < 3e-9 up to
+ * FX_ROT_TAB_MAX, fx_sincos's 3.2e-8 beyond (docs/fixed-point.md). */
+#define FX_ROT_TAB_MAX 0x40000000u /* pi/2 */
+void fx_rot_q30(int32_t step, int32_t *cos_q30, int32_t *sin_q30);
+
+/* (x, y) rotated by the angle whose cosine and sine are c, s (Q30):
+ * (x c - y s, x s + y c), Q24, one rounding each, saturated. */
+static inline void fx_rotate(q24_t x, q24_t y, int32_t c, int32_t s, q24_t *xo, q24_t *yo)
+{
+    /* |x c| < 2^61: fx_round_sat_sum's domain. */
+    *xo = fx_round_sat_sum((int64_t)x * c, -((int64_t)y * s), 30u);
+    *yo = fx_round_sat_sum((int64_t)x * s, (int64_t)y * c, 30u);
+}
+
+/* ---- the bodies of fx_sincos and fx_rot_q30, inline for the estimator's
+ * straight path (one copy each elsewhere, in fx.c) ---- */
+
+/* round(sin(i pi/1024) 2^30), i = 0..512: a quarter wave (fx.c). */
+extern const int32_t fx_sin_tab_q30[513];
+
+#define FX_Q29_PI_2 843314857 /* pi/2 in Q29: fx_angle_t units -> Q30 rad */
+
+/* (a b) / 2^30 rounded, for |a b| < 2^61. */
+static inline int32_t fx_mul30(int32_t a, int32_t b)
+{
+    return fx_keep32(fx_round_nosat((int64_t)a * b, 30u));
+}
+
+/* sin and cos from the nearest table point a_i = i pi/1024 (|d| <= pi/2048)
+ * turned by d: sin(a + d) = sin a cos d + cos a sin d, with cos d = 1 - d^2/2
+ * (error d^4/24 < 3e-13) and sin d = d (error d^3/6 < 6.2e-10), the table in
+ * Q30 (0.5 LSB = 4.7e-10 each), the sums rounded once to Q24: max error
+ * 0.5 LSB + 2e-9 = 3.2e-8. */
+static inline void fx_sincos_inline(fx_angle_t angle, q24_t *sin_out, q24_t *cos_out)
+{
+    const uint32_t quadrant = angle >> 30;
+    const uint32_t pos = angle & 0x3FFFFFFFu;
+    const uint32_t idx = (pos + (1u << 20)) >> 21; /* 0..512 */
+    /* d in angle units, [-2^20, 2^20]; in Q30 rad |x| <= 1.7e6 */
+    const int32_t frac = (int32_t)pos - (int32_t)(idx << 21);
+    const int32_t x = fx_keep32(fx_round_nosat((int64_t)frac * FX_Q29_PI_2, 29u));
+    const int32_t half_x2 = fx_keep32(fx_round_nosat((int64_t)x * x, 31u)); /* d^2/2, Q30 */
+    const int32_t sa = fx_sin_tab_q30[idx];
+    const int32_t ca = fx_sin_tab_q30[512u - idx];
+    const int32_t cd = FX_Q30_ONE - half_x2;
+    /* Q60 sums (|.| <= 2^60 (1 + 1.6e-3)): to Q24, rounded (|result| <= 2^24). */
+    const q24_t a = (q24_t)fx_rshift64_round((int64_t)sa * cd + (int64_t)ca * x, 36u);
+    const q24_t b = (q24_t)fx_rshift64_round((int64_t)ca * cd - (int64_t)sa * x, 36u);
+    switch (quadrant) {
+    case 0u:
+        *sin_out = a;
+        *cos_out = b;
+        break;
+    case 1u:
+        *sin_out = b;
+        *cos_out = -a;
+        break;
+    case 2u:
+        *sin_out = -a;
+        *cos_out = -b;
+        break;
+    default:
+        *sin_out = -b;
+        *cos_out = a;
+        break;
+    }
+}
+
+/* cos and sin of a signed step |step| <= pi/2 (2^30) in Q30: the nearest
+ * table point turned by the remainder d as in fx_sincos_inline, kept in Q30
+ * (error: d^3/6 < 6.2e-10, the table 2 x 4.7e-10, the roundings 2 x 4.7e-10:
+ * < 3e-9); beyond pi/2, fx_sincos (3.2e-8). */
+static inline void fx_rot_q30_inline(int32_t step, int32_t *cos_q30, int32_t *sin_q30)
+{
+    const uint32_t mag = step < 0 ? 0u - (uint32_t)step : (uint32_t)step;
+    if (mag > FX_ROT_TAB_MAX) {
+        q24_t s;
+        q24_t c;
+        fx_sincos_inline((fx_angle_t)step, &s, &c);
+        *cos_q30 = c * 64; /* |c| <= 2^24 */
+        *sin_q30 = s * 64;
+        return;
+    }
+    const uint32_t idx = (mag + (1u << 20)) >> 21; /* 0..512 */
+    const int32_t frac = (int32_t)mag - (int32_t)(idx << 21);
+    const int32_t x = fx_keep32(fx_round_nosat((int64_t)frac * FX_Q29_PI_2, 29u));
+    const int32_t cd = FX_Q30_ONE - fx_keep32(fx_round_nosat((int64_t)x * x, 31u));
+    const int32_t sa = fx_sin_tab_q30[idx];
+    const int32_t ca = fx_sin_tab_q30[512u - idx];
+    /* Q60 sums < 2^61, to Q30 */
+    const int32_t sn = fx_round_nosat((int64_t)sa * cd + (int64_t)ca * x, 30u);
+    *cos_q30 = fx_round_nosat((int64_t)ca * cd - (int64_t)sa * x, 30u);
+    *sin_q30 = step < 0 ? -sn : sn;
+}
 
 #endif /* CONTROL_FX_H */

@@ -109,19 +109,59 @@ static inline void ctrl_plan_legs(const ctrl_plan_t *p, ctrl_legs_t *legs)
                   d0 + d1);
 }
 
-/* The leg duties of a step's output: derived from the plan when it has one,
- * else those the controller wrote (ctrl_types.h). */
-static inline void ctrl_out_legs(ctrl_out_t *o)
+/* A step's output from its plan: the leg duties that realise it. */
+static inline void ctrl_out_plan(ctrl_out_t *o)
 {
-    if (o->plan.n_seg != 0u) {
-        ctrl_plan_legs(&o->plan, &o->legs);
-    }
+    ctrl_plan_legs(&o->plan, &o->legs);
+}
+
+/* One vector for the whole period, plan and leg duties. */
+static inline void ctrl_out_single(ctrl_out_t *o, uint8_t vec)
+{
+    ctrl_plan_single(&o->plan, vec);
+    const uint32_t m = ctrl_vec_legs[vec];
+    o->legs.duty[0] = (q24_t)((m & 1u) << FX_QBITS);
+    o->legs.duty[1] = (q24_t)(((m >> 1) & 1u) << FX_QBITS);
+    o->legs.duty[2] = (q24_t)((m >> 2) << FX_QBITS);
+}
+
+/* Active vector vec (1..6) for duty (clamped to [0, FX_ONE]), its zero vector
+ * ctrl_zero_after(vec) the rest: the plan of ctrl_plan_active_zero and its
+ * leg duties (= ctrl_out_plan of it, without the general sum): a leg high in
+ * vec is on for d, and for the rest too when the zero vector is V7. */
+static inline void ctrl_out_active_zero(ctrl_out_t *o, uint8_t vec, q24_t duty)
+{
+    const uint32_t v = vec <= 7u ? vec : 0u;
+    const uint32_t d = ctrl_plan_dur(duty);
+    const uint32_t z = ctrl_vec_zero_after[v]; /* 0 or 7 */
+    o->plan.n_seg = 2u;
+    o->plan.vec[0] = (uint8_t)v;
+    o->plan.vec[1] = (uint8_t)z;
+    o->plan.dur[0] = (q24_t)d;
+    o->plan.dur[1] = (q24_t)((uint32_t)FX_ONE - d);
+    const uint32_t m = ctrl_vec_legs[v];
+    const uint32_t rest = ((uint32_t)FX_ONE - d) & (0u - (z & 1u)); /* V7: all legs high */
+    o->legs.duty[0] = (q24_t)(rest + (d & (0u - (m & 1u))));
+    o->legs.duty[1] = (q24_t)(rest + (d & (0u - ((m >> 1) & 1u))));
+    o->legs.duty[2] = (q24_t)(rest + (d & (0u - (m >> 2))));
+}
+
+/* Stator-frame voltage of leg duties per unit of DC link, Q24, (4.4)
+ * averaged: (2 d_a - d_b - d_c) / 3 and (d_b - d_c) / sqrt(3). The
+ * differences are exact in 64 bits (|.| < 2^33 for any int32_t duties), times
+ * a Q30 constant < 2^30 (< 2^63), rounded once. */
+static inline void ctrl_legs_uab(const ctrl_legs_t *legs, q24_t *u_alpha, q24_t *u_beta)
+{
+    const int64_t da = legs->duty[0];
+    const int64_t db = legs->duty[1];
+    const int64_t dc = legs->duty[2];
+    *u_alpha = fx_round_sat((2 * da - db - dc) * FX_Q30_1_3, 30u);
+    *u_beta = fx_round_sat((db - dc) * FX_Q30_INV_SQRT3, 30u);
 }
 
 /* Period-average alpha/beta voltage of leg duties (each in [0, FX_ONE]) at DC
- * link vdc, (4.4) averaged: 2/3 Vdc (d_a + d_b e^{j2pi/3} + d_c e^{j4pi/3}); for
- * the duties of a plan whose on-times sum to at most FX_ONE this equals the
- * sum over its segments of dur_i V_i. */
+ * link vdc: vdc times ctrl_legs_uab; for the duties of a plan whose on-times
+ * sum to at most FX_ONE this equals the sum over its segments of dur_i V_i. */
 void ctrl_legs_voltage(const ctrl_legs_t *legs, q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
 
 #endif /* CONTROL_PLAN_H */

@@ -8,10 +8,9 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m1_t *s = state;
     ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref =
-        ctrl_mpc_ref_amp(&b, ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque));
+    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
     /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
     const q24_t num = fx_sub(t_ref, b.t0);
@@ -36,5 +35,5 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     s->trace.n = 6u;
     s->last_vec = best_v;
-    ctrl_plan_active_zero(&out->plan, best_v, best_d);
+    ctrl_out_active_zero(out, best_v, best_d);
 }

@@ -25,5 +25,5 @@ const ctrl_desc_t ctrl_desc_m1 = {
     .init = ctrl_mpc_winit,
     .reset = ctrl_mpc_wreset,
     .step = ctrl_m1_step,
-    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW,
+    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT),
 };

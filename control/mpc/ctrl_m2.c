@@ -24,11 +24,11 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m2_t *s = state;
     ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
     const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
-    const int32_t r2 = ctrl_mpc_ref_amp2(&b, psi_ref);
+    const int32_t r2 = ctrl_mpc_amp2(psi_ref, 0);
     const uint8_t vec =
         ctrl_m2_table(ctx->est->next.sector, t_ref >= b.t0, r2 >= ctrl_mpc_amp2(b.d0, b.q0));
     q24_t vd;
@@ -37,8 +37,8 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 
     /* Band of (6.17) on squared amplitudes. */
     const q24_t lo = fx_max(fx_sub(psi_ref, s->eps_psi), 0);
-    const int32_t lo2 = ctrl_mpc_ref_amp2(&b, lo);
-    const int32_t hi2 = ctrl_mpc_ref_amp2(&b, fx_add(psi_ref, s->eps_psi));
+    const int32_t lo2 = ctrl_mpc_amp2(lo, 0);
+    const int32_t hi2 = ctrl_mpc_amp2(fx_add(psi_ref, s->eps_psi), 0);
 
     int64_t best_g = INT64_MAX; /* best feasible |T_ref - Te| (6.16) */
     unsigned best = 0u;
@@ -70,9 +70,9 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         best = best_flux;
     }
     if (best == 0u) {
-        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
+        ctrl_mpc_out_zero(out, &s->last_vec);
     } else {
-        ctrl_plan_active_zero(&out->plan, vec, s->d_nu[best]);
+        ctrl_out_active_zero(out, vec, s->d_nu[best]);
         s->last_vec = vec;
     }
 }

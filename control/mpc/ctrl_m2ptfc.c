@@ -69,7 +69,7 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     ctrl_m2ptfc_t *s = state;
     /* Only V1..V3 are rotated: the two candidates are any V_i (ctrl_mpc_vec3_dq). */
     ctrl_mpc_basis3_t b;
-    ctrl_mpc_basis3(&s->model, ctx->params, ctx->est, &b);
+    ctrl_mpc_basis3(&s->model, ctx->est, &b);
     const ctrl_estimate_t *est = ctx->est;
     const q24_t t_ref = ctx->ref->torque;
     const q24_t t1 = est->next.torque;
@@ -88,10 +88,8 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     uint8_t cand[2];
     ctrl_m2ptfc_candidates(est->next.sector, t_upper, te, cand);
 
-    /* psi_ref^2 of (6.9), compared on squares: no square root (MTPA (4.15)
-     * squared), scaled by mag2 as ctrl_mpc_ref2_amp2: psi2 <= 2^30 (amp2
-     * clamp) and mag2 < 2^24 (1 + 2.5e-6), product < 2^55 - 2^23: no saturation. */
-    const int32_t r2 = fx_mul_nosat(m2ptfc_psi2(s, ctx->params, ctx->ref), b.mag2);
+    /* psi_ref^2 of (6.9), compared on squares: no square root (MTPA (4.15) squared). */
+    const int32_t r2 = m2ptfc_psi2(s, ctx->params, ctx->ref);
 
     q24_t duty[2];
     int32_t a2[2];
@@ -116,5 +114,5 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     s->trace.vec[1] = cand[1];
     s->trace.duty[0] = duty[0];
     s->trace.duty[1] = duty[1];
-    ctrl_plan_active_zero(&out->plan, cand[best], duty[best]);
+    ctrl_out_active_zero(out, cand[best], duty[best]);
 }

@@ -57,5 +57,5 @@ const ctrl_desc_t ctrl_desc_m2ptfc = {
     .init = m2ptfc_init,
     .reset = ctrl_m2ptfc_reset,
     .step = ctrl_m2ptfc_step,
-    .est_unused = CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NOW,
+    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT),
 };

@@ -5,7 +5,6 @@
 
 #include "mtpa.h"
 #include "plan.h"
-#include "predict.h"
 #include "vectors.h"
 
 /* Forced inlining of the shared basis core: an out-of-line call costs each
@@ -17,38 +16,37 @@
 #endif
 
 /* The part of the basis common to ctrl_mpc_basis and ctrl_mpc_basis3:
- * d0, q0, t0, mag2 and Ts V1 = (w[0], w[1]), Ts V2 = (w[2], w[3]) in the
- * rotor frame at k+2 (inlined into both, one set of arithmetic). */
+ * d0, q0, t0 and Ts V1 = (w[0], w[1]), Ts V2 = (w[2], w[3]) in the rotor
+ * frame at k+2 (inlined into both, one set of arithmetic). */
 static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
-                                                    const ctrl_params_t *p,
                                                     const ctrl_estimate_t *est, q24_t *d0,
-                                                    q24_t *q0, q24_t *t0, q24_t *mag2, q24_t w[4])
+                                                    q24_t *q0, q24_t *t0, q24_t w[4])
 {
     const ctrl_mstate_t *n = &est->next;
-    /* (6.10) with a zero vector, alpha/beta: psi(k+1) - Ts Rs i(k+1). The
-     * clamps only act on states far outside any machine's range; they give the
-     * fast arithmetic its bounds (ctrl_mpc_basis_t). */
-    const q24_t ia = fx_clamp(n->i_alpha, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
-    const q24_t ib = fx_clamp(n->i_beta, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
-    const q24_t fa = fx_clamp(n->psi_alpha, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    const q24_t fb = fx_clamp(n->psi_beta, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    /* |Ts Rs i| <= 64 pu and |psi| <= 8 pu: the differences fit an int32_t. */
-    const q24_t pa =
-        fx_clamp(fa - fx_mul_nosat(m->ts_rs, ia), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    const q24_t pb =
-        fx_clamp(fb - fx_mul_nosat(m->ts_rs, ib), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    /* theta(k+2) = theta(k+1) + omega Ts (unsigned angle arithmetic wraps a turn). */
-    const fx_angle_t th2 = n->theta_e + ctrl_angle_step(p, est->omega_e);
-    q24_t s;
-    q24_t c;
-    fx_sincos(th2, &s, &c);
-    /* Park (3.7): d = c a + s b, q = c b - s a. */
-    const q24_t d = fx_dot_nosat(c, s, pa, pb);
-    const q24_t q = fx_dot_nosat(c, -s, pb, pa);
+    /* (6.10) with a zero vector in the frame at k+1: psi(k+1) - Ts Rs i(k+1).
+     * The clamps only act on states far outside any machine's range; they
+     * give the fast arithmetic its bounds (ctrl_mpc_basis_t): |Ts Rs i| <=
+     * 64 pu and |psi| <= 8 pu, the differences fit an int32_t. */
+    const q24_t id = fx_clamp(n->i_d, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
+    const q24_t iq = fx_clamp(n->i_q, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
+    const q24_t fd = fx_clamp(n->psi_d, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t fq = fx_clamp(n->psi_q, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t ad =
+        fx_clamp(fd - fx_mul_nosat(m->ts_rs, id), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t aq =
+        fx_clamp(fq - fx_mul_nosat(m->ts_rs, iq), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    /* The frame at k+2 is the frame at k+1 turned by delta = omega Ts (the
+     * estimator's rotation, Q30, |.| <= 1): psi e^{-j delta}; |sum| < 2^34 2^30. */
+    const int32_t rc = est->rot_c;
+    const int32_t rs = est->rot_s;
+    const q24_t d = fx_round_nosat((int64_t)ad * rc + (int64_t)aq * rs, 30u);
+    const q24_t q = fx_round_nosat((int64_t)aq * rc - (int64_t)ad * rs, 30u);
     *d0 = d;
     *q0 = q;
     *t0 = ctrl_mpc_torque(m, d, q);
-    *mag2 = fx_dot_nosat(s, c, s, c);
+    /* theta(k+2) = theta(k+1) + delta: its cosine and sine from those at k+1. */
+    const q24_t c = fx_round_nosat((int64_t)n->cos_theta * rc - (int64_t)n->sin_theta * rs, 30u);
+    const q24_t s = fx_round_nosat((int64_t)n->sin_theta * rc + (int64_t)n->cos_theta * rs, 30u);
     /* Ts V1 = Ts 2/3 Vdc on alpha; in the rotor frame Ts|V| e^{-j th2}:
      * (mv c, -mv s). V2 = Ts|V| e^{j(pi/3 - th2)}: cos(th2 - pi/3) =
      * c/2 + s sqrt3/2, sin(th2 - pi/3) = s/2 - c sqrt3/2. */
@@ -61,11 +59,10 @@ static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
     w[3] = -fx_mul_nosat(mv, s1);
 }
 
-void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                    ctrl_mpc_basis_t *b)
+void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_mpc_basis_t *b)
 {
     q24_t w[4];
-    mpc_basis_core(m, p, est, &b->d0, &b->q0, &b->t0, &b->mag2, w);
+    mpc_basis_core(m, est, &b->d0, &b->q0, &b->t0, w);
     const q24_t w0d = w[0];
     const q24_t w0q = w[1];
     const q24_t w1d = w[2];
@@ -87,11 +84,10 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctr
     b->wq[5] = -w2q;
 }
 
-void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                     ctrl_mpc_basis3_t *b)
+void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_mpc_basis3_t *b)
 {
     q24_t w[4];
-    mpc_basis_core(m, p, est, &b->d0, &b->q0, &b->t0, &b->mag2, w);
+    mpc_basis_core(m, est, &b->d0, &b->q0, &b->t0, w);
     b->wd[0] = w[0];
     b->wq[0] = w[1];
     b->wd[1] = w[2];

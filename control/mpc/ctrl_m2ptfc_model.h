@@ -21,6 +21,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
+#include "plan.h"
 #include "vectors.h"
 
 /* Model constants, computed once from the machine (ctrl_m2ptfc_model_config.c). */
@@ -35,15 +36,11 @@ typedef struct {
 
 /* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
  * bounds the fast arithmetic below relies on): |d0|, |q0| <= 8 sqrt(2) pu
- * (psi0 clamped to +-8 pu per alpha/beta component), |wd|, |wq| <= 16 pu. */
+ * (psi0 clamped to +-8 pu per rotor-frame component), |wd|, |wq| <= 16 pu. */
 typedef struct {
     q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
     q24_t wd[6], wq[6]; /* Ts V_1 .. Ts V_6 in the same frame (index i - 1), Q24 pu */
     q24_t t0;           /* Te(k+2) with a zero vector, Q24 pu */
-    q24_t mag2;         /* sin^2 + cos^2 of theta(k+2) as fx_sincos gives them, Q24:
-                         * the rotation scales every amplitude by sqrt(mag2)
-                         * (|mag2 - 1| < 2.5e-6); references are scaled alike
-                         * so amplitude comparisons do not see it */
 } ctrl_mpc_basis_t;
 
 /* The same basis with only V1..V3 (V_{i+3} = -V_i): for controllers that use
@@ -53,7 +50,6 @@ typedef struct {
     q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
     q24_t wd[3], wq[3]; /* Ts V_1 .. Ts V_3, rotor frame (index i - 1), Q24 pu */
     q24_t t0;           /* Te(k+2) with a zero vector, Q24 pu */
-    q24_t mag2;         /* as in ctrl_mpc_basis_t, Q24 */
 } ctrl_mpc_basis3_t;
 
 /* Model limits checked by ctrl_mpc_model_init (CTRL_ERANGE outside). */
@@ -88,14 +84,14 @@ typedef struct {
  * and the last vector; the controllers keep no other dynamic state. */
 void ctrl_mpc_wreset(void *state);
 
-/* Basis for the candidates of this sample from the k+1 state of est. */
-void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                    ctrl_mpc_basis_t *b);
+/* Basis for the candidates of this sample from the k+1 state of est (rotor
+ * frame, with next.sin_theta/cos_theta: CTRL_EST_SC_NEXT) and its rotation
+ * over one period (rot_c, rot_s). */
+void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_mpc_basis_t *b);
 
-/* ctrl_mpc_basis() with V1..V3 only (no V4..V6): the same d0, q0, t0, mag2
- * and wd/wq[0..2] bit for bit. */
-void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                     ctrl_mpc_basis3_t *b);
+/* ctrl_mpc_basis() with V1..V3 only (no V4..V6): the same d0, q0, t0 and
+ * wd/wq[0..2] bit for bit. */
+void ctrl_mpc_basis3(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_mpc_basis3_t *b);
 
 /* The flux reference ctrl_flux_ref (mtpa.h) of the torque reference, squared, in ctrl_mpc_amp2
  * units (Q24 pu^2), for the amplitude comparisons on squares: for the SPMSM MTPA, (4.15) squared,
@@ -106,12 +102,10 @@ int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref);
 
 /* A zero vector for the whole period after a plan whose segment 0 was
  * last_vec (the one that switches one leg), recorded as the new last vector. */
-static inline void ctrl_mpc_plan_zero(ctrl_plan_t *out, uint8_t *last_vec)
+static inline void ctrl_mpc_out_zero(ctrl_out_t *out, uint8_t *last_vec)
 {
     const uint8_t z = *last_vec <= 7u ? ctrl_vec_zero_after[*last_vec] : 0u;
-    out->n_seg = 1u;
-    out->vec[0] = z;
-    out->dur[0] = FX_ONE;
+    ctrl_out_single(out, z);
     *last_vec = z;
 }
 
@@ -131,8 +125,8 @@ int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2);
 
 /* Weighted cost (6.13) of a candidate: the active vector with Ts V = (vd, vq)
  * on for duty, the zero vector the rest: |T_ref - Te(k+2)| + zeta |psi_ref - |psi(k+2)||,
- * Q24 pu (64-bit, no overflow); psi_ref scaled by ctrl_mpc_ref_amp(). The
- * amplitude needs one fx_mag (square root). */
+ * Q24 pu (64-bit, no overflow); the amplitude needs one fx_mag (square
+ * root). */
 int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
                                q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta);
 
@@ -178,24 +172,6 @@ static inline int32_t ctrl_mpc_amp2(q24_t psi_d, q24_t psi_q)
     const uint64_t sq = (uint64_t)((int64_t)psi_d * psi_d) + (uint64_t)((int64_t)psi_q * psi_q);
     const uint64_t a2 = (sq + ((uint64_t)1 << 23)) >> 24;
     return a2 > ((uint64_t)1 << 30) ? (int32_t)1 << 30 : (int32_t)a2;
-}
-
-/* A flux-amplitude reference in the scale of the rotor-frame amplitudes:
- * from its square (ctrl_mpc_psi_ref2), squared (ctrl_mpc_amp2 units) and linear. */
-static inline int32_t ctrl_mpc_ref2_amp2(const ctrl_mpc_basis_t *b, int32_t psi2)
-{
-    return fx_mul(psi2, b->mag2);
-}
-
-static inline int32_t ctrl_mpc_ref_amp2(const ctrl_mpc_basis_t *b, q24_t psi)
-{
-    return fx_mul(ctrl_mpc_amp2(psi, 0), b->mag2);
-}
-
-static inline q24_t ctrl_mpc_ref_amp(const ctrl_mpc_basis_t *b, q24_t psi)
-{
-    /* sqrt(mag2) = 1 + (mag2 - 1)/2 to 1e-12 */
-    return fx_add(psi, fx_mul(psi, fx_rshift32_round(fx_sub(b->mag2, FX_ONE), 1u)));
 }
 
 /* Flux of a candidate: psi0 + D Ts V, rotor frame, for 0 <= duty <= FX_ONE

@@ -9,11 +9,10 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m3_t *s = state;
     ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
     const ctrl_mstate_t *n = &ctx->est->next;
-    const q24_t psi_ref =
-        ctrl_mpc_ref_amp(&b, ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque));
+    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
     /* (6.1) by the sign of the torque error. */
     const int x = (int)n->sector;
@@ -50,9 +49,9 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     s->trace.duty[2] = 0;
     s->trace.n = 3u;
     if (g0 < best_g) {
-        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
+        ctrl_mpc_out_zero(out, &s->last_vec);
     } else {
-        ctrl_plan_active_zero(&out->plan, cand[best], duty[best]);
+        ctrl_out_active_zero(out, cand[best], duty[best]);
         s->last_vec = cand[best];
     }
 }

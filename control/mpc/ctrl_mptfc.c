@@ -8,10 +8,9 @@ void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_mptfc_t *s = state;
     ctrl_mpc_basis_t b;
-    ctrl_mpc_basis(&s->model, ctx->params, ctx->est, &b);
+    ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref =
-        ctrl_mpc_ref_amp(&b, ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque));
+    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
     /* Zero vector (V0 = V7): duty 0 of any active vector. */
     int64_t best_g = ctrl_mpc_cost_weighted(&s->model, &b, 0, 0, 0, t_ref, psi_ref, s->zeta);
@@ -33,9 +32,9 @@ void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     s->trace.n = 7u;
     if (best_v == 0u) {
-        ctrl_mpc_plan_zero(&out->plan, &s->last_vec);
+        ctrl_mpc_out_zero(out, &s->last_vec);
     } else {
-        ctrl_plan_single(&out->plan, best_v);
+        ctrl_out_single(out, best_v);
         s->last_vec = best_v;
     }
 }

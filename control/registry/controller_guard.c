@@ -38,8 +38,7 @@ void ctrl_step(const ctrl_desc_t *d, void *state, const ctrl_ctx_t *ctx, ctrl_ou
     }
     if (d == NULL || d->step == NULL || state == NULL || ctx == NULL || ctx->params == NULL ||
         ctx->est == NULL || ctx->ref == NULL) {
-        ctrl_plan_single(&out->plan, 0u); /* no voltage */
-        ctrl_out_legs(out);
+        ctrl_out_single(out, 0u); /* no voltage */
         return;
     }
     d->step(state, ctx, out);

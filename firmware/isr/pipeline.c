@@ -18,13 +18,23 @@ static void fw_fault_now(fw_t *fw, uint32_t code)
     fw->cm_gates = 0u;
 }
 
-static void fw_pwm_off(fw_t *fw)
+static void fw_pwm_off(fw_t *fw, fw_telemetry_t *tm)
 {
     const hal_pwm_t off = {{0u, 0u, 0u}};
     hal_gate_enable(fw->hal, false);
     hal_pwm_write(fw->hal, &off);
     fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
-    fw->tm.legs[0] = fw->tm.legs[1] = fw->tm.legs[2] = 0;
+    tm->legs[0] = tm->legs[1] = tm->legs[2] = 0;
+}
+
+/* A period without an estimate (not running, or a fault before it). */
+static void fw_tm_no_estimate(fw_telemetry_t *tm)
+{
+    tm->vec = 0u;
+    tm->duty = 0;
+    tm->i_d = tm->i_q = 0;
+    tm->psi_d = tm->psi_q = 0;
+    tm->torque = tm->omega_e = tm->torque_ref = 0;
 }
 
 /* Q8 counts -> Q24 pu with a Q30 gain: round(d gain / 2^14), saturated. raw
@@ -165,7 +175,7 @@ static inline fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc
     return (fx_angle_t)(e & 0xFFFFFFFFu) + fw->enc_offset;
 }
 
-static void fw_apply_commands(fw_t *fw)
+static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
 {
     if (fw->req_clear != 0u) {
         fw->req_clear = 0u;
@@ -182,7 +192,7 @@ static void fw_apply_commands(fw_t *fw)
             /* Stop: the step ends, gates off now. */
             cm_abort_stop(&fw->cm);
             fw->cm_gates = 0u;
-            fw_pwm_off(fw);
+            fw_pwm_off(fw, tm);
         }
     }
     if (fw->req_cm != 0u) {
@@ -190,7 +200,7 @@ static void fw_apply_commands(fw_t *fw)
         if (fw_state_event(&fw->sm, FW_EV_CM_START, 0u)) {
             /* The steps enable the gates when they first drive the legs. */
             fw->cm_gates = 0u;
-            fw_pwm_off(fw);
+            fw_pwm_off(fw, tm);
             cm_begin(&fw->cm);
         }
     }
@@ -199,7 +209,7 @@ static void fw_apply_commands(fw_t *fw)
         if (fw_state_event(&fw->sm, FW_EV_ARM, 0u)) {
             /* Fresh dynamic state; the first gated period is k+1. */
             fw->ctrl->reset(fw->ctrl_state.bytes);
-            ctrl_estimator_reset(&fw->est);
+            ctrl_estimator_reset(&fw->est, &fw->params);
             ctrl_speed_pi_reset(&fw->speed_pi, 0);
             fw->speed_tref = 0;
             fw->speed_cnt = 0u;
@@ -244,11 +254,11 @@ static inline void fw_measure_rest(fw_t *fw, const hal_adc_raw_t *raw, const hal
 
 /* Leg duties (each in [0, FX_ONE], so the compare values are in [0, N]) ->
  * telemetry, compare values -> hal_pwm_write (effective at k+1). */
-static inline void fw_pwm_out(fw_t *fw, hal_t *hal, const ctrl_legs_t *legs)
+static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_legs_t *legs)
 {
-    fw->tm.legs[0] = legs->duty[0];
-    fw->tm.legs[1] = legs->duty[1];
-    fw->tm.legs[2] = legs->duty[2];
+    tm->legs[0] = legs->duty[0];
+    tm->legs[1] = legs->duty[1];
+    tm->legs[2] = legs->duty[2];
     hal_pwm_t pwm;
     const uint32_t n8 = fw->pwm_n8;
     if (n8 != 0u) {
@@ -264,15 +274,22 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, const ctrl_legs_t *legs)
     hal_pwm_write(hal, &pwm);
 }
 
-static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
+static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
-    ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, &fw->estimate);
-    if (fw_protect_overspeed(&fw->prot, fw->estimate.omega_e) != FW_FAULT_NONE) {
+    ctrl_estimate_t *const est = &fw->estimate;
+    ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, est);
+    tm->omega_e = est->omega_e;
+    tm->i_d = est->now.i_d;
+    tm->i_q = est->now.i_q;
+    tm->psi_d = est->now.psi_d;
+    tm->psi_q = est->now.psi_q;
+    tm->torque = est->now.torque;
+    if (fw_protect_overspeed(&fw->prot, est->omega_e) != FW_FAULT_NONE) {
         fw_fault_now(fw, FW_FAULT_OVERSPEED);
-        fw->tm.vec = 0u;
-        fw->tm.duty = 0;
-        fw_pwm_off(fw);
-        fw->tm.omega_e = fw->estimate.omega_e;
+        tm->vec = 0u;
+        tm->duty = 0;
+        tm->torque_ref = 0;
+        fw_pwm_off(fw, tm);
         return;
     }
 
@@ -283,7 +300,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
          * outer loop (a reference that changes every period would also keep
          * FST's reference-step logic, §4.5.3, permanently in its dynamic mode). */
         if (fw->speed_cnt == 0u) {
-            fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, fw->estimate.omega_e);
+            fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, est->omega_e);
         }
         fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
         tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
@@ -293,31 +310,29 @@ static inline void fw_control(fw_t *fw, hal_t *hal, const ctrl_meas_t *m)
     fw->refs.torque = tref;
     fw->refs.psi = 0;
 
-    const ctrl_ctx_t ctx = {&fw->params, &fw->estimate, &fw->refs};
+    const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed
-     * (fw_select_controller): its step is called directly. */
+     * (fw_select_controller): its step is called directly; it writes the leg
+     * duties and, if it has one, the plan (ctrl_out_t). */
     ctrl_out_t out;
-    ctrl_plan_single(&out.plan, 0u); /* V0 unless the step writes its output */
+    out.plan.n_seg = 0u;
     fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &out);
-    ctrl_out_legs(&out);
-    fw_pwm_out(fw, hal, &out.legs);
-    fw->tm.vec = out.plan.n_seg > 0u ? out.plan.vec[0] : 0u;
-    fw->tm.duty = out.plan.n_seg > 0u ? out.plan.dur[0] : 0;
+    fw_pwm_out(fw, hal, tm, &out.legs);
     /* The duties written now act during [k+1, k+2): they are "applied" for
      * the estimator's prediction at k+1. */
     fw->applied = out.legs;
-    fw->tm.psi_amp = fw->estimate.now.psi_amp;
-    fw->tm.torque = fw->estimate.now.torque;
-    fw->tm.omega_e = fw->estimate.omega_e;
-    fw->tm.torque_ref = fw->refs.torque;
+    const int has_plan = out.plan.n_seg > 0u;
+    tm->vec = has_plan ? out.plan.vec[0] : 0u;
+    tm->duty = has_plan ? out.plan.dur[0] : 0;
+    tm->torque_ref = tref;
 }
 
 /* A running period: measurements, protections, control. */
-static inline void fw_period_running(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
-                                     const hal_encoder_raw_t *enc)
+static inline void fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
+                                     const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc)
 {
-    /* The measurements go straight into the telemetry sample. */
-    ctrl_meas_t *const m = &fw->tm.meas;
+    /* The measurements go straight into the telemetry record. */
+    ctrl_meas_t *const m = &tm->meas;
     const q24_t i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
     const q24_t i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
     m->i_a = i_a;
@@ -331,11 +346,10 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, const hal_adc_raw_t *
         }
     }
     if (f == FW_FAULT_NONE) {
-        fw_control(fw, hal, m);
+        fw_control(fw, hal, tm, m);
     } else {
-        fw->tm.vec = 0u;
-        fw->tm.duty = 0;
-        fw_pwm_off(fw);
+        fw_tm_no_estimate(tm);
+        fw_pwm_off(fw, tm);
     }
 }
 
@@ -344,10 +358,10 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, const hal_adc_raw_t *
  * decides the next period: gates off, leg duties, or the controller with a
  * torque reference. A protection or a failed step ends it with the gates off
  * (the step's reason stays in fw->cm.err, the fault latches). */
-static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
+static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const hal_adc_raw_t *raw,
                                  const hal_encoder_raw_t *enc)
 {
-    ctrl_meas_t *const m = &fw->tm.meas;
+    ctrl_meas_t *const m = &tm->meas;
     m->i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
     m->i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
     /* The step's record of the largest current sees a tripping sample too. */
@@ -360,10 +374,9 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
             fw_fault_now(fw, f);
         }
     }
-    fw->tm.vec = 0u;
-    fw->tm.duty = 0;
+    fw_tm_no_estimate(tm);
     if (f != FW_FAULT_NONE) {
-        fw_pwm_off(fw); /* fw_fault_now ended the step */
+        fw_pwm_off(fw, tm); /* fw_fault_now ended the step */
         return;
     }
     cm_in_t in;
@@ -378,7 +391,7 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
     cm_out_t out;
     if (!cm_period(&fw->cm, &in, &out)) {
         fw->cm_gates = 0u;
-        fw_pwm_off(fw);
+        fw_pwm_off(fw, tm);
         if (fw->cm.err == CM_E_NONE) {
             (void)fw_state_event(&fw->sm, FW_EV_CM_END, 0u);
         } else {
@@ -388,7 +401,7 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
     }
     if (out.mode == CM_OUT_OFF) {
         fw->cm_gates = 0u;
-        fw_pwm_off(fw);
+        fw_pwm_off(fw, tm);
         return;
     }
     if (fw->cm_gates == 0u) {
@@ -400,33 +413,33 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, const hal_adc_raw_t *raw,
     if (out.mode == CM_OUT_CTRL) {
         if (out.ctrl_reset != 0u) {
             fw->ctrl->reset(fw->ctrl_state.bytes);
-            ctrl_estimator_reset(&fw->est);
+            ctrl_estimator_reset(&fw->est, &fw->params);
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
         }
         fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
         fw->ref_mode = FW_REF_TORQUE;
-        fw_control(fw, hal, m);
+        fw_control(fw, hal, tm, m);
         return;
     }
     const ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
-    fw_pwm_out(fw, hal, &legs);
+    fw_pwm_out(fw, hal, tm, &legs);
     fw->applied = legs; /* acting in [k+1, k+2) */
 }
 
 /* Every other state (boot, calibration, ready, fault): gates off. */
-static void fw_period_idle(fw_t *fw, const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc)
+static void fw_period_idle(fw_t *fw, fw_telemetry_t *tm, const hal_adc_raw_t *raw,
+                           const hal_encoder_raw_t *enc)
 {
-    fw->tm.vec = 0u;
-    fw->tm.duty = 0;
+    fw_tm_no_estimate(tm);
     if (fw->sm.state == FW_STATE_BOOT) {
         (void)fw_state_event(&fw->sm, FW_EV_START, 0u);
     }
     if (fw->sm.state == FW_STATE_CALIB) {
-        fw_pwm_off(fw);
+        fw_pwm_off(fw, tm);
         fw_calibrate(fw, raw);
         return;
     }
-    ctrl_meas_t *const m = &fw->tm.meas;
+    ctrl_meas_t *const m = &tm->meas;
     m->i_a = fw_current_pu(raw->i_a, fw->off_q8[0], fw->gain_q30[0]);
     m->i_b = fw_current_pu(raw->i_b, fw->off_q8[1], fw->gain_q30[1]);
     if (fw->sm.state != FW_STATE_FAULT) {
@@ -439,7 +452,7 @@ static void fw_period_idle(fw_t *fw, const hal_adc_raw_t *raw, const hal_encoder
             fw_fault_now(fw, f);
         }
     }
-    fw_pwm_off(fw);
+    fw_pwm_off(fw, tm);
 }
 
 void fw_isr(fw_t *fw)
@@ -457,6 +470,8 @@ void fw_isr(fw_t *fw)
     }
     fw->busy = true;
     fw->period++;
+    /* This period's record: the ring slot after the published ones. */
+    fw_telemetry_t *const tm = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
 
     hal_adc_raw_t raw;
     hal_encoder_raw_t enc;
@@ -464,16 +479,16 @@ void fw_isr(fw_t *fw)
     hal_encoder_read(hal, &enc);
 
     if ((fw->req_clear | fw->req_disarm | fw->req_arm | fw->req_cm) != 0) {
-        fw_apply_commands(fw);
+        fw_apply_commands(fw, tm);
     }
     /* Running: one predictable branch to the straight path; boot,
      * calibration, ready and fault take the general one. */
     if (fw->sm.state == FW_STATE_RUNNING) {
-        fw_period_running(fw, hal, &raw, &enc);
+        fw_period_running(fw, hal, tm, &raw, &enc);
     } else if (fw->sm.state == FW_STATE_COMMISSION) {
-        fw_period_commission(fw, hal, &raw, &enc);
+        fw_period_commission(fw, hal, tm, &raw, &enc);
     } else {
-        fw_period_idle(fw, &raw, &enc);
+        fw_period_idle(fw, tm, &raw, &enc);
     }
 
     const uint32_t wf = fw_protect_watchdog_tick(&fw->prot);
@@ -481,22 +496,34 @@ void fw_isr(fw_t *fw)
         fw_fault_now(fw, wf);
     }
 
-    fw->tm.period = fw->period;
-    fw->tm.state = (uint8_t)fw->sm.state;
-    fw->tm.fault = (uint8_t)fw->sm.fault_code;
-    fw->tm.gates = fw->sm.state == FW_STATE_RUNNING || fw->cm_gates != 0u ? 1u : 0u;
-    fw->tm.cm_step = fw->cm.step;
-    fw->tm.cm_progress = fw->cm.progress;
+    tm->period = fw->period;
+    tm->state = (uint8_t)fw->sm.state;
+    tm->fault = (uint8_t)fw->sm.fault_code;
+    tm->gates = fw->sm.state == FW_STATE_RUNNING || fw->cm_gates != 0u ? 1u : 0u;
+    tm->cm_step = fw->cm.step;
+    tm->cm_progress = fw->cm.progress;
 
     /* Deadline: duration of this ISR against the period's cycle budget. */
     const uint32_t elapsed = hal_cycles(hal) - t0;
-    fw->tm.cycles = elapsed;
+    tm->cycles = elapsed;
     const uint32_t df = fw_protect_deadline(&fw->prot, elapsed);
     if (df != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, df);
-        fw->tm.state = (uint8_t)fw->sm.state;
-        fw->tm.fault = (uint8_t)fw->sm.fault_code;
-        fw->tm.gates = 0u;
+        tm->state = (uint8_t)fw->sm.state;
+        tm->fault = (uint8_t)fw->sm.fault_code;
+        tm->gates = 0u;
+    }
+    /* Publish the record once in tm_every periods, unless the main loop is
+     * a full ring behind (then it is dropped, counted). */
+    fw->tm_last = tm;
+    const uint32_t every = fw->tm_every;
+    if (every != 0u && --fw->tm_count == 0u) {
+        fw->tm_count = every;
+        if (fw->tm_head - fw->tm_tail < FW_TM_RING - 1u) {
+            fw->tm_head++;
+        } else {
+            fw->tm_dropped++;
+        }
     }
     fw->busy = false;
 }
@@ -564,7 +591,33 @@ uint32_t fw_fault(const fw_t *fw)
 
 const fw_telemetry_t *fw_telemetry(const fw_t *fw)
 {
-    return fw != NULL ? &fw->tm : NULL;
+    return fw != NULL ? fw->tm_last : NULL;
+}
+
+void fw_tm_stream(fw_t *fw, uint32_t every)
+{
+    if (fw == NULL) {
+        return;
+    }
+    fw->tm_every = 0u; /* the interrupt publishes nothing while this runs */
+    fw->tm_tail = fw->tm_head;
+    fw->tm_count = 1u;
+    fw->tm_every = every;
+}
+
+const fw_telemetry_t *fw_tm_peek(const fw_t *fw)
+{
+    if (fw == NULL || fw->tm_tail == fw->tm_head) {
+        return NULL;
+    }
+    return &fw->tm_ring[fw->tm_tail & (FW_TM_RING - 1u)];
+}
+
+void fw_tm_release(fw_t *fw)
+{
+    if (fw != NULL && fw->tm_tail != fw->tm_head) {
+        fw->tm_tail++;
+    }
 }
 
 void *fw_ctrl_state(fw_t *fw)

@@ -11,11 +11,12 @@
  *   ctrl_estimator_update                   estimate at k, predict k+1 with
  *                                           the plan acting in [k, k+1)
  *   speed PI (speed mode) -> torque reference
- *   desc->step                              plan or leg duties for [k+1, k+2)
- *   plan -> leg duties (ctrl_out_legs, plan.h) -> compare values ->
- *   hal_pwm_write (effective at k+1)
- *   telemetry sample
+ *   desc->step                              leg duties (and the plan they
+ *                                           realise) for [k+1, k+2)
+ *   leg duties -> compare values -> hal_pwm_write (effective at k+1)
  *   deadline check (hal_cycles against the period budget)
+ *   telemetry: the period's record is written into the ring as it is
+ *   computed, published once in tm_every periods (fw_tm_stream)
  *
  * Fixed-point formats of the conversion (computed at init, pipeline_config.c):
  *   ADC offsets: Q8 counts (average of calib_samples samples, 8 fractional bits)
@@ -64,7 +65,10 @@
 #define FW_EBUSY (-4)  /* not allowed while running */
 #define FW_ENOENT (-5) /* unknown name */
 
-/* One period's signals for telemetry, tests and the simulator. */
+/* One period's record, written by the interrupt straight into the telemetry
+ * ring (fw_t.tm_ring) and nothing else of telemetry: the main loop derives
+ * the rest (|psi_s|, the sector, SI units; fw_link). Also read by tests and
+ * the simulator (fw_telemetry). */
 typedef struct {
     uint32_t period; /* ISR count (modulo 2^32) */
     uint8_t state;   /* fw_state_id_t */
@@ -81,7 +85,8 @@ typedef struct {
             fx_angle_t theta_e; /* electrical angle from the encoder */
         };
     };
-    q24_t psi_amp;        /* |psi_s| estimate at k, Q24 pu */
+    q24_t i_d, i_q;       /* rotor-frame current at k, Q24 pu */
+    q24_t psi_d, psi_q;   /* rotor-frame stator flux at k, Q24 pu (|psi_s|, sector: main loop) */
     q24_t torque;         /* torque estimate at k, Q24 pu */
     q24_t omega_e;        /* electrical speed estimate, Q24 pu */
     q24_t torque_ref;     /* torque reference used at k, Q24 pu */
@@ -91,6 +96,10 @@ typedef struct {
     uint8_t cm_step;      /* commissioning step running (cm_step_id_t), 0 = none */
     uint16_t cm_progress; /* its progress, per mille */
 } fw_telemetry_t;
+
+/* Records kept for the main loop (power of 2): at one record in `every`
+ * periods the main loop may fall FW_TM_RING - 1 records behind. */
+#define FW_TM_RING 16u
 
 typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
 
@@ -190,8 +199,19 @@ typedef struct {
     volatile uint8_t req_arm, req_disarm, req_clear, req_cm;
     bool busy; /* re-entry flag */
     uint32_t period;
-    fw_telemetry_t tm;
-    ctrl_diag_t why; /* why the core refused the last configuration (fw_explain) */
+    /* Telemetry ring: the interrupt writes each period's record into slot
+     * tm_head and publishes it (tm_head + 1) once in
+     * tm_every periods; the main loop takes records from tm_tail
+     * (fw_tm_peek / fw_tm_release). Single producer, single consumer: the
+     * interrupt never writes a slot in [tm_tail, tm_head). */
+    fw_telemetry_t tm_ring[FW_TM_RING];
+    const fw_telemetry_t *tm_last; /* the last complete record */
+    volatile uint32_t tm_head;     /* records published (interrupt) */
+    volatile uint32_t tm_tail;     /* records taken (main loop) */
+    volatile uint32_t tm_every;    /* publish one record in tm_every periods; 0: none */
+    uint32_t tm_count;             /* periods until the next publication */
+    uint32_t tm_dropped;           /* records not published: ring full */
+    ctrl_diag_t why;               /* why the core refused the last configuration (fw_explain) */
 } fw_t;
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),
@@ -224,7 +244,15 @@ void fw_set_speed_ref_rpm(fw_t *fw, double rpm);
 
 fw_state_id_t fw_state(const fw_t *fw);
 uint32_t fw_fault(const fw_t *fw);
+/* The record of the last period (zeroes before the first; NULL for NULL). */
 const fw_telemetry_t *fw_telemetry(const fw_t *fw);
+/* Main loop: publish one record in every `every` periods into the ring, the
+ * first at the next period (0: stop); records not yet taken are dropped. */
+void fw_tm_stream(fw_t *fw, uint32_t every);
+/* Main loop: the oldest published record not yet taken, or NULL; it stays
+ * valid until fw_tm_release(). */
+const fw_telemetry_t *fw_tm_peek(const fw_t *fw);
+void fw_tm_release(fw_t *fw);
 /*
  * Main-loop side, configuration time (double allowed; pipeline_config.c).
  * Refused with FW_EBUSY while running (the ISR uses the controller state).

@@ -196,6 +196,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         return FW_EINVAL;
     }
     memset(fw, 0, sizeof *fw);
+    fw->tm_last = &fw->tm_ring[0];
     fw->hal = hal;
     hal_gate_enable(hal, false);
     hal_info_get(hal, &fw->info);
@@ -331,9 +332,9 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     memcpy(fw->ctrl_state.bytes, st.bytes, sizeof st.bytes);
     memcpy(fw->ctrl_cfg.bytes, cfg, CTRL_CFG_MAX);
     fw->ctrl = d;
-    /* Skip the estimates the controller never reads; |psi_s| at k stays on for
-     * telemetry (the status command derives the sector itself). */
-    fw->est.outputs = (uint8_t)((CTRL_EST_ALL & ~(unsigned)d->est_unused) | CTRL_EST_AMP_NOW);
+    /* Skip the estimates the controller never reads (telemetry takes the
+     * rotor-frame values and derives |psi_s| and the sector itself). */
+    ctrl_estimator_set_outputs(&fw->est, CTRL_EST_ALL & ~(unsigned)d->est_unused);
     return FW_OK;
 }
 

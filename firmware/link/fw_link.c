@@ -6,6 +6,7 @@
 
 #include "controller.h"
 #include "ctrl_units.h"
+#include "transforms.h"
 #include "vectors.h"
 
 static fw_link_t *fw_link_of(void *ctx)
@@ -239,14 +240,16 @@ static int op_telemetry_start(void *ctx, uint32_t mask, uint32_t decimation)
     if (tel_start(&l->tel, mask, decimation) != 0) {
         return CMD_E_RANGE;
     }
-    l->q_tail = l->q_head; /* drop samples of an earlier mask */
+    fw_tm_stream(l->fw, decimation); /* drops records of an earlier stream */
     l->send_meta = 1u;
     return CMD_OK;
 }
 
 static int op_telemetry_stop(void *ctx)
 {
-    tel_stop(&fw_link_of(ctx)->tel);
+    fw_link_t *l = fw_link_of(ctx);
+    tel_stop(&l->tel);
+    fw_tm_stream(l->fw, 0u);
     return CMD_OK;
 }
 
@@ -486,41 +489,39 @@ void fw_link_rx(fw_link_t *l, uint8_t byte)
     }
 }
 
-void fw_link_isr(fw_link_t *l)
+/* A telemetry sample from an interrupt record (main loop): |psi_s| (4.3)
+ * and the sector (4.5) from the rotor-frame flux and the angle, the
+ * references from the main loop's own values. */
+static void fw_link_sample(const fw_t *fw, const fw_telemetry_t *r, tel_sample_t *s)
 {
-    if (l == NULL || !tel_due(&l->tel)) {
-        return;
-    }
-    if (l->q_head - l->q_tail >= FW_LINK_QLEN) {
-        l->dropped++;
-        return;
-    }
-    const fw_t *fw = l->fw;
-    const fw_telemetry_t *tm = &fw->tm;
-    tel_sample_t *s = &l->q[l->q_head & (FW_LINK_QLEN - 1u)];
-    s->tick = tm->period;
-    s->i_a = tm->i_a;
-    s->i_b = tm->i_b;
-    s->i_d = fw->estimate.now.i_d;
-    s->i_q = fw->estimate.now.i_q;
-    s->psi = tm->psi_amp;
+    s->tick = r->period;
+    s->i_a = r->i_a;
+    s->i_b = r->i_b;
+    s->i_d = r->i_d;
+    s->i_q = r->i_q;
+    s->psi = fx_mag(r->psi_d, r->psi_q);
     s->psi_ref = fw->refs.psi;
-    s->torque = tm->torque;
-    s->torque_ref = tm->torque_ref;
-    s->speed = tm->omega_e;
+    s->torque = r->torque;
+    s->torque_ref = r->torque_ref;
+    s->speed = r->omega_e;
     s->speed_ref = fw->speed_ref;
-    s->vector = (int32_t)tm->vec;
-    s->duty = tm->duty;
-    s->vdc = tm->vdc;
-    s->theta = (int32_t)(tm->theta_e >> 8);
-    /* now.sector may be switched off in the estimator (controller.h est_unused). */
-    s->sector = (int32_t)ctrl_sector(fw->estimate.now.psi_alpha, fw->estimate.now.psi_beta);
-    s->state = (int32_t)tm->state;
-    s->fault = (int32_t)tm->fault;
-    s->cycles = (int32_t)(tm->cycles > (uint32_t)INT32_MAX ? (uint32_t)INT32_MAX : tm->cycles);
-    s->cm_step = (int32_t)tm->cm_step;
-    s->cm_progress = (int32_t)tm->cm_progress;
-    l->q_head++;
+    s->vector = (int32_t)r->vec;
+    s->duty = r->duty;
+    s->vdc = r->vdc;
+    s->theta = (int32_t)(r->theta_e >> 8);
+    q24_t sn;
+    q24_t cs;
+    fx_sincos(r->theta_e, &sn, &cs);
+    q24_t pa;
+    q24_t pb;
+    ctrl_inv_park(r->psi_d, r->psi_q, sn, cs, &pa, &pb);
+    /* no estimate in the record (not running): no sector */
+    s->sector = (r->psi_d | r->psi_q) != 0 ? (int32_t)ctrl_sector(pa, pb) : 0;
+    s->state = (int32_t)r->state;
+    s->fault = (int32_t)r->fault;
+    s->cycles = (int32_t)(r->cycles > (uint32_t)INT32_MAX ? (uint32_t)INT32_MAX : r->cycles);
+    s->cm_step = (int32_t)r->cm_step;
+    s->cm_progress = (int32_t)r->cm_progress;
 }
 
 void fw_link_poll(fw_link_t *l)
@@ -542,10 +543,12 @@ void fw_link_poll(fw_link_t *l)
             l->write(l->write_ctx, wire, n);
         }
     }
-    while (l->q_tail != l->q_head) {
-        const tel_sample_t *s = &l->q[l->q_tail & (FW_LINK_QLEN - 1u)];
-        const size_t n = tel_encode_sample(&l->tel, s, wire, sizeof wire);
-        l->q_tail++;
+    const fw_telemetry_t *r;
+    while ((r = fw_tm_peek(l->fw)) != NULL) {
+        tel_sample_t s;
+        fw_link_sample(l->fw, r, &s);
+        fw_tm_release(l->fw);
+        const size_t n = tel_encode_sample(&l->tel, &s, wire, sizeof wire);
         if (n > 0u) {
             l->write(l->write_ctx, wire, n);
         }

@@ -4,10 +4,10 @@
  * feeds the telemetry producer (telemetry.h) from the pipeline's per-period
  * sample.
  *
- * Contexts: fw_link_isr() runs right after fw_isr() in the PWM interrupt (it
- * only copies one sample into a ring when tel_due() says so); fw_link_rx() and
- * fw_link_poll() run in the main loop (command execution, frame encoding and
- * the byte output). The command ops run in the main loop: they only request
+ * Contexts: everything runs in the main loop (fw_link_rx: command
+ * execution; fw_link_poll: telemetry samples from the interrupt's record ring,
+ * fw_tm_peek, and the byte output); the interrupt only writes its records
+ * (pipeline.h). The command ops run in the main loop: they only request
  * state changes (fw_cmd_*), and the configuration ops (controller selection,
  * tunables) are refused while the drive is running.
  */
@@ -20,8 +20,6 @@
 #include "cmd.h"
 #include "pipeline.h"
 #include "telemetry.h"
-
-#define FW_LINK_QLEN 16u /* samples queued between ISR and main loop (power of 2) */
 
 typedef void (*fw_link_write_fn)(void *ctx, const uint8_t *bytes, size_t len);
 
@@ -40,10 +38,6 @@ typedef struct {
     fw_t *fw;
     cmd_t cmd;
     tel_t tel;
-    tel_sample_t q[FW_LINK_QLEN];
-    volatile uint32_t q_head; /* written by the ISR */
-    volatile uint32_t q_tail; /* written by the main loop */
-    uint32_t dropped;         /* samples lost to a full queue */
     uint8_t send_meta;
     double speed_max_rpm;       /* |speed reference| limit (fw_speed_info_t: the rated speed) */
     char cm_detail[48];         /* detail of the last refused commissioning start */
@@ -65,9 +59,8 @@ void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, v
 void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why);
 /* Main loop: one received byte. */
 void fw_link_rx(fw_link_t *l, uint8_t byte);
-/* ISR, after fw_isr: queue this period's telemetry sample when due. */
-void fw_link_isr(fw_link_t *l);
-/* Main loop: META frame after "tel start", then the queued sample frames. */
+/* Main loop: META frame after "tel start", then a sample frame for each
+ * record the interrupt published (fw_tm_stream). */
 void fw_link_poll(fw_link_t *l);
 
 #endif /* FIRMWARE_FW_LINK_H */

@@ -104,7 +104,6 @@ int tel_start(tel_t *t, uint32_t mask, uint32_t every)
     }
     t->mask = mask;
     t->every = every;
-    t->count = 0;
     return 0;
 }
 
@@ -118,19 +117,6 @@ void tel_stop(tel_t *t)
 bool tel_active(const tel_t *t)
 {
     return t != NULL && t->mask != 0u;
-}
-
-bool tel_due(tel_t *t)
-{
-    if (t == NULL || t->mask == 0u) {
-        return false;
-    }
-    if (t->count == 0u) {
-        t->count = t->every - 1u;
-        return true;
-    }
-    t->count--;
-    return false;
 }
 
 size_t tel_wire_size(uint32_t mask)

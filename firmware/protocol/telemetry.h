@@ -2,13 +2,13 @@
  * Telemetry producer: which signals exist, how to scale them to SI, and the
  * decimated, framed stream of chosen signals (PROTOCOL.md, "Telemetry").
  *
- * Data flow: the control ISR fills a tel_sample_t every period and, when
- * tel_due() says so, queues it; the main loop turns queued samples into wire
- * frames with tel_encode_sample() and writes them to the UART whole (a frame
- * and a text response line are never interleaved byte-wise). If the link is
- * too slow the main loop drops whole samples; the PC sees the gap in seq.
- * Concurrency: tel_due() is the only call made from the ISR; tel_start/stop
- * must be made with the ISR masked or between periods (the caller's job).
+ * Data flow: the control interrupt writes one record per period into a ring
+ * and publishes one in `every` (pipeline.h, fw_tm_stream); the main loop
+ * turns each into a tel_sample_t (fw_link) and a wire frame with
+ * tel_encode_sample() and writes it to the UART whole (a frame and a text
+ * response line are never interleaved byte-wise). If the link is too slow
+ * whole samples are dropped; the PC sees the gap in seq. Nothing here runs
+ * in the interrupt.
  */
 #ifndef FIRMWARE_TELEMETRY_H
 #define FIRMWARE_TELEMETRY_H
@@ -99,8 +99,7 @@ double tel_signal_scale(size_t index, const ctrl_bases_t *bases, int32_t pole_pa
 /* Producer state. */
 typedef struct {
     uint32_t mask;  /* signals being sent, 0 = stopped */
-    uint32_t every; /* decimation: one sample in `every` periods */
-    uint32_t count; /* periods until the next due sample */
+    uint32_t every; /* decimation: one sample in `every` periods (the producer's) */
     uint16_t seq;   /* sequence number of the next frame */
 } tel_t;
 
@@ -112,9 +111,6 @@ void tel_init(tel_t *t);
 int tel_start(tel_t *t, uint32_t mask, uint32_t every);
 void tel_stop(tel_t *t);
 bool tel_active(const tel_t *t);
-/* Call once per control period (ISR): true when this period's sample is to be
- * sent; the first period after tel_start is due. */
-bool tel_due(tel_t *t);
 /* Wire bytes of a sample frame for this mask (for link-budget checks):
  * bytes/s = tel_wire_size(mask) * fs / every. */
 size_t tel_wire_size(uint32_t mask);

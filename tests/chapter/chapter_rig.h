@@ -44,12 +44,17 @@ static inline void chapter_rig_init(chapter_rig_t *rig, const char *name, const 
     rig->est.vdc = rig->params.vdc_nom;
 }
 
-/* One step of the rig's controller; its output as leg duties in out->legs. */
+/* One step of the rig's controller; its output as leg duties in out->legs,
+ * which must realise its plan when it has one (ctrl_plan_legs). */
 static inline void chapter_rig_step(chapter_rig_t *rig, ctrl_out_t *out)
 {
-    ctrl_plan_single(&out->plan, 0u);
+    memset(out, 0xA5, sizeof *out);
     rig->d->step(rig->state, &rig->ctx, out);
-    ctrl_out_legs(out);
+    if (out->plan.n_seg > 0u) {
+        ctrl_legs_t want;
+        ctrl_plan_legs(&out->plan, &want);
+        TEST_ASSERT_EQUAL_INT32_ARRAY(want.duty, out->legs.duty, 3);
+    }
 }
 
 #endif /* TESTS_CHAPTER_CHAPTER_RIG_H */

@@ -11,7 +11,7 @@
  *     controller's v_d, v_q and the plan's period-average voltage.
  * The reference takes the Q24 inputs the controller sees (exact in double),
  * so the differences are the controller's arithmetic only. Bounds from the
- * Q24 formats, L = 2^-24, S = 1.2362e-6 (fx_sincos, control/README.md §9):
+ * Q24 formats, L = 2^-24, S = 3.18e-8 (fx_sincos, docs/fixed-point.md):
  *   - duties: inverse Clarke 1 L, Q24 reciprocal of Vdc (relative L/Vdc^-1),
  *     one rounding -> 8 L (16 L when the hexagon limit rescales first);
  *   - svm_dtc: unit vector (fx_div, 0.5 L each, relative to |psi| >= 0.5 ->
@@ -29,6 +29,7 @@
 #include <Eigen/Dense>
 
 extern "C" {
+#include "angle_source.h"
 #include "controller.h"
 #include "ctrl_foc.h"
 #include "ctrl_params.h"
@@ -49,7 +50,7 @@ void tearDown(void)
 
 static const double PI = 3.14159265358979323846;
 static const double L = 1.0 / 16777216.0;
-static const double S = 1.2362e-6;
+static const double S = 3.18e-8;
 
 static double q(q24_t x)
 {
@@ -216,6 +217,12 @@ static void test_foc_reference(void)
         nx->psi_q = ctrl_q24_from_double(q(nx->i_q));
         nx->theta_e = (fx_angle_t)(rng() & 0xffffffffu);
         rig.est.omega_e = ctrl_q24_from_double(0.8 * u(rng));
+        /* the estimator's angle at k and its rotation over the period (FOC
+         * turns the sine and cosine at k by 3/2 of it) */
+        rig.est.dtheta = fx_u2i(ctrl_angle_step(&rig.params, rig.est.omega_e));
+        fx_rot_q30(rig.est.dtheta, &rig.est.rot_c, &rig.est.rot_s);
+        rig.est.now.theta_e = nx->theta_e - (fx_angle_t)rig.est.dtheta;
+        fx_sincos(rig.est.now.theta_e, &rig.est.now.sin_theta, &rig.est.now.cos_theta);
         rig.ref.torque = ctrl_q24_from_double(0.5 * u(rng));
         q24_t idr;
         q24_t iqr;
@@ -223,7 +230,6 @@ static void test_foc_reference(void)
         rig.d->reset(rig.state);
         ctrl_out_t out;
         rig.d->step(rig.state, &rig.ctx, &out);
-        ctrl_out_legs(&out);
         const double w = q(rig.est.omega_e);
         const double vd = -w * q(nx->psi_q) + kp_d * (q(idr) - q(nx->i_d));
         const double vq = w * q(nx->psi_d) + kp_q * (q(iqr) - q(nx->i_q));

@@ -1,7 +1,7 @@
 /*
  * FOC (S1 §2, control/ctrl_foc.h): current references (i_d = 0 / exact MTPA),
  * the current PI's conditional-integration anti-windup, the current-loop
- * step response with the plant stand-in ctrl_predict (the model the
+ * step response with the plant stand-in fixture_predict (the model the
  * estimator predicts with: est->next is then exact, so the loop is the
  * designed first-order loop Kp = L wc, Ki = R wc), saturation recovery, and
  * the per-phase hysteresis decisions of foc_hyst.
@@ -19,13 +19,13 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "../core/est_fixture.h"
 #include "chapter_machines.h"
 #include "chapter_rig.h"
 #include "controller.h"
 #include "ctrl_foc.h"
 #include "ctrl_params.h"
 #include "plan.h"
-#include "predict.h"
 #include "unity.h"
 
 void setUp(void)
@@ -128,17 +128,18 @@ static void run_loop(double omega_pu, double torque_pu)
     q24_t s0;
     q24_t c0;
     fx_sincos(th0, &s0, &c0);
-    ctrl_mstate_from_flux(&rig.params, c0, s0, th0, &x); /* i = 0: psi = psi_pm on d */
+    fixture_state_from_flux(&rig.params, c0, s0, th0, &x); /* i = 0: psi = psi_pm on d */
     ctrl_legs_t applied = {{0, 0, 0}};
     rig.d->reset(rig.state);
     rig.est.omega_e = ctrl_q24_from_double(omega_pu);
+    fixture_rotation(&rig.params, &rig.est);
     rig.ref.torque = ctrl_q24_from_double(torque_pu);
     for (int k = 0; k < NSTEP; k++) {
         q24_t va;
         q24_t vb;
         ctrl_legs_voltage(&applied, rig.est.vdc, &va, &vb);
         rig.est.now = x;
-        ctrl_predict(&rig.params, &x, va, vb, rig.est.omega_e, &rig.est.next);
+        fixture_predict(&rig.params, &x, va, vb, rig.est.omega_e, &rig.est.next);
         rec_d[k] = q(x.i_d);
         rec_q[k] = q(x.i_q);
         ctrl_out_t out;

@@ -23,7 +23,7 @@ void tearDown(void)
 
 #define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
-#define SINCOS_ERR 1.24e-6
+#define SINCOS_ERR 3.18e-8
 
 static q24_t q(double x)
 {

@@ -1,12 +1,14 @@
 /*
  * Fixed-point primitives (control/fx.h, fx.c): saturation at the edges,
  * rounding of negative values, division by zero, exactness of the integer
- * square root, rounding of the magnitude, and the sin/cos error bound derived
- * in control/README.md (1.24e-6: interpolation h^2/8 with h = pi/1024, plus
- * one LSB of table and interpolation rounding).
+ * square root, rounding of the magnitude, the sin/cos error bound derived in
+ * docs/fixed-point.md (0.5 LSB + 2e-9: the nearest Q30 table point turned by
+ * the remainder, rounded once to Q24) and that of the rotation over a period,
+ * fx_rot_q30 (3e-9 up to pi/2, fx_sincos's beyond).
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "fx.h"
 #include "unity.h"
@@ -19,8 +21,10 @@ void tearDown(void)
 }
 
 #define LSB (1.0 / 16777216.0)
-#define SINCOS_BOUND                                                                               \
-    (((3.14159265358979323846 / 1024.0) * (3.14159265358979323846 / 1024.0)) / 8.0 + LSB)
+/* the final rounding to Q24 (0.5 LSB) + the Q30 table (2 x 0.5 2^-30), d^3/6
+ * <= 6.2e-10 for sin d = d, the Q30 roundings of d and d^2/2 */
+#define SINCOS_BOUND (0.5 * LSB + 2.0e-9)
+#define ROT_TAB_BOUND 3.0e-9 /* fx_rot_q30 up to pi/2 */
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
 static uint64_t rng(void)
@@ -377,7 +381,68 @@ static void test_sincos(void)
         const double th = (double)a * (2.0 * 3.14159265358979323846 / 4294967296.0);
         worst = fmax(worst, fmax(fabs((double)s * LSB - sin(th)), fabs((double)c * LSB - cos(th))));
     }
+    char msg[96];
+    snprintf(msg, sizeof msg, "fx_sincos worst error %.3e (bound %.3e)", worst, SINCOS_BOUND);
+    TEST_MESSAGE(msg);
     TEST_ASSERT_TRUE_MESSAGE(worst <= SINCOS_BOUND, "sin/cos error above the derived bound");
+}
+
+/* fx_rot_q30: cos and sin of a signed step, the nearest Q30 table point
+ * turned up to pi/2, fx_sincos beyond; and the rotation fx_rotate with them. */
+static void test_rot_q30(void)
+{
+    double worst_near = 0.0;
+    double worst_tab = 0.0;
+    for (int i = -200000; i <= 200000; i++) {
+        /* up to +-1.7 rad, densely around 0 and the boundaries */
+        const int32_t step = (int32_t)((double)i * 5840.3) + (int32_t)(rng() % 7u) - 3;
+        int32_t c;
+        int32_t s;
+        fx_rot_q30(step, &c, &s);
+        const double a = (double)step * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double e = fmax(fabs(c / 1073741824.0 - cos(a)), fabs(s / 1073741824.0 - sin(a)));
+        const uint32_t mag = step < 0 ? 0u - (uint32_t)step : (uint32_t)step;
+        if (mag <= FX_ROT_TAB_MAX) {
+            worst_near = fmax(worst_near, e);
+        } else {
+            worst_tab = fmax(worst_tab, e);
+        }
+    }
+    for (int i = 0; i < 20000; i++) { /* any step */
+        const int32_t step = (int32_t)(uint32_t)rng();
+        int32_t c;
+        int32_t s;
+        fx_rot_q30(step, &c, &s);
+        const double a = (double)step * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double e = fmax(fabs(c / 1073741824.0 - cos(a)), fabs(s / 1073741824.0 - sin(a)));
+        const uint32_t mag = step < 0 ? 0u - (uint32_t)step : (uint32_t)step;
+        if (mag > FX_ROT_TAB_MAX) {
+            worst_tab = fmax(worst_tab, e);
+        }
+    }
+    char msg[96];
+    snprintf(msg, sizeof msg, "fx_rot_q30 worst error %.3e (up to pi/2), %.3e (beyond)", worst_near,
+             worst_tab);
+    TEST_MESSAGE(msg);
+    TEST_ASSERT_TRUE(worst_near <= ROT_TAB_BOUND);
+    TEST_ASSERT_TRUE(worst_tab <= SINCOS_BOUND);
+    int32_t c;
+    int32_t s;
+    fx_rot_q30(0, &c, &s);
+    TEST_ASSERT_EQUAL_INT32(FX_Q30_ONE, c);
+    TEST_ASSERT_EQUAL_INT32(0, s);
+    /* fx_rotate: (x, y) turned, one rounding each, saturated at the edges */
+    fx_rot_q30(0x10000000, &c, &s); /* pi/8 */
+    q24_t xo;
+    q24_t yo;
+    fx_rotate(FX_ONE, 0, c, s, &xo, &yo);
+    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(cos(3.14159265358979323846 / 8) * FX_ONE), xo);
+    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(sin(3.14159265358979323846 / 8) * FX_ONE), yo);
+    fx_rotate(FX_MAX, FX_MAX, FX_Q30_ONE, FX_Q30_ONE, &xo, &yo); /* 45 deg x sqrt2 */
+    TEST_ASSERT_EQUAL_INT32(0, xo);
+    TEST_ASSERT_EQUAL_INT32(FX_MAX, yo);
+    fx_rotate(FX_MIN, FX_MIN, FX_Q30_ONE, FX_Q30_ONE, &xo, &yo);
+    TEST_ASSERT_EQUAL_INT32(FX_MIN, yo);
 }
 
 int main(void)
@@ -389,5 +454,6 @@ int main(void)
     RUN_TEST(test_isqrt_exact);
     RUN_TEST(test_mag);
     RUN_TEST(test_sincos);
+    RUN_TEST(test_rot_q30);
     return UNITY_END();
 }

@@ -10,6 +10,7 @@
 
 #include "controller.h"
 #include "ctrl_params.h"
+#include "est_fixture.h"
 #include "estimator.h"
 #include "machines.h"
 #include "mtpa.h"
@@ -379,7 +380,7 @@ static void test_mtpa_oracle_spmsm(void)
     /* Load angle: the MTPA point of an SPMSM is i_d = 0, i_q = T (pu); the
      * current model gives the stator flux, delta = atan2(psi_q, psi_d). */
     ctrl_mstate_t s;
-    ctrl_mstate_from_current(&p, 0, t, 0u, 0, FX_ONE, &s); /* theta = 0: alpha = d */
+    fixture_state_from_current(&p, 0, t, 0u, &s); /* theta = 0: alpha = d */
     const double delta = atan2(d(s.psi_q), d(s.psi_d));
     TEST_ASSERT_DOUBLE_WITHIN(5e-5 + 1e-6, 0.2177, delta);
     TEST_ASSERT_INT32_WITHIN(1, psi, s.psi_amp); /* consistent amplitude (0.5 + 0.5 LSB) */

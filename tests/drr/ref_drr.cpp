@@ -21,12 +21,12 @@
 #include <Eigen/Dense>
 
 extern "C" {
+#include "../core/est_fixture.h"
 #include "controller.h"
 #include "ctrl_drr.h"
 #include "ctrl_drr_config.h"
 #include "ctrl_params.h"
 #include "mtpa.h"
-#include "predict.h"
 #include "unity.h"
 }
 
@@ -114,8 +114,8 @@ Sample random_sample(std::mt19937_64 &rng)
     }
     const fx_angle_t a =
         static_cast<fx_angle_t>(static_cast<uint64_t>(std::llround(fr * 4294967296.0)));
-    ctrl_mstate_from_flux(&P, q(amp * std::cos(th)), q(amp * std::sin(th)), a, &s.est.now);
-    ctrl_mstate_from_flux(&P, q(amp * std::cos(th)), q(amp * std::sin(th)), a, &s.est.next);
+    fixture_state_from_flux(&P, q(amp * std::cos(th)), q(amp * std::sin(th)), a, &s.est.now);
+    fixture_state_from_flux(&P, q(amp * std::cos(th)), q(amp * std::sin(th)), a, &s.est.next);
     s.est.omega_e = q(-0.6 + 1.2 * u(rng));
     s.est.vdc = P.vdc_nom;
     // reference near the torque (steady state) or far (transients)

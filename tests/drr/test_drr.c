@@ -6,13 +6,13 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "../core/est_fixture.h"
 #include "controller.h"
 #include "ctrl_drr.h"
 #include "ctrl_drr_config.h"
 #include "ctrl_params.h"
 #include "drr_machines.h"
 #include "plan.h"
-#include "predict.h"
 #include "unity.h"
 #include "vectors.h"
 
@@ -227,8 +227,8 @@ static void fill_est(ctrl_estimate_t *est, double th_s, double amp, double delta
     const double th_r = th_s - delta;
     const fx_angle_t a =
         (fx_angle_t)(int64_t)llround(fmod(th_r / (2 * PI) + 2.0, 1.0) * 4294967296.0);
-    ctrl_mstate_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->now);
-    ctrl_mstate_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->next);
+    fixture_state_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->now);
+    fixture_state_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->next);
     est->omega_e = q(w);
     est->vdc = P.vdc_nom;
 }

@@ -103,7 +103,8 @@ static void test_identify_and_apply(void)
     for (int k = 0; k < 4; k++) {
         TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
     }
-    const double th_fw = (double)run.fw.tm.theta_e / 4294967296.0 * 2.0 * 3.14159265358979323846;
+    const double th_fw =
+        (double)fw_telemetry(&run.fw)->theta_e / 4294967296.0 * 2.0 * 3.14159265358979323846;
     TEST_ASSERT_TRUE(fabs(ang_deg(th_fw, plant_theta_e(&run.plant))) <= 2.0);
 
     /* Torque mode with the re-initialised controller: 0.5 N*m on the free

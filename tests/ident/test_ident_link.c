@@ -60,7 +60,6 @@ static void periods(int n)
 {
     for (int k = 0; k < n; k++) {
         TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-        fw_link_isr(&link);
         fw_link_poll(&link);
     }
 }
@@ -95,8 +94,8 @@ static void test_ident_commands(void)
     TEST_ASSERT_EQUAL_STRING("ok ident encoder\r\n", out);
     send("tel start cm_step cm_progress state every 1");
     periods(6000);
-    TEST_ASSERT_EQUAL_UINT8(CM_STEP_ENCODER, run.fw.tm.cm_step);
-    TEST_ASSERT_TRUE(run.fw.tm.cm_progress > 0u);
+    TEST_ASSERT_EQUAL_UINT8(CM_STEP_ENCODER, fw_telemetry(&run.fw)->cm_step);
+    TEST_ASSERT_TRUE(fw_telemetry(&run.fw)->cm_progress > 0u);
     TEST_ASSERT_TRUE(hal_sim_gates_on(&run.hal));
     send("tel stop");
     send("stop");

@@ -50,8 +50,7 @@ static void ol_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     (void)ctx;
     ol_state_t *s = (ol_state_t *)state;
-    ctrl_plan_active_zero(&out->plan, (uint8_t)(1u + s->k % 6u),
-                          (q24_t)((s->k % 4u + 1u) * (FX_ONE / 8)));
+    ctrl_out_active_zero(out, (uint8_t)(1u + s->k % 6u), (q24_t)((s->k % 4u + 1u) * (FX_ONE / 8)));
     if (s->k < OL_HIST) {
         s->out[s->k] = out->plan;
     }
@@ -253,6 +252,52 @@ static void test_protect_checks(void)
 }
 
 /* Bad configuration: NULLs and a controller without functions are rejected. */
+/* Telemetry ring: one record published in `every` periods, the first at the
+ * next period; the published records are the periods' own (period numbers
+ * `every` apart, the last record equal to fw_telemetry); a main loop that
+ * takes nothing leaves FW_TM_RING - 1 records and counts the rest as dropped;
+ * stopping publishes nothing and empties the ring. */
+static void test_telemetry_ring(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "bst", 750.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_t *fw = &run.fw;
+    TEST_ASSERT_NULL(fw_tm_peek(fw)); /* nothing published before a stream */
+    const uint32_t every = 3u;
+    fw_tm_stream(fw, every);
+    const uint32_t first = fw->period + 1u;
+    uint32_t taken = 0u;
+    for (uint32_t k = 0; k < 60u; k++) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+        const fw_telemetry_t *r;
+        while ((r = fw_tm_peek(fw)) != NULL) {
+            TEST_ASSERT_EQUAL_UINT32(first + taken * every, r->period);
+            TEST_ASSERT_EQUAL_UINT8(FW_STATE_RUNNING, r->state);
+            if (r->period == fw->period) {
+                TEST_ASSERT_TRUE(r == fw_telemetry(fw));
+            }
+            fw_tm_release(fw);
+            taken++;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(20u, taken);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw->tm_dropped);
+    /* nobody reads: the ring fills to FW_TM_RING - 1, the rest is dropped */
+    fw_tm_stream(fw, 1u);
+    for (uint32_t k = 0; k < FW_TM_RING + 5u; k++) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+    }
+    TEST_ASSERT_EQUAL_UINT32(FW_TM_RING - 1u, fw->tm_head - fw->tm_tail);
+    TEST_ASSERT_EQUAL_UINT32(6u, fw->tm_dropped);
+    fw_tm_stream(fw, 0u);
+    TEST_ASSERT_NULL(fw_tm_peek(fw));
+    TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
+    TEST_ASSERT_NULL(fw_tm_peek(fw));
+    fw_tm_release(fw); /* nothing to release: no change */
+    TEST_ASSERT_EQUAL_UINT32(fw->tm_head, fw->tm_tail);
+}
+
 static void test_init_rejects(void)
 {
     fw_t fw;
@@ -284,5 +329,6 @@ int main(void)
     RUN_TEST(test_state_machine);
     RUN_TEST(test_protect_checks);
     RUN_TEST(test_init_rejects);
+    RUN_TEST(test_telemetry_ring);
     return UNITY_END();
 }

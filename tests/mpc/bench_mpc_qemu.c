@@ -103,7 +103,6 @@ static void test_instruction_counts(void)
     const ctrl_desc_t *d[NC];
     ctrl_legs_t applied[NC];
     stat_t st_est = {0, 0, 0};
-    stat_t st_legs = {0, 0, 0};
     stat_t st_step[NC];
     stat_t st_pipe[NC];
     memset(st_step, 0, sizeof st_step);
@@ -147,24 +146,17 @@ static void test_instruction_counts(void)
             const ctrl_ctx_t ctx = {&p, &est, &ref};
             ctrl_out_t out;
             t0 = timer1_read();
-            d[c]->step(state[c], &ctx, &out);
+            d[c]->step(state[c], &ctx, &out); /* leg duties included */
             t1 = timer1_read();
-            ctrl_out_legs(&out);
-            const uint32_t t2 = timer1_read();
             const double n_step = instr(t1 - t0);
-            const double n_legs = instr(t2 - t1);
             stat_add(&st_step[c], n_step);
-            if (c == 0) {
-                stat_add(&st_legs, n_legs);
-            }
-            stat_add(&st_pipe[c], n_est + n_step + n_legs);
+            stat_add(&st_pipe[c], n_est + n_step);
             applied[c] = out.legs;
         }
     }
     /* Integer output: the target's printf has no floating point. */
     printf("  estimator        mean %6u  max %6u instructions\n", U(st_est.sum / st_est.n),
            U(st_est.max));
-    printf("  plan -> legs     mean %6u  max %6u\n", U(st_legs.sum / st_legs.n), U(st_legs.max));
     for (int c = 0; c < NC; c++) {
         printf("  %-7s step     mean %6u  max %6u   pipeline mean %6u  max %6u\n", names[c],
                U(st_step[c].sum / st_step[c].n), U(st_step[c].max),

@@ -16,14 +16,13 @@
  * Error budget of the fixed point (Q24 LSB = 2^-24 pu): k+2 flux amplitude
  * within TOL_PSI = 16 LSB + 1.5 LSB per pu of DC link (roundings of Ts V (the
  * Q24 Ts 2/3 times Vdc), of the rotation and of the sum) + 0.25 LSB / |psi|
- * (the rounding of |psi|^2, through the square root);
- * the rotation's scale error from fx_sincos is removed by scaling the
- * reference alike, ctrl_mpc_ref_amp2); k+2 torque within the state-dependent
- * RefPoint::tol_torque (fx_sincos error EPS_SC on the rotor-frame flux, Q24
- * roundings). A duty num/den then differs by at most
- * (d_num + D d_den)/|den| + 1 LSB. A decision
- * whose reference costs (or clamp / band / sign tests) are closer than the
- * error this budget allows is a tie: counted, not compared, asserted rare.
+ * (the rounding of |psi|^2, through the square root); the k+1 state is
+ * the estimator's rotor-frame one, turned to k+2 by fx_rot_q30; k+2 torque
+ * within the state-dependent RefPoint::tol_torque (fx_sincos error EPS_SC on
+ * the turned voltage, fx_rot_q30's EPS_ROT on the flux, Q24 roundings). A duty num/den then differs
+ * by at most (d_num + D d_den)/|den| + 1 LSB. A decision whose reference costs (or clamp / band /
+ * sign tests) are closer than the error this budget allows is a tie: counted, not compared,
+ * asserted rare.
  */
 #include <Eigen/Dense>
 #include <cmath>
@@ -32,6 +31,7 @@
 #include <cstring>
 
 extern "C" {
+#include "../core/est_fixture.h"
 #include "controller.h"
 #include "ctrl_m1.h"
 #include "ctrl_m2.h"
@@ -41,7 +41,6 @@ extern "C" {
 #include "ctrl_m3.h"
 #include "ctrl_mptfc.h"
 #include "plan.h"
-#include "predict.h"
 #include "unity.h"
 }
 
@@ -59,7 +58,8 @@ static double tol_psi(double vdc)
 {
     return TOL_PSI0 + 1.5 * vdc * LSB;
 }
-static const double EPS_SC = 1.24e-6; /* fx_sincos maximum error (control/fx.c) */
+static const double EPS_SC = 3.18e-8; /* fx_sincos maximum error (fx.h) */
+static const double EPS_ROT = 3.0e-9; /* fx_rot_q30 maximum error up to pi/2 (fx.h) */
 static const int N_POINTS = 3000;
 static const double TIE_RATE_MAX = 0.02; /* "rare": at most 2 % of the decisions */
 
@@ -120,10 +120,11 @@ struct RefPoint {
 
     RefPoint(const RefMachine &mm, const ctrl_estimate_t &e) : m(&mm)
     {
-        psi1 = Vector2d(d24(e.next.psi_alpha), d24(e.next.psi_beta));
-        i1 = Vector2d(d24(e.next.i_alpha), d24(e.next.i_beta));
-        t1 = d24(e.next.torque);
         th1 = (double)e.next.theta_e * (2.0 * M_PI / 4294967296.0);
+        /* the rotor-frame state turned exactly into the stator frame */
+        psi1 = Rotation2Dd(th1) * Vector2d(d24(e.next.psi_d), d24(e.next.psi_q));
+        i1 = Rotation2Dd(th1) * Vector2d(d24(e.next.i_d), d24(e.next.i_q));
+        t1 = d24(e.next.torque);
         omega = d24(e.omega_e);
         vdc = d24(e.vdc);
         sector = e.next.sector;
@@ -148,18 +149,21 @@ struct RefPoint {
         *te = dq.x() * iq - dq.y() * id;                                     /* (6.11) */
         *amp = psi.norm();
         if (tol_t != nullptr) {
-            *tol_t = tol_torque(dq);
+            *tol_t = tol_torque(dq, duty * tsv());
         }
     }
     /* Te = psi_q (a + b psi_d): an error dpsi in each rotor-frame component
-     * gives (|a + b psi_d| + |b psi_q|) dpsi. dpsi: fx_sincos error EPS_SC on
-     * each of sin, cos (sqrt(2) EPS_SC |psi|) plus 8 LSB of roundings (Ts V,
-     * rotation, sum); plus 4 LSB for the torque's own roundings and the Q24
-     * quantisation of a and b. */
-    double tol_torque(const Vector2d &dq) const
+     * gives (|a + b psi_d| + |b psi_q|) dpsi. dpsi: the voltage D Ts V turned
+     * with table sine/cosine values (error EPS_SC on each: sqrt(2) EPS_SC
+     * D Ts |V|), the flux turned by omega Ts with fx_rot_q30 (sqrt(2) EPS_ROT
+     * |psi|, EPS_SC beyond pi/2), plus 8 LSB of roundings (Ts V, rotation, sum); plus 4 LSB for
+     * the torque's own roundings and the Q24 quantisation of a and b. */
+    double tol_torque(const Vector2d &dq, double tsv_d) const
     {
         const double a = m->psi_pm / m->ld, bb = 1.0 / m->lq - 1.0 / m->ld;
-        const double dpsi = std::sqrt(2.0) * EPS_SC * dq.norm() + 8.0 * LSB;
+        /* fx_rot_q30 takes fx_sincos beyond pi/2 per period */
+        const double e_rot = std::fabs(omega * m->ts) <= M_PI / 2 ? EPS_ROT : EPS_SC;
+        const double dpsi = std::sqrt(2.0) * (EPS_SC * tsv_d + e_rot * dq.norm()) + 8.0 * LSB;
         return (std::fabs(a + bb * dq.x()) + std::fabs(bb * dq.y())) * dpsi + 4.0 * LSB;
     }
     double tsv() const
@@ -204,15 +208,14 @@ static void random_point(const ctrl_params_t &p, ctrl_estimate_t &est, ctrl_refs
 {
     const double imax = 1.2 * d24(p.current_rated);
     const double id = uni(-0.6 * imax, 0.3 * imax), iq = uni(-imax, imax);
-    const double psid = d24(p.ld) * id + d24(p.psi_pm), psiq = d24(p.lq) * iq;
     const fx_angle_t theta = rng_u32();
-    const double th = theta * (2.0 * M_PI / 4294967296.0);
     std::memset(&est, 0, sizeof est);
-    ctrl_mstate_from_flux(&p, ctrl_q24_from_double(psid * cos(th) - psiq * sin(th)),
-                          ctrl_q24_from_double(psid * sin(th) + psiq * cos(th)), theta, &est.next);
+    /* the rotor-frame state, as the estimator hands it */
+    fixture_state_dq(&p, ctrl_q24_from_double(id), ctrl_q24_from_double(iq), theta, &est.next);
     est.now = est.next;
     est.omega_e = ctrl_q24_from_double(uni(-1.1, 1.1) * d24(p.speed_rated_e));
     est.vdc = ctrl_q24_from_double(d24(p.vdc_nom) * uni(0.9, 1.1));
+    fixture_rotation(&p, &est);
     ref.torque = ctrl_q24_from_double(d24(est.next.torque) + uni(-0.3, 0.3) * d24(p.torque_rated));
     ref.psi = ctrl_q24_from_double(d24(est.next.psi_amp) * uni(0.95, 1.05));
 }
@@ -260,7 +263,7 @@ static void run_model(const ctrl_machine_t &mach, uint32_t fs, double *e_t, doub
         ctrl_refs_t ref;
         random_point(p, est, ref);
         ctrl_mpc_basis_t bs;
-        ctrl_mpc_basis(&s.model, &p, &est, &bs);
+        ctrl_mpc_basis(&s.model, &est, &bs);
         const RefPoint rp(rm, est);
         for (uint8_t v = 0; v <= 6; v++) {
             const q24_t duty = v == 0 ? 0 : ctrl_q24_from_double(uni(0.0, 1.0));
@@ -272,15 +275,19 @@ static void run_model(const ctrl_machine_t &mach, uint32_t fs, double *e_t, doub
             double te, amp, tol_t;
             rp.at(v, d24(duty), &te, &amp, &tol_t);
             /* ... plus the square's rounding (0.5 LSB of pu^2) seen through the
-             * root: 0.25 LSB / |psi| (large only near zero flux) */
-            const double tp = tol_psi(rp.vdc) + 0.25 * LSB / std::max(amp, 1e-3);
+             * root: 0.25 LSB / |psi| (large only near zero flux), and the scale
+             * of the rotations: D Ts V turned with table values (EPS_SC of
+             * D Ts |V|), the zero-vector flux by fx_rot_q30 (EPS_ROT of |psi|, the
+             * EPS_SC of fx_sincos beyond pi/2 per period) */
+            const double e_rot = std::fabs(rp.omega * rm.ts) <= M_PI / 2 ? EPS_ROT : EPS_SC;
+            const double tp = tol_psi(rp.vdc) + 0.25 * LSB / std::max(amp, 1e-3) +
+                              EPS_SC * d24(duty) * rp.tsv() + e_rot * amp;
             const double et = std::fabs(d24(ctrl_mpc_torque(&s.model, pd, pq)) - te);
             *e_t = std::max(*e_t, et / tol_t);
-            /* amplitude in the reference's scale (the comparisons scale psi_ref by mag2);
-             * beyond 8 pu ctrl_mpc_amp2 saturates at 64 pu^2 (ctrl_m2ptfc_model.h):
+            /* beyond 8 pu ctrl_mpc_amp2 saturates at 64 pu^2 (ctrl_m2ptfc_model.h):
              * reachable only with flux steps Ts |V| of several pu (small motors
              * on a high DC link), far above any flux reference */
-            const double a_fix = std::sqrt(d24(ctrl_mpc_amp2(pd, pq)) / d24(bs.mag2));
+            const double a_fix = std::sqrt(d24(ctrl_mpc_amp2(pd, pq)));
             if (amp < 8.0 - 1e-3) {
                 *e_psi = std::max(*e_psi, std::fabs(a_fix - amp) / tp);
             } else {
@@ -481,8 +488,8 @@ static void run_weighted(Kind kind, const ctrl_machine_t &mach, uint32_t fs, Sta
             double te, tol_te;
             rp.at(v, k.duty, &te, &amp, &tol_te);
             k.g = std::fabs(t_ref - te) + zeta * std::fabs(psi_ref - amp); /* (6.13) */
-            k.g_tol =
-                tol_te + zeta * tol_psi(rp.vdc) + (std::fabs(t_full - t0) + zeta * rp.tsv()) * k.bound;
+            k.g_tol = tol_te + zeta * tol_psi(rp.vdc) +
+                      (std::fabs(t_full - t0) + zeta * rp.tsv()) * k.bound;
             c[nc++] = k;
         };
         if (kind == K_M1) {

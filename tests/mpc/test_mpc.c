@@ -3,15 +3,16 @@
  * ctrl_m1*, ctrl_mptfc*, ctrl_m3*, ctrl_m2*). Needs only pmsm_control: also
  * runs on the Cortex-M4 in QEMU.
  *
- * The brute-force checks evaluate every candidate with the core's
- * ctrl_predict() (predict.h), independently of the controllers' fast k+2
- * model, and assert the controllers' choice against it.
+ * The brute-force checks evaluate every candidate with the test fixture's
+ * rotor-frame prediction fixture_predict_dq() (tests/core/est_fixture.h),
+ * independently of the controllers' fast k+2 model, and assert the
+ * controllers' choice against it.
  *
- * Tolerances (Q24 LSB = 2^-24 pu): the fast model and ctrl_predict() use the
- * same fx_sincos values at the same angle theta(k+2) (ctrl_angle_step), so
- * they differ by roundings only; the rotation's scale error (|sin^2 + cos^2 - 1|
- * < 2.5e-6) is cancelled in the controllers' amplitude comparisons by scaling
- * the reference alike. The k+2 flux then differs by at most the roundings of
+ * Tolerances (Q24 LSB = 2^-24 pu): both start from the same k+1 state in the
+ * rotor frame and turn it by the same fx_rot_q30 rotation; the fixture turns
+ * the voltage with the table at theta(k+1), the model with the table values
+ * turned to theta(k+2) (a difference of 1.3e-7 of |Ts V| < 0.15 pu: < 1
+ * LSB). The k+2 flux then differs by at most that and the roundings of
  * Ts V (3), of the rotation (2 per axis) and of the sums (2): < 16 LSB. The
  * torque multiplies that by |a + b psi_d| + |b psi_q| (< 3 pu for these
  * machines and currents) plus its own 4 roundings: < 64 LSB.
@@ -21,6 +22,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "../core/est_fixture.h"
 #include "controller.h"
 #include "ctrl_m1.h"
 #include "ctrl_m2.h"
@@ -31,7 +33,6 @@
 #include "mpc_machines.h"
 #include "mtpa.h"
 #include "plan.h"
-#include "predict.h"
 #include "unity.h"
 #include "vectors.h"
 
@@ -100,31 +101,27 @@ static void random_point(const ctrl_params_t *p, ctrl_estimate_t *est, ctrl_refs
     const double imax = 1.2 * d24(p->current_rated);
     const double id = rng_uniform(-0.6 * imax, 0.3 * imax);
     const double iq = rng_uniform(-imax, imax);
-    const double psid = d24(p->ld) * id + d24(p->psi_pm);
-    const double psiq = d24(p->lq) * iq;
     const fx_angle_t theta = rng_u32();
-    const double th = (double)theta * (2.0 * PI / 4294967296.0);
-    const double pa = psid * cos(th) - psiq * sin(th);
-    const double pb = psid * sin(th) + psiq * cos(th);
     memset(est, 0, sizeof *est);
-    ctrl_mstate_from_flux(p, q24(pa), q24(pb), theta, &est->next);
+    fixture_state_dq(p, q24(id), q24(iq), theta, &est->next); /* as the estimator hands it */
     est->now = est->next;
     est->omega_e = q24(rng_uniform(-1.1, 1.1) * d24(p->speed_rated_e));
     est->vdc = q24(d24(p->vdc_nom) * rng_uniform(0.9, 1.1));
+    fixture_rotation(p, est);
     const double tr = d24(p->torque_rated);
     ref->torque = q24(d24(est->next.torque) + rng_uniform(-0.3, 0.3) * tr);
     ref->psi = (rng_u32() & 1u) ? 0 : q24(d24(est->next.psi_amp) * rng_uniform(0.95, 1.05));
     ctrl_plan_active_zero(applied, (uint8_t)(1u + rng_u32() % 6u), q24(rng_uniform(0.0, 1.0)));
 }
 
-/* k+2 state with vec on for duty (zero vector the rest), by ctrl_predict(). */
+/* k+2 state with vec on for duty (zero vector the rest), by fixture_predict(). */
 static void predict2(const ctrl_params_t *p, const ctrl_estimate_t *est, uint8_t vec, q24_t duty,
                      ctrl_mstate_t *out)
 {
     q24_t va;
     q24_t vb;
     ctrl_vector_ab(vec, est->vdc, &va, &vb);
-    ctrl_predict(p, &est->next, fx_mul(duty, va), fx_mul(duty, vb), est->omega_e, out);
+    fixture_predict_dq(p, &est->next, fx_mul(duty, va), fx_mul(duty, vb), est->omega_e, out);
 }
 
 static double psi_ref_of(const ctrl_params_t *p, const ctrl_refs_t *ref)
@@ -237,7 +234,7 @@ static void test_closer_matches_sqrt(void)
 /* ------------------------------------------------------- brute force */
 
 /* centre: the tunable (1: Te_c = Te(k+1) + dT0/2 in (6.5), (6.7), (6.8), the
- * zero-vector change dT0 from ctrl_predict(); 0: Te(k+1), the thesis literally). */
+ * zero-vector change dT0 from fixture_predict(); 0: Te(k+1), the thesis literally). */
 static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs, double centre)
 {
     ctrl_params_t p;
@@ -676,20 +673,19 @@ static void test_basis3_equals_basis(void)
             ctrl_plan_t applied;
             random_point(&p, &est, &ref, &applied);
             if (i % 8 == 7) { /* any int32_t: beyond the clamps */
-                est.next.i_alpha = fx_u2i(rng_u32());
-                est.next.i_beta = fx_u2i(rng_u32());
-                est.next.psi_alpha = fx_u2i(rng_u32());
-                est.next.psi_beta = fx_u2i(rng_u32());
+                est.next.i_d = fx_u2i(rng_u32());
+                est.next.i_q = fx_u2i(rng_u32());
+                est.next.psi_d = fx_u2i(rng_u32());
+                est.next.psi_q = fx_u2i(rng_u32());
                 est.vdc = fx_u2i(rng_u32());
             }
             ctrl_mpc_basis_t b6;
             ctrl_mpc_basis3_t b3;
-            ctrl_mpc_basis(&s.model, &p, &est, &b6);
-            ctrl_mpc_basis3(&s.model, &p, &est, &b3);
+            ctrl_mpc_basis(&s.model, &est, &b6);
+            ctrl_mpc_basis3(&s.model, &est, &b3);
             TEST_ASSERT_EQUAL_INT32(b6.d0, b3.d0);
             TEST_ASSERT_EQUAL_INT32(b6.q0, b3.q0);
             TEST_ASSERT_EQUAL_INT32(b6.t0, b3.t0);
-            TEST_ASSERT_EQUAL_INT32(b6.mag2, b3.mag2);
             for (uint8_t v = 1u; v <= 6u; v++) {
                 q24_t d6;
                 q24_t q6;

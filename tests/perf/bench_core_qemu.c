@@ -27,6 +27,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "angle_source.h"
+#include "est_fixture.h"
 #include "estimator.h"
 #include "flux_observer.h"
 #include "flux_observer_config.h"
@@ -34,7 +36,6 @@
 #include "machines.h"
 #include "mtpa.h"
 #include "plan.h"
-#include "predict.h"
 #include "qemu_mps2.h"
 #include "transforms.h"
 #include "unity.h"
@@ -66,7 +67,7 @@ static input_t in[N_IN];
 static ctrl_params_t P;         /* thesis SPMSM, 10 kHz */
 static ctrl_params_t P_ipm;     /* 80 kW IPMSM, 10 kHz (MTPA table) */
 static ctrl_estimator_t E;      /* every output (CTRL_EST_ALL) */
-static ctrl_estimator_t E_lean; /* outputs = 0: no |psi|, no sector at k */
+static ctrl_estimator_t E_lean; /* no optional output */
 static ctrl_fobs_t O_sl;        /* flux observer, sensorless, dead time compensated */
 static ctrl_fobs_t O_enc;       /* flux observer, encoder mode */
 static volatile int32_t sink;
@@ -115,11 +116,11 @@ static void make_inputs(void)
         t->meas.i_b = t->ib;
         t->meas.vdc = t->vdc;
         t->meas.theta_e = t->th;
-        ctrl_mstate_from_current(&P, t->al, t->be, t->th, t->s, t->c, &t->now);
+        fixture_state_from_current(&P, t->al, t->be, t->th, &t->now);
     }
     ctrl_estimator_init(&E, &P);
     ctrl_estimator_init(&E_lean, &P);
-    E_lean.outputs = 0u;
+    ctrl_estimator_set_outputs(&E_lean, 0u);
     ctrl_fobs_config_t fc;
     ctrl_fobs_config_default(&fc, &spm);
     fc.dead_time_s = 1e-6;
@@ -196,35 +197,36 @@ __attribute__((noinline)) static void w_plan_legs(int k)
     ctrl_plan_legs(&in[k].plan, &l);
     sink = l.duty[0] + l.duty[1] + l.duty[2];
 }
-__attribute__((noinline)) static void w_predict_flux(int k)
+__attribute__((noinline)) static void w_rot_q30(int k)
+{
+    int32_t c;
+    int32_t s;
+    fx_rot_q30(fx_u2i(ctrl_angle_step(&P, in[k].omega)), &c, &s);
+    sink = c + s;
+}
+__attribute__((noinline)) static void w_rotate(int k)
 {
     q24_t a;
     q24_t b;
-    ctrl_predict_flux(&P, &in[k].now, in[k].x, in[k].y, &a, &b);
+    fx_rotate(in[k].x, in[k].y, in[k].c * 64, in[k].s * 64, &a, &b);
     sink = a + b;
 }
 __attribute__((noinline)) static void w_from_current(int k)
 {
     ctrl_mstate_t o;
-    ctrl_mstate_from_current(&P, in[k].al, in[k].be, in[k].th, in[k].s, in[k].c, &o);
-    sink = o.torque;
-}
-__attribute__((noinline)) static void w_from_flux_sc(int k)
-{
-    ctrl_mstate_t o;
-    ctrl_mstate_from_flux_sc(&P, in[k].x, in[k].y, in[k].th, in[k].s, in[k].c, &o);
+    fixture_state_from_current(&P, in[k].al, in[k].be, in[k].th, &o);
     sink = o.torque;
 }
 __attribute__((noinline)) static void w_from_flux(int k)
 {
     ctrl_mstate_t o;
-    ctrl_mstate_from_flux(&P, in[k].x, in[k].y, in[k].th, &o);
+    fixture_state_from_flux(&P, in[k].x, in[k].y, in[k].th, &o);
     sink = o.torque;
 }
 __attribute__((noinline)) static void w_predict(int k)
 {
     ctrl_mstate_t o;
-    ctrl_predict(&P, &in[k].now, in[k].x, in[k].y, in[k].omega, &o);
+    fixture_predict(&P, &in[k].now, in[k].x, in[k].y, in[k].omega, &o);
     sink = o.torque;
 }
 __attribute__((noinline)) static void w_mtpa_spm(int k)
@@ -248,13 +250,6 @@ __attribute__((noinline)) static void w_estimator_lean(int k)
     ctrl_estimator_update(&E_lean, &P, &in[k].meas, &in[k].legs, &est);
     sink = est.next.torque;
 }
-__attribute__((noinline)) static void w_from_flux_noamp(int k)
-{
-    ctrl_mstate_t o;
-    ctrl_mstate_from_flux_noamp(&P, in[k].x, in[k].y, in[k].th, in[k].s, in[k].c, &o);
-    sink = o.torque;
-}
-
 __attribute__((noinline)) static void w_atan2(int k)
 {
     sink = (int32_t)(fx_atan2(in[k].y, in[k].x) >> 1);
@@ -292,18 +287,17 @@ static const bench_t benches[] = {
     {"ctrl_park", w_park},
     {"ctrl_sector", w_sector},
     {"ctrl_angle_step", w_angle_step},
+    {"fx_rot_q30 (omega Ts)", w_rot_q30},
+    {"fx_rotate", w_rotate},
     {"ctrl_legs_voltage", w_legs_voltage},
     {"ctrl_plan_legs", w_plan_legs},
-    {"ctrl_predict_flux", w_predict_flux},
-    {"ctrl_mstate_from_current", w_from_current},
-    {"ctrl_mstate_from_flux_sc", w_from_flux_sc},
-    {"ctrl_mstate_from_flux_noamp", w_from_flux_noamp},
-    {"ctrl_mstate_from_flux", w_from_flux},
-    {"ctrl_predict", w_predict},
     {"ctrl_mtpa_psi SPMSM", w_mtpa_spm},
     {"ctrl_mtpa_psi IPMSM", w_mtpa_ipm},
     {"ctrl_estimator_update", w_estimator},
     {"ctrl_estimator_update outputs=0", w_estimator_lean},
+    {"(test fixture) state from current", w_from_current},
+    {"(test fixture) state from flux", w_from_flux},
+    {"(test fixture) stator-frame predict", w_predict},
     {"fx_atan2", w_atan2},
     {"ctrl_fobs_voltage (dead time)", w_fobs_voltage},
     {"ctrl_fobs_update sensorless", w_fobs_sl},
@@ -371,8 +365,8 @@ static void test_core_counts(void)
         uint32_t mn = UINT32_MAX;
         uint32_t mx = 0u;
         uint32_t sum = 0u;
-        ctrl_estimator_reset(&E);
-        ctrl_estimator_reset(&E_lean);
+        ctrl_estimator_reset(&E, &P);
+        ctrl_estimator_reset(&E_lean, &P);
         (void)ticks_of(benches[f].fn, 0); /* prime the estimator */
         for (int k = 0; k < N_IN; k++) {
             const uint32_t n = instr_of(benches[f].fn, k);

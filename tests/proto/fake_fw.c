@@ -48,6 +48,7 @@ int main(void)
     b.w_rad_s = 2333.7;
     const uint32_t fs = 20000u;
     uint32_t tick = 0;
+    uint32_t tel_tick0 = 0; /* period of the first sample after tel start */
     uint32_t mask_prev = 0;
     uint32_t every_prev = 0;
     uint8_t w[TEL_WIRE_MAX];
@@ -74,6 +75,7 @@ int main(void)
                     if (mask_prev == 0u) {
                         tel_stop(&t);
                     } else if (tel_start(&t, mask_prev, every_prev) == 0) {
+                        tel_tick0 = tick; /* the first sample is the next period's */
                         const size_t k = tel_encode_meta(&t, fs, &b, 4, w, sizeof w);
                         write_all(w, k);
                     }
@@ -82,7 +84,7 @@ int main(void)
         }
         /* 10 ms of control periods */
         for (int k = 0; k < 200; k++, tick++) {
-            if (!tel_due(&t)) {
+            if (!tel_active(&t) || (tick - tel_tick0) % t.every != 0u) {
                 continue;
             }
             const double time = (double)tick / fs;

@@ -70,8 +70,8 @@ int main(int argc, char **argv)
     uint32_t s = 2024u;
     unsigned k_frame = 0;
     for (uint32_t k = 0; k < 2000u; k++) {
-        if (!tel_due(&t)) {
-            continue;
+        if (!tel_active(&t) || k % t.every != 0u) {
+            continue; /* one sample in `every` periods, the first at k = 0 */
         }
         tel_sample_t smp;
         memset(&smp, 0, sizeof smp);

@@ -73,7 +73,7 @@ static void ev_hook(void *ctx)
         e->primed = false;
         return;
     }
-    const ctrl_meas_t *m = &r->fw.tm.meas;
+    const ctrl_meas_t *m = &fw_telemetry(&r->fw)->meas;
     q24_t ia;
     q24_t ib;
     ctrl_clarke(m->i_a, m->i_b, &ia, &ib);

@@ -32,7 +32,7 @@ extern "C" {
 #include "flux_observer.h"
 #include "flux_observer_config.h"
 #include "fx.h"
-#include "predict.h"
+#include "angle_source.h"
 #include "unity.h"
 }
 

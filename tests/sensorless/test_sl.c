@@ -3,13 +3,13 @@
  * return to the forced angle and its configuration (host and QEMU).
  */
 #include <math.h>
-#include <stdio.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "../core/machines.h"
+#include "angle_source.h"
 #include "fx.h"
-#include "predict.h"
 #include "sensorless.h"
 #include "sensorless_config.h"
 #include "unity.h"

@@ -1,6 +1,6 @@
 /*
  * Closed loop on the model of the control core: the plant is the core's
- * discrete machine model (ctrl_predict: psi += Ts (v - Rs i), theta += omega Ts,
+ * discrete machine model (fixture_predict: psi += Ts (v - Rs i), theta += omega Ts,
  * (5.15)/(6.10)-(6.12)) at constant speed, the estimate is exact and the
  * prediction to k+1 uses the vector applied during [k, k+1) (one-step delay,
  * docs/conventions.md). Each table must hold torque and flux in steady state in the
@@ -20,11 +20,11 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "../core/est_fixture.h"
 #include "controller.h"
 #include "ctrl_params.h"
 #include "mtpa.h"
 #include "plan.h"
-#include "predict.h"
 #include "unity.h"
 
 void setUp(void)
@@ -70,7 +70,7 @@ static loop_result_t run_loop_ex(const char *name, double tref, double omega, in
     d->reset(st);
 
     ctrl_mstate_t x;
-    ctrl_mstate_from_flux(&p, FX_ONE, 0, 0u, &x); /* rotor flux only, i = 0 */
+    fixture_state_from_flux(&p, FX_ONE, 0, 0u, &x); /* rotor flux only, i = 0 */
     ctrl_legs_t applied = {{0, 0, 0}};
     ctrl_estimate_t est;
     memset(&est, 0, sizeof est);
@@ -90,10 +90,10 @@ static loop_result_t run_loop_ex(const char *name, double tref, double omega, in
         est.omega_e = w;
         est.vdc = p.vdc_nom;
         ctrl_legs_voltage(&applied, p.vdc_nom, &va, &vb);
-        ctrl_predict(&p, &x, va, vb, w, &est.next);
+        fixture_predict(&p, &x, va, vb, w, &est.next);
         ctrl_out_t o;
+        fixture_rotation(&p, &est);
         d->step(st, &ctx, &o);
-        ctrl_out_legs(&o);
         const ctrl_plan_t out = o.plan;
         /* plant: [k, k+1) with the applied plan; then the new plan takes over */
         x = est.next;

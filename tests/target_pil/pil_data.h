@@ -32,7 +32,7 @@ typedef struct {
     uint32_t cmp[3]; /* last compare values written (shadow) */
     uint8_t gates;   /* gate request after the ISR (1 = enable requested) */
     uint8_t state, fault, vec;
-    int32_t i_a, i_b, vdc, psi_amp, torque, omega_e, torque_ref, duty;
+    int32_t i_a, i_b, vdc, i_d, i_q, psi_d, psi_q, torque, omega_e, torque_ref, duty;
     int32_t legs[3];
     uint32_t theta_e, period, cycles;
 } pil_out_t;

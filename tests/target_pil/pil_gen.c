@@ -110,7 +110,10 @@ static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t
         o->i_a = tm->i_a;
         o->i_b = tm->i_b;
         o->vdc = tm->vdc;
-        o->psi_amp = tm->psi_amp;
+        o->i_d = tm->i_d;
+        o->i_q = tm->i_q;
+        o->psi_d = tm->psi_d;
+        o->psi_q = tm->psi_q;
         o->torque = tm->torque;
         o->omega_e = tm->omega_e;
         o->torque_ref = tm->torque_ref;
@@ -151,12 +154,14 @@ static int record(FILE *f, size_t idx, const ctrl_desc_t *d, const sim_machine_t
     for (uint32_t k = 0; k < n; k++) {
         const pil_out_t *o = &out[k];
         fprintf(f,
-                "{{%uu,%uu,%uu},%u,%u,%u,%u,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,{%ld,%ld,%ld},%uu,%uu,"
+                "{{%uu,%uu,%uu},%u,%u,%u,%u,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,%ld,{%ld,%ld,%"
+                "ld},%uu,%uu,"
                 "%uu},\n",
                 o->cmp[0], o->cmp[1], o->cmp[2], o->gates, o->state, o->fault, o->vec, (long)o->i_a,
-                (long)o->i_b, (long)o->vdc, (long)o->psi_amp, (long)o->torque, (long)o->omega_e,
-                (long)o->torque_ref, (long)o->duty, (long)o->legs[0], (long)o->legs[1],
-                (long)o->legs[2], o->theta_e, o->period, o->cycles);
+                (long)o->i_b, (long)o->vdc, (long)o->i_d, (long)o->i_q, (long)o->psi_d,
+                (long)o->psi_q, (long)o->torque, (long)o->omega_e, (long)o->torque_ref,
+                (long)o->duty, (long)o->legs[0], (long)o->legs[1], (long)o->legs[2], o->theta_e,
+                o->period, o->cycles);
     }
     fprintf(f, "};\n\n");
     free(in);

@@ -63,7 +63,7 @@ static inline uint32_t pil_ident_mix(uint32_t h, uint32_t v)
 
 static inline uint32_t pil_ident_hash(const hal_pwm_t *pwm, int gates, const fw_t *fw)
 {
-    const fw_telemetry_t *t = &fw->tm;
+    const fw_telemetry_t *t = fw_telemetry(fw);
     uint32_t h = 2166136261u;
     for (int x = 0; x < 3; x++) {
         h = pil_ident_mix(h, pwm->cmp[x]);

@@ -114,7 +114,8 @@ int main(void)
             printf("FAIL period %u (of %u): output hash %08lx, recorded %08lx (state %u, step "
                    "%u, phase %lu)\n",
                    (unsigned)k, (unsigned)r->n, (unsigned long)h, (unsigned long)r->hash[k],
-                   (unsigned)fw.tm.state, (unsigned)fw.tm.cm_step, (unsigned long)fw.cm.phase);
+                   (unsigned)fw_telemetry(&fw)->state, (unsigned)fw_telemetry(&fw)->cm_step,
+                   (unsigned long)fw.cm.phase);
             return 1;
         }
     }

@@ -35,7 +35,10 @@ static int pil_compare(pil_mismatch_t *mm, uint32_t k, const pil_out_t *w, const
         pil_cmp(mm, k, "tm.i_a", w->i_a, tm->i_a) != 0 ||
         pil_cmp(mm, k, "tm.i_b", w->i_b, tm->i_b) != 0 ||
         pil_cmp(mm, k, "tm.vdc", w->vdc, tm->vdc) != 0 ||
-        pil_cmp(mm, k, "tm.psi_amp", w->psi_amp, tm->psi_amp) != 0 ||
+        pil_cmp(mm, k, "tm.i_d", w->i_d, tm->i_d) != 0 ||
+        pil_cmp(mm, k, "tm.i_q", w->i_q, tm->i_q) != 0 ||
+        pil_cmp(mm, k, "tm.psi_d", w->psi_d, tm->psi_d) != 0 ||
+        pil_cmp(mm, k, "tm.psi_q", w->psi_q, tm->psi_q) != 0 ||
         pil_cmp(mm, k, "tm.torque", w->torque, tm->torque) != 0 ||
         pil_cmp(mm, k, "tm.omega_e", w->omega_e, tm->omega_e) != 0 ||
         pil_cmp(mm, k, "tm.torque_ref", w->torque_ref, tm->torque_ref) != 0 ||

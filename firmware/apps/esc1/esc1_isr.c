@@ -5,6 +5,5 @@ void esc1_control_isr(esc1_t *s)
 {
     g4_hal_adc_irq_ack(&s->hal);
     fw_isr(&s->fw);
-    fw_link_isr(&s->link);
     s->isr_count++;
 }

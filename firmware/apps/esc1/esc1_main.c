@@ -11,7 +11,7 @@
  *
  * Interrupts (priority: lower number first):
  *   0 TIM1_BRK_TIM15  break: the hardware has cleared MOE; latch the cause
- *   1 ADC1_2          end of the injected sequence: fw_isr, fw_link_isr
+ *   1 ADC1_2          end of the injected sequence: fw_isr
  *   2 USART2          byte rings
  * Main loop: received bytes -> command interpreter, telemetry frames out,
  * firmware watchdog kick, board temperature every 100 ms, independent

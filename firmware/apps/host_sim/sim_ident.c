@@ -74,7 +74,7 @@ static void sim_trace_row(const sim_run_t *r, double t, uint64_t k)
     fprintf(sim_trace_f, "%.6f,%u,%u,%.5g,%.5g,%.5g,%.6f,%.6g,%.6f,%.5g,%.5g\n", t,
             (unsigned)cm->step, (unsigned)cm->phase, i[0], i[1], i[2], plant_theta_e(&r->plant),
             plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI),
-            (double)fw->tm.theta_e / 4294967296.0 * 2.0 * SIM_PI, cm->io.va_al[1] * vb,
+            (double)fw_telemetry(fw)->theta_e / 4294967296.0 * 2.0 * SIM_PI, cm->io.va_al[1] * vb,
             cm->io.va_be[1] * vb);
 }
 

@@ -38,12 +38,6 @@ static struct {
     volatile int plant_failed;
 } app;
 
-static void app_after_isr(void *ctx)
-{
-    (void)ctx;
-    fw_link_isr(&app.link);
-}
-
 /* The PWM-period interrupt (Timer0). */
 static void app_isr(void)
 {
@@ -78,7 +72,6 @@ int main(void)
     c.defer_start = true;    /* the interrupt runs every period from boot on */
     c.auto_arm = false;      /* only the user arms */
     c.kick_watchdog = false; /* the main loop kicks */
-    c.after_isr = app_after_isr;
     c.skip_thd = true;
     char err[256];
     if (sim_run_init(&app.run, &c, err, sizeof err) != 0) {

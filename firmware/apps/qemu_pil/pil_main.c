@@ -6,7 +6,7 @@
  *
  * Timer0 interrupt = one PWM period of plant time Ts = 1/fs: sim_run_period
  * (scenario and metrics bookkeeping at the period start, ADC/encoder samples,
- * fw_isr, fw_link_isr, the plant through the period). fw_isr's own
+ * fw_isr, the plant through the period). fw_isr's own
  * hal_cycles (Timer1) timing is the only one the deadline check sees. The
  * main loop polls UART0 RX into the command interpreter (fw_link), kicks the
  * watchdog and adapts the Timer0 rate to the measured interrupt cost (plant
@@ -92,7 +92,6 @@ static void pil_slow_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 static void pil_after_isr(void *ctx)
 {
     pil_t *s = ctx;
-    fw_link_isr(&s->link);
     const fw_telemetry_t *tm = fw_telemetry(&s->run.fw);
     if (s->state_before == FW_STATE_RUNNING && tm->state == FW_STATE_RUNNING) {
         if (tm->cycles > s->pipe_max_running) {
