@@ -46,16 +46,16 @@ typedef struct {
     double adc_vdc_v_per_count;      /* nominal gain (V per count) */
     uint32_t encoder_counts_per_rev; /* quadrature counts per mechanical revolution */
     bool has_i_c;                    /* third phase-current channel present */
-    /* Appended by "loop": rate of hal_cycles() in Hz, for the deadline check
+    /* Rate of hal_cycles() in Hz, for the deadline check
      * (cycle budget = cycle_clock_hz / pwm_freq_hz); 0 = unknown, check off. */
     uint32_t cycle_clock_hz;
-    /* Appended by "board": the largest compare value the back-end applies;
-     * hal_pwm_write limits larger ones to it. Low-side shunt sensing needs a
-     * zero vector around the sampling instant (dead time, settling, sampling),
-     * so a board keeps every leg low for at least period_counts - pwm_cmp_max
-     * counts at the period boundary. The firmware should plan within it (the
-     * estimator then sees the voltage actually applied). 0 = no limit
-     * (period_counts), as on the simulated back-ends. */
+    /* The largest compare value the back-end applies; hal_pwm_write limits
+     * larger ones to it. Low-side shunt sensing needs a zero vector around the
+     * sampling instant (dead time, settling, sampling), so a board keeps every
+     * leg low for at least period_counts - pwm_cmp_max counts at the period
+     * boundary. The pipeline limits its leg duties to it, so the estimator is
+     * told the voltage actually applied (tests/loop/test_loop_duty_cap.c).
+     * 0 = no limit (period_counts). */
     uint32_t pwm_cmp_max;
 } hal_info_t;
 

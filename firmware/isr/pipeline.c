@@ -253,9 +253,16 @@ static inline void fw_measure_rest(fw_t *fw, const hal_adc_raw_t *raw, const hal
 }
 
 /* Leg duties (each in [0, FX_ONE], so the compare values are in [0, N]) ->
- * telemetry, compare values -> hal_pwm_write (effective at k+1). */
-static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_legs_t *legs)
+ * limited to the HAL's largest duty (a board keeps a zero vector around the
+ * current sampling instant, hal_info_t.pwm_cmp_max), so that what the
+ * estimator is told was applied is what the inverter applies -> telemetry,
+ * compare values -> hal_pwm_write (effective at k+1). */
+static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_legs_t *legs)
 {
+    const q24_t dmax = fw->duty_max;
+    legs->duty[0] = legs->duty[0] < dmax ? legs->duty[0] : dmax;
+    legs->duty[1] = legs->duty[1] < dmax ? legs->duty[1] : dmax;
+    legs->duty[2] = legs->duty[2] < dmax ? legs->duty[2] : dmax;
     tm->legs[0] = legs->duty[0];
     tm->legs[1] = legs->duty[1];
     tm->legs[2] = legs->duty[2];
@@ -421,7 +428,7 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         fw_control(fw, hal, tm, m);
         return;
     }
-    const ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
+    ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
     fw_pwm_out(fw, hal, tm, &legs);
     fw->applied = legs; /* acting in [k+1, k+2) */
 }

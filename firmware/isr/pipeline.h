@@ -180,6 +180,7 @@ typedef struct {
     int32_t vdc_gain_q30; /* Q30 pu per count */
     uint16_t adc_mid;     /* 2^(bits-1) */
     uint32_t pwm_n8;      /* period_counts * 2^8 if period_counts < 2^24, else 0 */
+    q24_t duty_max;       /* largest leg duty the HAL applies (hal_info_t.pwm_cmp_max), Q24 */
     /* encoder */
     uint32_t enc_cpr;
     uint32_t enc_q32; /* floor(p 2^32 / cpr) mod 2^32 (angle per count, integer part) */

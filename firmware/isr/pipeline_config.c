@@ -205,7 +205,8 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         in->adc_bits > 16u || !(in->adc_current_a_per_count > 0.0) ||
         !(in->adc_vdc_v_per_count > 0.0) || in->encoder_counts_per_rev == 0u ||
         cfg->calib_samples == 0u || cfg->calib_samples > 65536u ||
-        (cfg->enc_direction != 1 && cfg->enc_direction != -1)) {
+        (cfg->enc_direction != 1 && cfg->enc_direction != -1) ||
+        in->pwm_cmp_max > in->period_counts) {
         return FW_EINVAL;
     }
     fw->machine_own = *cfg->machine;
@@ -222,6 +223,10 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     }
     fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
     fw->pwm_n8 = in->period_counts < (1u << 24) ? in->period_counts << 8 : 0u;
+    /* floor(cmp_max 2^24 / N): its compare value round(d N / 2^24) <= cmp_max. */
+    fw->duty_max = in->pwm_cmp_max == 0u
+                       ? FX_ONE
+                       : (q24_t)(((uint64_t)in->pwm_cmp_max << 24) / in->period_counts);
     fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
     fw->calib_samples = cfg->calib_samples;
     fw->ref_mode = FW_REF_TORQUE;

@@ -66,7 +66,8 @@ int hal_sim_init(hal_t *h, const hal_sim_config_t *cfg, plant_t *plant)
         !(cfg->vdc_fullscale_v > 0.0) || !(cfg->adc_noise_counts >= 0.0) ||
         !isfinite(cfg->i_fullscale_a) || !isfinite(cfg->vdc_fullscale_v) ||
         !isfinite(cfg->adc_noise_counts) || cfg->enc_lines == 0u || cfg->enc_lines > 100000000u ||
-        !(cfg->trip_level_a >= 0.0) || !isfinite(cfg->enc_zero_rad)) {
+        !(cfg->trip_level_a >= 0.0) || !isfinite(cfg->enc_zero_rad) ||
+        !(cfg->duty_max >= 0.0 && cfg->duty_max <= 1.0)) {
         return HAL_SIM_EINVAL;
     }
     for (int i = 0; i < 4; i++) {
@@ -79,6 +80,7 @@ int hal_sim_init(hal_t *h, const hal_sim_config_t *cfg, plant_t *plant)
     h->plant = plant;
     const double n = floor((double)cfg->timer_clock_hz / (2.0 * (double)cfg->pwm_freq_hz) + 0.5);
     h->period_counts = (uint32_t)n;
+    h->cmp_max = cfg->duty_max > 0.0 ? (uint32_t)floor(cfg->duty_max * n) : h->period_counts;
     h->period_s = 1.0 / (double)cfg->pwm_freq_hz;
     h->rng = cfg->seed;
     h->gates_on = false;
@@ -191,8 +193,8 @@ int hal_sim_period_end(hal_t *h)
     if (h->gates_on && !h->motor_off) {
         double d[3];
         for (int x = 0; x < 3; x++) {
-            const uint32_t cmp =
-                h->active.cmp[x] > h->period_counts ? h->period_counts : h->active.cmp[x];
+            /* The back-end limits the compare values as a board does. */
+            const uint32_t cmp = h->active.cmp[x] > h->cmp_max ? h->cmp_max : h->active.cmp[x];
             d[x] = (double)cmp / (double)h->period_counts;
         }
         rc = plant_advance_period(h->plant, h->period_s, d);
@@ -308,6 +310,7 @@ void hal_info_get(const hal_t *h, hal_info_t *info)
     info->encoder_counts_per_rev = 4u * h->cfg.enc_lines;
     info->has_i_c = true;
     info->cycle_clock_hz = h->cfg.cycle_clock_hz;
+    info->pwm_cmp_max = h->cmp_max;
 }
 
 void hal_adc_read(hal_t *h, hal_adc_raw_t *raw)

@@ -106,6 +106,10 @@ typedef struct {
     bool sense_motor_side;       /* currents sensed at the motor terminals instead of the
                                     inverter output (the shunts of a real board); differs
                                     only with a plant output filter; default false */
+    double duty_max;             /* largest leg duty applied, (0, 1]; 0 = 1 (no limit). A
+                                    board with low-side shunts keeps a zero vector around
+                                    the sampling instant (B-G431B-ESC1: 3910/4250 = 0.92 at
+                                    20 kHz); reported as hal_info_t.pwm_cmp_max */
 } hal_sim_config_t;
 
 /* The back-end's handle (hal_t in hal.h). Fields are private. */
@@ -113,6 +117,7 @@ struct hal {
     hal_sim_config_t cfg;
     plant_t *plant;
     uint32_t period_counts;
+    uint32_t cmp_max; /* floor(duty_max period_counts), or period_counts */
     double period_s;
     uint64_t period_index; /* index k of the current period */
     hal_pwm_t shadow, active;
