@@ -1,6 +1,6 @@
 /*
  * The firmware side of the serial link: connects the command interpreter
- * (cmd.h, owner "proto") to the pipeline (cmd_ops_t implemented on fw_t) and
+ * (cmd.h) to the pipeline (cmd_ops_t implemented on fw_t) and
  * feeds the telemetry producer (telemetry.h) from the pipeline's per-period
  * sample.
  *

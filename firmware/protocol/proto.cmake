@@ -1,4 +1,4 @@
-# Command interpreter and telemetry of the firmware (owner: proto).
+# Command interpreter and telemetry of the firmware.
 # Included from firmware/CMakeLists.txt and from tests/proto/CMakeLists.txt;
 # builds for host, cm4 and cm0 (no host libraries).
 if(NOT TARGET pmsm_fw_proto)

@@ -1,5 +1,5 @@
 /*
- * hal/sim's models (hal_sim.c, owner "loop") compiled unchanged for the QEMU
+ * hal/sim's models (hal_sim.c) compiled unchanged for the QEMU
  * PIL back-end. hal_sim.c defines hal.h's functions on its own struct hal; here
  * they are renamed with the preprocessor so that hal_qemu.c can implement
  * hal.h (Timer1 cycle counter, plant sequencing) and forward to them.

@@ -1,6 +1,5 @@
 /*
- * Closed loop on the host (plant + HAL sim + firmware pipeline, owner
- * "loop"), the chapter's controllers:
+ * Closed loop on the host (plant + HAL sim + firmware pipeline), the chapter's controllers:
  *
  * 1. foc on the thesis SPMSM, dynamometer 750 r/min, T_ref 1.8 N*m: mean
  *    torque within 2 %, current error zero-mean (mean i_q,ref - i_q and mean

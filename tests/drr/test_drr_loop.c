@@ -1,5 +1,5 @@
 /*
- * Closed loop on the host (plant + HAL sim + firmware pipeline, owner "loop"),
+ * Closed loop on the host (plant + HAL sim + firmware pipeline),
  * thesis SPMSM, load point of thesis §5.6: 1.8 N*m at 750 and 2250 r/min,
  * dynamometer (imposed speed), torque mode. DRR methods at 10 kHz, BST at
  * 20 kHz (thesis §5.6: DRR methods at half the CDTC sampling frequency).
@@ -16,7 +16,7 @@
  *   |T_sse(drr)| <= 0.5 min(|T_sse| of bst, drr_d1, drr_d2)   (thesis <= 0.24)
  * Dynamic (thesis Fig. 5.12): T_ref 0 -> 2 N*m, -2 N*m once the speed reaches
  * 75 % of rated (2250 r/min), free mechanics with a passive 1.6 N*m load (the
- * loop owner's reversal scenario): the speed reverses without a fault and the
+ * reversal scenario of the closed-loop tests): the speed reverses without a fault and the
  * torque holds -2 N*m afterwards; fall time (step to 90 % of the 4 N*m step,
  * T <= -1.6 N*m) < 1 ms.
  */

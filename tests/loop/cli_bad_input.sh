@@ -180,7 +180,7 @@ fi
 "$sim" --help | grep -q -- "--window START:END.*default duration/3 : duration" &&
   "$sim" --help | grep -q "3 the drive" || { echo "FAIL: --help"; fails=$((fails + 1)); }
 
-# Open-loop replay of two intervals: exit 0, the plant owner's trace header.
+# Open-loop replay of two intervals: exit 0, the plant trace header.
 printf 't_start_s,duration_s,S1,S2,S3\n0,0.0001,1,0,0\n0.0001,0.0001,0,0,0\n' >"$tmp/rp.csv"
 if "$sim" --machine "$m" --replay "$tmp/rp.csv" --speed-rpm 100 --trace "$tmp/rp_out.csv" >/dev/null 2>&1 &&
    head -n1 "$tmp/rp_out.csv" | grep -q "^t,i_a" && [ "$(wc -l <"$tmp/rp_out.csv")" -eq 3 ]; then

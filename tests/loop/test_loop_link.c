@@ -1,6 +1,6 @@
 /*
- * The serial link on the host closed loop: command lines through the proto
- * owner's interpreter reach the pipeline (fw_link.c), and telemetry frames
+ * The serial link on the host closed loop: command lines through the command
+ * interpreter reach the pipeline (fw_link.c), and telemetry frames
  * come out at the requested decimation.
  */
 #include <stdio.h>

@@ -1,5 +1,5 @@
 /*
- * Closed loop (plant + HAL sim + firmware pipeline, owner "loop") of the
+ * Closed loop (plant + HAL sim + firmware pipeline) of the
  * chapter-6 predictive controllers. Host only. One executable per group
  * (MPC_LOOP_GROUP): 1 = SPMSM steady state (thesis §6.6.2, Table 6.2),
  * 2 = dynamics (Fig. 6.17), 3 = IPMSMs (§6.5.1 case study).
@@ -290,7 +290,7 @@ static void test_table62_weights_report(void)
 
 /* Thesis Fig. 6.17: torque mode 2 N*m with a passive load, step to -2 N*m once
  * the speed reaches 0.5 pu (1500 r/min); continue to -1000 r/min. Load 1.6 N*m
- * as the loop owner's Fig. 4.14 scenario and tools/compare.py (the thesis:
+ * as the closed-loop tests' Fig. 4.14 scenario and tools/compare.py (the thesis:
  * "around 1.8"). Fall time: from the step command until Te <= -1.6 N*m
  * (90 % of the 4 N*m swing). */
 static loop_reversal_t reversal(const mpc_ctrl_t *k)

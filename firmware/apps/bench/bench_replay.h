@@ -1,7 +1,7 @@
 /*
  * Replay of a bench recording (bench_blob.h) through fw_isr, shared by the PC
  * (bench_host) and the Cortex-M4 image (bench_cm4). The hal.h back-end is the
- * "target" owner's replay HAL (tests/target_pil/hal_replay.*).
+ * replay HAL (tests/target_pil/hal_replay.*).
  */
 #ifndef TOOLS_BENCH_FW_BENCH_REPLAY_H
 #define TOOLS_BENCH_FW_BENCH_REPLAY_H
