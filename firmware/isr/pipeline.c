@@ -253,16 +253,13 @@ static inline void fw_measure_rest(fw_t *fw, const hal_adc_raw_t *raw, const hal
 }
 
 /* Leg duties (each in [0, FX_ONE], so the compare values are in [0, N]) ->
- * limited to the HAL's largest duty (a board keeps a zero vector around the
- * current sampling instant, hal_info_t.pwm_cmp_max), so that what the
- * estimator is told was applied is what the inverter applies -> telemetry,
- * compare values -> hal_pwm_write (effective at k+1). */
+ * limited to the HAL's largest duty (fw_legs_limit: a board keeps a zero
+ * vector around the current sampling instant, hal_info_t.pwm_cmp_max), so
+ * that what the estimator is told was applied is what the inverter applies
+ * -> telemetry, compare values -> hal_pwm_write (effective at k+1). */
 static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_legs_t *legs)
 {
-    const q24_t dmax = fw->duty_max;
-    legs->duty[0] = legs->duty[0] < dmax ? legs->duty[0] : dmax;
-    legs->duty[1] = legs->duty[1] < dmax ? legs->duty[1] : dmax;
-    legs->duty[2] = legs->duty[2] < dmax ? legs->duty[2] : dmax;
+    fw_legs_limit(legs->duty, fw->duty_max);
     tm->legs[0] = legs->duty[0];
     tm->legs[1] = legs->duty[1];
     tm->legs[2] = legs->duty[2];

@@ -5,6 +5,7 @@
  *    vector pair (and bad indices), every n_seg and random, edge and
  *    out-of-range durations;
  *  - fw_pwm_compare8 (one UMULL) against the 64-bit rounding of compare values;
+ *  - fw_legs_limit (the board's duty cap) against its properties;
  *  - fw_protect_current against the saturating |i_a|, |i_b|,
  *    |-(i_a + i_b)| > i_max test for every limit fw_protect_init takes (and
  *    the refusal of the others);
@@ -357,12 +358,67 @@ static void test_deadline_watchdog_limits(void)
     }
 }
 
+/* fw_legs_limit: every leg within [0, dmax]; unchanged below the cap; the
+ * line voltages kept exactly where max - min <= dmax; otherwise the lowest
+ * leg at 0 and each leg min(d - min, dmax) (the least volt-seconds cut). */
+static void check_limit(const int32_t in[3], int32_t dmax)
+{
+    int32_t d[3] = {in[0], in[1], in[2]};
+    fw_legs_limit(d, dmax);
+    int32_t hi = in[0], lo = in[0];
+    for (int x = 1; x < 3; x++) {
+        hi = in[x] > hi ? in[x] : hi;
+        lo = in[x] < lo ? in[x] : lo;
+    }
+    char msg[120];
+    snprintf(msg, sizeof msg, "in %ld %ld %ld dmax %ld -> %ld %ld %ld", (long)in[0], (long)in[1],
+             (long)in[2], (long)dmax, (long)d[0], (long)d[1], (long)d[2]);
+    for (int x = 0; x < 3; x++) {
+        TEST_ASSERT_TRUE_MESSAGE(d[x] >= 0 && d[x] <= dmax, msg);
+        if (hi <= dmax) {
+            TEST_ASSERT_EQUAL_INT32_MESSAGE(in[x], d[x], msg);
+        } else if (hi - lo <= dmax) {
+            TEST_ASSERT_EQUAL_INT32_MESSAGE(in[x] - in[(x + 1) % 3], d[x] - d[(x + 1) % 3], msg);
+        } else {
+            const int32_t want = in[x] - lo < dmax ? in[x] - lo : dmax;
+            TEST_ASSERT_EQUAL_INT32_MESSAGE(want, d[x], msg);
+        }
+    }
+}
+
+static void test_legs_limit(void)
+{
+    const int32_t one = 1 << 24;
+    const int32_t esc1 = (int32_t)(((int64_t)3910 << 24) / 4250); /* B-G431B-ESC1, 20 kHz */
+    const int32_t dmaxes[] = {one, esc1, one - 1, 1, one / 2};
+    const int32_t edges[][3] = {{one, one, one},    {one, 0, 0},       {one, one, 0},
+                                {0, 0, 0},          {one, one - 1, 1}, {esc1, esc1, esc1},
+                                {esc1 + 1, 0, esc1}};
+    for (size_t k = 0; k < sizeof dmaxes / sizeof dmaxes[0]; k++) {
+        for (size_t e = 0; e < sizeof edges / sizeof edges[0]; e++) {
+            check_limit(edges[e], dmaxes[k]);
+        }
+        for (int i = 0; i < 20000; i++) {
+            const int32_t in[3] = {(int32_t)(rnd() % (uint32_t)(one + 1)),
+                                   (int32_t)(rnd() % (uint32_t)(one + 1)),
+                                   (int32_t)(rnd() % (uint32_t)(one + 1))};
+            check_limit(in, dmaxes[k]);
+        }
+    }
+    /* An active vector with V7 as its zero vector, below the cap's reach:
+     * the same line voltages with V0 instead. */
+    int32_t v7[3] = {one, one - one / 4, one - one / 4};
+    fw_legs_limit(v7, esc1);
+    TEST_ASSERT_EQUAL_INT32(one / 4, v7[0] - v7[1]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_legs_every_pair);
     RUN_TEST(test_legs_helper_plans);
     RUN_TEST(test_pwm_compare);
+    RUN_TEST(test_legs_limit);
     RUN_TEST(test_current_fast);
     RUN_TEST(test_encoder_fast);
     RUN_TEST(test_deadline_watchdog_limits);
