@@ -628,9 +628,8 @@ CAUSE = {
     ("foc_hyst", "sse"): "hysteresis current control at 10 kHz: the same mechanism as " + _HYST,
     ("hdtc", "sse"): ("the chapter's hysteresis DTC at 10 kHz (half the tables' rate), so twice "
                       "the per-period deviation; the same mechanism as " + _HYST),
-    ("fst", 2250, "sse"): _HYST,
-    ("fst", 750, "sse"): ("negative: FST's mean torque lies above T_ref at 750 r/min; not "
-                          "analysed in this report"),
+    ("fst", 2250, "sse"): None,  # fst_offset_text (computed from the machine file)
+    ("fst", 750, "sse"): None,
     ("drr_d1", "sse"): ("D1 (5.19) sets the duty from the torque and flux errors alone, without "
                         "the back-EMF term of (5.6)–(5.7); the thesis reports D1's large T_sse "
                         "(the −95 % claim above) — it is the baseline DRR removes it from"),
@@ -653,6 +652,39 @@ CAUSE = {
 }
 
 
+def fst_offset_text(rpm, fs=20000.0):
+    """FST's mean-torque offset from the machine data (docs/algorithms.md, FST's
+    integrator): one vector per period, decided on sign(T_ref - T(k+1)), so the
+    mean settles near T_ref + (dTa - |dT0|)/2 with dTa, dT0 the torque changes of
+    one period of the forward active vector and of the zero vector."""
+    import configparser
+    c = configparser.ConfigParser(inline_comment_prefixes=(";", "#"))
+    c.read(MACHINE)
+    p = c.getint("machine", "pole_pairs")
+    rs = c.getfloat("machine", "rs_ohm")
+    ls = c.getfloat("machine", "lq_mh") * 1e-3
+    psi = c.getfloat("machine", "psi_pm_wb")
+    vdc = c.getfloat("inverter", "vdc_v")
+    kt = 1.5 * p * psi
+    iq = LOAD_NM / kt
+    w = rpm * 2 * math.pi / 60 * p
+    delta = math.atan(ls * iq / psi)  # load angle of the SPMSM at T_ref
+    # The forward vector lies 30..90 deg ahead of the flux, i.e. delta - 60 deg ..
+    # delta from the q axis: its mean q component over the sector.
+    a0, a1 = delta - math.pi / 3, delta
+    vq = 2 / 3 * vdc * (math.sin(a1) - math.sin(a0)) / (a1 - a0)
+    ts = 1 / fs
+    d_ta = kt * (vq - rs * iq - w * psi) * ts / ls
+    d_t0 = kt * (rs * iq + w * psi) * ts / ls
+    off = (d_ta - d_t0) / 2
+    return (f"one vector per period decided on sign(T_ref − T(k+1)): the mean settles near "
+            f"T_ref + (ΔTa − |ΔT0|)/2 (docs/algorithms.md, FST). From the machine data at "
+            f"{rpm} r/min and {LOAD_NM} N·m (load angle {math.degrees(delta):.1f}°, forward "
+            f"vector's mean q component {vq:.0f} V): ΔTa = {d_ta:.3f} N·m and ΔT0 = "
+            f"{d_t0:.3f} N·m per {ts * 1e6:.0f} µs period, so the mean lies {off:+.3f} N·m "
+            f"from T_ref: predicted T_sse {-off:+.3f} N·m")
+
+
 def notes(S, names):
     """A note for every trip and every steady-state error above 5 % of T_ref."""
     trips, errs = [], []
@@ -671,6 +703,8 @@ def notes(S, names):
             if e is not None and abs(e) > 0.05 * LOAD_NM:
                 cause = CAUSE.get((n, rpm, "sse"), CAUSE.get((n, "sse"),
                                                              "cause not analysed in this report"))
+                if cause is None:
+                    cause = fst_offset_text(rpm)
                 errs.append(f"**{n} at {rpm} r/min**: T_sse {e:+.3f} N·m "
                             f"({100 * e / LOAD_NM:+.0f} % of T_ref; mean torque "
                             f"{m['torque_mean_nm']:.3f} N·m): {cause}")
