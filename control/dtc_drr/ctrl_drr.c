@@ -211,9 +211,32 @@ static q24_t drr_predict_516(const ctrl_drr_state_t *s, const ctrl_ctx_t *ctx)
     return fx_sub(t, fx_mul(FX_ONE - d, kbw));
 }
 
+/* A (5.9) and B (5.10) for the PM flux in use (they scale as psi_pm and
+ * psi_pm^2), with what follows from A; only when params->psi_pm moved (the
+ * pipeline tracks it from the voltage model, fw_config_t.psi_adapt). */
+static void drr_track_psi(ctrl_drr_state_t *s, q24_t psi)
+{
+    s->psi_seen = psi;
+    if (s->a_psi != 0) {
+        s->a = fx_mul(s->a_psi, psi);
+        s->sqrt3_a = fx_mul(2 * FX_Q24_SQRT3_2, s->a);
+        if (s->dc_fixed == 0) {
+            s->c_num = fx_lshift_sat(s->sqrt3_a, 1u);
+            /* -c_num / CTRL_DRR_C_MAX (= 2^6), below zero */
+            s->dc_max = fx_min(-fx_rshift32_round(s->c_num, 6u), -1);
+        }
+    }
+    if (s->kb_psi2 != 0) {
+        s->kb = fx_mul(s->kb_psi2, fx_mul(psi, psi));
+    }
+}
+
 void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_drr_state_t *s = state;
+    if (ctx->params->psi_pm != s->psi_seen) {
+        drr_track_psi(s, ctx->params->psi_pm);
+    }
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t w = ctx->est->omega_e;
     const q24_t t_k1 = s->pred_516 != 0u ? drr_predict_516(s, ctx) : nx->torque;

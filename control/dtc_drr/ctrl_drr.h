@@ -52,6 +52,12 @@ typedef struct {
     ctrl_vreplace_t vr;
     uint8_t pred_516;
     uint8_t centre; /* T_e taken at the active-vector start of a centre-aligned period */
+
+    /* A (5.9) and B (5.10) scale as psi_pm and psi_pm^2: per pu of PM flux,
+     * Q24 (0: given as tunables, fixed), and the params->psi_pm they were
+     * formed for; recomputed when the pipeline's PM-flux estimate moves. */
+    q24_t a_psi, kb_psi2, psi_seen;
+
     /* dynamic */
     q24_t rt;        /* r_ts T_e of this sample, pu torque (set by ctrl_drr_step) */
     q24_t gamma;     /* EMA output gamma[k-1] -> gamma[k], pu torque (5.4) */

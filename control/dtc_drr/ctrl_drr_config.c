@@ -187,6 +187,13 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
     if (rc != CTRL_OK) {
         return rc;
     }
+    {
+        /* per pu of PM flux, for the tracking in ctrl_drr_step (0: fixed) */
+        const double psi = ctrl_q24_to_double(p->psi_pm);
+        s->a_psi = c->a_nm > 0.0 ? 0 : ctrl_q24_from_double(a_pu / psi);
+        s->kb_psi2 = c->b_nm > 0.0 ? 0 : ctrl_q24_from_double(kb_pu / (psi * psi));
+        s->psi_seen = p->psi_pm;
+    }
     if (c->c == 0.0) {
         /* (5.13) per sample: C = 2 sqrt(3) A / (2 B |w| / w_rn - sqrt(3) A) */
         s->c_num = ctrl_q24_from_double(2.0 * CTRL_SQRT3 * a_pu);

@@ -8,6 +8,7 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m1_t *s = state;
     ctrl_mpc_basis_t b;
+    ctrl_mpc_model_track(&s->model, ctx->params);
     ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
     const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);

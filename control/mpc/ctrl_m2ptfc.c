@@ -69,6 +69,7 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     ctrl_m2ptfc_t *s = state;
     /* Only V1..V3 are rotated: the two candidates are any V_i (ctrl_mpc_vec3_dq). */
     ctrl_mpc_basis3_t b;
+    ctrl_mpc_model_track(&s->model, ctx->params);
     ctrl_mpc_basis3(&s->model, ctx->est, &b);
     const ctrl_estimate_t *est = ctx->est;
     const q24_t t_ref = ctx->ref->torque;

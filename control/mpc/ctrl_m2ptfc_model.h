@@ -32,6 +32,10 @@ typedef struct {
     q24_t ts_v;    /* Ts * 2/3: |V_i| Ts per pu of DC link, Q24 pu */
     q24_t vdc_max; /* DC-link clamp of the basis, 2 x nominal, Q24 pu
                     * (ts_v vdc_max <= CTRL_MPC_TSV_MAX) */
+
+    /* a per pu of PM flux (1/Ld), Q24, 0: a fixed (psi_pm_model given); the
+     * params->psi_pm a was formed for (ctrl_mpc_model_track). */
+    q24_t a_psi, psi_seen;
 } ctrl_mpc_model_t;
 
 /* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
@@ -83,6 +87,18 @@ typedef struct {
 /* ctrl_desc_t.reset of m1, m3, mptfc (ctrl_mpc_wstate_t): clears the trace
  * and the last vector; the controllers keep no other dynamic state. */
 void ctrl_mpc_wreset(void *state);
+
+/* a = psi_pm / Ld for the PM flux in use: when the pipeline tracks psi_pm
+ * from the voltage model (fw_config_t.psi_adapt) params->psi_pm moves and the
+ * k+2 model follows it (unless its psi_pm is fixed by psi_pm_model). Called
+ * at the start of each step; nothing changes while psi_pm does not. */
+static inline void ctrl_mpc_model_track(ctrl_mpc_model_t *m, const ctrl_params_t *p)
+{
+    if (p->psi_pm != m->psi_seen && m->a_psi != 0) {
+        m->psi_seen = p->psi_pm;
+        m->a = fx_mul(m->a_psi, p->psi_pm);
+    }
+}
 
 /* Basis for the candidates of this sample from the k+1 state of est (rotor
  * frame, with next.sin_theta/cos_theta: CTRL_EST_SC_NEXT) and its rotation

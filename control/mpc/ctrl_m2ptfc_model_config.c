@@ -81,6 +81,9 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
                                  1.0, CTRL_MPC_PSI_MAX);
     }
     m->a = ctrl_q24_from_double(a);
+    /* With the machine's psi_pm the model follows the PM flux in use. */
+    m->a_psi = c->psi_pm_wb > 0.0 ? 0 : ctrl_q24_from_double(inv_ld);
+    m->psi_seen = params->psi_pm;
     m->b = ctrl_q24_from_double(b);
     m->ts_rs = ctrl_q24_from_double(ts_rs);
     m->ts_v = ctrl_q24_from_double(ts_v);

@@ -9,6 +9,7 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m3_t *s = state;
     ctrl_mpc_basis_t b;
+    ctrl_mpc_model_track(&s->model, ctx->params);
     ctrl_mpc_basis(&s->model, ctx->est, &b);
     const q24_t t_ref = ctx->ref->torque;
     const ctrl_mstate_t *n = &ctx->est->next;

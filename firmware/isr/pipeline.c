@@ -210,6 +210,8 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             /* Fresh dynamic state; the first gated period is k+1. */
             fw->ctrl->reset(fw->ctrl_state.bytes);
             ctrl_estimator_reset(&fw->est, &fw->params);
+            fw->fobs.primed = 0u; /* restarted from the current model at the first period */
+            fw->fobs_va = fw->fobs_vb = 0;
             ctrl_speed_pi_reset(&fw->speed_pi, 0);
             fw->speed_tref = 0;
             fw->speed_cnt = 0u;
@@ -278,10 +280,39 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
     hal_pwm_write(hal, &pwm);
 }
 
+/* PM flux from the voltage model (fw_config_t.psi_adapt): the encoder-mode
+ * observer over [k-1, k) with the estimator's rotor frame at k (its sin/cos
+ * and i_dq: no second look-up), then its estimate - which it only moves
+ * where the voltage model is reliable - into the parameters every consumer
+ * reads, with 1/psi_pm by a Newton step (y (2 - psi y)) and the SPMSM's
+ * MTPA slope Lq/psi_pm. The voltage of [k, k+1) for the next period. */
+static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estimate_t *est)
+{
+    ctrl_fobs_t *const o = &fw->fobs;
+    ctrl_params_t *const p = &fw->params;
+    const ctrl_mstate_t *n = &est->now;
+    if (o->primed == 0u) {
+        ctrl_fobs_reset(o, p, n->theta_e, est->omega_e, n->i_alpha, n->i_beta);
+    } else {
+        (void)ctrl_fobs_integrate(o, p, fw->fobs_va, fw->fobs_vb, n->i_alpha, n->i_beta);
+        ctrl_fobs_correct(o, p, n->theta_e, n->sin_theta, n->cos_theta, n->i_d, n->i_q);
+    }
+    ctrl_fobs_voltage(o, &fw->applied, m->vdc, m->i_a, m->i_b, &fw->fobs_va, &fw->fobs_vb);
+    const q24_t psi = ctrl_fobs_psi_pm(o);
+    if (psi > 0 && psi != p->psi_pm) {
+        p->psi_pm = psi;
+        p->inv_psi_pm = fx_mul(p->inv_psi_pm, fx_sub(2 * FX_ONE, fx_mul(psi, p->inv_psi_pm)));
+        p->mtpa_k = fx_mul(p->lq, p->inv_psi_pm);
+    }
+}
+
 static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, est);
+    if (fw->cfg.psi_adapt && fw->sm.state == FW_STATE_RUNNING) {
+        fw_psi_track(fw, m, est);
+    }
     tm->omega_e = est->omega_e;
     tm->i_d = est->now.i_d;
     tm->i_q = est->now.i_q;

@@ -52,6 +52,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "estimator.h"
+#include "flux_observer.h"
 #include "fw_state.h"
 #include "hal.h"
 #include "protect.h"
@@ -127,6 +128,14 @@ typedef struct {
                                 0 = every period */
     double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x the machine's
                                 maximum speed (fw_speed_max_rpm, protect.h) */
+    /* PM flux from the voltage model where it is reliable (|speed| >= 10 % of
+     * rated; flux_observer.h, encoder mode): the current model, the
+     * predictions and every controller then use it instead of the configured
+     * psi_pm, so the torque does not depend on that value at speed. Default
+     * on. The inverter's dead time and device drop (0 = none) are what the
+     * observer's voltage reconstruction removes. */
+    bool psi_adapt;
+    double dead_time_s, v_fwd_v;
 } fw_config_t;
 
 /* The speed loop and speed limits in force (SI, for reports; set by fw_init). */
@@ -157,6 +166,10 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
+    /* PM-flux tracking (fw_config_t.psi_adapt): the encoder-mode observer,
+     * the mean voltage of [k-1, k) it integrates (Q24 pu). */
+    ctrl_fobs_t fobs;
+    q24_t fobs_va, fobs_vb;
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
     ctrl_refs_t refs;
     ctrl_speed_pi_t speed_pi;

@@ -7,6 +7,8 @@
 
 #include "ctrl_units.h"
 #include "pipeline.h"
+
+#include "flux_observer_config.h"
 #include "plan.h"
 #include "speed_loop.h"
 #include "speed_pi_config.h"
@@ -37,6 +39,9 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->speed_out_max_nm = fw_torque_limit_nm(machine, NULL);
     c->speed_loop_hz = 1000u;
     c->overspeed_rpm = 0.0;
+    c->psi_adapt = true;
+    c->dead_time_s = 0.0;
+    c->v_fwd_v = 0.0;
 }
 
 size_t fw_explain(const fw_t *fw, char *buf, size_t cap)
@@ -94,6 +99,24 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     }
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
+    /* PM-flux tracking: the encoder-mode observer, its estimate adopted above
+     * 10 % of rated speed with a 20 ms time constant (docs/algorithms.md,
+     * "PM flux from the voltage model"). */
+    {
+        ctrl_fobs_config_t oc;
+        ctrl_fobs_config_default(&oc, fw->machine);
+        oc.mode = CTRL_FOBS_ENCODER;
+        oc.psi_tau_s = 0.02;
+        oc.psi_speed_min = 0.1;
+        /* its PLL only gates the estimate by speed: within the discrete
+         * loop's range at any fs */
+        oc.pll_hz = fmin(oc.pll_hz, 0.4 * (double)in->pwm_freq_hz / (4.0 * CTRL_PI));
+        oc.dead_time_s = cfg->dead_time_s;
+        oc.v_fwd_v = cfg->v_fwd_v;
+        if (ctrl_fobs_init(&fw->fobs, &fw->params, &fw->bases, &oc, &fw->why) != CTRL_OK) {
+            return FW_EINVAL;
+        }
+    }
     const int sel = fw_select_controller(fw, ctrl, ctrl_cfg);
     if (sel != FW_OK) {
         return sel;

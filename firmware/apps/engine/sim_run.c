@@ -61,6 +61,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->trace_end_s = 1.0e9;
     c->calib_samples = 256u;
     c->stop_on_fault = false;
+    c->psi_adapt = true;
     c->speed_bw_hz = m->speed_bw_hz;
     c->speed_pm_deg = m->speed_pm_deg;
     c->speed_kp = m->speed_kp;
@@ -269,6 +270,36 @@ static void sim_observer_update(sim_run_t *r, double t)
     }
 }
 
+/* The estimator's angle and speed at k against the plant's (sim_run_est_errors). */
+static void sim_est_error_add(sim_run_t *r, double t, double th_true, double w_true)
+{
+    const sim_machine_t *m = &r->cfg.plant_machine;
+    const double w_rated = m->speed_rated_rpm * 2.0 * SIM_PI / 60.0 * (double)m->pole_pairs;
+    if (t < r->cfg.win_start_s || t > r->cfg.win_end_s || fw_state(&r->fw) != FW_STATE_RUNNING ||
+        fabs(w_true) < 0.1 * w_rated) {
+        return;
+    }
+    const ctrl_estimate_t *e = &r->fw.estimate;
+    double d = (double)e->now.theta_e * (2.0 * SIM_PI / 4294967296.0) - th_true;
+    d -= 2.0 * SIM_PI * floor((d + SIM_PI) / (2.0 * SIM_PI)); /* [-pi, pi) */
+    const double deg = d * 180.0 / SIM_PI;
+    const double w_est = ctrl_q24_to_double(e->omega_e) * r->fw.bases.w_rad_s;
+    const double rpm = (w_est - w_true) / (double)m->pole_pairs * 60.0 / (2.0 * SIM_PI);
+    r->est_ang_sum2 += deg * deg;
+    r->est_ang_max = fmax(r->est_ang_max, fabs(deg));
+    r->est_spd_sum2 += rpm * rpm;
+    r->est_n++;
+}
+
+void sim_run_est_errors(const sim_run_t *r, double *ang_rms_deg, double *ang_max_deg,
+                        double *spd_rms_rpm)
+{
+    const double n = (double)r->est_n;
+    *ang_rms_deg = r->est_n > 0u ? sqrt(r->est_ang_sum2 / n) : NAN;
+    *ang_max_deg = r->est_n > 0u ? r->est_ang_max : NAN;
+    *spd_rms_rpm = r->est_n > 0u ? sqrt(r->est_spd_sum2 / n) : NAN;
+}
+
 bool sim_run_done(const sim_run_t *r)
 {
     return r->armed && sim_run_time(r) + 0.5 / (double)r->cfg.fs_hz >= r->t_end;
@@ -309,7 +340,11 @@ int sim_run_period(sim_run_t *r)
         metrics_add(&r->m_ctrl, t, plant_torque(&r->plant), sim_torque_ref_nm(r),
                     plant_psi_amp(&r->plant), i_abc[0]);
     }
+    /* The truth at t_k, for the estimate the interrupt forms from the samples at k. */
+    const double th_true = plant_theta_e(&r->plant);
+    const double w_true = plant_omega_e(&r->plant);
     const int rc = sim_period_raw(r);
+    sim_est_error_add(r, t, th_true, w_true);
     if (isnan(r->fault_time_s) && fw_state(&r->fw) == FW_STATE_FAULT) {
         r->fault_time_s = t;
     }
@@ -381,6 +416,10 @@ static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_co
         fc->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
     }
     fc->overspeed_rpm = c->overspeed_rpm;
+    fc->psi_adapt = c->psi_adapt;
+    /* The inverter's dead time and device drop, known to the firmware. */
+    fc->dead_time_s = c->plant_machine.dead_time_s;
+    fc->v_fwd_v = c->plant_machine.v_fwd_v;
     /* The firmware's encoder configuration (the control machine's [sensors]). */
     double off = fmod(c->ctrl_enc_offset_deg, 360.0);
     off = off < 0.0 ? off + 360.0 : off;
@@ -950,6 +989,13 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : NAN;
     sim_json_num(f, "speed_mean_rpm", mean_rpm);
     sim_json_num(f, "speed_end_rpm", sim_run_speed_rpm(r));
+    double ea;
+    double em;
+    double es;
+    sim_run_est_errors(r, &ea, &em, &es);
+    sim_json_num(f, "est_angle_err_rms_deg", ea);
+    sim_json_num(f, "est_angle_err_max_deg", em);
+    sim_json_num(f, "est_speed_err_rms_rpm", es);
     sim_json_num(f, "fault_time_s", r->fault_time_s);
     fprintf(f, "  \"scenario_fired_s\": [");
     for (size_t i = 0; r->has_scn && i < r->scn.n; i++) {

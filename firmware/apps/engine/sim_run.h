@@ -86,6 +86,7 @@ typedef struct {
     double speed_kp, speed_ki;        /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
     double overspeed_rpm;             /* 0 = 1.05 x rated speed */
     bool stop_on_fault;               /* end the run at a fault (default false) */
+    bool psi_adapt;                   /* fw_config_t.psi_adapt (default true) */
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
     bool auto_arm;                /* arm with the references above once calibrated (default) */
@@ -128,6 +129,10 @@ typedef struct {
     double torque_limit_nm;         /* the firmware's torque-reference clamp */
     double torque_ref_requested_nm; /* last torque reference asked for (torque mode) */
     double fault_time_s;            /* scenario time of the first fault, NaN if none */
+    /* Estimator against the plant at the control instants of the window where
+     * |speed| >= 10 % of rated (sim_run_est_errors). */
+    double est_ang_sum2, est_ang_max, est_spd_sum2;
+    uint64_t est_n;
     double scn_fired_s[SIM_SCN_MAX_EVENTS]; /* scenario time each event fired, NaN if not */
     unsigned char ctrl_cfg_buf[CTRL_CFG_MAX] __attribute__((aligned(16)));
     /* output filter (plant_machine.filter): cumulative statistics at the
@@ -168,6 +173,13 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
 void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
                                 const metrics_result_t *mc);
 void sim_run_free(sim_run_t *r);
+
+/* The estimator's errors (rotor angle used for control and electrical speed
+ * against the plant's, at the control instants of the metrics window where
+ * |speed| >= 10 % of rated): rms and largest angle error (electrical deg),
+ * rms speed error (mechanical r/min); NaN without such instants. */
+void sim_run_est_errors(const sim_run_t *r, double *ang_rms_deg, double *ang_max_deg,
+                        double *spd_rms_rpm);
 
 /* True when the run ended at a fault or the firmware is in the fault state. */
 bool sim_run_faulted(const sim_run_t *r);

@@ -52,7 +52,7 @@ typedef struct {
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
     cli_span_t window, trace_window;
-    int free_mech, help, list_controllers, continue_on_fault;
+    int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt;
     sim_set_t sets[SIM_MAX_SETS];
     size_t n_sets;
 } cli_t;
@@ -123,6 +123,9 @@ static const cli_opt_t k_opts[] = {
     {"--current-sense", "WHERE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(current_sense),
      "inverter | motor: where the drive's current sensors sit, with a machine [filter] "
      "(default: the machine file's current_sense, else inverter)"},
+    {"--no-psi-adapt", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(no_psi_adapt),
+     "keep the configured psi_pm: no PM flux from the voltage model above 10 % of rated speed "
+     "(docs/algorithms.md)"},
     {"--continue-on-fault", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(continue_on_fault),
      "keep simulating after a fault (gates off) to the end; the exit status stays 3"},
     {"--list-controllers", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(list_controllers),
@@ -489,6 +492,14 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
                 fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
                 fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
     }
+    double ea;
+    double em;
+    double es;
+    sim_run_est_errors(r, &ea, &em, &es);
+    fprintf(f,
+            "  estimator (|speed| >= 10 %% rated): angle error rms %s max %s, speed error rms %s\n",
+            fmt_num(b[0], 32, "%.3f deg", ea), fmt_num(b[1], 32, "%.3f deg", em),
+            fmt_num(b[2], 32, "%.2f r/min", es));
     if (!isnan(r->fault_time_s)) {
         fprintf(f, "  fault %s at t = %.6f s\n", fw_fault_name(fw_fault(&r->fw)), r->fault_time_s);
     }
@@ -732,6 +743,7 @@ int main(int argc, char **argv)
     memcpy(cfg.sets, c.sets, sizeof c.sets);
     cfg.n_sets = c.n_sets;
     cfg.stop_on_fault = !c.continue_on_fault;
+    cfg.psi_adapt = !c.no_psi_adapt;
     if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
         /* The command line's sizing replaces the machine file's speed loop. */
         cfg.speed_kp = cfg.speed_ki = 0.0;
