@@ -283,9 +283,10 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
 /* PM flux from the voltage model (fw_config_t.psi_adapt): the encoder-mode
  * observer over [k-1, k) with the estimator's rotor frame at k (its sin/cos
  * and i_dq: no second look-up), then its estimate - which it only moves
- * where the voltage model is reliable - into the parameters every consumer
- * reads, with 1/psi_pm by a Newton step (y (2 - psi y)) and the SPMSM's
- * MTPA slope Lq/psi_pm. The voltage of [k, k+1) for the next period. */
+ * where the voltage model is reliable - once it has left the 2 % band
+ * around the configured value into the parameters every consumer reads,
+ * with 1/psi_pm by a Newton step (y (2 - psi y)) and the SPMSM's MTPA slope
+ * Lq/psi_pm. The voltage of [k, k+1) for the next period. */
 static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estimate_t *est)
 {
     ctrl_fobs_t *const o = &fw->fobs;
@@ -299,6 +300,12 @@ static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estim
     }
     ctrl_fobs_voltage(o, &fw->applied, m->vdc, m->i_a, m->i_b, &fw->fobs_va, &fw->fobs_vb);
     const q24_t psi = ctrl_fobs_psi_pm(o);
+    if (!fw->psi_engaged) {
+        if (fx_abs(fx_sub(psi, fw->psi_pm_cfg)) <= fw->psi_band) {
+            return; /* agrees with the configured value: nothing changes */
+        }
+        fw->psi_engaged = true;
+    }
     if (psi > 0 && psi != p->psi_pm) {
         p->psi_pm = psi;
         p->inv_psi_pm = fx_mul(p->inv_psi_pm, fx_sub(2 * FX_ONE, fx_mul(psi, p->inv_psi_pm)));

@@ -129,10 +129,12 @@ typedef struct {
     double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x the machine's
                                 maximum speed (fw_speed_max_rpm, protect.h) */
     /* PM flux from the voltage model where it is reliable (|speed| >= 10 % of
-     * rated; flux_observer.h, encoder mode): the current model, the
-     * predictions and every controller then use it instead of the configured
-     * psi_pm, so the torque does not depend on that value at speed. Default
-     * on. The inverter's dead time and device drop (0 = none) are what the
+     * rated; flux_observer.h, encoder mode): once it differs from the
+     * configured psi_pm by more than 2 %, the current model, the predictions
+     * and every controller use it instead, so the torque does not depend on
+     * that value at speed. Default on; off with an output filter between the
+     * inverter and the motor (the leg voltages are not the motor's). The
+     * inverter's dead time and device drop (0 = none) are what the
      * observer's voltage reconstruction removes. */
     bool psi_adapt;
     double dead_time_s, v_fwd_v;
@@ -170,6 +172,9 @@ typedef struct {
      * the mean voltage of [k-1, k) it integrates (Q24 pu). */
     ctrl_fobs_t fobs;
     q24_t fobs_va, fobs_vb;
+    q24_t psi_pm_cfg;    /* the configured psi_pm, Q24 pu */
+    q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
+    bool psi_engaged;    /* the estimate has left the band: params follow it */
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
     ctrl_refs_t refs;
     ctrl_speed_pi_t speed_pi;

@@ -116,6 +116,13 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         if (ctrl_fobs_init(&fw->fobs, &fw->params, &fw->bases, &oc, &fw->why) != CTRL_OK) {
             return FW_EINVAL;
         }
+        /* The configured value stays while the estimate agrees with it within
+         * 2 %: about its own uncertainty (a 10 % resistance error moves it by
+         * dR i / (w psi_pm), 1.3 % on the thesis SPMSM at 750 r/min and rated
+         * current), and a 2 % torque error at most. */
+        fw->psi_pm_cfg = fw->params.psi_pm;
+        fw->psi_band = fx_mul(fw->params.psi_pm, ctrl_q24_from_double(0.02));
+        fw->psi_engaged = false;
     }
     const int sel = fw_select_controller(fw, ctrl, ctrl_cfg);
     if (sel != FW_OK) {

@@ -84,10 +84,20 @@ static void test_fixed_psi_pm_fails(void)
     TEST_ASSERT_TRUE(fabs(run_sse("drr", 750.0, 1.2, false)) > 0.1);
 }
 
+/* With the configured psi_pm right the estimate stays in its 2 % band: the
+ * drive is bit for bit the one without the tracking. */
+static void test_nominal_unchanged(void)
+{
+    const double a = run_sse("drr", 2250.0, 1.0, true);
+    const double b = run_sse("drr", 2250.0, 1.0, false);
+    TEST_ASSERT_EQUAL_DOUBLE(b, a);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_psi_pm_off_20pct);
     RUN_TEST(test_fixed_psi_pm_fails);
+    RUN_TEST(test_nominal_unchanged);
     return UNITY_END();
 }

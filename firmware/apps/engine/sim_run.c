@@ -416,7 +416,8 @@ static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_co
         fc->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
     }
     fc->overspeed_rpm = c->overspeed_rpm;
-    fc->psi_adapt = c->psi_adapt;
+    /* With an output filter the leg voltages are not the motor's: no voltage model. */
+    fc->psi_adapt = c->psi_adapt && c->plant_machine.filter.type == PLANT_FILTER_NONE;
     /* The inverter's dead time and device drop, known to the firmware. */
     fc->dead_time_s = c->plant_machine.dead_time_s;
     fc->v_fwd_v = c->plant_machine.v_fwd_v;
