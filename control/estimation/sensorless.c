@@ -37,10 +37,30 @@ static fx_angle_t sl_gamma(q24_t t_start, q24_t torque)
     return fx_atan2(sn, t);
 }
 
-static void sl_forced_out(ctrl_sl_t *s, ctrl_sl_out_t *out)
+/* The forced angle shifted against the rotor's speed error (the observer's
+ * speed against the forced one): a rotor that runs ahead of the current sees
+ * its torque reduced by t_start sin(gamma) delta, one that lags it increased,
+ * which damps its swing about the forced current (critical damping with the
+ * configured kd; nothing else does in a drive without friction). Speed error
+ * taken within +-1 pu, the shift within +-45 deg. */
+static fx_angle_t sl_damp(const ctrl_sl_t *s, q24_t w_obs)
+{
+    if (s->kd == 0 || s->obs.primed == 0u) {
+        return 0u;
+    }
+    const q24_t dw = fx_clamp(fx_sub(w_obs, s->omega_f), -FX_ONE, FX_ONE);
+    /* |dw kd| <= 2^24 CTRL_SL_KD_MAX = 2^62; rounded, saturated to 32 bits, then
+     * to +-45 deg */
+    const int32_t d = fx_round_sat((int64_t)dw * s->kd, FX_QBITS);
+    const int32_t lim = (int32_t)1 << 29;
+    const int32_t dc = fx_clamp(fx_neg(d), -lim, lim);
+    return (fx_angle_t)(uint32_t)dc;
+}
+
+static void sl_forced_out(ctrl_sl_t *s, ctrl_sl_out_t *out, q24_t w_obs)
 {
     out->mode = CTRL_SL_FORCED;
-    out->theta = s->theta_f;
+    out->theta = s->theta_f + sl_damp(s, w_obs);
     out->omega = s->omega_f;
     out->torque_ref = s->t_start;
 }
@@ -76,20 +96,23 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
 
     /* Forced: the ramp towards the speed reference, at most +-w_on. */
     const q24_t target = fx_clamp(speed_ref, fx_neg(s->w_on), s->w_on);
-    if (s->ramping == 0u && (target != 0 || s->omega_f != 0)) {
-        /* The ramp starts: the observer from where an unloaded rotor lines up
-         * with the current (the forced q axis). Held at zero speed it waits:
-         * at rest it would only drift. */
+    if (o->primed == 0u) {
+        /* From the first forced period: the observer from where an unloaded
+         * rotor lines up with the current (the forced q axis). Its error
+         * decays as soon as the rotor moves - in the swing the forced current
+         * starts, which its speed then damps (sl_damp). */
         ctrl_fobs_reset(o, p, s->theta_f + SL_QUARTER_TURN, s->omega_f, i_alpha, i_beta);
         o->kappa_ts = s->kappa_start;
+    }
+    if (s->ramping == 0u && (target != 0 || s->omega_f != 0)) {
         s->ramping = 1u;
     }
-    sl_forced_out(s, out);
+    sl_forced_out(s, out, w_obs);
     s->theta_f += ctrl_angle_step(p, s->omega_f);
     const q24_t w_next = sl_ramp(s->omega_f, target, s->ramp_dw);
     if ((w_next > 0 && s->omega_f < 0) || (w_next < 0 && s->omega_f > 0) ||
         (w_next == 0 && s->omega_f != 0)) {
-        s->ramping = 0u; /* through or to zero: the observer restarts with the next ramp */
+        s->ramping = 0u; /* through or to zero */
     }
     s->omega_f = w_next;
     s->count = fx_abs(s->omega_f) >= s->w_on ? s->count + 1u : 0u;
@@ -104,4 +127,46 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
         out->torque_ref = 0;
         out->handover = 1u;
     }
+}
+
+/* ---- the angle source (sensorless.h) ---- */
+
+static void angle_sl_reset(void *state, const ctrl_params_t *p)
+{
+    (void)p;
+    ctrl_angle_sl_t *s = state;
+    ctrl_sl_reset(&s->sl);
+    s->v_alpha = 0;
+    s->v_beta = 0;
+    s->out.mode = CTRL_SL_FORCED;
+    s->out.handover = 0u;
+    s->out.torque_ref = 0;
+}
+
+static void angle_sl_update(void *state, const ctrl_params_t *p, const ctrl_angle_in_t *in,
+                            ctrl_angle_out_t *out)
+{
+    ctrl_angle_sl_t *s = state;
+    ctrl_sl_update(&s->sl, p, s->v_alpha, s->v_beta, in->i_alpha, in->i_beta, s->speed_ref,
+                   s->torque_est, &s->out);
+    out->theta = s->out.theta;
+    out->omega = s->out.omega;
+}
+
+const ctrl_angle_src_t ctrl_angle_sensorless = {
+    .name = "sensorless",
+    .state_size = sizeof(ctrl_angle_sl_t) +
+                  0 * sizeof(struct {
+                      _Static_assert(sizeof(ctrl_angle_sl_t) <= CTRL_ANGLE_STATE_MAX, "state");
+                      int ok;
+                  }),
+    .uses_voltage = 0u, /* its own reconstruction: ctrl_angle_sl_voltage */
+    .reset = angle_sl_reset,
+    .update = angle_sl_update,
+};
+
+void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, q24_t vdc, q24_t i_a,
+                           q24_t i_b)
+{
+    ctrl_fobs_voltage(&s->sl.obs, legs, vdc, i_a, i_b, &s->v_alpha, &s->v_beta);
 }

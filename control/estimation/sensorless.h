@@ -37,6 +37,7 @@
 
 #include <stdint.h>
 
+#include "angle_source.h"
 #include "ctrl_params.h"
 #include "flux_observer.h"
 #include "fx.h"
@@ -56,6 +57,10 @@ typedef struct {
     q24_t kappa_ts;    /* observer gain in the observer mode (obs.kappa_ts then) */
     q24_t kappa_start; /* observer gain while forced, Q24 (kappa Ts_pu) */
     fx_angle_t theta0; /* forced angle at the start */
+#define CTRL_SL_KD_MAX ((int64_t)1 << 38) /* bound on kd (the product in 64 bits) */
+    int64_t kd; /* damping of the forced start: the forced angle shifted by
+                 * -kd (omega^ - omega_f) >> 24, fx_angle_t units per pu of
+                 * speed (0: off); the shift within +-45 deg */
     /* ---- state ---- */
     uint8_t mode;       /* CTRL_SL_* */
     uint8_t ramping;    /* the forced ramp has started (observer restarted) */
@@ -88,5 +93,32 @@ void ctrl_sl_reset(ctrl_sl_t *s);
 void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
                     q24_t i_alpha, q24_t i_beta, q24_t speed_ref, q24_t torque_est,
                     ctrl_sl_out_t *out);
+
+/*
+ * The sensorless angle as the estimator's angle source (angle_source.h):
+ * ctrl_estimator_set_angle_src(e, p, &ctrl_angle_sensorless), then
+ * ctrl_sl_init on ((ctrl_angle_sl_t *)ctrl_estimator_angle_state(e))->sl.
+ * Its voltage is the observer's own reconstruction (dead time and forward
+ * drop removed, ctrl_fobs_voltage), not the estimator's plain duties x Vdc:
+ * the caller hands it over after each period with ctrl_angle_sl_voltage,
+ * together with the speed it wants and the torque estimate (speed_ref,
+ * torque_est), and reads the mode, the handover and the forced torque
+ * reference from out.
+ */
+typedef struct {
+    ctrl_sl_t sl;
+    q24_t v_alpha, v_beta; /* mean voltage of the last period, Q24 pu (ctrl_angle_sl_voltage) */
+    q24_t speed_ref;       /* caller: the speed it wants, Q24 pu electrical */
+    q24_t torque_est;      /* caller: the torque estimate of the last period, Q24 pu */
+    ctrl_sl_out_t out;     /* the last update's output */
+} ctrl_angle_sl_t;
+
+extern const ctrl_angle_src_t ctrl_angle_sensorless;
+
+/* After the period's estimate: the voltage the leg duties acting in [k, k+1)
+ * give at the DC link vdc(k) with the phase currents i_a, i_b at k (Q24 pu),
+ * for the next update. */
+void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, q24_t vdc, q24_t i_a,
+                           q24_t i_b);
 
 #endif /* CONTROL_SENSORLESS_H */

@@ -19,6 +19,8 @@ void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m)
     c->settle_s = 6.0 / w_on;
     c->kappa_start = 2.0;
     c->theta0_rad = 0.0;
+    c->damp_zeta = 0.7;
+    c->inertia_kgm2 = m->inertia_kgm2;
 }
 
 static int sl_in(double v, double lo, double hi, const char *q, const char *unit, ctrl_diag_t *why)
@@ -56,7 +58,9 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
         !sl_in(c->low_s, 1.0 / fs, 100.0, "low_s", "s", why) ||
         !sl_in(c->settle_s, 1.0 / fs, 100.0, "settle_s", "s", why) ||
         !sl_in(c->kappa_start, 0.0, 4.0, "kappa_start", "", why) ||
-        !sl_in(c->theta0_rad, -1e3, 1e3, "theta0_rad", "rad", why)) {
+        !sl_in(c->theta0_rad, -1e3, 1e3, "theta0_rad", "rad", why) ||
+        !sl_in(c->damp_zeta, 0.0, 2.0, "damp_zeta", "", why) ||
+        !sl_in(c->inertia_kgm2, 0.0, 1e6, "inertia_kgm2", "kg*m^2", why)) {
         return CTRL_EINVAL;
     }
     ctrl_sl_t n;
@@ -84,6 +88,20 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
     n.w_off = ctrl_q24_from_double(c->w_off_frac * w_rated / b->w_rad_s);
     n.settle_n = (uint32_t)ceil(c->settle_s * fs);
     n.low_n = (uint32_t)ceil(c->low_s * fs);
+    {
+        /* The rotor about the forced current: J theta_m'' = -t_start p
+         * theta_m (small swings about the unloaded equilibrium), w_n =
+         * sqrt(t_start p / J); the shift -kd dw gives the torque -t_start kd dw_e,
+         * damping ratio zeta for kd = 2 zeta / w_n (s, per electrical rad/s). */
+        const double pp = (double)p->pole_pairs;
+        const double j = c->inertia_kgm2;
+        const double kd_s = j > 0.0 ? 2.0 * c->damp_zeta * sqrt(j / (c->t_start_nm * pp)) : 0.0;
+        const double kd = kd_s * b->w_rad_s * 4294967296.0 / CTRL_TWO_PI;
+        if (!sl_in(kd, 0.0, (double)CTRL_SL_KD_MAX, "damp_zeta", "", why)) {
+            return CTRL_EINVAL;
+        }
+        n.kd = (int64_t)llround(kd);
+    }
     double th = fmod(c->theta0_rad, CTRL_TWO_PI);
     if (th < 0.0) {
         th += CTRL_TWO_PI;

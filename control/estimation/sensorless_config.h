@@ -20,6 +20,8 @@ typedef struct {
     double settle_s;        /* time at the handover speed before the handover, s */
     double kappa_start;     /* observer gain while forced (obs.kappa afterwards) */
     double theta0_rad;      /* forced angle at the start, electrical rad */
+    double damp_zeta;       /* damping ratio of the forced start's swing (0: off) */
+    double inertia_kgm2;    /* rotor (and load) inertia the damping is sized for (0: off) */
 } ctrl_sl_config_t;
 
 /*

@@ -39,7 +39,8 @@ typedef struct {
     q24_t omega;      /* electrical speed, Q24 pu (positive: theta increasing) */
 } ctrl_angle_out_t;
 
-#define CTRL_ANGLE_STATE_MAX 64 /* bytes of a source's state (estimator.h) */
+#define CTRL_ANGLE_STATE_MAX                                                                       \
+    256 /* bytes of a source's state (estimator.h): the sensorless one, 232 */
 
 typedef struct ctrl_angle_src {
     const char *name;     /* "encoder", "forced", ... */

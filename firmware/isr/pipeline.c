@@ -313,11 +313,33 @@ static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estim
     }
 }
 
+/* Sensorless (fw_config_t.sensorless): what the angle source needs before
+ * the estimate of this period - the speed wanted (in torque mode one of the
+ * torque's sign, so that the forced start turns the right way) and the
+ * torque estimate of the last period. */
+static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
+{
+    q24_t w = fw->speed_ref;
+    if (fw->ref_mode != FW_REF_SPEED) {
+        w = fw->torque_ref_lim > 0 ? FX_ONE : (fw->torque_ref_lim < 0 ? -FX_ONE : 0);
+    }
+    sl->speed_ref = w;
+    sl->torque_est = fw->estimate.now.torque;
+}
+
 static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
+    ctrl_angle_sl_t *const sl =
+        fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
+    if (sl != NULL) {
+        fw_sl_inputs(fw, sl);
+    }
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, est);
-    if (fw->cfg.psi_adapt && fw->sm.state == FW_STATE_RUNNING) {
+    if (sl != NULL) {
+        /* the voltage of [k, k+1) for the observer's next period */
+        ctrl_angle_sl_voltage(sl, &fw->applied, m->vdc, m->i_a, m->i_b);
+    } else if (fw->cfg.psi_adapt && fw->sm.state == FW_STATE_RUNNING) {
         fw_psi_track(fw, m, est);
     }
     tm->omega_e = est->omega_e;
@@ -336,7 +358,17 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     }
 
     q24_t tref;
-    if (fw->ref_mode == FW_REF_SPEED) {
+    if (sl != NULL && sl->out.mode == CTRL_SL_FORCED) {
+        /* Forced start: the start-up current along the forced q axis; the
+         * speed loop waits (sensorless.h). */
+        tref = sl->out.torque_ref;
+        fw->speed_cnt = 0u;
+    } else if (fw->ref_mode == FW_REF_SPEED) {
+        if (sl != NULL && sl->out.handover != 0u) {
+            /* bumpless: the speed loop starts from the torque it takes over */
+            ctrl_speed_pi_reset(&fw->speed_pi, est->now.torque);
+            fw->speed_cnt = 0u;
+        }
         /* The speed loop runs at its own, lower rate and holds its output in
          * between: a piecewise-constant torque reference, as from a drive's
          * outer loop (a reference that changes every period would also keep
@@ -382,7 +414,8 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
     uint32_t f = fw_protect_fast(fw, hal, i_a, i_b);
     fw_measure_rest(fw, raw, enc, m);
     if (f == FW_FAULT_NONE) {
-        f = fw_protect_slow(fw, m->vdc, enc->count);
+        f = fw->cfg.sensorless ? fw_protect_vdc(&fw->prot, m->vdc)
+                               : fw_protect_slow(fw, m->vdc, enc->count);
         if (f != FW_FAULT_NONE) {
             fw_fault_now(fw, f);
         }

@@ -56,6 +56,7 @@
 #include "fw_state.h"
 #include "hal.h"
 #include "protect.h"
+#include "sensorless.h"
 #include "speed_pi.h"
 #include "speed_pi_config.h"
 
@@ -138,6 +139,12 @@ typedef struct {
      * observer's voltage reconstruction removes. */
     bool psi_adapt;
     double dead_time_s, v_fwd_v;
+    /* No position sensor (control/estimation/sensorless.h): the angle and
+     * speed from the stator-flux observer, started on a forced angle
+     * (current-frequency ramp to 5 % of rated speed, then the handover); the
+     * encoder and its protections unused, psi_adapt off (the observer's
+     * correction needs the configured psi_pm). Default off. */
+    bool sensorless;
 } fw_config_t;
 
 /* The speed loop and speed limits in force (SI, for reports; set by fw_init). */

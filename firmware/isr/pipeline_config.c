@@ -10,6 +10,7 @@
 
 #include "flux_observer_config.h"
 #include "plan.h"
+#include "sensorless_config.h"
 #include "speed_loop.h"
 #include "speed_pi_config.h"
 
@@ -42,6 +43,7 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->psi_adapt = true;
     c->dead_time_s = 0.0;
     c->v_fwd_v = 0.0;
+    c->sensorless = false;
 }
 
 size_t fw_explain(const fw_t *fw, char *buf, size_t cap)
@@ -123,6 +125,34 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         fw->psi_pm_cfg = fw->params.psi_pm;
         fw->psi_band = fx_mul(fw->params.psi_pm, ctrl_q24_from_double(0.02));
         fw->psi_engaged = false;
+    }
+    if (cfg->sensorless) {
+        /* The sensorless angle source with its defaults (sensorless_config.h)
+         * and the inverter's dead time and drop; its PLL within the discrete
+         * loop's range at any fs, as above. */
+        if (ctrl_estimator_set_angle_src(&fw->est, &fw->params, &ctrl_angle_sensorless) !=
+            CTRL_OK) {
+            return FW_EINVAL;
+        }
+        ctrl_sl_config_t sc;
+        ctrl_sl_config_default(&sc, fw->machine);
+        sc.obs.pll_hz = fmin(sc.obs.pll_hz, 0.4 * (double)in->pwm_freq_hz / (4.0 * CTRL_PI));
+        {
+            /* the observer's gains within what one period takes at rated
+             * speed (k Ts <= 0.5, flux_observer_config.c): fast motors at
+             * low fs */
+            const double w_rated =
+                ctrl_rpm_to_elec(fw->machine->speed_rated_rpm, fw->machine->pole_pairs);
+            const double k_max = 0.45 * (double)in->pwm_freq_hz / w_rated;
+            sc.kappa_start = fmin(sc.kappa_start, k_max);
+            sc.obs.kappa = fmin(sc.obs.kappa, k_max);
+        }
+        sc.obs.dead_time_s = cfg->dead_time_s;
+        sc.obs.v_fwd_v = cfg->v_fwd_v;
+        ctrl_angle_sl_t *const sl = ctrl_estimator_angle_state(&fw->est);
+        if (ctrl_sl_init(&sl->sl, &fw->params, &fw->bases, &sc, &fw->why) != CTRL_OK) {
+            return FW_EINVAL;
+        }
     }
     const int sel = fw_select_controller(fw, ctrl, ctrl_cfg);
     if (sel != FW_OK) {

@@ -62,6 +62,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->calib_samples = 256u;
     c->stop_on_fault = false;
     c->psi_adapt = true;
+    c->sensorless = false;
     c->speed_bw_hz = m->speed_bw_hz;
     c->speed_pm_deg = m->speed_pm_deg;
     c->speed_kp = m->speed_kp;
@@ -419,6 +420,7 @@ static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_co
     /* With an output filter the leg voltages are not the motor's: no voltage model. */
     fc->psi_adapt = c->psi_adapt && c->plant_machine.filter.type == PLANT_FILTER_NONE;
     /* The inverter's dead time and device drop, known to the firmware. */
+    fc->sensorless = c->sensorless;
     fc->dead_time_s = c->plant_machine.dead_time_s;
     fc->v_fwd_v = c->plant_machine.v_fwd_v;
     /* The firmware's encoder configuration (the control machine's [sensors]). */

@@ -52,7 +52,7 @@ typedef struct {
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
     cli_span_t window, trace_window;
-    int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt;
+    int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, sensorless;
     sim_set_t sets[SIM_MAX_SETS];
     size_t n_sets;
 } cli_t;
@@ -126,6 +126,9 @@ static const cli_opt_t k_opts[] = {
     {"--no-psi-adapt", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(no_psi_adapt),
      "keep the configured psi_pm: no PM flux from the voltage model above 10 % of rated speed "
      "(docs/algorithms.md)"},
+    {"--sensorless", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(sensorless),
+     "no encoder: angle and speed from the stator-flux observer, forced-angle start-up "
+     "(docs/algorithms.md, \"Sensorless start-up\")"},
     {"--continue-on-fault", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(continue_on_fault),
      "keep simulating after a fault (gates off) to the end; the exit status stays 3"},
     {"--list-controllers", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(list_controllers),
@@ -744,6 +747,7 @@ int main(int argc, char **argv)
     cfg.n_sets = c.n_sets;
     cfg.stop_on_fault = !c.continue_on_fault;
     cfg.psi_adapt = !c.no_psi_adapt;
+    cfg.sensorless = c.sensorless != 0;
     if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
         /* The command line's sizing replaces the machine file's speed loop. */
         cfg.speed_kp = cfg.speed_ki = 0.0;
