@@ -46,6 +46,7 @@ typedef struct {
     uint32_t n; /* periods (ISR calls) */
     const pil_in_t *in;
     const pil_out_t *out;
+    uint8_t sensorless; /* fw_config_t.sensorless: no encoder, the observer's angle */
 } pil_rec_t;
 
 extern const pil_rec_t pil_recs[];

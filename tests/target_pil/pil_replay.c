@@ -70,6 +70,7 @@ int pil_replay_run(const pil_rec_t *rec, fw_t *fw, hal_t *hal, pil_mismatch_t *m
     fw_config_t fc;
     fw_config_default(&fc, &rec->machine, desc);
     fc.calib_samples = rec->calib_samples;
+    fc.sensorless = rec->sensorless != 0u;
     if (fw_init(fw, hal, &fc) != FW_OK) {
         mm->field = "fw_init failed";
         return -1;

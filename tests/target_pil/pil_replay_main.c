@@ -22,18 +22,20 @@ int main(void)
     size_t checked = 0u;
     for (size_t i = 0; i < pil_n_recs; i++) {
         const pil_rec_t *rec = &pil_recs[i];
+        const char *mode = rec->sensorless != 0u ? "sensorless" : "encoder";
         pil_mismatch_t mm;
         const int rc = pil_replay_run(rec, &replay_fw, &replay_hal, &mm);
         if (rc == 0) {
-            printf("PASS %-8s %u periods bit-identical (pwm compare, gates, telemetry)\n",
-                   rec->name, (unsigned)rec->n);
+            printf("PASS %-8s %-10s %u periods bit-identical (pwm compare, gates, telemetry)\n",
+                   rec->name, mode, (unsigned)rec->n);
         } else if (rc > 0) {
-            printf("FAIL %-8s period %u (of %u) field %s: recorded %lld, replayed %lld\n",
-                   rec->name, (unsigned)mm.period, (unsigned)rec->n, mm.field, (long long)mm.want,
-                   (long long)mm.got);
+            printf("FAIL %-8s %-10s period %u (of %u) field %s: recorded %lld, replayed %lld\n",
+                   rec->name, mode, (unsigned)mm.period, (unsigned)rec->n, mm.field,
+                   (long long)mm.want, (long long)mm.got);
             fails++;
         } else {
-            printf("FAIL %-8s setup: %s\n", rec->name, mm.field != NULL ? mm.field : "?");
+            printf("FAIL %-8s %-10s setup: %s\n", rec->name, mode,
+                   mm.field != NULL ? mm.field : "?");
             fails++;
         }
         checked++;
@@ -50,7 +52,8 @@ int main(void)
             fails++;
         }
     }
-    printf("%s: %u of %u controllers bit-identical\n", fails == 0 ? "PASS" : "FAIL",
-           (unsigned)(checked - (size_t)fails), (unsigned)checked);
+    printf("%s: %u of %u recordings bit-identical (every controller with the encoder, some "
+           "sensorless)\n",
+           fails == 0 ? "PASS" : "FAIL", (unsigned)(checked - (size_t)fails), (unsigned)checked);
     return fails == 0 ? 0 : 1;
 }

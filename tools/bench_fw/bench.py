@@ -26,6 +26,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 FW = os.path.join(ROOT, "tools", "bench_fw")
 SPEEDS = (750, 2250)
 TORQUE_NM = 1.8
+SENSORLESS_RPM = 150  # 5 % of the thesis SPMSM's rated 3000 r/min (sensorless_config.h w_on)
 # Section indices of the plugin's end markers (order of the end= arguments).
 SECTIONS = ("empty", "boot", "run", "est", "step")
 MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
@@ -209,6 +210,10 @@ def main():
     ap.add_argument("--no-callgrind", action="store_true")
     ap.add_argument("--quick", action="store_true",
                     help="determinism self-test only (one controller, twice; no table)")
+    ap.add_argument("--sensorless", action="store_true",
+                    help="the firmware without its encoder (fw_config_t.sensorless): recorded at "
+                         "5 %% of rated speed (the forced start's final speed), so that the forced "
+                         "start, the handover (about 1100 periods) and the observer are counted")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--hotspots", default="m2ptfc,m1",
                     help="controllers with a per-source-line profile (empty: none)")
@@ -230,6 +235,8 @@ def main():
         speeds = (750,)
     else:
         speeds = SPEEDS
+    if args.sensorless:
+        speeds = (SENSORLESS_RPM,)
     recdir = os.path.join(args.work, "rec")
     os.makedirs(recdir, exist_ok=True)
     log("recording %d controller(s) x %s r/min, %g N*m, %d running periods" %
@@ -238,7 +245,8 @@ def main():
     def record(job):
         n, s = job
         run([tools["rec"], "record", "--machine", machine, "--speed", str(s), "--torque",
-             str(TORQUE_NM), "--periods", str(args.periods), "--outdir", recdir, "--ctrl", n])
+             str(TORQUE_NM), "--periods", str(args.periods), "--outdir", recdir, "--ctrl", n,
+             "--sensorless", "1" if args.sensorless else "0"])
 
     jobs = [(n, s) for n in names for s in speeds]
     with cf.ThreadPoolExecutor(args.jobs) as ex:

@@ -2,7 +2,7 @@
  * PC recorder of the interrupt-cost benchmark (tools/bench):
  *
  *   bench_rec record --machine INI --speed RPM --torque NM --periods N --outdir DIR
- *                    [--ctrl NAME]
+ *                    [--ctrl NAME] [--sensorless 0|1]
  *       For every registered controller (or NAME): a closed loop on the PC
  *       (plant, dynamometer at RPM + hal/sim + firmware) from fw_init through
  *       calibration and arm, then N running periods at the controller's
@@ -13,6 +13,7 @@
  * the hal.h functions.)
  */
 #define _POSIX_C_SOURCE 200809L
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,14 +45,14 @@ static void put_name(char *dst, size_t n, const char *src)
 /* ---- record ------------------------------------------------------------ */
 
 static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double speed_rpm,
-                      double torque_nm, uint32_t periods, const char *outdir)
+                      double torque_nm, uint32_t periods, bool sensorless, const char *outdir)
 {
     static rec_loop_t loop;
     const uint32_t calib = 256u;
     ctrl_machine_t cm;
     sim_ctrl_machine_from(sm, &cm);
     const uint32_t fs = d->fs_default_hz != 0u ? d->fs_default_hz : (uint32_t)sm->fs_hz;
-    const char *fail = rec_loop_init(&loop, d, sm, fs, speed_rpm, calib);
+    const char *fail = rec_loop_init(&loop, d, sm, fs, speed_rpm, calib, sensorless);
     if (fail != NULL) {
         return die(fail, d->name);
     }
@@ -121,6 +122,7 @@ static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double spee
     h->cycle_clock_hz = info.cycle_clock_hz;
     h->adc_bits = info.adc_bits;
     h->has_i_c = info.has_i_c ? 1u : 0u;
+    h->sensorless = sensorless ? 1u : 0u;
     h->adc_current_a_per_count = info.adc_current_a_per_count;
     h->adc_vdc_v_per_count = info.adc_vdc_v_per_count;
     h->pole_pairs = cm.pole_pairs;
@@ -156,6 +158,7 @@ static int cmd_record(int argc, char **argv)
     const char *machine = NULL, *outdir = NULL, *only = NULL;
     double speed = 750.0, torque = 1.8;
     unsigned long periods = 2000u;
+    bool sensorless = false;
     for (int i = 0; i < argc; i += 2) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -179,6 +182,11 @@ static int cmd_record(int argc, char **argv)
             if (*end != '\0' || !(torque >= 0.0) || torque > 10000.0) {
                 return die("--torque expects 0 .. 10000 N*m, got ", v);
             }
+        } else if (strcmp(a, "--sensorless") == 0) {
+            if (strcmp(v, "0") != 0 && strcmp(v, "1") != 0) {
+                return die("--sensorless expects 0 or 1, got ", v);
+            }
+            sensorless = v[0] == '1';
         } else if (strcmp(a, "--periods") == 0) {
             periods = strtoul(v, &end, 10);
             if (*end != '\0' || periods == 0u || periods > 20000u) {
@@ -201,10 +209,11 @@ static int cmd_record(int argc, char **argv)
         if (d == NULL) {
             return die("unknown controller ", only);
         }
-        return record_one(d, &sm, speed, torque, (uint32_t)periods, outdir);
+        return record_one(d, &sm, speed, torque, (uint32_t)periods, sensorless, outdir);
     }
     for (size_t i = 0; i < ctrl_count(); i++) {
-        if (record_one(ctrl_at(i), &sm, speed, torque, (uint32_t)periods, outdir) != 0) {
+        if (record_one(ctrl_at(i), &sm, speed, torque, (uint32_t)periods, sensorless, outdir) !=
+            0) {
             return 1;
         }
     }
