@@ -16,7 +16,7 @@
 
 #define DRR_LAMBDA_DEFAULT 0.03                    /* §5.3.2: f_c = 50 Hz at 10 kHz by (5.5) */
 #define DRR_SIGMA_DEFAULT (10.0 * CTRL_PI / 180.0) /* §5.3.5, Fig. 5.9: sigma = 10 deg */
-#define DRR_SIGMA_MAX (CTRL_PI / 12.0)             /* (4.19) */
+#define DRR_SIGMA_MAX CTRL_VR_SIGMA_MAX            /* (4.19): pi/12, accepted to pi/6 */
 #define DRR_PU_MAX 4.0                             /* A, B/w_rn must fit the per-sample clamps */
 #define DRR_RS_DT_REL 0.1 /* rs_dt default on when Rs i_rated >= 10 % of the rated back-EMF */
 

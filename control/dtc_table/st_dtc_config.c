@@ -17,7 +17,7 @@
 #define ST_BAND_REL 0.02                  /* h_T = 2 % T_rated, h_psi = 2 % psi_pm (Table 4.7) */
 #define ST_PU_MAX 100.0                   /* bands and steps beyond 100 pu are unit mistakes */
 #define ST_SIGMA_DEFAULT (CTRL_PI / 12.0) /* §4.6.2 experiments */
-#define ST_SIGMA_MAX (CTRL_PI / 12.0)     /* (4.19) */
+#define ST_SIGMA_MAX CTRL_VR_SIGMA_MAX    /* (4.19): pi/12, accepted to pi/6 */
 /* f_i default: the DRR EMA's corner (thesis §5.3.2, 1/20 of the bandwidth),
  * where A (5.9) at 20 kHz is at least half the rated torque. */
 #define ST_FI_HZ 50.0

@@ -26,7 +26,7 @@
 #include "fx.h"
 
 typedef struct {
-    q24_t cos_b, sin_b; /* of pi/6 - sigma, sigma the subsector width in (0, pi/12], Q24 */
+    q24_t cos_b, sin_b; /* of pi/6 - sigma, sigma the subsector width in (0, pi/6], Q24 */
     uint8_t enabled;    /* 0 (sigma == 0): ctrl_vreplace returns vec unchanged */
 } ctrl_vreplace_t;
 

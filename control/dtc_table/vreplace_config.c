@@ -9,16 +9,18 @@
 
 int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad)
 {
-    /* pi/12, the largest subsector of (4.19); 1e-12 rad of slack so that
-     * e.g. 15 * pi / 180 is accepted. */
-    const double sigma_max = CTRL_PI / 12.0;
+    /* (4.19) takes sigma in [0, pi/12]; the subsectors I and II stay apart up
+     * to pi/6, where they split the sector in halves (the sigma study of
+     * docs/algorithms.md goes that far); 1e-9 rad of slack so that e.g.
+     * 30 * pi / 180 is accepted. */
+    const double sigma_max = CTRL_VR_SIGMA_MAX;
     if (c == NULL) {
         return CTRL_EINVAL;
     }
     c->cos_b = 0;
     c->sin_b = 0;
     c->enabled = 0u;
-    if (!isfinite(sigma_rad) || sigma_rad < 0.0 || sigma_rad > sigma_max + 1e-12) {
+    if (!isfinite(sigma_rad) || sigma_rad < 0.0 || sigma_rad > sigma_max + 1e-9) {
         return CTRL_EINVAL;
     }
     if (sigma_rad > sigma_max) {

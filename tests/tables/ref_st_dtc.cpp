@@ -258,7 +258,7 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
     std::uniform_real_distribution<double> U(0.0, 1.0);
     RefCtrl ref{kind};
     if (kind == FSTK) {
-        double sigma = U(rng) < 0.2 ? 0.0 : U(rng) * PI / 12.0;
+        double sigma = U(rng) < 0.2 ? 0.0 : U(rng) * PI / 6.0;
         if (U(rng) < 0.3) {
             sigma = PI / 12.0;
         }
@@ -458,7 +458,7 @@ void test_reference_vreplace(void)
     std::uniform_real_distribution<double> U(0.0, 1.0);
     long n = 0, near = 0, bad = 0;
     for (int i = 0; i < 20000; i++) {
-        const double sigma = U(rng) * PI / 12.0;
+        const double sigma = U(rng) * PI / 6.0;
         ctrl_vreplace_t c;
         TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, sigma));
         const double th = -PI + 2.0 * PI * U(rng);

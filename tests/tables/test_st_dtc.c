@@ -136,8 +136,8 @@ static void test_registry_and_defaults(void)
             } else if (strcmp(t->name, "h_psi") == 0) {
                 TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.02 * 0.09427, v); /* 2 % psi_pm */
             } else if (strcmp(t->name, "sigma") == 0) {
-                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, v);      /* §4.6.2 */
-                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, t->max); /* (4.19) */
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, v);     /* §4.6.2 */
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 6.0, t->max); /* half sector */
             } else if (strcmp(t->name, "dT_step") == 0) {
                 TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* Delta T_ref != 0 */
             } else if (strcmp(t->name, "f_i") == 0) {
@@ -202,7 +202,7 @@ static void test_tunables_by_name(void)
     rig_open("fst");
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(R.d, R.cfg, "sigma", &v));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, v);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", PI / 12.0 + 1e-3));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", PI / 6.0 + 1e-3));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", NAN));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "sigma", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "dT_step", 0.1));

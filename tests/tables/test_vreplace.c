@@ -97,6 +97,14 @@ static void test_subsector_boundaries_sigma_max(void)
     check_sigma(PI / 12.0);
 }
 
+/* Beyond (4.19)'s pi/12 up to pi/6, where subsectors I and II meet at the
+ * sector centre (the sigma study). */
+static void test_subsector_boundaries_sigma_wide(void)
+{
+    check_sigma(PI / 8.0);
+    check_sigma(PI / 6.0 - 1e-3);
+}
+
 static void test_subsector_boundaries_sigma_small(void)
 {
     check_sigma(PI / 48.0);
@@ -140,7 +148,8 @@ static void test_disabled_and_bad_input(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(NULL, 0.1));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, -1e-9));
     TEST_ASSERT_EQUAL_UINT8(0, c.enabled);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, PI / 12.0 + 1e-6));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, PI / 6.0 + 1e-6));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 30.0 * PI / 180.0));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, NAN));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, INFINITY));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 15.0 * PI / 180.0));
@@ -152,6 +161,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_subsector_boundaries_sigma_max);
     RUN_TEST(test_subsector_boundaries_sigma_small);
+    RUN_TEST(test_subsector_boundaries_sigma_wide);
     RUN_TEST(test_exact_axis_points);
     RUN_TEST(test_disabled_and_bad_input);
     return UNITY_END();
