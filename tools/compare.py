@@ -897,6 +897,9 @@ def main():
       "Ts/10 grid. n/a: undefined (no fundamental, a trip, or not commanded).\n")
     w("The book chapter's output filters (§6) on its IPMSM: [filters.md](filters.md) "
       "(`tools/filters.py`).\n")
+    w("Field weakening (torque-speed envelope of every controller), the voltage-replacement "
+      "angle σ, the flux-ripple gap and the robustness to parameter errors: "
+      "[fieldweak.md](fieldweak.md) (`tools/fw_studies.py`).\n")
     w("## Findings\n")
     w("### The sources' claims beside the measurements\n")
     w("Verdicts: *reproduced* — same direction and a size within ±50 % of the claim (for "

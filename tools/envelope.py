@@ -370,7 +370,7 @@ def plot(m, lim, path, rpm_max=None, extra=None):
     ax.set_xlabel("speed (r/min)")
     ax.set_ylabel("torque (N*m)")
     ax.set_title(f"{m.name}: I_max {lim.i_max:g} A, V_max {lim.v_max:.1f} V "
-                 f"(base {we_to_rpm(m, wb):.0f} r/min)")
+                 f"(MTPA corner at I_max: {we_to_rpm(m, wb):.0f} r/min)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7)
     # dq plane
