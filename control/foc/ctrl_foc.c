@@ -56,6 +56,7 @@ void ctrl_foc_reset(void *state)
     s->pi_q.integ = 0;
     s->v_d = 0;
     s->v_q = 0;
+    ctrl_fieldweak_reset(&s->fw);
 }
 
 /* foc: PI current loops + SVPWM. */
@@ -124,7 +125,14 @@ void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     ctrl_foc_state_t *s = state;
     q24_t id_ref;
     q24_t iq_ref;
-    ctrl_foc_iref(ctx->params, &s->iref, ctx->ref->torque, &id_ref, &iq_ref);
+    if (ctx->ref->psi > 0) {
+        /* d-axis current from the voltage limit: the flux circle the voltage
+         * allows (MTPA currents when their flux is inside it). */
+        ctrl_fieldweak_currents(&s->fw, ctx->params, ctx->ref->torque, ctx->ref->psi, &id_ref,
+                                &iq_ref);
+    } else {
+        ctrl_foc_iref(ctx->params, &s->iref, ctx->ref->torque, &id_ref, &iq_ref);
+    }
     if (s->hyst != 0u) {
         foc_hyst_step(s, ctx, id_ref, iq_ref, out);
     } else {

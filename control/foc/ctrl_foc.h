@@ -4,7 +4,11 @@
  *
  * Current references: T_ref -> (i_d, i_q) on the MTPA locus (IPMSM: the
  * machine's MTPA table, ctrl_mtpa_current) or with i_d = 0 (SPMSM, or tunable
- * mtpa = 0: Algorithm 1), |T_ref| limited to the torque at current_max.
+ * mtpa = 0: Algorithm 1), |T_ref| limited to the torque at current_max; in
+ * field weakening (a flux reference ref->psi > 0 from the pipeline's limits,
+ * field_weak.h) the point of T_ref on the flux circle |psi_s| = ref->psi
+ * (negative i_d from the voltage limit, MTPV at most), where that circle lies
+ * inside the MTPA flux.
  * foc: d and q current PI with decoupling feed-forward (S1(1)),
  *   v_d = -omega psi_q + Kp_d e_d + I_d,  v_q = omega psi_d + Kp_q e_q + I_q,
  * gains Kp = L wc, Ki = R wc (default wc = 2 pi fs / 20), conditional
@@ -21,6 +25,7 @@
 #include <stdint.h>
 
 #include "controller.h"
+#include "field_weak.h"
 #include "fx.h"
 
 /* One current PI (Q formats at the fields). */
@@ -46,6 +51,9 @@ typedef struct {
     uint8_t limited; /* foc: the last voltage was limited by the hexagon */
     q24_t h_i;       /* foc_hyst band, Q24 pu */
     ctrl_foc_iref_t iref;
+    /* Field weakening (ref->psi > 0 below the MTPA flux): the currents of the
+     * torque on that flux circle (ctrl_fieldweak_currents, MTPV at most). */
+    ctrl_fieldweak_t fw;
     ctrl_foc_pi_t pi_d, pi_q;
     q24_t v_d, v_q; /* last commanded voltage before the limit (telemetry/tests), Q24 pu */
 } ctrl_foc_state_t;

@@ -12,6 +12,7 @@
 #include "ctrl_params.h"
 #include "ctrl_units.h"
 #include "estimator.h"
+#include "field_weak_config.h"
 
 #define FOC_FS_HZ 10000u      /* S1 §2: Ts = 100 us */
 #define FOC_WC_PER_FS 20.0    /* default wc = 2 pi fs / 20 */
@@ -118,6 +119,20 @@ static int foc_init_common(void *state, const void *cfg, const ctrl_setup_t *su,
     }
     if (rc == CTRL_OK) {
         rc = foc_pi_config(&s->pi_q, c->kp_q, c->ki_q, ctrl_q24_to_double(p->lq), wc, su);
+    }
+    if (rc == CTRL_OK) {
+        /* The flux-circle constants of the machine (current and voltage
+         * limits unused here: the pipeline limits the torque). */
+        ctrl_fieldweak_cfg_t fwc;
+        ctrl_fieldweak_cfg_default(&fwc);
+        rc = ctrl_fieldweak_init(&s->fw, &fwc, su->machine, su->bases, p, NULL, 0u);
+        if (rc != CTRL_OK && !(su->machine->lq_h >= su->machine->ld_h)) {
+            rc = ctrl_setup_refuse(su, rc, "lq_h (reverse saliency Lq < Ld, field weakening)", "H",
+                                   su->machine->lq_h, su->machine->ld_h, INFINITY);
+        } else if (rc != CTRL_OK) {
+            rc = ctrl_setup_refuse(su, rc, "a field-weakening constant (field_weak_config.c)", "pu",
+                                   0.0, -100.0, 100.0);
+        }
     }
     if (rc == CTRL_OK) {
         rc = ctrl_setup_q24(su, "h_i / current base", c->h_i, su->bases->i_a, 0.0, 127.0, &s->h_i);

@@ -34,7 +34,8 @@ static void fw_tm_no_estimate(fw_telemetry_t *tm)
     tm->duty = 0;
     tm->i_d = tm->i_q = 0;
     tm->psi_d = tm->psi_q = 0;
-    tm->torque = tm->omega_e = tm->torque_ref = 0;
+    tm->torque = tm->omega_e = tm->torque_ref = tm->torque_max = 0;
+    tm->fw_limit = 0u;
 }
 
 /* Q8 counts -> Q24 pu with a Q30 gain: round(d gain / 2^14), saturated. raw
@@ -213,6 +214,9 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             fw->fobs.primed = 0u; /* restarted from the current model at the first period */
             fw->fobs_va = fw->fobs_vb = 0;
             ctrl_speed_pi_reset(&fw->speed_pi, 0);
+            ctrl_fieldweak_reset(&fw->fwk);
+            fw->torque_max = fw->torque_ref_max;
+            fw->trim = 0;
             fw->speed_tref = 0;
             fw->speed_cnt = 0u;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
@@ -353,6 +357,8 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         tm->vec = 0u;
         tm->duty = 0;
         tm->torque_ref = 0;
+        tm->torque_max = 0;
+        tm->fw_limit = 0u;
         fw_pwm_off(fw, tm);
         return;
     }
@@ -374,6 +380,11 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
          * outer loop (a reference that changes every period would also keep
          * FST's reference-step logic, §4.5.3, permanently in its dynamic mode). */
         if (fw->speed_cnt == 0u) {
+            /* Anti-windup against the torque limit of the last period (field
+             * weakening) as well as the configured one: the integrator stays
+             * within what the drive can deliver, so leaving the limit does not
+             * overshoot. */
+            fw->speed_pi.out_max = fx_max(fx_min(fw->torque_ref_max, fw->torque_max), 1);
             fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, est->omega_e);
         }
         fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
@@ -381,8 +392,29 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     } else {
         tref = fw->torque_ref_lim; /* torque_ref clamped by fw_set_torque_ref */
     }
-    fw->refs.torque = tref;
-    fw->refs.psi = 0;
+    /* Torque limited by the current and voltage limits; flux reference
+     * weakened to what the voltage allows (0 = the controller's own below
+     * base speed, so nothing changes there). */
+    ctrl_fieldweak_out_t lim;
+    ctrl_fieldweak_step(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, 0, &lim);
+    tref = lim.torque;
+    /* Mean-torque trim in field weakening: with the flux at the voltage's
+     * limit the torque rises slowly (little voltage beyond the back-EMF) and
+     * falls fast, so a hysteresis or duty-ratio controller settles below its
+     * reference; an integrator of the estimated torque's error (corner
+     * FW_TRIM_HZ, the DRR EMA's of thesis sec. 5.3.2) restores the mean.
+     * Outside field weakening it decays with the same time constant (smooth
+     * exit); bounded by a quarter of the torque limit. */
+    const uint8_t weak = lim.weakening;
+    const q24_t trim_lim = fx_rshift32_round(lim.torque_max, 2u);
+    const q24_t trim_in = weak != 0u ? fx_sub(tref, est->now.torque) : fx_neg(fw->trim);
+    fw->trim = fx_clamp(fx_add(fw->trim, fx_mul(fw->trim_k, trim_in)), fx_neg(trim_lim), trim_lim);
+    fw->refs.torque = fx_add(tref, fw->trim);
+    fw->refs.psi = weak != 0u ? lim.psi_ref : 0;
+    fw->torque_max = lim.torque_max;
+    fw->torque_ref_now = tref;
+    tm->torque_max = lim.torque_max;
+    tm->fw_limit = (uint8_t)(lim.limit + 4u * lim.clipped + 8u * weak);
 
     const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed
@@ -489,6 +521,8 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         if (out.ctrl_reset != 0u) {
             fw->ctrl->reset(fw->ctrl_state.bytes);
             ctrl_estimator_reset(&fw->est, &fw->params);
+            ctrl_fieldweak_reset(&fw->fwk);
+            fw->trim = 0;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
         }
         fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
@@ -645,8 +679,8 @@ void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu)
     if (fw != NULL) {
         if (fw->ref_mode != FW_REF_SPEED) {
             /* Bumpless: the integrator starts at the present torque reference. */
-            ctrl_speed_pi_reset(&fw->speed_pi, fw->refs.torque);
-            fw->speed_tref = fw->refs.torque;
+            ctrl_speed_pi_reset(&fw->speed_pi, fw->torque_ref_now);
+            fw->speed_tref = fw->torque_ref_now;
             fw->speed_cnt = 0u;
         }
         fw->speed_ref = omega_e_pu;

@@ -52,6 +52,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "estimator.h"
+#include "field_weak.h"
 #include "flux_observer.h"
 #include "fw_state.h"
 #include "hal.h"
@@ -91,7 +92,10 @@ typedef struct {
     q24_t psi_d, psi_q;   /* rotor-frame stator flux at k, Q24 pu (|psi_s|, sector: main loop) */
     q24_t torque;         /* torque estimate at k, Q24 pu */
     q24_t omega_e;        /* electrical speed estimate, Q24 pu */
-    q24_t torque_ref;     /* torque reference used at k, Q24 pu */
+    q24_t torque_ref;     /* torque reference used at k (after the limits), Q24 pu */
+    q24_t torque_max;     /* |torque| limit of this period (field_weak.h), Q24 pu */
+    uint8_t fw_limit;     /* what bounds it: ctrl_fw_limit_t, + 4 when the request was
+                             clipped, + 8 when the flux reference is weakened */
     q24_t duty;           /* on-time of segment 0, Q24 fraction */
     q24_t legs[3];        /* leg duties written at k, Q24 fraction */
     uint32_t cycles;      /* ISR duration measured with hal_cycles */
@@ -104,6 +108,10 @@ typedef struct {
 #define FW_TM_RING 16u
 
 typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
+
+/* Corner of the mean-torque trim in field weakening (pipeline.c): the DRR
+ * EMA's, thesis sec. 5.3.2, as FST's f_i. */
+#define FW_TRIM_HZ 50.0
 
 /* Start-up configuration (SI, read once by fw_init). */
 typedef struct {
@@ -184,6 +192,13 @@ typedef struct {
     bool psi_engaged;    /* the estimate has left the band: params follow it */
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
     ctrl_refs_t refs;
+    /* Field weakening and the torque limit (regulators/field_weak.h): flux the
+     * voltage of this period allows, torque limit from the current circle,
+     * the voltage ellipse and MTPV; the references every controller sees. */
+    ctrl_fieldweak_t fwk;
+    q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */
+    q24_t trim;           /* mean-torque trim in field weakening, Q24 pu (pipeline.c) */
+    q24_t trim_k;         /* its gain per period, 1 - exp(-2 pi FW_TRIM_HZ / fs), Q24 */
     ctrl_speed_pi_t speed_pi;
     fw_ref_mode_t ref_mode;
     q24_t torque_ref;     /* Q24 pu (torque mode) */
@@ -192,6 +207,7 @@ typedef struct {
     q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
     q24_t torque_ref_min; /* Q24 pu, fx_neg(torque_ref_max) (set with it) */
     q24_t speed_tref;     /* last speed-PI output, Q24 pu (held between updates) */
+    q24_t torque_max;     /* torque limit of the last period (field weakening), Q24 pu */
     uint32_t speed_div;   /* periods per speed-PI update (>= 1) */
     uint32_t speed_cnt;   /* periods since the last update */
     fw_speed_info_t speed_info;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "ctrl_units.h"
+#include "field_weak_config.h"
 #include "pipeline.h"
 
 #include "flux_observer_config.h"
@@ -99,6 +100,22 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     if ((uint64_t)fw->enc_cpr * (uint64_t)fw->params.pole_pairs > (uint64_t)INT32_MAX) {
         return FW_ERANGE;
     }
+    /* Field weakening and the torque limit: rated current, 92 % of Vdc/sqrt(3)
+     * (field_weak_config.h defaults). */
+    ctrl_fieldweak_cfg_t fwc;
+    ctrl_fieldweak_cfg_default(&fwc);
+    const int fwrc =
+        ctrl_fieldweak_init(&fw->fwk, &fwc, fw->machine, &fw->bases, &fw->params, NULL, 0u);
+    if (fwrc != CTRL_OK) {
+        const ctrl_diag_t d = {
+            fwrc, "field-weakening constants (Lq < Ld, or beyond 100 pu)", "", 0.0, 0.0,
+            0.0,  "psi_pm_wb, ld_h, lq_h, rs_ohm, current_rated_a"};
+        fw->why = d;
+        return fwrc == CTRL_ERANGE ? FW_ERANGE : FW_EINVAL;
+    }
+    fw->torque_max = 0;
+    fw->trim_k =
+        ctrl_q24_from_double(1.0 - exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
     /* PM-flux tracking: the encoder-mode observer, its estimate adopted above

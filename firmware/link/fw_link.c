@@ -40,7 +40,7 @@ static void op_get_status(void *ctx, cmd_status_t *st)
     st->mode = fw->ref_mode == FW_REF_SPEED ? CMD_MODE_SPEED : CMD_MODE_TORQUE;
     st->speed_rpm = fw_link_rpm(fw, fw->estimate.omega_e);
     st->torque_nm = ctrl_q24_to_double(fw->estimate.now.torque) * fw->bases.torque_nm;
-    st->torque_ref_nm = ctrl_q24_to_double(fw->refs.torque) * fw->bases.torque_nm;
+    st->torque_ref_nm = ctrl_q24_to_double(fw->torque_ref_now) * fw->bases.torque_nm;
     st->speed_ref_rpm = fw_link_rpm(fw, fw->speed_ref);
     st->torque_max_nm = ctrl_q24_to_double(fw->torque_ref_max) * fw->bases.torque_nm;
     st->speed_max_rpm = l->speed_max_rpm;
@@ -522,6 +522,8 @@ static void fw_link_sample(const fw_t *fw, const fw_telemetry_t *r, tel_sample_t
     s->cycles = (int32_t)(r->cycles > (uint32_t)INT32_MAX ? (uint32_t)INT32_MAX : r->cycles);
     s->cm_step = (int32_t)r->cm_step;
     s->cm_progress = (int32_t)r->cm_progress;
+    s->torque_max = r->torque_max;
+    s->fw_limit = (int32_t)r->fw_limit;
 }
 
 void fw_link_poll(fw_link_t *l)

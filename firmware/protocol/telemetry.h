@@ -42,6 +42,8 @@ typedef enum {
     TEL_SIG_CYCLES,      /* ISR execution time, CPU cycles */
     TEL_SIG_CM_STEP,     /* commissioning step running (cm_step_id_t, 0 none) */
     TEL_SIG_CM_PROGRESS, /* its progress, per mille */
+    TEL_SIG_TORQUE_MAX,  /* |torque| limit of the period (current, voltage, MTPV) */
+    TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fw_limit_t) + 4 clipped + 8 flux weakened */
     TEL_SIG_COUNT
 } tel_sig_t;
 
@@ -51,12 +53,12 @@ typedef enum {
  * One sample, filled by the pipeline. Units of the raw int32 values:
  *   i_a i_b i_d i_q      Q24 pu of the current base (ctrl_bases_t.i_a)
  *   psi psi_ref          Q24 pu of the flux base (Wb)
- *   torque torque_ref    Q24 pu of the torque base (N*m)
+ *   torque torque_ref torque_max   Q24 pu of the torque base (N*m)
  *   speed speed_ref      Q24 pu of the speed base, electrical (w_rad_s)
  *   vdc                  Q24 pu of the voltage base (V)
  *   duty                 Q24 fraction of the period (FX_ONE = 100 %)
  *   theta                theta_e >> 8: Q24 fraction of a turn, [0, 2^24)
- *   vector sector state fault cycles cm_step cm_progress   plain integers
+ *   vector sector state fault cycles cm_step cm_progress fw_limit   plain integers
  */
 typedef struct {
     uint32_t tick; /* control period index k (wraps), sent in every frame */
@@ -67,6 +69,7 @@ typedef struct {
     int32_t vector, duty, vdc, theta, sector;
     int32_t state, fault, cycles;
     int32_t cm_step, cm_progress;
+    int32_t torque_max, fw_limit;
 } tel_sample_t;
 
 /* How a raw value turns into SI. */

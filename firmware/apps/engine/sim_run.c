@@ -77,7 +77,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
 
 static double sim_torque_ref_nm(const sim_run_t *r)
 {
-    return ctrl_q24_to_double(r->fw.refs.torque) * r->fw.bases.torque_nm;
+    return ctrl_q24_to_double(r->fw.torque_ref_now) * r->fw.bases.torque_nm;
 }
 
 /* The speed reference in force (r/min), NaN in torque mode. */
@@ -961,6 +961,18 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
                  c->speed_mode ? NAN
                                : ctrl_q24_to_double(r->fw.torque_ref_lim) * r->fw.bases.torque_nm);
     sim_json_num(f, "torque_limit_nm", r->torque_limit_nm);
+    {
+        /* Field weakening at the end of the run (pipeline.h fw_telemetry_t):
+         * the torque limit of the last period and what set it. */
+        static const char *const lim_names[CTRL_FW_LIMIT_COUNT] = {"current", "voltage", "mtpv",
+                                                                   "flux"};
+        const fw_telemetry_t *tm = fw_telemetry(&r->fw);
+        sim_json_num(f, "torque_max_nm",
+                     ctrl_q24_to_double(tm->torque_max) * r->fw.bases.torque_nm);
+        fprintf(f, "  \"fw_limit\": \"%s\",\n", lim_names[tm->fw_limit & 3u]);
+        fprintf(f, "  \"fw_clipped\": %u,\n  \"fw_weakening\": %u,\n", (tm->fw_limit >> 2) & 1u,
+                (tm->fw_limit >> 3) & 1u);
+    }
     sim_json_num(f, "speed_ref_rpm", sim_run_speed_ref_now(r));
     sim_json_num(f, "speed_imposed_rpm", c->free_mech ? NAN : sim_run_speed_rpm(r));
     sim_json_num(f, "load_nm", c->free_mech ? r->plant.load_torque_nm : NAN);
