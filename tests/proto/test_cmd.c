@@ -105,7 +105,7 @@ static void test_help_status_lists(void)
     assert_ok("ctrl list", "ok 3\r\n  * bst mock controller\r\n  - fst");
     assert_ok("param list", "ok 4\r\n  h_T 0.048 N*m [0, 1] torque");
     TEST_ASSERT_NOT_NULL(strstr(m.out, "  fs 10000 Hz [1000, 40000] ro control"));
-    assert_ok("tel list", "ok 20\r\n  0 i_a A phase current a\r\n");
+    assert_ok("tel list", "ok 22\r\n  0 i_a A phase current a\r\n");
     assert_ok("fault", "ok fault 0 none");
     TEST_ASSERT_EQUAL_UINT(0, m.mut_calls);
 }
