@@ -13,11 +13,14 @@
             the flux that gives the request within the current limit spans 1.7 % below the
             voltage's limit, less than the flux hysteresis half band (2 % of psi_pm, 2.6 %
             of the flux): checked for no fault and at least 75 % of the request.
+  robust    drr at 2250 r/min, 1.8 N*m, thesis SPMSM, with psi_pm +20 % in the controller:
+            torque ripple at most 1.5x the nominal (the PM-flux tracking of
+            fw_config_t.psi_adapt, default on, replaces the configured value at speed).
   reversal  thesis SPMSM, free rotor, speed reference +3400 -> -3400 r/min (field
             weakening on both sides, through standstill): no fault, the speed reaches
             -3200 r/min.
 
-usage: tools/fw_done_test.py SIM [--only envelope,reversal] [--machines ipmsm,spmsm]
+usage: tools/fw_done_test.py SIM [--only envelope,robust,reversal] [--machines ipmsm,spmsm]
                              [--ctrls m2ptfc,drr,fst,foc]
 Exit 0 when every point holds; prints one line per point.
 """
@@ -66,7 +69,7 @@ def sim(binary, args, tmp):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("sim")
-    ap.add_argument("--only", default="envelope,reversal")
+    ap.add_argument("--only", default="envelope,robust,reversal")
     ap.add_argument("--machines", default="ipmsm,spmsm")
     ap.add_argument("--ctrls", default="m2ptfc,drr,fst,foc")
     a = ap.parse_args()
@@ -96,6 +99,25 @@ def main():
                               f"request {want:.4g} N*m, mean {got if got is None else round(got, 4)}"
                               f" N*m ({'n/a' if got is None else f'{100 * (got / want - 1):+.1f} %'}),"
                               f" limit {r.get('torque_max_nm')} N*m ({r.get('fw_limit')}), fault {r.get('fault', r.get('err'))}")
+        if "robust" in a.only:
+            mfile = CASES["spmsm"][0]
+            off = os.path.join(tmp, "spmsm_psi120.ini")
+            with open(mfile) as f, open(off, "w") as g:
+                for ln in f:
+                    k = ln.split("=")[0].strip()
+                    g.write(f"psi_pm_wb = {1.2 * env.load_machine(mfile).psi!r}\n"
+                            if k == "psi_pm_wb" else ln)
+            base = ["--machine", mfile, "--controller", "drr", "--speed-rpm", 2250,
+                    "--torque-ref", 1.8, "--duration", 0.2, "--window", "0.1:0.2"]
+            nom = sim(a.sim, base, tmp)
+            err = sim(a.sim, base + ["--control-machine", off], tmp)
+            rn, re_ = nom.get("torque_ripple_nm"), err.get("torque_ripple_nm")
+            good = (nom.get("fault") == "none" and err.get("fault") == "none" and rn and re_
+                    and re_ <= 1.5 * rn)
+            bad += not good
+            print(f"{'ok  ' if good else 'FAIL'} robust drr 2250 r/min psi_pm +20 %: torque ripple "
+                  f"{re_} N*m against {rn} N*m nominal (x{re_ / rn if rn and re_ else float('nan'):.2f}"
+                  f", bound x1.5)")
         if "reversal" in a.only:
             mfile = CASES["spmsm"][0]
             scn = os.path.join(tmp, "rev.scn")

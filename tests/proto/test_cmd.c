@@ -130,7 +130,7 @@ static void test_state_changing_commands(void)
     assert_ok("tel start i_a i_b torque every 10", "ok tel mask=0x00000043 every=10 bytes=");
     TEST_ASSERT_EQUAL_HEX32(0x43u, m.st.tel_mask);
     TEST_ASSERT_EQUAL_UINT32(10u, m.st.tel_every);
-    assert_ok("tel start all", "ok tel mask=0x000fffff every=1");
+    assert_ok("tel start all", "ok tel mask=0x003fffff every=1");
     assert_ok("tel stop", "ok tel stopped");
     TEST_ASSERT_EQUAL_HEX32(0u, m.st.tel_mask);
     assert_ok("disarm", "ok disarmed");
