@@ -5,6 +5,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "arm_semihost.h"
 #include "qemu_mps2.h"
 
 #define REG32(addr) (*(volatile uint32_t *)(addr))
@@ -33,12 +34,6 @@
 #define NVIC_ISER0 REG32(0xE000E100u)
 #define NVIC_ICER0 REG32(0xE000E180u)
 #define NVIC_ICPR0 REG32(0xE000E280u)
-
-/* Semihosting operations */
-#define SYS_WRITE0 0x04
-#define SYS_EXIT 0x18
-#define SYS_EXIT_EXTENDED 0x20
-#define ADP_STOPPED_APPLICATION_EXIT 0x20026
 
 void TIMER0_Handler(void);
 
@@ -87,30 +82,16 @@ void uart_put_u32(uint32_t v)
     }
 }
 
-static int semihost_call(int op, const void *arg)
-{
-    register int r0 __asm__("r0") = op;
-    register const void *r1 __asm__("r1") = arg;
-    __asm__ volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");
-    return r0;
-}
-
 void semihost_write0(const char *s)
 {
     if (s != NULL) {
-        (void)semihost_call(SYS_WRITE0, s);
+        (void)arm_semihost_call(SYS_WRITE0, s);
     }
 }
 
 void semihost_exit(int code)
 {
-    /* SYS_EXIT_EXTENDED: QEMU exits with code & 0xFF (QEMU.md). */
-    const uint32_t block[2] = {ADP_STOPPED_APPLICATION_EXIT, (uint32_t)code};
-    (void)semihost_call(SYS_EXIT_EXTENDED, block);
-    /* Not reached under QEMU; a debugger without the extension gets SYS_EXIT. */
-    (void)semihost_call(SYS_EXIT, (const void *)(uintptr_t)ADP_STOPPED_APPLICATION_EXIT);
-    for (;;) {
-    }
+    arm_semihost_exit(code); /* QEMU exits with code & 0xFF */
 }
 
 int timer0_start(uint32_t hz, timer0_callback_t callback)

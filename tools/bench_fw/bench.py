@@ -7,7 +7,9 @@ Called by ./tools/bench (see README.md, "Interrupt cost and memory footprint"). 
   2. record a host closed loop per controller at 750 and 2250 r/min, 1.8 N*m;
   3. replay each recording through fw_isr on the emulated Cortex-M4 (QEMU with
      the plugin: exact instruction counts per call) and on the PC (wall time;
-     callgrind instruction counts);
+     callgrind instruction counts); shorter recordings through the same image
+     built for ARMv6-M on QEMU's microbit (Cortex-M0): instructions and a
+     Cortex-M0+ cycle range per call (cm0 preset flags, --no-cm0 skips it);
   4. footprint: per-controller image minus the baseline image;
   5. one table on stdout, everything in out/bench.json.
 """
@@ -30,6 +32,13 @@ SENSORLESS_RPM = 150  # 5 % of the thesis SPMSM's rated 3000 r/min (sensorless_c
 # Section indices of the plugin's end markers (order of the end= arguments).
 SECTIONS = ("empty", "boot", "run", "est", "step")
 MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
+# ARMv6-M: QEMU microbit (Cortex-M0, the Cortex-M0+'s instruction set), the
+# recording in the flash above the image (hal/qemu_microbit/qemu_microbit.h).
+CM0_BLOB_ADDR = 0x30000
+CM0_BLOB_MAX = 0x10000
+# The question of issue 11: m2ptfc's worst interrupt within one 10 kHz period of
+# a 64 MHz Cortex-M0+.
+CM0_FIT = {"ctrl": "m2ptfc", "f_cpu_hz": 64000000, "f_pwm_hz": 10000}
 # Thesis execution times (thesis Fig. 6.14), dSPACE DS1202 at 2 GHz, us.
 THESIS_US = {"m2ptfc": 4.6, "m1": 6.96, "m2": 9.24, "m3": 4.8}
 
@@ -78,8 +87,20 @@ def build(args):
     run(["cc", "-shared", "-fPIC", "-O2", "-Wall", "-Wextra", "-o", plugin,
          os.path.join(FW, "bench_plugin.c")])
     cdir = os.path.join(cm4, "tests", "bench", "bench_fw")
-    return {"rec": os.path.join(bdir, "bench_rec"), "host": os.path.join(bdir, "bench_host"),
-            "elf": os.path.join(cdir, "bench_cm4.elf"), "cdir": cdir, "plugin": plugin}
+    tools = {"rec": os.path.join(bdir, "bench_rec"), "host": os.path.join(bdir, "bench_host"),
+             "elf": os.path.join(cdir, "bench_cm4.elf"), "cdir": cdir, "plugin": plugin,
+             "machine": "mps2-an386", "blob": 0x20200000}
+    if args.cm0:
+        cm0 = args.cm0_build
+        configure(cm0, {"CMAKE_BUILD_TYPE": "Release", "CMAKE_C_FLAGS_RELEASE": "-O2 -g",
+                        "CMAKE_CXX_FLAGS_RELEASE": "-O2 -g", "PMSM_TARGET": "cm0"},
+                  toolchain=os.path.join(ROOT, "tools", "cmake", "arm-none-eabi-cm0.cmake"))
+        log("building cm0 (bench_cm0) in " + cm0)
+        run(["cmake", "--build", cm0, "-j2", "--target", "bench_cm0"])
+        tools["cm0"] = dict(tools, elf=os.path.join(cm0, "tests", "bench", "bench_fw",
+                                                    "bench_cm0.elf"),
+                            machine="microbit", blob=CM0_BLOB_ADDR)
+    return tools
 
 
 def symbols(elf):
@@ -104,13 +125,15 @@ def symbols(elf):
 
 def qemu_count(tools, syms_file, marks, rec, out_file, timeout=300, pcsec=None):
     """Runs the bench image on one recording with the counting plugin."""
+    cm0 = tools["machine"] == "microbit"
     plugin = ",".join([tools["plugin"], "out=" + out_file, "begin=%x" % marks[0]] +
                       ["end=%x" % a for a in marks[1:]] + ["syms=" + syms_file] +
-                      (["pcsec=%d" % pcsec] if pcsec is not None else []))
-    cmd = ["timeout", str(timeout), "qemu-system-arm", "-machine", "mps2-an386",
+                      (["pcsec=%d" % pcsec] if pcsec is not None else []) +
+                      (["cycles=m0plus"] if cm0 else []))
+    cmd = ["timeout", str(timeout), "qemu-system-arm", "-machine", tools["machine"],
            "-display", "none", "-monitor", "none", "-serial", "stdio",
            "-semihosting-config", "enable=on,target=native",
-           "-device", "loader,file=%s,addr=0x20200000,force-raw=on" % rec,
+           "-device", "loader,file=%s,addr=0x%x,force-raw=on" % (rec, tools["blob"]),
            "-plugin", plugin, "-kernel", tools["elf"]]
     r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                        stdin=subprocess.DEVNULL)
@@ -119,6 +142,7 @@ def qemu_count(tools, syms_file, marks, rec, out_file, timeout=300, pcsec=None):
         raise SystemExit("bench: QEMU replay of %s failed (%d): %s %s" %
                          (rec, r.returncode, line, r.stderr[-2000:]))
     sec = {s: [] for s in SECTIONS}
+    cyc = {s: [] for s in SECTIONS}  # (cycles as taken, conditional branches)
     prof = {s: {} for s in SECTIONS}
     pcs = {}
     with open(out_file) as f:
@@ -128,6 +152,8 @@ def qemu_count(tools, syms_file, marks, rec, out_file, timeout=300, pcsec=None):
                 pcs[int(p[1], 16)] = int(p[2])
             elif p[0] == "S":
                 sec[SECTIONS[int(p[1])]].append(int(p[2]))
+            elif p[0] == "C":
+                cyc[SECTIONS[int(p[1])]].append((int(p[2]), int(p[3])))
             elif p[0] == "F":
                 prof[SECTIONS[int(p[1])]][p[2]] = (int(p[3]), int(p[4]))
     over = set(sec["empty"])
@@ -136,8 +162,100 @@ def qemu_count(tools, syms_file, marks, rec, out_file, timeout=300, pcsec=None):
     o = over.pop()
     res = {s: [v - o for v in sec[s]] for s in SECTIONS if s != "empty"}
     kv = dict(re.findall(r"(\w+) (\d+)", line.replace("bench: ", "")))
+    if cm0:
+        # the marker pair's own cycles: those of the empty windows
+        co = set(cyc["empty"])
+        if len(co) != 1:
+            raise SystemExit("bench: marker cycles not constant: %s" % sorted(co))
+        oc, ob = co.pop()
+        cyc = {s: [(c - oc, b - ob) for c, b in cyc[s]] for s in SECTIONS if s != "empty"}
     return {"sections": res, "profile": prof, "overhead": o, "summary": kv,
-            "raw": sec, "pcs": pcs}
+            "raw": sec, "pcs": pcs, "cycles": cyc}
+
+
+def symbols_file(elf, path):
+    """Writes the image's functions for the plugin; returns (syms, marker addresses)."""
+    syms = symbols(elf)
+    with open(path, "w") as f:
+        for name, (a, size) in syms.items():
+            f.write("%x %d %s\n" % (a, size, name))
+    return syms, [syms[m][0] for m in MARKERS]
+
+
+def cm0_counts(args, tools, names, speeds, machine):
+    """ARMv6-M: record shorter closed loops (the recording must fit the
+    microbit's free flash), replay them on QEMU microbit; per controller the
+    instructions and the Cortex-M0+ cycle range of fw_isr, estimator and step."""
+    t = tools["cm0"]
+    recdir = os.path.join(args.work, "rec_cm0")
+    os.makedirs(recdir, exist_ok=True)
+    jobs = [(n, s) for n in names for s in speeds]
+
+    def record(job):
+        n, s = job
+        run([tools["rec"], "record", "--machine", machine, "--speed", str(s), "--torque",
+             str(TORQUE_NM), "--periods", str(args.cm0_periods), "--outdir", recdir,
+             "--ctrl", n])
+        path = os.path.join(recdir, "%s_%d.bin" % job)
+        if os.path.getsize(path) > CM0_BLOB_MAX:
+            raise SystemExit("bench: %s is %d bytes, above the %d the microbit image takes "
+                             "(--cm0-periods)" % (path, os.path.getsize(path), CM0_BLOB_MAX))
+        return path
+
+    log("ARMv6-M: recording %d run(s) of %d periods, counting on QEMU microbit" %
+        (len(jobs), args.cm0_periods))
+    with cf.ThreadPoolExecutor(args.jobs) as ex:
+        recs = dict(zip(jobs, ex.map(record, jobs)))
+    syms_file = os.path.join(args.work, "syms_cm0.txt")
+    _, marks = symbols_file(t["elf"], syms_file)
+
+    def count(job):
+        c = qemu_count(t, syms_file, marks, recs[job],
+                       os.path.join(args.work, "count_cm0_%s_%d.txt" % job))
+        if int(c["summary"].get("differs", -1)) != 0:
+            raise SystemExit("bench: ARMv6-M replay of %s at %d r/min differs from the "
+                             "recording" % job)
+        return job, c
+
+    with cf.ThreadPoolExecutor(args.jobs) as ex:
+        cnt = dict(ex.map(count, jobs))
+    res = {}
+    for n in names:
+        run_v = [v for s in speeds for v in cnt[(n, s)]["sections"]["run"]]
+        if not run_v:
+            continue
+        cyc = [c for s in speeds for c in cnt[(n, s)]["cycles"]["run"]]
+        est = [v for s in speeds for v in cnt[(n, s)]["sections"]["est"]]
+        stp = [v for s in speeds for v in cnt[(n, s)]["sections"]["step"]]
+        res[n] = {"cm0_instr_mean": round(statistics.fmean(run_v), 1),
+                  "cm0_instr_max": max(run_v),
+                  "cm0_est_mean": round(statistics.fmean(est), 1) if est else None,
+                  "cm0_step_mean": round(statistics.fmean(stp), 1) if stp else None,
+                  # worst call: cycles with every conditional branch taken (upper
+                  # bound) and with none taken (lower bound)
+                  "cm0p_cycles_max": max(c for c, _ in cyc),
+                  "cm0p_cycles_max_lo": max(c - b for c, b in cyc),
+                  "cm0p_cycles_mean": round(statistics.fmean(c - b / 2 for c, b in cyc), 1),
+                  "cm0_periods": len(run_v)}
+    return res
+
+
+def cm0_fit(cm0):
+    """Does CM0_FIT's controller fit its period on the Cortex-M0+? The worst
+    call's cycle range against f_cpu / f_pwm."""
+    r = cm0.get(CM0_FIT["ctrl"])
+    if r is None:
+        return None
+    budget = CM0_FIT["f_cpu_hz"] // CM0_FIT["f_pwm_hz"]
+    lo, hi = r["cm0p_cycles_max_lo"], r["cm0p_cycles_max"]
+    fits = True if hi <= budget else (False if lo > budget else None)
+    verdict = {True: "fits", False: "does not fit", None: "undecided (range spans the budget)"}
+    text = ("%s on a %d MHz Cortex-M0+ at %d kHz: worst fw_isr %d-%d cycles (%d ARMv6-M "
+            "instructions) against %d per period (%.0f-%.0f %%): %s" %
+            (CM0_FIT["ctrl"], CM0_FIT["f_cpu_hz"] // 1000000, CM0_FIT["f_pwm_hz"] // 1000,
+             lo, hi, r["cm0_instr_max"], budget, 100.0 * lo / budget, 100.0 * hi / budget,
+             verdict[fits]))
+    return dict(CM0_FIT, budget_cycles=budget, worst_cycles=[lo, hi], fits=fits, text=text)
 
 
 def hotspots(tools, syms, syms_file, marks, recs, name, speeds, work):
@@ -215,6 +333,12 @@ def main():
                          "5 %% of rated speed (the forced start's final speed), so that the forced "
                          "start, the handover (about 1100 periods) and the observer are counted")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--cm0-build", default=os.environ.get(
+        "BENCH_CM0_BUILD", os.path.join(ROOT, "build", "cm0")))
+    ap.add_argument("--cm0-periods", type=int, default=1000,
+                    help="running periods per ARMv6-M recording (its flash holds about 1700)")
+    ap.add_argument("--no-cm0", dest="cm0", action="store_false",
+                    help="no ARMv6-M (QEMU microbit) counts")
     ap.add_argument("--hotspots", default="m2ptfc,m1",
                     help="controllers with a per-source-line profile (empty: none)")
     args = ap.parse_args()
@@ -254,12 +378,8 @@ def main():
     recs = {(n, s): os.path.join(recdir, "%s_%d.bin" % (n, s)) for n, s in jobs}
 
     # --- Cortex-M4 instruction counts (QEMU + plugin) ---
-    syms = symbols(tools["elf"])
     syms_file = os.path.join(args.work, "syms.txt")
-    with open(syms_file, "w") as f:
-        for name, (a, size) in syms.items():
-            f.write("%x %d %s\n" % (a, size, name))
-    marks = [syms[m][0] for m in MARKERS]
+    syms, marks = symbols_file(tools["elf"], syms_file)
     log("counting Cortex-M4 instructions in QEMU (%d runs)" % len(jobs))
 
     def count(job):
@@ -287,6 +407,20 @@ def main():
                                         len(v), deterministic))
         if not (min(v) > 100 and max(v) < 20000):
             raise SystemExit("bench: implausible count")
+        if args.cm0:
+            r = cm0_counts(args, tools, [det_job[0]], speeds, machine).get(det_job[0])
+            if r is None:
+                raise SystemExit("bench: %s: no running period on ARMv6-M" % det_job[0])
+            print("bench quick: ARMv6-M (QEMU microbit) %s %d r/min: fw_isr mean %.1f max %d "
+                  "instructions over %d calls, replay identical to the recording; worst call "
+                  "%d-%d Cortex-M0+ cycles" % (det_job[0], det_job[1], r["cm0_instr_mean"],
+                                               r["cm0_instr_max"], r["cm0_periods"],
+                                               r["cm0p_cycles_max_lo"], r["cm0p_cycles_max"]))
+            # every instruction takes at least one cycle; the bound with every
+            # branch taken is not below the one with none taken
+            if not (100 < r["cm0_instr_max"] < 100000 and
+                    r["cm0_instr_max"] <= r["cm0p_cycles_max_lo"] <= r["cm0p_cycles_max"]):
+                raise SystemExit("bench: implausible ARMv6-M count")
         return 0
 
     failed = [n for n in names if any(not cm4[(n, s)]["sections"]["run"] for s in speeds)]
@@ -329,6 +463,8 @@ def main():
         with cf.ThreadPoolExecutor(args.jobs) as ex:
             host_instr = dict(ex.map(cg, names))
 
+    cm0 = cm0_counts(args, tools, names, speeds, machine) if args.cm0 else {}
+
     # --- footprint ---
     sizes = {}
     for n in ["none"] + names:
@@ -367,6 +503,7 @@ def main():
         r["ram_bytes"] = sizes[n][1] - sizes["none"][1]
         r["state_bytes"] = int(cm4[(n, speeds[0])]["summary"].get("state_bytes", 0))
         r["fs_hz"] = int(cm4[(n, speeds[0])]["summary"].get("fs", 0))
+        r.update(cm0.get(n, {}))
         res[n] = r
     ref = "m1" if "m1" in res else names[0]
     for n in names:
@@ -390,6 +527,15 @@ def main():
                          "whose registry holds only this controller, minus the same image with "
                          "an empty registry; flash = text + data, ram = data + bss; "
                          "state_bytes = desc->state_size (lives in fw_t's fixed block)",
+            "cm0": "QEMU microbit (Cortex-M0, ARMv6-M = the Cortex-M0+'s instruction set), "
+                   "image bench_cm0 built with the cm0 preset's flags (-mcpu=cortex-m0plus "
+                   "-O2 -g), %d-period recordings replayed through fw_isr, checked period by "
+                   "period; cm0_instr_*: instructions per running-period call; cm0p_cycles_*: "
+                   "Cortex-M0+ cycles from the plugin's per-instruction weights (ARM DDI 0484C "
+                   "Table 3-1, zero-wait-state memory, single-cycle multiplier; max: worst call "
+                   "with every conditional branch taken, max_lo: with none taken; mean: "
+                   "half taken); exception entry and exit (about 30 cycles) not included"
+                   % args.cm0_periods,
         },
         "deterministic": deterministic,
         "thesis_us": THESIS_US,
@@ -398,6 +544,7 @@ def main():
         "controllers": res,
         "failed": failed,
         "hotspots": hot,
+        "cm0_fit": cm0_fit(cm0) if cm0 else None,
     }
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, "w") as f:
@@ -408,9 +555,9 @@ def main():
 
 def print_table(doc, names, ref, out_path):
     c = doc["controllers"]
-    hdr = ("%-10s %9s %7s %8s %8s %8s %8s %8s %6s %9s %7s %6s %6s" %
+    hdr = ("%-10s %9s %7s %8s %8s %8s %8s %8s %6s %9s %7s %6s %6s %8s %6s" %
            ("controller", "cm4 mean", "max", "@750", "@2250", "est", "step", "host ns", "/m1",
-            "host ins", "flash", "ram", "state"))
+            "host ins", "flash", "ram", "state", "m0 mean", "max"))
     print(hdr)
     print("-" * len(hdr))
     for n in names:
@@ -419,19 +566,23 @@ def print_table(doc, names, ref, out_path):
         m2250 = (r.get("cm4_2250") or {}).get("mean", float("nan"))
         flag = "*" if any(r.get("not_running_periods_%d" % s, 0) for s in SPEEDS) else ""
         hi = r["host_instr"]
-        print("%-10s %9.1f %7d %8.1f %8.1f %8s %8s %8.1f %6.2f %9s %7d %6d %6d" %
+        print("%-10s %9.1f %7d %8.1f %8.1f %8s %8s %8.1f %6.2f %9s %7d %6d %6d %8s %6s" %
               (n + flag, r["cm4_instr_mean"], r["cm4_instr_max"], m750, m2250,
                "%.1f" % r["cm4_est_mean"] if r["cm4_est_mean"] is not None else "-",
                "%.1f" % r["cm4_step_mean"] if r["cm4_step_mean"] is not None else "-",
                r["host_ns_median"], r["host_ratio_to_m1"],
                "%.1f" % hi if hi is not None else "-", r["flash_bytes"], r["ram_bytes"],
-               r["state_bytes"]))
+               r["state_bytes"], "%.1f" % r["cm0_instr_mean"] if "cm0_instr_mean" in r else "-",
+               r.get("cm0_instr_max", "-")))
     print()
     print("cm4: Cortex-M4 instructions per fw_isr call (QEMU, exact, deterministic: %s); "
           "est/step: estimator / controller step alone (mean); host ns: median wall time per "
           "call (-O2, this PC); /m1: host ratio to %s; host ins: callgrind instructions per "
-          "call; flash/ram: bytes added to a cm4 image; state: controller state bytes."
+          "call; flash/ram: bytes added to a cm4 image; state: controller state bytes; "
+          "m0: ARMv6-M instructions per fw_isr call (QEMU microbit, shorter recordings)."
           % (doc["deterministic"], ref))
+    if doc.get("cm0_fit"):
+        print(doc["cm0_fit"]["text"])
     faulted = ["%s@%d" % (n, s) for n in names for s in SPEEDS
                if c[n].get("not_running_periods_%d" % s, 0)]
     if faulted:

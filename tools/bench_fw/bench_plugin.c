@@ -13,6 +13,15 @@
  *   pcsec=N       optional: per-instruction-address counts of the windows that
  *                 end in section N ("A addr count" at exit; slower: one
  *                 callback per instruction; addresses below 1 MB only)
+ *   cycles=m0plus optional: also a Cortex-M0+ cycle bound per window,
+ *                 "C i cycles cond_branches" after its "S" line: every
+ *                 instruction weighted by its cycle count in the Cortex-M0+
+ *                 Technical Reference Manual (ARM DDI 0484C, Table 3-1:
+ *                 loads and stores 2, LDM/STM/PUSH 1+N, POP 1+N or 3+N with PC,
+ *                 B and BX 2, BL 3, MULS 1 with the single-cycle multiplier, the
+ *                 rest 1), a conditional branch counted as taken (2): the true
+ *                 count lies in [cycles - cond_branches, cycles] (zero-wait-state
+ *                 memory)
  * Every instruction adds 1 to a global counter (and to its function's counter)
  * with an inline operation. When the begin marker's first instruction is
  * reached the counters are snapshot; when end marker i's is reached, the
@@ -61,6 +70,8 @@ void qemu_plugin_register_vcpu_insn_exec_inline(struct qemu_plugin_insn *insn,
 size_t qemu_plugin_tb_n_insns(const struct qemu_plugin_tb *tb);
 struct qemu_plugin_insn *qemu_plugin_tb_get_insn(const struct qemu_plugin_tb *tb, size_t idx);
 uint64_t qemu_plugin_insn_vaddr(const struct qemu_plugin_insn *insn);
+const void *qemu_plugin_insn_data(const struct qemu_plugin_insn *insn);
+size_t qemu_plugin_insn_size(const struct qemu_plugin_insn *insn);
 void qemu_plugin_register_atexit_cb(qemu_plugin_id_t id, qemu_plugin_udata_cb_t cb, void *userdata);
 void qemu_plugin_outs(const char *string);
 
@@ -99,6 +110,51 @@ static uint32_t *pc_pending; /* counts of the open window */
 static uint64_t *pc_total;   /* of the windows of section pc_sec */
 static uint32_t *pc_touched; /* slots incremented in the open window, in order */
 static uint32_t pc_n_touched;
+static bool cycles_m0plus;
+static uint64_t ccount, ccount0; /* Cortex-M0+ cycles, conditional branches as taken */
+static uint64_t bcount, bcount0; /* conditional branches executed */
+
+static unsigned popcount8(unsigned v)
+{
+    unsigned n = 0;
+    for (; v != 0u; v &= v - 1u) {
+        n++;
+    }
+    return n;
+}
+
+/* Cycles of one ARMv6-M instruction on a Cortex-M0+ (ARM DDI 0484C, Table 3-1),
+ * a conditional branch as taken; *cond = 1 for a conditional branch. */
+static unsigned m0plus_cycles(const uint8_t *b, size_t size, unsigned *cond)
+{
+    *cond = 0u;
+    const unsigned h = (unsigned)b[0] | ((unsigned)b[1] << 8);
+    if (size == 4u) {
+        return 3u; /* BL; MSR, MRS, DMB, DSB, ISB: the other 32-bit ones */
+    }
+    if ((h >> 11) == 0x09u || (h >> 12) == 0x5u || (h >> 13) == 0x3u || (h >> 12) == 0x8u ||
+        (h >> 12) == 0x9u) {
+        return 2u; /* LDR literal, register offset, immediate, halfword, SP-relative; STR */
+    }
+    if ((h & 0xFE00u) == 0xB400u) {
+        return 1u + popcount8(h & 0xFFu) + ((h >> 8) & 1u); /* PUSH {..., LR} */
+    }
+    if ((h & 0xFE00u) == 0xBC00u) {
+        const unsigned pc = (h >> 8) & 1u;
+        return 1u + popcount8(h & 0xFFu) + pc + 2u * pc; /* POP, 3 + N with PC */
+    }
+    if ((h >> 12) == 0xCu) {
+        return 1u + popcount8(h & 0xFFu); /* LDM, STM */
+    }
+    if ((h >> 12) == 0xDu && ((h >> 8) & 0xEu) != 0xEu) {
+        *cond = 1u;
+        return 2u; /* B<cond>: 2 taken, 1 not */
+    }
+    if ((h >> 11) == 0x1Cu || (h & 0xFF00u) == 0x4700u) {
+        return 2u; /* B, BX, BLX */
+    }
+    return 1u;
+}
 
 static int sym_index(uint64_t a)
 {
@@ -147,6 +203,8 @@ static void on_begin(unsigned int vcpu, void *ud)
         pc_clear(false);
     }
     icount0 = icount;
+    ccount0 = ccount;
+    bcount0 = bcount;
     memcpy(fsnap, fcount, sizeof(uint64_t) * (size_t)(n_syms + 1));
     memcpy(esnap, fentry, sizeof(uint64_t) * (size_t)(n_syms + 1));
     open_window = true;
@@ -164,6 +222,9 @@ static void on_end(unsigned int vcpu, void *ud)
         pc_clear(sec == pc_sec);
     }
     fprintf(out, "S %d %" PRIu64 "\n", sec, icount - icount0);
+    if (cycles_m0plus) {
+        fprintf(out, "C %d %" PRIu64 " %" PRIu64 "\n", sec, ccount - ccount0, bcount - bcount0);
+    }
     for (int i = 0; i <= n_syms; i++) {
         fprof[sec][i] += fcount[i] - fsnap[i];
         eprof[sec][i] += fentry[i] - esnap[i];
@@ -193,6 +254,17 @@ static void on_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
                                                    (void *)(uintptr_t)(a / 2u));
         }
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64, &icount, 1u);
+        if (cycles_m0plus) {
+            unsigned cond;
+            const unsigned w =
+                m0plus_cycles(qemu_plugin_insn_data(insn), qemu_plugin_insn_size(insn), &cond);
+            qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64, &ccount,
+                                                       w);
+            if (cond != 0u) {
+                qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
+                                                           &bcount, 1u);
+            }
+        }
         if (n_syms > 0) {
             const int si = sym_index(a);
             qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
@@ -275,6 +347,8 @@ int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info, int argc, 
             if (pc_pending == NULL || pc_total == NULL || pc_touched == NULL) {
                 return -1;
             }
+        } else if (strcmp(a, "cycles=m0plus") == 0) {
+            cycles_m0plus = true;
         } else if (strncmp(a, "syms=", 5) == 0) {
             if (load_syms(a + 5) != 0) {
                 fprintf(stderr, "bench_plugin: cannot read %s\n", a + 5);

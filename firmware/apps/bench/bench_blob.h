@@ -19,8 +19,10 @@
 
 #define BENCH_MAGIC 0x42534d50u /* "PMSB" */
 #define BENCH_VERSION 1u
+#ifndef BENCH_BLOB_ADDR             /* the build may place it elsewhere (bench_cm0) */
 #define BENCH_BLOB_ADDR 0x20200000u /* QEMU RAM, 2 MB below the stack top */
 #define BENCH_BLOB_MAX 0x00100000u  /* 1 MB */
+#endif
 
 #define BENCH_CMD_TORQUE 0x1u /* fw_set_torque_ref(hdr.torque_ref_q24) before the ISR */
 #define BENCH_CMD_ARM 0x2u    /* fw_cmd_arm before the ISR */

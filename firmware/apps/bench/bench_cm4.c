@@ -1,5 +1,6 @@
 /*
- * Cortex-M4 (QEMU mps2-an386) image of the interrupt-cost benchmark.
+ * Cortex-M4 (QEMU mps2-an386) image of the interrupt-cost benchmark; built as
+ * bench_cm0 for ARMv6-M (QEMU microbit, BENCH_MICROBIT).
  *
  * QEMU's `-device loader` puts a recording (bench_blob.h) at BENCH_BLOB_ADDR;
  * this image replays it through fw_isr with the replay HAL and brackets every
@@ -26,7 +27,11 @@
 #include "controller.h"
 #include "estimator.h"
 #include "plan.h"
+#if defined(BENCH_MICROBIT)
+#include "qemu_microbit.h" /* bench_cm0: the same image on ARMv6-M */
+#else
 #include "qemu_mps2.h"
+#endif
 
 /* Markers: distinct (the image is built with -fno-ipa-icf), never inlined. */
 #define BENCH_MARK(name)                                                                           \
