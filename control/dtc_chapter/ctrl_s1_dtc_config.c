@@ -241,19 +241,8 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 }
 
 #define S1_DESC(id, label, st, tun, initfn, resetfn, stepfn, est)                                  \
-    const ctrl_desc_t ctrl_desc_##id = {                                                           \
-        .name = #id,                                                                               \
-        .title = label,                                                                            \
-        .fs_default_hz = S1_FS_HZ,                                                                 \
-        CTRL_DESC_SIZES(st, ctrl_s1_cfg_t),                                                        \
-        .tunables = tun,                                                                           \
-        .n_tunables = sizeof tun / sizeof tun[0],                                                  \
-        .cfg_default = s1_cfg_default,                                                             \
-        .init = initfn,                                                                            \
-        .reset = resetfn,                                                                          \
-        .step = stepfn,                                                                            \
-        .est_unused = CTRL_EST_ONLY(est),                                                          \
-    }
+    CTRL_DESC_DEFINE(id, label, S1_FS_HZ, st, ctrl_s1_cfg_t, tun, s1_cfg_default, initfn, resetfn, \
+                     stepfn, est)
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",
         ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step,

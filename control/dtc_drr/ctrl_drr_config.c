@@ -238,20 +238,11 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return CTRL_OK;
 }
 
-const ctrl_desc_t ctrl_desc_drr = {
-    .name = "drr",
-    .title = "DRR-DTC: multiobjective duty-ratio regulation, virtual reference (thesis ch. 5, "
-             "(5.1)-(5.16))",
-    .fs_default_hz = CTRL_DRR_FS_HZ,
-    CTRL_DESC_SIZES(ctrl_drr_state_t, ctrl_drr_cfg_t),
-    .tunables = drr_tunables,
-    .n_tunables = sizeof drr_tunables / sizeof drr_tunables[0],
-    .cfg_default = drr_cfg_default,
-    .init = drr_init,
-    .reset = ctrl_drr_reset,
-    .step = ctrl_drr_step,
-    .est_unused = CTRL_EST_ONLY(CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT),
-};
+CTRL_DESC_DEFINE(drr,
+                 "DRR-DTC: multiobjective duty-ratio regulation, virtual reference (thesis ch. 5, "
+                 "(5.1)-(5.16))",
+                 CTRL_DRR_FS_HZ, ctrl_drr_state_t, ctrl_drr_cfg_t, drr_tunables, drr_cfg_default,
+                 drr_init, ctrl_drr_reset, ctrl_drr_step, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 
 /* ---------------- baselines ---------------- */
 
@@ -375,19 +366,8 @@ static int df_init(void *state, const void *cfg, const ctrl_setup_t *su)
 }
 
 #define DRR_BASE_DESC(id, label, tun, initfn, est)                                                 \
-    const ctrl_desc_t ctrl_desc_##id = {                                                           \
-        .name = #id,                                                                               \
-        .title = label,                                                                            \
-        .fs_default_hz = CTRL_DRR_FS_HZ,                                                           \
-        CTRL_DESC_SIZES(ctrl_drr_base_state_t, ctrl_drr_base_cfg_t),                               \
-        .tunables = tun,                                                                           \
-        .n_tunables = sizeof tun / sizeof tun[0],                                                  \
-        .cfg_default = base_cfg_default,                                                           \
-        .init = initfn,                                                                            \
-        .reset = ctrl_drr_base_reset,                                                              \
-        .step = ctrl_drr_base_step,                                                                \
-        .est_unused = CTRL_EST_ONLY(est),                                                          \
-    }
+    CTRL_DESC_DEFINE(id, label, CTRL_DRR_FS_HZ, ctrl_drr_base_state_t, ctrl_drr_base_cfg_t, tun,   \
+                     base_cfg_default, initfn, ctrl_drr_base_reset, ctrl_drr_base_step, est)
 
 DRR_BASE_DESC(drr_d1, "DRR baseline D1: D = |T_err/C_T| + |psi_err/C_psi| (thesis (5.19))",
               d1_tunables, d1_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);

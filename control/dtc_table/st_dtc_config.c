@@ -144,19 +144,8 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
 }
 
 #define ST_HYST_DESC(id, label, initfn, est)                                                       \
-    const ctrl_desc_t ctrl_desc_##id = {                                                           \
-        .name = #id,                                                                               \
-        .title = label,                                                                            \
-        .fs_default_hz = ST_FS_HZ,                                                                 \
-        CTRL_DESC_SIZES(st_hyst_state_t, st_hyst_cfg_t),                                           \
-        .tunables = hyst_tunables,                                                                 \
-        .n_tunables = sizeof hyst_tunables / sizeof hyst_tunables[0],                              \
-        .cfg_default = st_hyst_cfg_default,                                                        \
-        .init = initfn,                                                                            \
-        .reset = st_hyst_reset,                                                                    \
-        .step = st_hyst_step,                                                                      \
-        .est_unused = CTRL_EST_ONLY(est),                                                          \
-    }
+    CTRL_DESC_DEFINE(id, label, ST_FS_HZ, st_hyst_state_t, st_hyst_cfg_t, hyst_tunables,           \
+                     st_hyst_cfg_default, initfn, st_hyst_reset, st_hyst_step, est)
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init,
              CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
@@ -168,16 +157,7 @@ ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4
 ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (Table 4.5)",
              st_zst_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
 
-const ctrl_desc_t ctrl_desc_fst = {
-    .name = "fst",
-    .title = "ST-DTC, flexible switching table + voltage replacement (thesis sec. 4.5, Table 4.6)",
-    .fs_default_hz = ST_FS_HZ,
-    CTRL_DESC_SIZES(st_fst_state_t, st_fst_cfg_t),
-    .tunables = fst_tunables,
-    .n_tunables = sizeof fst_tunables / sizeof fst_tunables[0],
-    .cfg_default = st_fst_cfg_default,
-    .init = st_fst_init,
-    .reset = st_fst_reset,
-    .step = st_fst_step,
-    .est_unused = CTRL_EST_ONLY(CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT),
-};
+CTRL_DESC_DEFINE(
+    fst, "ST-DTC, flexible switching table + voltage replacement (thesis sec. 4.5, Table 4.6)",
+    ST_FS_HZ, st_fst_state_t, st_fst_cfg_t, fst_tunables, st_fst_cfg_default, st_fst_init,
+    st_fst_reset, st_fst_step, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);

@@ -156,31 +156,14 @@ static int foc_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return foc_init_common(state, cfg, su, 1);
 }
 
-const ctrl_desc_t ctrl_desc_foc = {
-    .name = "foc",
-    .title =
-        "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
-    .fs_default_hz = FOC_FS_HZ,
-    CTRL_DESC_SIZES(ctrl_foc_state_t, ctrl_foc_cfg_t),
-    .tunables = foc_tunables,
-    .n_tunables = sizeof foc_tunables / sizeof foc_tunables[0],
-    .cfg_default = foc_cfg_default,
-    .init = foc_init,
-    .reset = ctrl_foc_reset,
-    .step = ctrl_foc_step,
-    .est_unused = CTRL_EST_ONLY(0u), /* rotor-frame currents and fluxes only */
-};
+/* FOC reads no optional estimator output: rotor-frame currents and fluxes only. */
+CTRL_DESC_DEFINE(
+    foc, "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
+    FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_tunables, foc_cfg_default, foc_init,
+    ctrl_foc_reset, ctrl_foc_step, 0u);
 
-const ctrl_desc_t ctrl_desc_foc_hyst = {
-    .name = "foc_hyst",
-    .title = "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
-    .fs_default_hz = FOC_FS_HZ,
-    CTRL_DESC_SIZES(ctrl_foc_state_t, ctrl_foc_cfg_t),
-    .tunables = foc_hyst_tunables,
-    .n_tunables = sizeof foc_hyst_tunables / sizeof foc_hyst_tunables[0],
-    .cfg_default = foc_cfg_default,
-    .init = foc_hyst_init,
-    .reset = ctrl_foc_reset,
-    .step = ctrl_foc_step,
-    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT), /* the angle at k+1 */
-};
+/* The hysteresis variant reads the angle at k+1. */
+CTRL_DESC_DEFINE(foc_hyst,
+                 "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
+                 FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_hyst_tunables, foc_cfg_default,
+                 foc_hyst_init, ctrl_foc_reset, ctrl_foc_step, CTRL_EST_SC_NEXT);

@@ -93,6 +93,26 @@ typedef struct ctrl_desc {
                     int ok;                                                                        \
                 })
 
+/* Defines the descriptor ctrl_desc_<id> (name "<id>"): its sizes checked
+ * against the blocks above (CTRL_DESC_SIZES), the tunables counted from their
+ * array, est_read the optional estimator outputs (CTRL_EST_* of estimator.h)
+ * the controller reads (est_unused = the others). */
+#define CTRL_DESC_DEFINE(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_, init_,  \
+                         reset_, step_, est_read)                                                  \
+    const ctrl_desc_t ctrl_desc_##id = {                                                           \
+        .name = #id,                                                                               \
+        .title = title_,                                                                           \
+        .fs_default_hz = fs_hz,                                                                    \
+        CTRL_DESC_SIZES(state_type, cfg_type),                                                     \
+        .tunables = tunables_,                                                                     \
+        .n_tunables = sizeof tunables_ / sizeof tunables_[0],                                      \
+        .cfg_default = cfg_default_,                                                               \
+        .init = init_,                                                                             \
+        .reset = reset_,                                                                           \
+        .step = step_,                                                                             \
+        .est_unused = CTRL_EST_ONLY(est_read),                                                     \
+    }
+
 /* Registry (controller_registry.c; the entries are chosen at build time by
  * the CMake list PMSM_CONTROLLERS). */
 size_t ctrl_count(void);

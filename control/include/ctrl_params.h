@@ -51,7 +51,8 @@ typedef struct {
 } ctrl_bases_t;
 
 #define CTRL_MTPA_N 64                  /* segments of the IPMSM MTPA table */
-#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (docs/algorithms.md) */
+#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (docs/algorithms.md)   \
+                                         */
 #define CTRL_DANGLE_SHIFT 26u           /* fractional bits of dangle_to_omega */
 /* Range of Ts in pu, the angle one period turns at rated speed (rad). */
 #define CTRL_TS_PU_MIN 1.0e-3
@@ -117,6 +118,11 @@ typedef struct {
     double value, min, max;
     const char *depends; /* the SI data a derived quantity follows from, or NULL */
 } ctrl_diag_t;
+
+/* Fill *d (if not NULL) with the refusal and return code (configuration
+ * only; one home for ctrl_params_init_diag's and ctrl_setup_refuse's records). */
+int ctrl_diag_refuse(ctrl_diag_t *d, int code, const char *quantity, const char *unit, double value,
+                     double lo, double hi, const char *depends);
 
 /*
  * Validate the machine data and compute bases and fixed-point parameters for a

@@ -134,18 +134,11 @@ static int mtpa_table(ctrl_params_t *p, double ld, double lq, double psi_pm, dou
     return CTRL_OK;
 }
 
-/* Record why a value was refused (quantity, value, accepted range) and return code. */
-static int refuse(ctrl_diag_t *d, int code, const char *quantity, const char *unit, double value,
-                  double lo, double hi, const char *depends)
+int ctrl_diag_refuse(ctrl_diag_t *d, int code, const char *quantity, const char *unit, double value,
+                     double lo, double hi, const char *depends)
 {
     if (d != NULL) {
-        d->code = code;
-        d->quantity = quantity;
-        d->unit = unit;
-        d->value = value;
-        d->min = lo;
-        d->max = hi;
-        d->depends = depends;
+        *d = (ctrl_diag_t){code, quantity, unit, value, lo, hi, depends};
     }
     return code;
 }
@@ -161,11 +154,12 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
 {
     /* ---- SI data: finite, positive, below limits that only catch unit mistakes ---- */
     if (m->pole_pairs < 1 || m->pole_pairs > LIM_POLE_PAIRS) {
-        return refuse(d, CTRL_EINVAL, "pole_pairs", "", (double)m->pole_pairs, 1.0,
-                      (double)LIM_POLE_PAIRS, NULL);
+        return ctrl_diag_refuse(d, CTRL_EINVAL, "pole_pairs", "", (double)m->pole_pairs, 1.0,
+                                (double)LIM_POLE_PAIRS, NULL);
     }
     if (fs_hz == 0u || fs_hz > LIM_FS_HZ) {
-        return refuse(d, CTRL_EINVAL, "fs_hz", "Hz", (double)fs_hz, 1.0, (double)LIM_FS_HZ, NULL);
+        return ctrl_diag_refuse(d, CTRL_EINVAL, "fs_hz", "Hz", (double)fs_hz, 1.0,
+                                (double)LIM_FS_HZ, NULL);
     }
     const struct {
         const char *name, *unit;
@@ -187,8 +181,8 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     };
     for (size_t k = 0; k < sizeof si / sizeof si[0]; k++) {
         if (!si_ok(si[k].value, si[k].lo, si[k].hi, si[k].open)) {
-            return refuse(d, CTRL_EINVAL, si[k].name, si[k].unit, si[k].value, si[k].lo, si[k].hi,
-                          NULL);
+            return ctrl_diag_refuse(d, CTRL_EINVAL, si[k].name, si[k].unit, si[k].value, si[k].lo,
+                                    si[k].hi, NULL);
         }
     }
 
@@ -241,8 +235,8 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
     };
     for (size_t k = 0; k < sizeof pu / sizeof pu[0]; k++) {
         if (!(pu[k].value >= pu[k].lo && pu[k].value <= pu[k].hi)) {
-            return refuse(d, CTRL_ERANGE, pu[k].name, pu[k].unit, pu[k].value, pu[k].lo, pu[k].hi,
-                          pu[k].depends);
+            return ctrl_diag_refuse(d, CTRL_ERANGE, pu[k].name, pu[k].unit, pu[k].value, pu[k].lo,
+                                    pu[k].hi, pu[k].depends);
         }
     }
 
@@ -275,15 +269,16 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
 
     if (ctrl_params_set_speed_lpf(p, CTRL_SPEED_LPF_HZ_DEFAULT) != CTRL_OK &&
         ctrl_params_set_speed_lpf(p, 0.25 * (double)fs_hz) != CTRL_OK) {
-        return refuse(d, CTRL_ERANGE, "speed filter coefficient", "", 0.0, 0.0, 1.0, "fs_hz");
+        return ctrl_diag_refuse(d, CTRL_ERANGE, "speed filter coefficient", "", 0.0, 0.0, 1.0,
+                                "fs_hz");
     }
 
     p->mtpa_k = ctrl_q24_from_double(lq / psi_pm); /* (4.15): Lq / psi_pm */
     /* The MTPA table (for the SPMSM from the closed forms, dL = 0, for tools). */
     const int rc = mtpa_table(p, ld, p->salient != 0u ? lq : ld, psi_pm, i_max);
     if (rc != CTRL_OK) {
-        return refuse(d, rc, "MTPA torque at current_max", "pu", 0.0, 0.002, FIT_MAX,
-                      "current_max_a, psi_pm_wb, ld_h, lq_h");
+        return ctrl_diag_refuse(d, rc, "MTPA torque at current_max", "pu", 0.0, 0.002, FIT_MAX,
+                                "current_max_a, psi_pm_wb, ld_h, lq_h");
     }
     return CTRL_OK;
 }
@@ -295,12 +290,12 @@ int ctrl_params_init_diag(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_mach
         memset(why, 0, sizeof *why);
     }
     if (p == NULL || bases == NULL) {
-        return refuse(why, CTRL_EINVAL, "output pointer", "", 0.0, 0.0, 0.0, NULL);
+        return ctrl_diag_refuse(why, CTRL_EINVAL, "output pointer", "", 0.0, 0.0, 0.0, NULL);
     }
     memset(p, 0, sizeof *p);
     memset(bases, 0, sizeof *bases);
     if (m == NULL) {
-        return refuse(why, CTRL_EINVAL, "machine", "", 0.0, 0.0, 0.0, NULL);
+        return ctrl_diag_refuse(why, CTRL_EINVAL, "machine", "", 0.0, 0.0, 0.0, NULL);
     }
     const int rc = params_compute(p, bases, m, fs_hz, why);
     if (rc != CTRL_OK) {

@@ -7,25 +7,22 @@
 void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m1_t *s = state;
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_model_track(&s->model, ctx->params);
-    ctrl_mpc_basis(&s->model, ctx->est, &b);
-    const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+    ctrl_mpc_in_t in;
+    ctrl_mpc_in(&s->model, ctx, &in);
 
     /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
-    const q24_t num = fx_sub(t_ref, b.t0);
+    const q24_t num = fx_sub(in.t_ref, in.b.t0);
     int64_t best_g = INT64_MAX;
     uint8_t best_v = 1u;
     q24_t best_d = 0;
     for (uint8_t i = 1u; i <= 6u; i++) {
         q24_t vd;
         q24_t vq;
-        ctrl_mpc_vec_dq(&b, i, &vd, &vq);
-        const q24_t t_full = ctrl_mpc_torque(&s->model, b.d0 + vd, b.q0 + vq);
-        const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, b.t0)); /* (5.18) */
-        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &b, vd, vq, duty, t_ref, psi_ref,
-                                                 s->zeta); /* (6.13) */
+        ctrl_mpc_vec_dq(&in.b, i, &vd, &vq);
+        const q24_t t_full = ctrl_mpc_torque(&s->model, in.b.d0 + vd, in.b.q0 + vq);
+        const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, in.b.t0)); /* (5.18) */
+        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty, in.t_ref,
+                                                 in.psi_ref, s->zeta); /* (6.13) */
         s->trace.vec[i - 1u] = i;
         s->trace.duty[i - 1u] = duty;
         if (g < best_g) {

@@ -23,32 +23,29 @@ void ctrl_m2_reset(void *state)
 void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m2_t *s = state;
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_model_track(&s->model, ctx->params);
-    ctrl_mpc_basis(&s->model, ctx->est, &b);
-    const q24_t t_ref = ctx->ref->torque;
-    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+    ctrl_mpc_in_t in;
+    ctrl_mpc_in(&s->model, ctx, &in);
 
-    const int32_t r2 = ctrl_mpc_amp2(psi_ref, 0);
-    const uint8_t vec =
-        ctrl_m2_table(ctx->est->next.sector, t_ref >= b.t0, r2 >= ctrl_mpc_amp2(b.d0, b.q0));
+    const int32_t r2 = ctrl_mpc_amp2(in.psi_ref, 0);
+    const uint8_t vec = ctrl_m2_table(ctx->est->next.sector, in.t_ref >= in.b.t0,
+                                      r2 >= ctrl_mpc_amp2(in.b.d0, in.b.q0));
     q24_t vd;
     q24_t vq;
-    ctrl_mpc_vec_dq(&b, vec, &vd, &vq);
+    ctrl_mpc_vec_dq(&in.b, vec, &vd, &vq);
 
     /* Band of (6.17) on squared amplitudes. */
-    const q24_t lo = fx_max(fx_sub(psi_ref, s->eps_psi), 0);
+    const q24_t lo = fx_max(fx_sub(in.psi_ref, s->eps_psi), 0);
     const int32_t lo2 = ctrl_mpc_amp2(lo, 0);
-    const int32_t hi2 = ctrl_mpc_amp2(fx_add(psi_ref, s->eps_psi), 0);
+    const int32_t hi2 = ctrl_mpc_amp2(fx_add(in.psi_ref, s->eps_psi), 0);
 
     int64_t best_g = INT64_MAX; /* best feasible |T_ref - Te| (6.16) */
     unsigned best = 0u;
-    unsigned best_flux = 0u; /* fallback: smallest |psi_ref - |psi|| */
+    unsigned best_flux = 0u; /* fallback: smallest |in.psi_ref - |psi|| */
     int32_t best_flux_a2 = 0;
     for (unsigned nu = 0; nu <= s->y; nu++) {
         q24_t pd;
         q24_t pq;
-        ctrl_mpc_flux(&b, vd, vq, s->d_nu[nu], &pd, &pq);
+        ctrl_mpc_flux(&in.b, vd, vq, s->d_nu[nu], &pd, &pq);
         const int32_t a2 = ctrl_mpc_amp2(pd, pq);
         if (nu == 0u || ctrl_mpc_closer(a2, best_flux_a2, r2) < 0) {
             best_flux = nu;
@@ -59,7 +56,7 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         if (a2 < lo2 || a2 > hi2) {
             continue; /* phi = infinity (6.17) */
         }
-        const int64_t e_t = (int64_t)t_ref - ctrl_mpc_torque(&s->model, pd, pq);
+        const int64_t e_t = (int64_t)in.t_ref - ctrl_mpc_torque(&s->model, pd, pq);
         const int64_t g = e_t < 0 ? -e_t : e_t;
         if (g < best_g) {
             best_g = g;

@@ -52,17 +52,8 @@ static int m2_init(void *state, const void *cfg, const ctrl_setup_t *setup)
     return CTRL_OK;
 }
 
-const ctrl_desc_t ctrl_desc_m2 = {
-    .name = "m2",
-    .title = "Discrete-duty M2PTFC: D = nu/y (6.15), cost (6.16) with flux band (6.17) "
-             "(thesis 6.4.2)",
-    .fs_default_hz = 10000u,
-    CTRL_DESC_SIZES(ctrl_m2_t, ctrl_m2_cfg_t),
-    .tunables = m2_tunables,
-    .n_tunables = sizeof m2_tunables / sizeof m2_tunables[0],
-    .cfg_default = m2_cfg_default,
-    .init = m2_init,
-    .reset = ctrl_m2_reset,
-    .step = ctrl_m2_step,
-    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT),
-};
+CTRL_DESC_DEFINE(m2,
+                 "Discrete-duty M2PTFC: D = nu/y (6.15), cost (6.16) with flux band (6.17) "
+                 "(thesis 6.4.2)",
+                 10000u, ctrl_m2_t, ctrl_m2_cfg_t, m2_tunables, m2_cfg_default, m2_init,
+                 ctrl_m2_reset, ctrl_m2_step, CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT);

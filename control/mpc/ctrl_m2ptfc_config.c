@@ -46,16 +46,7 @@ static int m2ptfc_init(void *state, const void *cfg, const ctrl_setup_t *setup)
     return CTRL_OK;
 }
 
-const ctrl_desc_t ctrl_desc_m2ptfc = {
-    .name = "m2ptfc",
-    .title = "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
-    .fs_default_hz = 10000u,
-    CTRL_DESC_SIZES(ctrl_m2ptfc_t, ctrl_m2ptfc_cfg_t),
-    .tunables = m2ptfc_tunables,
-    .n_tunables = sizeof m2ptfc_tunables / sizeof m2ptfc_tunables[0],
-    .cfg_default = m2ptfc_cfg_default,
-    .init = m2ptfc_init,
-    .reset = ctrl_m2ptfc_reset,
-    .step = ctrl_m2ptfc_step,
-    .est_unused = CTRL_EST_ONLY(CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT),
-};
+CTRL_DESC_DEFINE(m2ptfc, "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
+                 10000u, ctrl_m2ptfc_t, ctrl_m2ptfc_cfg_t, m2ptfc_tunables, m2ptfc_cfg_default,
+                 m2ptfc_init, ctrl_m2ptfc_reset, ctrl_m2ptfc_step,
+                 CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT);

@@ -21,6 +21,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
+#include "mtpa.h"
 #include "plan.h"
 #include "vectors.h"
 
@@ -104,6 +105,23 @@ static inline void ctrl_mpc_model_track(ctrl_mpc_model_t *m, const ctrl_params_t
  * frame, with next.sin_theta/cos_theta: CTRL_EST_SC_NEXT) and its rotation
  * over one period (rot_c, rot_s). */
 void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_mpc_basis_t *b);
+
+/* What the six-candidate steps (M1, M2, M3, FS-MPTFC) start from: the model
+ * following psi_pm (ctrl_mpc_model_track), the basis and the references, the flux one from
+ * ctrl_flux_ref (MTPA (4.15) when the command is 0). */
+typedef struct {
+    ctrl_mpc_basis_t b;
+    q24_t t_ref;   /* torque reference, Q24 pu */
+    q24_t psi_ref; /* flux reference, Q24 pu */
+} ctrl_mpc_in_t;
+
+static inline void ctrl_mpc_in(ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_mpc_in_t *in)
+{
+    ctrl_mpc_model_track(m, ctx->params);
+    ctrl_mpc_basis(m, ctx->est, &in->b);
+    in->t_ref = ctx->ref->torque;
+    in->psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+}
 
 /* ctrl_mpc_basis() with V1..V3 only (no V4..V6): the same d0, q0, t0 and
  * wd/wq[0..2] bit for bit. */

@@ -54,6 +54,12 @@ int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_setup_t *setup);
      offsetof(T, model.lq_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
     {"psi_pm_model", "Wb", "psi_pm of the k+2 prediction (6.12); 0 = machine",     \
      offsetof(T, model.psi_pm_wb), 0.0, CTRL_MPC_LPSI_MODEL_MAX}
+/* The weighting factor zeta of (6.13) of M1, M3 and FS-MPTFC (field zeta of
+ * T), with what this controller's help adds. */
+#define CTRL_MPC_ZETA_TUNABLE(T, more)                                              \
+    {"zeta", "N*m/Wb",                                                             \
+     "weighting factor of (6.13); 0 = T_rated/psi_pm (default, equal importance, " \
+     "6.5); " more, offsetof(T, zeta), 0.0, 1e5}
 /* clang-format on */
 
 /* Model constants for the setup (with the overrides of c). CTRL_OK,

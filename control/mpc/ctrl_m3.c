@@ -8,35 +8,32 @@
 void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m3_t *s = state;
-    ctrl_mpc_basis_t b;
-    ctrl_mpc_model_track(&s->model, ctx->params);
-    ctrl_mpc_basis(&s->model, ctx->est, &b);
-    const q24_t t_ref = ctx->ref->torque;
+    ctrl_mpc_in_t in;
+    ctrl_mpc_in(&s->model, ctx, &in);
     const ctrl_mstate_t *n = &ctx->est->next;
-    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
 
     /* (6.1) by the sign of the torque error. */
     const int x = (int)n->sector;
     uint8_t cand[2];
-    if (t_ref >= n->torque) {
+    if (in.t_ref >= n->torque) {
         cand[0] = ctrl_vec_wrap(x + 1);
         cand[1] = ctrl_vec_wrap(x + 2);
     } else {
         cand[0] = ctrl_vec_wrap(x + 5);
         cand[1] = ctrl_vec_wrap(x + 4);
     }
-    const q24_t num = fx_sub(t_ref, b.t0); /* (5.18) numerator */
+    const q24_t num = fx_sub(in.t_ref, in.b.t0); /* (5.18) numerator */
     int64_t best_g = INT64_MAX;
     unsigned best = 2u;
     q24_t duty[2];
     for (unsigned k = 0; k < 2u; k++) {
         q24_t vd;
         q24_t vq;
-        ctrl_mpc_vec_dq(&b, cand[k], &vd, &vq);
-        const q24_t t_full = ctrl_mpc_torque(&s->model, b.d0 + vd, b.q0 + vq);
-        duty[k] = ctrl_mpc_duty_sat(num, fx_sub(t_full, b.t0));
-        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &b, vd, vq, duty[k], t_ref, psi_ref,
-                                                 s->zeta); /* (6.13) */
+        ctrl_mpc_vec_dq(&in.b, cand[k], &vd, &vq);
+        const q24_t t_full = ctrl_mpc_torque(&s->model, in.b.d0 + vd, in.b.q0 + vq);
+        duty[k] = ctrl_mpc_duty_sat(num, fx_sub(t_full, in.b.t0));
+        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty[k], in.t_ref,
+                                                 in.psi_ref, s->zeta); /* (6.13) */
         s->trace.vec[k] = cand[k];
         s->trace.duty[k] = duty[k];
         if (g < best_g) {
@@ -45,7 +42,8 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         }
     }
     /* The zero vector all period. */
-    const int64_t g0 = ctrl_mpc_cost_weighted(&s->model, &b, 0, 0, 0, t_ref, psi_ref, s->zeta);
+    const int64_t g0 =
+        ctrl_mpc_cost_weighted(&s->model, &in.b, 0, 0, 0, in.t_ref, in.psi_ref, s->zeta);
     s->trace.vec[2] = 0u;
     s->trace.duty[2] = 0;
     s->trace.n = 3u;

@@ -79,17 +79,8 @@ int ctrl_tunables_check(const ctrl_tunable_t *t, size_t n, const void *cfg)
 int ctrl_setup_refuse(const ctrl_setup_t *setup, int code, const char *quantity, const char *unit,
                       double value, double lo, double hi)
 {
-    if (setup != NULL && setup->diag != NULL) {
-        ctrl_diag_t *d = setup->diag;
-        d->code = code;
-        d->quantity = quantity;
-        d->unit = unit;
-        d->value = value;
-        d->min = lo;
-        d->max = hi;
-        d->depends = NULL;
-    }
-    return code;
+    return ctrl_diag_refuse(setup != NULL ? setup->diag : NULL, code, quantity, unit, value, lo, hi,
+                            NULL);
 }
 
 int ctrl_setup_q24(const ctrl_setup_t *setup, const char *quantity, double si, double base,
