@@ -31,6 +31,8 @@ TORQUE_NM = 1.8
 SENSORLESS_RPM = 150  # 5 % of the thesis SPMSM's rated 3000 r/min (sensorless_config.h w_on)
 # Section indices of the plugin's end markers (order of the end= arguments).
 SECTIONS = ("empty", "boot", "run", "est", "step")
+# The Cortex-M4 replay target: QEMU machine and where the recording is loaded.
+CM4_TARGET = {"machine": "mps2-an386", "blob": 0x20200000}
 MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
 # ARMv6-M: QEMU microbit (Cortex-M0, the Cortex-M0+'s instruction set), the
 # recording in the flash above the image (hal/qemu_microbit/qemu_microbit.h).
@@ -89,7 +91,7 @@ def build(args):
     cdir = os.path.join(cm4, "tests", "bench", "bench_fw")
     tools = {"rec": os.path.join(bdir, "bench_rec"), "host": os.path.join(bdir, "bench_host"),
              "elf": os.path.join(cdir, "bench_cm4.elf"), "cdir": cdir, "plugin": plugin,
-             "machine": "mps2-an386", "blob": 0x20200000}
+             **CM4_TARGET}
     if args.cm0:
         cm0 = args.cm0_build
         configure(cm0, {"CMAKE_BUILD_TYPE": "Release", "CMAKE_C_FLAGS_RELEASE": "-O2 -g",

@@ -84,7 +84,7 @@ def main():
                     f.write("%x %d %s\n" % (a, size, name))
             markers = [m for m in bench.MARKERS if m in syms]
             marks = [syms[m][0] for m in markers]
-            tools = {"elf": elf, "plugin": plugin}
+            tools = {"elf": elf, "plugin": plugin, **bench.CM4_TARGET}
             c = bench.qemu_count(tools, syms_file, marks, rec,
                                  os.path.join(work, "count_%s_%s.txt" % (kind, n)))
             if kind == "esc1" and c["summary"].get("differs") != "0":
