@@ -401,21 +401,27 @@ static void cmd_arm(cmd_t *c, size_t n)
     }
 }
 
-static void cmd_disarm(cmd_t *c, size_t n)
+/* A command without arguments that runs one operation: "<name>" -> "ok <done>". */
+static void cmd_run_op(cmd_t *c, size_t n, const char *name, int (*op)(void *ctx), const char *done)
 {
     if (n != 1) {
-        cmd_err(c, CMD_E_ARGS, "disarm");
+        cmd_err(c, CMD_E_ARGS, name);
         return;
     }
-    if (c->ops->disarm == NULL) {
+    if (op == NULL) {
         cmd_err(c, CMD_E_UNSUPPORTED, NULL);
         return;
     }
-    if (cmd_op_ok(c, c->ops->disarm(c->ctx))) {
+    if (cmd_op_ok(c, op(c->ctx))) {
         cmd_ok_begin(c);
-        cmd_out_str(c, " disarmed");
+        cmd_out_str(c, done);
         cmd_out_flush(c);
     }
+}
+
+static void cmd_disarm(cmd_t *c, size_t n)
+{
+    cmd_run_op(c, n, "disarm", c->ops->disarm, " disarmed");
 }
 
 static void cmd_ref(cmd_t *c, const cmd_tok_t *tok, size_t n)
@@ -887,19 +893,7 @@ static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
 
 static void cmd_stop(cmd_t *c, size_t n)
 {
-    if (n != 1) {
-        cmd_err(c, CMD_E_ARGS, "stop");
-        return;
-    }
-    if (c->ops->stop == NULL) {
-        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
-        return;
-    }
-    if (cmd_op_ok(c, c->ops->stop(c->ctx))) {
-        cmd_ok_begin(c);
-        cmd_out_str(c, " stopped");
-        cmd_out_flush(c);
-    }
+    cmd_run_op(c, n, "stop", c->ops->stop, " stopped");
 }
 
 /* ---- line handling ---- */
