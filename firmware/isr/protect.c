@@ -7,10 +7,9 @@
 const char *fw_fault_name(uint32_t code)
 {
     static const char *const names[FW_FAULT_COUNT] = {
-        "none",          "overcurrent",  "hw_trip",  "dc_overvoltage", "dc_undervoltage",
-        "encoder_stuck", "encoder_jump", "deadline", "watchdog",       "adc_calibration",
-        "overspeed",
-        "commission",
+        "none",          "overcurrent",  "hw_trip",      "dc_overvoltage", "dc_undervoltage",
+        "encoder_stuck", "encoder_jump", "deadline",     "watchdog",       "adc_calibration",
+        "overspeed",     "commission",   "speed_follow",
     };
     return code < (uint32_t)FW_FAULT_COUNT ? names[code] : "unknown";
 }
@@ -44,6 +43,10 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_move_still = 0u;
     p->enc_primed = 0u;
     p->wdg_count = 0u;
+    p->follow_ref = 0;
+    p->follow_min = 0;
+    p->follow_count = 0u;
+    p->follow_on = 0u;
 }
 
 uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)

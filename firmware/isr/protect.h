@@ -48,18 +48,19 @@
 
 enum {
     FW_FAULT_NONE = 0,
-    FW_FAULT_OVERCURRENT = 1,  /* phase current above i_max */
-    FW_FAULT_HW_TRIP = 2,      /* hardware trip comparator */
-    FW_FAULT_DC_OVERVOLT = 3,  /* DC link above vdc_max */
-    FW_FAULT_DC_UNDERVOLT = 4, /* DC link below vdc_min */
-    FW_FAULT_ENC_STUCK = 5,    /* encoder counter frozen while turning */
-    FW_FAULT_ENC_JUMP = 6,     /* implausible encoder step */
-    FW_FAULT_DEADLINE = 7,     /* ISR overrun or re-entry */
-    FW_FAULT_WATCHDOG = 8,     /* main loop stopped kicking */
-    FW_FAULT_CALIB = 9,        /* ADC offset outside the plausible range */
-    FW_FAULT_OVERSPEED = 10,   /* |speed| above the overspeed level */
-    FW_FAULT_COMMISSION = 11,  /* a commissioning step failed (cm_t.err names why) */
-    FW_FAULT_COUNT = 12
+    FW_FAULT_OVERCURRENT = 1,   /* phase current above i_max */
+    FW_FAULT_HW_TRIP = 2,       /* hardware trip comparator */
+    FW_FAULT_DC_OVERVOLT = 3,   /* DC link above vdc_max */
+    FW_FAULT_DC_UNDERVOLT = 4,  /* DC link below vdc_min */
+    FW_FAULT_ENC_STUCK = 5,     /* encoder counter frozen while turning */
+    FW_FAULT_ENC_JUMP = 6,      /* implausible encoder step */
+    FW_FAULT_DEADLINE = 7,      /* ISR overrun or re-entry */
+    FW_FAULT_WATCHDOG = 8,      /* main loop stopped kicking */
+    FW_FAULT_CALIB = 9,         /* ADC offset outside the plausible range */
+    FW_FAULT_OVERSPEED = 10,    /* |speed| above the overspeed level */
+    FW_FAULT_COMMISSION = 11,   /* a commissioning step failed (cm_t.err names why) */
+    FW_FAULT_SPEED_FOLLOW = 12, /* speed moves away from its reference at full torque */
+    FW_FAULT_COUNT = 13
 };
 
 /* Overspeed level relative to the machine's maximum speed (criteria above). */
@@ -91,6 +92,8 @@ typedef struct {
     uint32_t deadline_cycles;   /* cycle budget per ISR; 0 disables the overrun check */
     uint32_t wdg_periods;       /* periods without a kick before the fault; 0 disables */
     q24_t omega_max;            /* overspeed level, Q24 pu electrical speed (> 0) */
+    q24_t omega_follow;         /* speed-following band, Q24 pu electrical (0: off) */
+    uint32_t follow_periods;    /* periods beyond the band before the fault */
 } fw_protect_cfg_t;
 
 typedef struct {
@@ -116,6 +119,12 @@ typedef struct {
     /* deadline_cycles and wdg_periods with 0 ("off") as UINT32_MAX, which no
      * uint32_t exceeds: one compare each. */
     uint32_t deadline_lim, wdg_lim;
+    /* Speed following (fw_protect_speed_follow): the reference it watches, the
+     * least |speed error| since the torque reached its limit (Q24 pu
+     * electrical), 1 while it does. */
+    q24_t follow_ref, follow_min;
+    uint32_t follow_count; /* consecutive periods beyond the band */
+    uint8_t follow_on;
 } fw_protect_t;
 
 /*
@@ -267,6 +276,39 @@ static inline uint32_t fw_protect_overspeed(const fw_protect_t *p, q24_t omega_e
         return FW_FAULT_OVERSPEED;
     }
     return FW_FAULT_NONE;
+}
+
+/*
+ * Speed following (speed mode): while the speed loop's torque reference t is
+ * at its limit t_max in the direction of the speed error e = speed_ref -
+ * omega, |e| can only shrink - unless the load exceeds what the drive can
+ * give, or the machine does not make the torque the estimator reports (a
+ * sensorless angle off the rotor, a controller that lost the torque). Either
+ * way the speed runs away under full torque, so once |e| has stayed more
+ * than omega_follow above its least value since the torque saturated for
+ * follow_periods in a row (the speed estimate's spikes are shorter), the
+ * drive stops (gates off) instead of spinning up to the overspeed trip. A
+ * new reference or a torque off its limit starts the watch again.
+ */
+static inline uint32_t fw_protect_speed_follow(fw_protect_t *p, q24_t speed_ref, q24_t omega,
+                                               q24_t t, q24_t t_max)
+{
+    const q24_t e = fx_sub(speed_ref, omega);
+    const int toward = (e > 0 && t >= t_max) || (e < 0 && t <= fx_neg(t_max));
+    const q24_t a = fx_abs(e);
+    if (!toward || speed_ref != p->follow_ref || p->follow_on == 0u) {
+        p->follow_ref = speed_ref;
+        p->follow_min = a;
+        p->follow_on = (uint8_t)toward;
+        p->follow_count = 0u;
+        return FW_FAULT_NONE;
+    }
+    p->follow_min = fx_min(p->follow_min, a);
+    /* 0 <= follow_min <= a: the difference fits */
+    const int beyond = p->cfg.omega_follow > 0 && a - p->follow_min > p->cfg.omega_follow;
+    p->follow_count = beyond ? p->follow_count + 1u : 0u;
+    return p->follow_count >= p->cfg.follow_periods && beyond ? FW_FAULT_SPEED_FOLLOW
+                                                              : FW_FAULT_NONE;
 }
 
 static inline uint32_t fw_protect_watchdog_tick(fw_protect_t *p)

@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "sim_run.h"
+#include "speed_loop.h"
 #include "unity.h"
 
 void setUp(void)
@@ -126,6 +127,80 @@ static void test_mj5208_m2ptfc(void)
     run_case(&k);
 }
 
+/* A load the drive cannot hold: thesis SPMSM, m2ptfc, sensorless, at -800
+ * r/min an overhauling load 5 % above the speed loop's torque limit. The speed
+ * then runs away under full torque at a = (T_load - T_lim) / J; the
+ * speed-following check (firmware/isr/protect.h) must stop the drive with
+ * the gates off once the speed error has grown by its band (10 % of rated
+ * speed, reached after band / a) and stayed there for 50 ms - long before the
+ * overspeed trip. The same check ends the 80 kW IPMSM's runaway under 200 N*m
+ * (docs/algorithms.md, "Sensorless drive"). */
+static void test_runaway_trips_speed_follow(void)
+{
+    static sim_machine_t m;
+    char err[256];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &m, err, sizeof err), err);
+    const ctrl_desc_t *d = ctrl_find("m2ptfc");
+    TEST_ASSERT_NOT_NULL(d);
+    static sim_run_cfg_t c;
+    sim_run_config_default(&c, &m, d);
+    const double t_lim = fw_torque_limit_nm(&c.ctrl_machine, NULL);
+    const double t_load = 1.05 * t_lim;
+    const double t_step = 0.5;
+    char text[160];
+    snprintf(text, sizeof text,
+             "at 0 speed_ref=0 load=-0.5\nat 0.02 speed_ref=-800\nat %g load=%g\n", t_step, t_load);
+    static sim_scenario_t scn;
+    FILE *f = tmpfile();
+    TEST_ASSERT_NOT_NULL(f);
+    TEST_ASSERT_TRUE(fputs(text, f) >= 0);
+    rewind(f);
+    const int prc = sim_scenario_parse(&scn, f, "runaway", err, sizeof err);
+    fclose(f);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, prc, err);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = true;
+    c.speed_mode = true;
+    c.speed_ref_rpm = 0.0;
+    c.scenario = &scn;
+    c.duration_s = 0.8;
+    c.win_start_s = 0.0;
+    c.win_end_s = c.duration_s;
+    c.calib_samples = 64u;
+    c.sensorless = true;
+    static sim_run_t r;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
+    double rpm_before = 0.0;
+    double rpm_max = 0.0;
+    while (sim_run_time(&r) < c.duration_s && fw_state(&r.fw) != FW_STATE_FAULT) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+        const double rpm = sim_run_speed_rpm(&r);
+        if (sim_run_time(&r) < t_step) {
+            rpm_before = rpm;
+        }
+        rpm_max = fmax(rpm_max, fabs(rpm));
+    }
+    const double a = (t_load - t_lim) / m.inertia_kgm2;                           /* rad/s^2 */
+    const double band = 0.1 * m.speed_rated_rpm * 2.0 * 3.141592653589793 / 60.0; /* rad/s */
+    const double t_expect = band / a + 0.05;
+    printf("thesis_spmsm.ini m2ptfc  load %.3f N*m > limit %.3f N*m at %.2f s (%.1f r/min): "
+           "fault %s at %.4f s (expected %.4f s after the step), largest |speed| %.1f r/min, "
+           "overspeed level %.0f\n",
+           t_load, t_lim, t_step, rpm_before, fw_fault_name(fw_fault(&r.fw)), r.fault_time_s,
+           t_expect, rpm_max, r.fw.speed_info.overspeed_rpm);
+    TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(0.05 * 800.0, -800.0, rpm_before, "not at -800 r/min");
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_SPEED_FOLLOW, fw_fault(&r.fw));
+    TEST_ASSERT_EQUAL_UINT8(0u, fw_telemetry(&r.fw)->gates);
+    /* not before the band and the 50 ms, not much after (the speed loop's
+     * saturation and the estimate's noise: 20 ms) */
+    TEST_ASSERT_TRUE(r.fault_time_s >= t_step + 0.05);
+    TEST_ASSERT_TRUE(r.fault_time_s <= t_step + t_expect + 0.02);
+    TEST_ASSERT_TRUE(rpm_max < r.fw.speed_info.overspeed_rpm);
+    sim_run_free(&r);
+}
+
 /* Rated torque at low speed on the dynamometer (torque mode, started at the
  * forced start's 150 r/min, then the dynamometer steps to rpm): the mean
  * torque over the last 0.25 s, thesis SPMSM, m2ptfc. */
@@ -192,5 +267,6 @@ int main(void)
     RUN_TEST(test_spmsm_foc);
     RUN_TEST(test_mj5208_m2ptfc);
     RUN_TEST(test_rated_torque_low_speed);
+    RUN_TEST(test_runaway_trips_speed_follow);
     return UNITY_END();
 }
