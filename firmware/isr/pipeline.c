@@ -390,7 +390,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
         tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
         if (fw_protect_speed_follow(&fw->prot, fw->speed_ref, est->omega_e, tref,
-                                    fw->torque_ref_max) != FW_FAULT_NONE) {
+                                    fw->speed_pi.out_max) != FW_FAULT_NONE) {
             fw_fault_now(fw, FW_FAULT_SPEED_FOLLOW);
             tm->vec = 0u;
             tm->duty = 0;

@@ -280,7 +280,9 @@ static inline uint32_t fw_protect_overspeed(const fw_protect_t *p, q24_t omega_e
 
 /*
  * Speed following (speed mode): while the speed loop's torque reference t is
- * at its limit t_max in the direction of the speed error e = speed_ref -
+ * at its limit t_max (the speed PI's output limit: the configured one, or
+ * the last period's field-weakening limit) in the direction of the speed
+ * error e = speed_ref -
  * omega, |e| can only shrink - unless the load exceeds what the drive can
  * give, or the machine does not make the torque the estimator reports (a
  * sensorless angle off the rotor, a controller that lost the torque). Either
