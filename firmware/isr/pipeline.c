@@ -331,6 +331,19 @@ static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
     sl->torque_est = fw->estimate.now.torque;
 }
 
+/* A fault found after the estimate (overspeed, speed following): latch it,
+ * gates off, no references in the record. Out of line: rare. */
+static void fw_control_stop(fw_t *fw, fw_telemetry_t *tm, uint32_t code)
+{
+    fw_fault_now(fw, code);
+    tm->vec = 0u;
+    tm->duty = 0;
+    tm->torque_ref = 0;
+    tm->torque_max = 0;
+    tm->fw_limit = 0u;
+    fw_pwm_off(fw, tm);
+}
+
 static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
@@ -353,13 +366,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     tm->psi_q = est->now.psi_q;
     tm->torque = est->now.torque;
     if (fw_protect_overspeed(&fw->prot, est->omega_e) != FW_FAULT_NONE) {
-        fw_fault_now(fw, FW_FAULT_OVERSPEED);
-        tm->vec = 0u;
-        tm->duty = 0;
-        tm->torque_ref = 0;
-        tm->torque_max = 0;
-        tm->fw_limit = 0u;
-        fw_pwm_off(fw, tm);
+        fw_control_stop(fw, tm, FW_FAULT_OVERSPEED);
         return;
     }
 
@@ -391,11 +398,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
         if (fw_protect_speed_follow(&fw->prot, fw->speed_ref, est->omega_e, tref,
                                     fw->speed_pi.out_max) != FW_FAULT_NONE) {
-            fw_fault_now(fw, FW_FAULT_SPEED_FOLLOW);
-            tm->vec = 0u;
-            tm->duty = 0;
-            tm->torque_ref = 0;
-            fw_pwm_off(fw, tm);
+            fw_control_stop(fw, tm, FW_FAULT_SPEED_FOLLOW);
             return;
         }
     } else {

@@ -74,3 +74,25 @@ void fw_protect_watchdog_kick(fw_protect_t *p)
         p->wdg_count = 0u;
     }
 }
+
+/* Speed following (criterion in protect.h). */
+uint32_t fw_protect_speed_follow(fw_protect_t *p, q24_t speed_ref, q24_t omega, q24_t t,
+                                 q24_t t_max)
+{
+    const q24_t e = fx_sub(speed_ref, omega);
+    const int toward = (e > 0 && t >= t_max) || (e < 0 && t <= fx_neg(t_max));
+    const q24_t a = fx_abs(e);
+    if (!toward || speed_ref != p->follow_ref || p->follow_on == 0u) {
+        p->follow_ref = speed_ref;
+        p->follow_min = a;
+        p->follow_on = (uint8_t)toward;
+        p->follow_count = 0u;
+        return FW_FAULT_NONE;
+    }
+    p->follow_min = fx_min(p->follow_min, a);
+    /* 0 <= follow_min <= a: the difference fits */
+    const int beyond = p->cfg.omega_follow > 0 && a - p->follow_min > p->cfg.omega_follow;
+    p->follow_count = beyond ? p->follow_count + 1u : 0u;
+    return p->follow_count >= p->cfg.follow_periods && beyond ? FW_FAULT_SPEED_FOLLOW
+                                                              : FW_FAULT_NONE;
+}
