@@ -331,19 +331,6 @@ static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
     sl->torque_est = fw->estimate.now.torque;
 }
 
-/* A fault found after the estimate (overspeed, speed following): latch it,
- * gates off, no references in the record. Out of line: rare. */
-static void fw_control_stop(fw_t *fw, fw_telemetry_t *tm, uint32_t code)
-{
-    fw_fault_now(fw, code);
-    tm->vec = 0u;
-    tm->duty = 0;
-    tm->torque_ref = 0;
-    tm->torque_max = 0;
-    tm->fw_limit = 0u;
-    fw_pwm_off(fw, tm);
-}
-
 static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
@@ -365,10 +352,8 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     tm->psi_d = est->now.psi_d;
     tm->psi_q = est->now.psi_q;
     tm->torque = est->now.torque;
-    if (fw_protect_overspeed(&fw->prot, est->omega_e) != FW_FAULT_NONE) {
-        fw_control_stop(fw, tm, FW_FAULT_OVERSPEED);
-        return;
-    }
+    /* overspeed, or (speed mode) the speed running away at full torque */
+    uint32_t f = fw_protect_overspeed(&fw->prot, est->omega_e);
 
     q24_t tref;
     if (sl != NULL && sl->out.mode == CTRL_SL_FORCED) {
@@ -396,13 +381,23 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         }
         fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
         tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
-        if (fw_protect_speed_follow(&fw->prot, fw->speed_ref, est->omega_e, tref,
-                                    fw->speed_pi.out_max) != FW_FAULT_NONE) {
-            fw_control_stop(fw, tm, FW_FAULT_SPEED_FOLLOW);
-            return;
+        if (f == FW_FAULT_NONE) {
+            f = fw_protect_speed_follow(&fw->prot, fw->speed_ref, est->omega_e, tref,
+                                        fw->speed_pi.out_max);
         }
     } else {
         tref = fw->torque_ref_lim; /* torque_ref clamped by fw_set_torque_ref */
+    }
+    if (f != FW_FAULT_NONE) {
+        /* latched, gates off, no references in the record */
+        fw_fault_now(fw, f);
+        tm->vec = 0u;
+        tm->duty = 0;
+        tm->torque_ref = 0;
+        tm->torque_max = 0;
+        tm->fw_limit = 0u;
+        fw_pwm_off(fw, tm);
+        return;
     }
     /* Torque limited by the current and voltage limits; flux reference
      * weakened to what the voltage allows (0 = the controller's own below

@@ -3,6 +3,7 @@
 #include "protect.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 const char *fw_fault_name(uint32_t code)
 {
@@ -44,9 +45,8 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_primed = 0u;
     p->wdg_count = 0u;
     p->follow_ref = 0;
-    p->follow_min = 0;
+    p->follow_min = INT32_MAX;
     p->follow_count = 0u;
-    p->follow_on = 0u;
 }
 
 uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
@@ -80,19 +80,16 @@ uint32_t fw_protect_speed_follow(fw_protect_t *p, q24_t speed_ref, q24_t omega, 
                                  q24_t t_max)
 {
     const q24_t e = fx_sub(speed_ref, omega);
-    const int toward = (e > 0 && t >= t_max) || (e < 0 && t <= fx_neg(t_max));
-    const q24_t a = fx_abs(e);
-    if (!toward || speed_ref != p->follow_ref || p->follow_on == 0u) {
+    const int toward = e > 0 ? t >= t_max : (e < 0 && t <= fx_neg(t_max));
+    if (!toward || speed_ref != p->follow_ref) {
         p->follow_ref = speed_ref;
-        p->follow_min = a;
-        p->follow_on = (uint8_t)toward;
+        p->follow_min = INT32_MAX; /* the next saturated period sets it */
         p->follow_count = 0u;
         return FW_FAULT_NONE;
     }
+    const q24_t a = fx_abs(e);
     p->follow_min = fx_min(p->follow_min, a);
-    /* 0 <= follow_min <= a: the difference fits */
-    const int beyond = p->cfg.omega_follow > 0 && a - p->follow_min > p->cfg.omega_follow;
-    p->follow_count = beyond ? p->follow_count + 1u : 0u;
-    return p->follow_count >= p->cfg.follow_periods && beyond ? FW_FAULT_SPEED_FOLLOW
-                                                              : FW_FAULT_NONE;
+    /* 0 <= follow_min <= a: the difference fits; band = omega_max / 16 */
+    p->follow_count = a - p->follow_min > (p->cfg.omega_max >> 4) ? p->follow_count + 1u : 0u;
+    return p->follow_count > p->cfg.follow_periods ? FW_FAULT_SPEED_FOLLOW : FW_FAULT_NONE;
 }

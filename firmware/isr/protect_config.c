@@ -54,16 +54,7 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
         return CTRL_EINVAL;
     }
     cfg->omega_max = ctrl_q24_from_double(w_max_pu);
-    /* Speed-following band: 10 % of the rated speed, well above the speed
-     * estimate's noise (sensorless: 14-31 r/min rms, docs/algorithms.md) and
-     * the speed loop's overshoot at full torque; off without a rated speed. */
-    cfg->omega_follow =
-        isfinite(m->speed_rated_rpm) && m->speed_rated_rpm > 0.0
-            ? ctrl_q24_from_double(
-                  fmin(0.1 * ctrl_rpm_to_elec(m->speed_rated_rpm, m->pole_pairs) / b->w_rad_s, 1.0))
-            : 0;
-    /* ... for 50 ms: longer than the estimate's spikes, a fraction of a runaway */
-    cfg->follow_periods = (uint32_t)ceil(0.05 * (double)fs_hz);
+    cfg->follow_periods = fs_hz / 20u; /* speed following: 50 ms */
     const double fs = (double)fs_hz;
     if (ctrl_q24_from_si(m->current_max_a, b->i_a, 0.0, ctrl_q24_to_double(FW_PROTECT_I_MAX_LIM),
                          &cfg->i_max) != CTRL_OK) {

@@ -131,9 +131,9 @@ static void test_mj5208_m2ptfc(void)
  * r/min an overhauling load 5 % above the speed loop's torque limit. The speed
  * then runs away under full torque at a = (T_load - T_lim) / J; the
  * speed-following check (firmware/isr/protect.h) must stop the drive with
- * the gates off once the speed error has grown by its band (10 % of rated
- * speed, reached after band / a) and stayed there for 50 ms - long before the
- * overspeed trip. The same check ends the 80 kW IPMSM's runaway under 200 N*m
+ * the gates off once the speed error has grown by its band (a sixteenth of
+ * the overspeed level, reached after band / a) and stayed there for 50 ms -
+ * long before the overspeed trip. The same check ends the 80 kW IPMSM's runaway under 200 N*m
  * (docs/algorithms.md, "Sensorless drive"). */
 static void test_runaway_trips_speed_follow(void)
 {
@@ -182,8 +182,9 @@ static void test_runaway_trips_speed_follow(void)
         }
         rpm_max = fmax(rpm_max, fabs(rpm));
     }
-    const double a = (t_load - t_lim) / m.inertia_kgm2;                           /* rad/s^2 */
-    const double band = 0.1 * m.speed_rated_rpm * 2.0 * 3.141592653589793 / 60.0; /* rad/s */
+    const double a = (t_load - t_lim) / m.inertia_kgm2; /* rad/s^2 */
+    /* the band: a sixteenth of the overspeed level (protect.h), rad/s */
+    const double band = r.fw.speed_info.overspeed_rpm / 16.0 * 2.0 * 3.141592653589793 / 60.0;
     const double t_expect = band / a + 0.05;
     printf("thesis_spmsm.ini m2ptfc  load %.3f N*m > limit %.3f N*m at %.2f s (%.1f r/min): "
            "fault %s at %.4f s (expected %.4f s after the step), largest |speed| %.1f r/min, "
