@@ -119,16 +119,29 @@ else
   echo "ok: good run"
 fi
 # --torque-ref 50 on the 2.4 N*m machine: a warning on stderr and in the JSON,
-# with the requested and the applied reference.
+# with the requested and the applied reference. Applied: what the rated peak
+# current gives, 1.5 p psi_pm i_rated = 1.5 x 4 x 0.09427 x 4.2 = 2.3756 N*m
+# (the field-weakening limit's current circle), below the 2.4 N*m clamp.
 err="$("$sim" --machine "$m" --controller bst --speed-rpm 750 --torque-ref 50 --duration 0.01 \
-       --metrics "$tmp/clamp.json" 2>&1 >/dev/null)"; rc=$?
+       --window 0.005:0.01 --metrics "$tmp/clamp.json" 2>&1 >/dev/null)"; rc=$?
 if [ "$rc" -eq 0 ] && grep -q "warning: torque reference 50 N\*m is outside the drive's torque limit \[-2.4, 2.4\] N\*m" <<<"$err" &&
    grep -q '"torque_ref_requested_nm": 50,' "$tmp/clamp.json" &&
-   grep -Eq '"torque_ref_applied_nm": 2\.4[0-9]*,' "$tmp/clamp.json" &&
+   grep -Eq '"torque_ref_applied_nm": 2\.375[5-6][0-9]*,' "$tmp/clamp.json" &&
    grep -q '"warnings": \["torque reference 50 N\*m is outside' "$tmp/clamp.json"; then
   echo "ok: --torque-ref 50 warns and records requested/applied"
 else
   echo "FAIL: --torque-ref 50: status $rc: $err"; fails=$((fails + 1))
+fi
+# --torque-ref 2.4: inside the static clamp, beyond the current circle (2.3756
+# N*m): the limit is reported, not a T_sse of 0 against a silently lower value.
+err="$("$sim" --machine "$m" --controller bst --speed-rpm 750 --torque-ref 2.4 --duration 0.01 \
+       --window 0.005:0.01 --metrics "$tmp/fwclip.json" 2>&1 >/dev/null)"; rc=$?
+if [ "$rc" -eq 0 ] && grep -q "warning: torque reference 2.4 N\*m was limited to 2.376 N\*m .* by the current limit in 100 % of the window" <<<"$err" &&
+   grep -Eq '"torque_ref_applied_nm": 2\.375[5-6][0-9]*,' "$tmp/fwclip.json" &&
+   grep -q '"torque_ref_clipped_frac": 1,' "$tmp/fwclip.json"; then
+  echo "ok: --torque-ref 2.4 reports the current limit"
+else
+  echo "FAIL: --torque-ref 2.4: status $rc: $err"; fails=$((fails + 1))
 fi
 # THD at zero torque has no fundamental: null in JSON, n/a in text (was 984 %).
 out="$("$sim" --machine "$m" --controller bst --speed-rpm 750 --torque-ref 0 --duration 0.05 \

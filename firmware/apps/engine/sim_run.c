@@ -80,6 +80,23 @@ static double sim_torque_ref_nm(const sim_run_t *r)
     return ctrl_q24_to_double(r->fw.torque_ref_now) * r->fw.bases.torque_nm;
 }
 
+/* One period of the window: the field-weakening limit and whether it clipped
+ * the request (fw_telemetry_t.fw_limit bit 2), and the reference applied. */
+static void sim_limit_add(sim_run_t *r)
+{
+    const fw_telemetry_t *tm = fw_telemetry(&r->fw);
+    const double tmax = ctrl_q24_to_double(tm->torque_max) * r->fw.bases.torque_nm;
+    if (r->lim_n == 0u || tmax < r->lim_min_nm) {
+        r->lim_min_nm = tmax;
+    }
+    if ((tm->fw_limit & 4u) != 0u) {
+        r->lim_clipped_n++;
+        r->lim_last = tm->fw_limit;
+    }
+    r->tref_sum_nm += sim_torque_ref_nm(r);
+    r->lim_n++;
+}
+
 /* The speed reference in force (r/min), NaN in torque mode. */
 static double sim_run_speed_ref_now(const sim_run_t *r)
 {
@@ -346,6 +363,9 @@ int sim_run_period(sim_run_t *r)
     const double w_true = plant_omega_e(&r->plant);
     const int rc = sim_period_raw(r);
     sim_est_error_add(r, t, th_true, w_true);
+    if (t >= r->cfg.win_start_s && t <= r->cfg.win_end_s && fw_state(&r->fw) == FW_STATE_RUNNING) {
+        sim_limit_add(r);
+    }
     if (isnan(r->fault_time_s) && fw_state(&r->fw) == FW_STATE_FAULT) {
         r->fault_time_s = t;
     }
@@ -894,6 +914,19 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
         const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : 0.0;
         r->m_plant.f1_hz = fabs(mean_rpm) * (double)r->cfg.plant_machine.pole_pairs / 60.0;
     }
+    if (!r->cfg.speed_mode && r->lim_clipped_n > 0u && !r->lim_warned) {
+        /* Not a silent clamp: T_sse is against the reference the drive could
+         * apply, so say that it differs from the one asked for. */
+        static const char *const lim_names[CTRL_FW_LIMIT_COUNT] = {
+            "the current limit", "the voltage limit", "MTPV", "the flux reference's torque"};
+        sim_warn(r->cfg.warnings,
+                 "torque reference %g N*m was limited to %.4g N*m (mean; down to %.4g N*m) by %s "
+                 "in %.0f %% of the window's periods: T_sse and torque_ref_applied_nm are "
+                 "against the limited reference",
+                 r->torque_ref_requested_nm, r->tref_sum_nm / (double)r->lim_n, r->lim_min_nm,
+                 lim_names[r->lim_last & 3u], 100.0 * (double)r->lim_clipped_n / (double)r->lim_n);
+        r->lim_warned = true;
+    }
     const int a = metrics_finish(&r->m_plant, plant);
     const int b = metrics_finish(&r->m_ctrl, ctrl);
     return (a == 0 && b == 0) ? 0 : -1;
@@ -957,9 +990,13 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     fprintf(f, "  \"mechanics\": \"%s\",\n", c->free_mech ? "free" : "dynamometer");
     sim_json_num(f, "fs_hz", (double)c->fs_hz);
     sim_json_num(f, "torque_ref_requested_nm", c->speed_mode ? NAN : r->torque_ref_requested_nm);
+    /* Torque mode: the mean reference the controller got over the window,
+     * after the static clamp and the field-weakening limit. */
     sim_json_num(f, "torque_ref_applied_nm",
-                 c->speed_mode ? NAN
-                               : ctrl_q24_to_double(r->fw.torque_ref_lim) * r->fw.bases.torque_nm);
+                 c->speed_mode || r->lim_n == 0u ? NAN : r->tref_sum_nm / (double)r->lim_n);
+    sim_json_num(f, "torque_ref_clipped_frac",
+                 c->speed_mode || r->lim_n == 0u ? NAN
+                                                 : (double)r->lim_clipped_n / (double)r->lim_n);
     sim_json_num(f, "torque_limit_nm", r->torque_limit_nm);
     {
         /* Field weakening at the end of the run (pipeline.h fw_telemetry_t):

@@ -141,6 +141,13 @@ typedef struct {
     plant_filter_stats_t flt_w0, flt_w1;
     double flt_t0, flt_t1;
     bool flt_w1_set;
+    /* The torque limit of field weakening over the metrics window (torque
+     * mode): periods, periods the request was clipped, the smallest limit and
+     * the sum of the reference the controller got (before the trim). */
+    uint64_t lim_n, lim_clipped_n;
+    double lim_min_nm, tref_sum_nm;
+    uint8_t lim_last; /* fw_telemetry_t.fw_limit of the last clipped period */
+    bool lim_warned;
 } sim_run_t;
 
 /* Convert a machine file into the controller's machine description. */
