@@ -19,25 +19,6 @@ void ctrl_fobs_config_default(ctrl_fobs_config_t *c, const ctrl_machine_t *m)
     c->psi_speed_min = 0.2;
 }
 
-/* value inside [lo, hi]? Otherwise fill *why. */
-static int fobs_in(double v, double lo, double hi, const char *q, const char *unit,
-                   ctrl_diag_t *why)
-{
-    if (isfinite(v) && v >= lo && v <= hi) {
-        return 1;
-    }
-    if (why != NULL) {
-        memset(why, 0, sizeof *why);
-        why->code = CTRL_EINVAL;
-        why->quantity = q;
-        why->unit = unit;
-        why->value = v;
-        why->min = lo;
-        why->max = hi;
-    }
-    return 0;
-}
-
 int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b,
                    const ctrl_fobs_config_t *c, ctrl_diag_t *why)
 {
@@ -54,17 +35,18 @@ int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b
     const double w_rated = (double)p->speed_rated_e * b->w_rad_s / (double)FX_ONE;
     const double kappa_max = w_rated > 0.0 ? 0.5 / (w_rated * ts) : 0.0;
     const double i_rated = (double)p->current_rated * b->i_a / (double)FX_ONE;
-    if (!fobs_in((double)c->mode, 0.0, 1.0, "mode", "", why) ||
-        !fobs_in(c->k0_rad_s, 0.0, k_max, "k0_rad_s", "rad/s", why) ||
-        !fobs_in(c->kappa, 0.0, fmin(2.0, kappa_max), "kappa", "", why) ||
-        !fobs_in(c->kenc_rad_s, 0.0, k_max, "kenc_rad_s", "rad/s", why) ||
-        !fobs_in(c->pll_hz, 0.1, pll_max, "pll_hz", "Hz", why) ||
-        !fobs_in(c->dead_time_s, 0.0, 0.25 * ts, "dead_time_s", "s", why) ||
-        !fobs_in(c->v_fwd_v, 0.0, 0.1 * b->v_v * (double)p->vdc_nom / (double)FX_ONE, "v_fwd_v",
-                 "V", why) ||
-        !fobs_in(c->band_a, 1e-3 * i_rated, 10.0 * i_rated, "band_a", "A", why) ||
-        !fobs_in(c->psi_speed_min, 0.0, 2.0, "psi_speed_min", "", why) ||
-        !(c->psi_tau_s == 0.0 || fobs_in(c->psi_tau_s, 10.0 * ts, 100.0, "psi_tau_s", "s", why))) {
+    if (!ctrl_diag_in_range(why, "mode", "", (double)c->mode, 0.0, 1.0) ||
+        !ctrl_diag_in_range(why, "k0_rad_s", "rad/s", c->k0_rad_s, 0.0, k_max) ||
+        !ctrl_diag_in_range(why, "kappa", "", c->kappa, 0.0, fmin(2.0, kappa_max)) ||
+        !ctrl_diag_in_range(why, "kenc_rad_s", "rad/s", c->kenc_rad_s, 0.0, k_max) ||
+        !ctrl_diag_in_range(why, "pll_hz", "Hz", c->pll_hz, 0.1, pll_max) ||
+        !ctrl_diag_in_range(why, "dead_time_s", "s", c->dead_time_s, 0.0, 0.25 * ts) ||
+        !ctrl_diag_in_range(why, "v_fwd_v", "V", c->v_fwd_v, 0.0,
+                            0.1 * b->v_v * (double)p->vdc_nom / (double)FX_ONE) ||
+        !ctrl_diag_in_range(why, "band_a", "A", c->band_a, 1e-3 * i_rated, 10.0 * i_rated) ||
+        !ctrl_diag_in_range(why, "psi_speed_min", "", c->psi_speed_min, 0.0, 2.0) ||
+        !(c->psi_tau_s == 0.0 ||
+          ctrl_diag_in_range(why, "psi_tau_s", "s", c->psi_tau_s, 10.0 * ts, 100.0))) {
         return CTRL_EINVAL;
     }
     const double wn = CTRL_TWO_PI * c->pll_hz;
@@ -79,7 +61,7 @@ int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b
     n.pll_kp = ctrl_q24_from_double(2.0 * wn * ts);
     /* omega [pu] += w_n^2 Ts e [rad] / w_base, e = e_units 2 pi / 2^32, in Q48. */
     const double ki = wn * wn * ts * CTRL_TWO_PI * 65536.0 / b->w_rad_s;
-    if (!fobs_in(ki, 0.5, 2147483647.0, "pll_hz", "Hz", why)) {
+    if (!ctrl_diag_in_range(why, "pll_hz", "Hz", ki, 0.5, 2147483647.0)) {
         if (why != NULL) { /* report the frequency, with the range the Q format allows */
             why->value = c->pll_hz;
             why->min = sqrt(0.5 * b->w_rad_s / (ts * CTRL_TWO_PI * 65536.0)) / CTRL_TWO_PI;

@@ -23,23 +23,6 @@ void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m)
     c->inertia_kgm2 = m->inertia_kgm2;
 }
 
-static int sl_in(double v, double lo, double hi, const char *q, const char *unit, ctrl_diag_t *why)
-{
-    if (isfinite(v) && v >= lo && v <= hi) {
-        return 1;
-    }
-    if (why != NULL) {
-        memset(why, 0, sizeof *why);
-        why->code = CTRL_EINVAL;
-        why->quantity = q;
-        why->unit = unit;
-        why->value = v;
-        why->min = lo;
-        why->max = hi;
-    }
-    return 0;
-}
-
 int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
                  const ctrl_sl_config_t *c, ctrl_diag_t *why)
 {
@@ -51,16 +34,17 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
     const double w_rated = (double)p->speed_rated_e * b->w_rad_s / (double)FX_ONE;
     /* The ramp reaches the handover speed in at least 10 periods. */
     const double w_on = c->w_on_frac * w_rated;
-    if (!sl_in(c->t_start_nm, 1e-6 * t_max, t_max, "t_start_nm", "N*m", why) ||
-        !sl_in(c->w_on_frac, 0.005, 0.5, "w_on_frac", "", why) ||
-        !sl_in(c->w_off_frac, 0.0, c->w_on_frac, "w_off_frac", "", why) ||
-        !sl_in(c->ramp_rad_s2, 1e-3 * w_on, 0.1 * w_on * fs, "ramp_rad_s2", "rad/s^2", why) ||
-        !sl_in(c->low_s, 1.0 / fs, 100.0, "low_s", "s", why) ||
-        !sl_in(c->settle_s, 1.0 / fs, 100.0, "settle_s", "s", why) ||
-        !sl_in(c->kappa_start, 0.0, 4.0, "kappa_start", "", why) ||
-        !sl_in(c->theta0_rad, -1e3, 1e3, "theta0_rad", "rad", why) ||
-        !sl_in(c->damp_zeta, 0.0, 2.0, "damp_zeta", "", why) ||
-        !sl_in(c->inertia_kgm2, 0.0, 1e6, "inertia_kgm2", "kg*m^2", why)) {
+    if (!ctrl_diag_in_range(why, "t_start_nm", "N*m", c->t_start_nm, 1e-6 * t_max, t_max) ||
+        !ctrl_diag_in_range(why, "w_on_frac", "", c->w_on_frac, 0.005, 0.5) ||
+        !ctrl_diag_in_range(why, "w_off_frac", "", c->w_off_frac, 0.0, c->w_on_frac) ||
+        !ctrl_diag_in_range(why, "ramp_rad_s2", "rad/s^2", c->ramp_rad_s2, 1e-3 * w_on,
+                            0.1 * w_on * fs) ||
+        !ctrl_diag_in_range(why, "low_s", "s", c->low_s, 1.0 / fs, 100.0) ||
+        !ctrl_diag_in_range(why, "settle_s", "s", c->settle_s, 1.0 / fs, 100.0) ||
+        !ctrl_diag_in_range(why, "kappa_start", "", c->kappa_start, 0.0, 4.0) ||
+        !ctrl_diag_in_range(why, "theta0_rad", "rad", c->theta0_rad, -1e3, 1e3) ||
+        !ctrl_diag_in_range(why, "damp_zeta", "", c->damp_zeta, 0.0, 2.0) ||
+        !ctrl_diag_in_range(why, "inertia_kgm2", "kg*m^2", c->inertia_kgm2, 0.0, 1e6)) {
         return CTRL_EINVAL;
     }
     ctrl_sl_t n;
@@ -97,7 +81,7 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
         const double j = c->inertia_kgm2;
         const double kd_s = j > 0.0 ? 2.0 * c->damp_zeta * sqrt(j / (c->t_start_nm * pp)) : 0.0;
         const double kd = kd_s * b->w_rad_s * 4294967296.0 / CTRL_TWO_PI;
-        if (!sl_in(kd, 0.0, (double)CTRL_SL_KD_MAX, "damp_zeta", "", why)) {
+        if (!ctrl_diag_in_range(why, "damp_zeta", "", kd, 0.0, (double)CTRL_SL_KD_MAX)) {
             return CTRL_EINVAL;
         }
         n.kd = (int64_t)llround(kd);
@@ -109,7 +93,8 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
     n.theta0 =
         (fx_angle_t)(uint32_t)fmin(floor(th / CTRL_TWO_PI * 4294967296.0 + 0.5), 4294967295.0);
     if (n.t_start <= 0 || n.ramp_dw <= 0 || n.w_on <= 0) {
-        (void)sl_in(-1.0, 0.0, 0.0, n.t_start <= 0 ? "t_start_nm" : "ramp_rad_s2", "", why);
+        (void)ctrl_diag_in_range(why, n.t_start <= 0 ? "t_start_nm" : "ramp_rad_s2", "", -1.0, 0.0,
+                                 0.0);
         return CTRL_EINVAL;
     }
     *s = n;

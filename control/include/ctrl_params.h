@@ -50,10 +50,10 @@ typedef struct {
     double psi_wb, v_v, w_rad_s, t_s, i_a, torque_nm, r_ohm, l_h;
 } ctrl_bases_t;
 
-#define CTRL_MTPA_N 64                  /* segments of the IPMSM MTPA table */
-#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0 /* encoder-speed filter cut-off, Hz (docs/algorithms.md)   \
-                                         */
-#define CTRL_DANGLE_SHIFT 26u           /* fractional bits of dangle_to_omega */
+#define CTRL_MTPA_N 64 /* segments of the IPMSM MTPA table */
+/* Encoder-speed filter cut-off, Hz (docs/algorithms.md). */
+#define CTRL_SPEED_LPF_HZ_DEFAULT 500.0
+#define CTRL_DANGLE_SHIFT 26u /* fractional bits of dangle_to_omega */
 /* Range of Ts in pu, the angle one period turns at rated speed (rad). */
 #define CTRL_TS_PU_MIN 1.0e-3
 #define CTRL_TS_PU_MAX 1.0
@@ -123,6 +123,10 @@ typedef struct {
  * only; one home for ctrl_params_init_diag's and ctrl_setup_refuse's records). */
 int ctrl_diag_refuse(ctrl_diag_t *d, int code, const char *quantity, const char *unit, double value,
                      double lo, double hi, const char *depends);
+/* 1 if value is finite and inside [lo, hi]; else 0 with *d (if not NULL) the
+ * CTRL_EINVAL refusal naming quantity, value and range (configuration only). */
+int ctrl_diag_in_range(ctrl_diag_t *d, const char *quantity, const char *unit, double value,
+                       double lo, double hi);
 
 /*
  * Validate the machine data and compute bases and fixed-point parameters for a

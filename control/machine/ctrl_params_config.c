@@ -143,6 +143,16 @@ int ctrl_diag_refuse(ctrl_diag_t *d, int code, const char *quantity, const char 
     return code;
 }
 
+int ctrl_diag_in_range(ctrl_diag_t *d, const char *quantity, const char *unit, double value,
+                       double lo, double hi)
+{
+    if (isfinite(value) && value >= lo && value <= hi) {
+        return 1;
+    }
+    (void)ctrl_diag_refuse(d, CTRL_EINVAL, quantity, unit, value, lo, hi, NULL);
+    return 0;
+}
+
 /* An SI datum: finite and inside [lo, hi] (lo itself excluded when open). */
 static int si_ok(double x, double lo, double hi, int open)
 {
