@@ -94,8 +94,20 @@ void metrics_set_transitions(metrics_acc_t *m, uint64_t transitions, double wind
     m->trans_window_s = (isfinite(window_s) && window_s > 0.0) ? window_s : 0.0;
 }
 
-double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz, double fmax_hz,
-                       int *n_harm, double *window_s, double *i1_amp)
+/* The analysis window of both THD forms: K whole fundamental periods from
+ * t[0], harmonics up to fmax and half the mean sample rate, and the Fourier
+ * sums of harmonics 1..N. */
+typedef struct {
+    double t_end; /* t[0] + K T1 */
+    double w;     /* window length K T1, s */
+    double w1;    /* fundamental, rad/s */
+    int n_harm;   /* N */
+    double *re, *im;
+} thd_window_t;
+
+static int thd_window_open(thd_window_t *win, const double *t, const double *x, size_t n,
+                           double f1_hz, double fmax_hz, int *n_harm, double *window_s,
+                           double *amp1)
 {
     if (n_harm != NULL) {
         *n_harm = 0;
@@ -103,20 +115,18 @@ double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz,
     if (window_s != NULL) {
         *window_s = 0.0;
     }
-    if (i1_amp != NULL) {
-        *i1_amp = NAN;
+    if (amp1 != NULL) {
+        *amp1 = NAN;
     }
     if (t == NULL || x == NULL || n < 3 || !(f1_hz > 0.0)) {
-        return NAN;
+        return 0;
     }
     const double T1 = 1.0 / f1_hz;
     const double span = t[n - 1] - t[0];
     const double K = floor(span / T1 + 1e-9);
     if (K < 1.0) {
-        return NAN;
+        return 0;
     }
-    const double t_end = t[0] + K * T1;
-    /* Highest harmonic: fmax and half the mean sample rate. */
     const double fs_mean = (double)(n - 1) / span;
     double fm = (fmax_hz > 0.0) ? fmax_hz : 10e3;
     if (fm > 0.5 * fs_mean) {
@@ -124,16 +134,60 @@ double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz,
     }
     const int N = (int)floor(fm / f1_hz + 1e-9);
     if (N < 2) {
+        return 0;
+    }
+    win->re = calloc((size_t)N + 1, sizeof(double));
+    win->im = calloc((size_t)N + 1, sizeof(double));
+    if (win->re == NULL || win->im == NULL) {
+        free(win->re);
+        free(win->im);
+        return 0;
+    }
+    win->t_end = t[0] + K * T1;
+    win->w = K * T1;
+    win->w1 = 2.0 * METRICS_PI * f1_hz;
+    win->n_harm = N;
+    return 1;
+}
+
+/* Amplitudes 2/W |X_k|, THD (B.3) against harmonic 1; frees the sums. */
+static double thd_window_close(thd_window_t *win, int *n_harm, double *window_s, double *amp1)
+{
+    double a1 = 0.0, sum = 0.0;
+    for (int k = 1; k <= win->n_harm; ++k) {
+        const double amp = 2.0 / win->w * hypot(win->re[k], win->im[k]);
+        if (k == 1) {
+            a1 = amp;
+        } else {
+            sum += amp * amp;
+        }
+    }
+    free(win->re);
+    free(win->im);
+    if (n_harm != NULL) {
+        *n_harm = win->n_harm;
+    }
+    if (window_s != NULL) {
+        *window_s = win->w;
+    }
+    if (amp1 != NULL) {
+        *amp1 = a1;
+    }
+    if (!(a1 > 0.0)) {
         return NAN;
     }
-    double *re = calloc((size_t)N + 1, sizeof(double));
-    double *im = calloc((size_t)N + 1, sizeof(double));
-    if (re == NULL || im == NULL) {
-        free(re);
-        free(im);
+    return 100.0 * sqrt(sum) / a1; /* (B.3) */
+}
+
+double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz, double fmax_hz,
+                       int *n_harm, double *window_s, double *i1_amp)
+{
+    thd_window_t win;
+    if (!thd_window_open(&win, t, x, n, f1_hz, fmax_hz, n_harm, window_s, i1_amp)) {
         return NAN;
     }
-    const double w1 = 2.0 * METRICS_PI * f1_hz;
+    const double t_end = win.t_end;
+    const int N = win.n_harm;
     /* Trapezoid as a weighted sum of points: every sample in the window gets
      * half of each adjacent segment; the last segment is cut at t_end, whose
      * value is interpolated. Harmonic k's phasor by repeated multiplication
@@ -155,89 +209,35 @@ double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz,
                 cut = 1;
             }
         }
-        const double ph = w1 * (t[j] - t[0]);
+        const double ph = win.w1 * (t[j] - t[0]);
         const double br = cos(ph), bi = -sin(ph);
         double zr = 1.0, zi = 0.0;
         for (int k = 1; k <= N; ++k) {
             const double nr = zr * br - zi * bi;
             zi = zr * bi + zi * br;
             zr = nr;
-            re[k] += wgt * x[j] * zr;
-            im[k] += wgt * x[j] * zi;
+            win.re[k] += wgt * x[j] * zr;
+            win.im[k] += wgt * x[j] * zi;
         }
         if (cut) {
             /* the interpolated end point, weight h_end / 2, phase w1 K T1 = 2 pi K */
             for (int k = 1; k <= N; ++k) {
-                re[k] += 0.5 * h_end * x_end;
+                win.re[k] += 0.5 * h_end * x_end;
             }
         }
     }
-    const double W = K * T1;
-    double a1 = 0.0, sum = 0.0;
-    for (int k = 1; k <= N; ++k) {
-        const double amp = 2.0 / W * hypot(re[k], im[k]);
-        if (k == 1) {
-            a1 = amp;
-        } else {
-            sum += amp * amp;
-        }
-    }
-    free(re);
-    free(im);
-    if (n_harm != NULL) {
-        *n_harm = N;
-    }
-    if (window_s != NULL) {
-        *window_s = W;
-    }
-    if (i1_amp != NULL) {
-        *i1_amp = a1;
-    }
-    if (!(a1 > 0.0)) {
-        return NAN;
-    }
-    return 100.0 * sqrt(sum) / a1; /* (B.3) */
+    return thd_window_close(&win, n_harm, window_s, i1_amp);
 }
 
 double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1_hz, double fmax_hz,
                            int *n_harm, double *window_s, double *v1_amp)
 {
-    if (n_harm != NULL) {
-        *n_harm = 0;
-    }
-    if (window_s != NULL) {
-        *window_s = 0.0;
-    }
-    if (v1_amp != NULL) {
-        *v1_amp = NAN;
-    }
-    if (t == NULL || v == NULL || n < 3 || !(f1_hz > 0.0)) {
+    thd_window_t win;
+    if (!thd_window_open(&win, t, v, n, f1_hz, fmax_hz, n_harm, window_s, v1_amp)) {
         return NAN;
     }
-    const double T1 = 1.0 / f1_hz;
-    const double span = t[n - 1] - t[0];
-    const double K = floor(span / T1 + 1e-9);
-    if (K < 1.0) {
-        return NAN;
-    }
-    const double t_end = t[0] + K * T1;
-    const double fs_mean = (double)(n - 1) / span;
-    double fm = (fmax_hz > 0.0) ? fmax_hz : 10e3;
-    if (fm > 0.5 * fs_mean) {
-        fm = 0.5 * fs_mean;
-    }
-    const int N = (int)floor(fm / f1_hz + 1e-9);
-    if (N < 2) {
-        return NAN;
-    }
-    double *re = calloc((size_t)N + 1, sizeof(double));
-    double *im = calloc((size_t)N + 1, sizeof(double));
-    if (re == NULL || im == NULL) {
-        free(re);
-        free(im);
-        return NAN;
-    }
-    const double w1 = 2.0 * METRICS_PI * f1_hz;
+    const double t_end = win.t_end;
+    const double w1 = win.w1;
     /* Interval j = [t[j-1], t[j]] holds the constant v[j]: integral of
      * e^{-j k w1 (t - t0)} over it is (e^{-j k w1 (b - t0)} - e^{-j k w1 (a - t0)})
      * / (-j k w1); the phasors of the ends by repeated multiplication. */
@@ -247,7 +247,7 @@ double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1
         const double ar = cos(w1 * a), ai = -sin(w1 * a);
         const double br = cos(w1 * b), bi = -sin(w1 * b);
         double zar = 1.0, zai = 0.0, zbr = 1.0, zbi = 0.0;
-        for (int k = 1; k <= N; ++k) {
+        for (int k = 1; k <= win.n_harm; ++k) {
             double tmp = zar * ar - zai * ai;
             zai = zar * ai + zai * ar;
             zar = tmp;
@@ -257,35 +257,11 @@ double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1
             /* (zb - za) / (-j k w1) = j (zb - za) / (k w1) */
             const double dr = zbr - zar, di = zbi - zai;
             const double kw = (double)k * w1;
-            re[k] += v[j] * (-di / kw);
-            im[k] += v[j] * (dr / kw);
+            win.re[k] += v[j] * (-di / kw);
+            win.im[k] += v[j] * (dr / kw);
         }
     }
-    const double W = K * T1;
-    double a1 = 0.0, sum = 0.0;
-    for (int k = 1; k <= N; ++k) {
-        const double amp = 2.0 / W * hypot(re[k], im[k]);
-        if (k == 1) {
-            a1 = amp;
-        } else {
-            sum += amp * amp;
-        }
-    }
-    free(re);
-    free(im);
-    if (n_harm != NULL) {
-        *n_harm = N;
-    }
-    if (window_s != NULL) {
-        *window_s = W;
-    }
-    if (v1_amp != NULL) {
-        *v1_amp = a1;
-    }
-    if (!(a1 > 0.0)) {
-        return NAN;
-    }
-    return 100.0 * sqrt(sum) / a1;
+    return thd_window_close(&win, n_harm, window_s, v1_amp);
 }
 
 int metrics_finish(const metrics_acc_t *m, metrics_result_t *r)
