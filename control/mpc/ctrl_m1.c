@@ -22,7 +22,7 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         const q24_t t_full = ctrl_mpc_torque(&s->model, in.b.d0 + vd, in.b.q0 + vq);
         const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, in.b.t0)); /* (5.18) */
         const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty, in.t_ref,
-                                                 in.psi_ref, s->zeta); /* (6.13) */
+                                                 in.psi_ref, s->zeta, best_g); /* (6.13) */
         s->trace.vec[i - 1u] = i;
         s->trace.duty[i - 1u] = duty;
         if (g < best_g) {

@@ -15,6 +15,17 @@
 #define MPC_ALWAYS_INLINE
 #endif
 
+/* x within [-2^(bits-1), 2^(bits-1) - 1]: one SSAT on a Cortex-M4 (the
+ * compiler's ACLE __ssat builtin; a symmetric clamp costs four compares and
+ * moves), the same value elsewhere. */
+#if defined(__ARM_FEATURE_SAT) && defined(__GNUC__)
+#define MPC_SAT(x, bits) ((q24_t)__builtin_arm_ssat((int)(x), (bits##u)))
+#else
+#define MPC_SAT(x, bits) fx_clamp((x), -((q24_t)1 << ((bits)-1)), ((q24_t)1 << ((bits)-1)) - 1)
+#endif
+_Static_assert(CTRL_MPC_PSI_CLAMP == (q24_t)1 << 27, "MPC_SAT(x, 28) is the psi0 clamp");
+_Static_assert(CTRL_MPC_I_CLAMP == (q24_t)1 << 30, "MPC_SAT(x, 31) is the current clamp");
+
 /* The part of the basis common to ctrl_mpc_basis and ctrl_mpc_basis3:
  * d0, q0, t0 and Ts V1 = (w[0], w[1]), Ts V2 = (w[2], w[3]) in the rotor
  * frame at k+2 (inlined into both, one set of arithmetic). */
@@ -27,14 +38,12 @@ static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
      * The clamps only act on states far outside any machine's range; they
      * give the fast arithmetic its bounds (ctrl_mpc_basis_t): |Ts Rs i| <=
      * 64 pu and |psi| <= 8 pu, the differences fit an int32_t. */
-    const q24_t id = fx_clamp(n->i_d, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
-    const q24_t iq = fx_clamp(n->i_q, -CTRL_MPC_I_CLAMP, CTRL_MPC_I_CLAMP);
-    const q24_t fd = fx_clamp(n->psi_d, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    const q24_t fq = fx_clamp(n->psi_q, -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    const q24_t ad =
-        fx_clamp(fd - fx_mul_nosat(m->ts_rs, id), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
-    const q24_t aq =
-        fx_clamp(fq - fx_mul_nosat(m->ts_rs, iq), -CTRL_MPC_PSI_CLAMP, CTRL_MPC_PSI_CLAMP);
+    const q24_t id = MPC_SAT(n->i_d, 31);
+    const q24_t iq = MPC_SAT(n->i_q, 31);
+    const q24_t fd = MPC_SAT(n->psi_d, 28);
+    const q24_t fq = MPC_SAT(n->psi_q, 28);
+    const q24_t ad = MPC_SAT(fd - fx_mul_nosat(m->ts_rs, id), 28);
+    const q24_t aq = MPC_SAT(fq - fx_mul_nosat(m->ts_rs, iq), 28);
     /* The frame at k+2 is the frame at k+1 turned by delta = omega Ts (the
      * estimator's rotation, Q30, |.| <= 1): psi e^{-j delta}; |sum| < 2^34 2^30. */
     const int32_t rc = est->rot_c;
@@ -190,13 +199,18 @@ int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2)
 }
 
 int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
-                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta)
+                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta,
+                               int64_t bound)
 {
     q24_t pd;
     q24_t pq;
     ctrl_mpc_flux(b, vd, vq, duty, &pd, &pq);
     const q24_t te = ctrl_mpc_torque(m, pd, pq);
     const int64_t e_t = (int64_t)t_ref - te;
+    const int64_t g_t = e_t < 0 ? -e_t : e_t;
+    if (g_t >= bound) {
+        return INT64_MAX; /* g_t + zeta e_psi >= bound: no square root needed */
+    }
     const q24_t e_psi = fx_abs(fx_sub(psi_ref, fx_mag(pd, pq)));
-    return (e_t < 0 ? -e_t : e_t) + fx_mul(zeta, e_psi);
+    return g_t + fx_mul(zeta, e_psi);
 }

@@ -41,7 +41,7 @@ typedef struct {
 
 /* Per-sample prediction basis in the rotor frame at theta(k+2). Ranges (the
  * bounds the fast arithmetic below relies on): |d0|, |q0| <= 8 sqrt(2) pu
- * (psi0 clamped to +-8 pu per rotor-frame component), |wd|, |wq| <= 16 pu. */
+ * (psi0 clamped to [-8, 8) pu per rotor-frame component), |wd|, |wq| <= 16 pu. */
 typedef struct {
     q24_t d0, q0;       /* psi(k+2) with a zero vector, rotor frame, Q24 pu */
     q24_t wd[6], wq[6]; /* Ts V_1 .. Ts V_6 in the same frame (index i - 1), Q24 pu */
@@ -61,8 +61,8 @@ typedef struct {
 #define CTRL_MPC_AB_MAX (2 * FX_ONE)    /* |a|, |b| <= 2 pu */
 #define CTRL_MPC_TSV_MAX (16 * FX_ONE)  /* |Ts V_i| at the DC-link clamp <= 16 pu */
 #define CTRL_MPC_TS_RS_MAX FX_ONE       /* Ts Rs <= 1 pu */
-#define CTRL_MPC_PSI_CLAMP (8 * FX_ONE) /* psi0 components, pu */
-#define CTRL_MPC_I_CLAMP (64 * FX_ONE)  /* i(k+1) components, pu */
+#define CTRL_MPC_PSI_CLAMP (8 * FX_ONE) /* psi0 components within [-8, 8) pu */
+#define CTRL_MPC_I_CLAMP (64 * FX_ONE)  /* i(k+1) components within [-64, 64) pu */
 #define CTRL_MPC_PSI_MAX 7.0            /* |psi| at current_max, pu: inside the clamp */
 
 /* Candidate trace of the last step (for tests and telemetry). */
@@ -160,9 +160,13 @@ int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2);
 /* Weighted cost (6.13) of a candidate: the active vector with Ts V = (vd, vq)
  * on for duty, the zero vector the rest: |T_ref - Te(k+2)| + zeta |psi_ref - |psi(k+2)||,
  * Q24 pu (64-bit, no overflow); the amplitude needs one fx_mag (square
- * root). */
+ * root). INT64_MAX instead when the torque term alone is at least bound:
+ * the flux term is >= 0 (zeta >= 0), so that cost is not below bound and a
+ * search that keeps the strictly smallest cost (bound = the best so far)
+ * decides exactly as with the full cost, without the square root. */
 int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
-                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta);
+                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta,
+                               int64_t bound);
 
 /* ---- bounded fast arithmetic of the k+2 model ----
  * With the ranges of ctrl_mpc_basis_t and the model limits every product

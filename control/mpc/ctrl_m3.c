@@ -33,7 +33,7 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         const q24_t t_full = ctrl_mpc_torque(&s->model, in.b.d0 + vd, in.b.q0 + vq);
         duty[k] = ctrl_mpc_duty_sat(num, fx_sub(t_full, in.b.t0));
         const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty[k], in.t_ref,
-                                                 in.psi_ref, s->zeta); /* (6.13) */
+                                                 in.psi_ref, s->zeta, best_g); /* (6.13) */
         s->trace.vec[k] = cand[k];
         s->trace.duty[k] = duty[k];
         if (g < best_g) {
@@ -43,7 +43,7 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     /* The zero vector all period. */
     const int64_t g0 =
-        ctrl_mpc_cost_weighted(&s->model, &in.b, 0, 0, 0, in.t_ref, in.psi_ref, s->zeta);
+        ctrl_mpc_cost_weighted(&s->model, &in.b, 0, 0, 0, in.t_ref, in.psi_ref, s->zeta, best_g);
     s->trace.vec[2] = 0u;
     s->trace.duty[2] = 0;
     s->trace.n = 3u;
