@@ -14,6 +14,7 @@ void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
     s->primed = 0u;
     s->t_prev = 0;
     s->psi_d = 0;
+    s->own_valid = 0u;
 }
 
 /* floor(sqrt(x)) of a Q48 value >= 0 as Q24 (x < 2^62: the result < 2^31). */
@@ -31,9 +32,12 @@ static int64_t fw_sq48(q24_t x)
 }
 
 /* psi_d of the MTPV point on the flux circle psi (field_weak.h):
- * -2 c2 psi^2 / (c1 + sqrt(c1^2 + 8 c2^2 psi^2)). */
+ * -2 c2 psi^2 / (c1 + sqrt(c1^2 + 8 c2^2 psi^2)); 0 for c2 = 0. */
 static q24_t fw_mtpv_psid(const ctrl_fieldweak_t *s, q24_t psi)
 {
+    if (s->c2 == 0) {
+        return 0; /* SPMSM: the expression is exactly 0 */
+    }
     const q24_t psi2 = fx_mul(psi, psi);
     const int64_t rad = (int64_t)s->c1_sq * FX_ONE + (int64_t)s->c2_sq8 * psi2; /* Q48 */
     return fx_neg(fx_div(fx_mul(fx_add(s->c2, s->c2), psi2), fx_add(s->c1, fw_sqrt48(rad))));
@@ -108,7 +112,15 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
     const q24_t w = fx_abs(omega);
     q24_t psi_max = s->psi_ceil;
     if (w != 0) {
-        psi_max = fx_min(fx_div(fw_sqrt48(x), w), s->psi_ceil);
+        /* At the ceiling without a root or a division where x >= c^2,
+         * c = ceil(psi_ceil w / 2^24) (< 2^31: c^2 < 2^62): then
+         * floor(sqrt(x)) 2^24 >= psi_ceil w, so the rounded quotient is
+         * >= psi_ceil - exactly the value below (below ~0.75 x base speed
+         * on the thesis SPMSM). */
+        const uint64_t c = ((uint64_t)s->psi_ceil * (uint32_t)w + (FX_ONE - 1u)) >> FX_QBITS;
+        if (c >= ((uint64_t)1 << 31) || x < (int64_t)(c * c)) {
+            psi_max = fx_min(fx_div(fw_sqrt48(x), w), s->psi_ceil);
+        }
     }
     out->psi_max = psi_max;
 
@@ -127,7 +139,21 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
         }
     }
     const q24_t t = fx_clamp(t_req, fx_neg(t_lim), t_lim);
-    const q24_t psi_own = ctrl_flux_ref(p, psi_cmd, t);
+    /* The flux reference of t, recomputed only when an input moved (the
+     * torque at the speed loop's rate or on a command, psi_pm with the
+     * PM-flux tracking; the MTPA table is fixed between resets). */
+    if (s->own_valid == 0u || t != s->own_t || psi_cmd != s->own_cmd || p != s->own_p ||
+        p->psi_pm != s->own_psi_pm || p->mtpa_k != s->own_mtpa_k || p->psi_ref != s->own_psi_ref) {
+        s->own_psi = ctrl_flux_ref(p, psi_cmd, t);
+        s->own_t = t;
+        s->own_cmd = psi_cmd;
+        s->own_p = p;
+        s->own_psi_pm = p->psi_pm;
+        s->own_mtpa_k = p->mtpa_k;
+        s->own_psi_ref = p->psi_ref;
+        s->own_valid = 1u;
+    }
+    const q24_t psi_own = s->own_psi;
     out->torque_max = t_lim;
     out->torque = t;
     out->psi_ref = fx_min(psi_own, psi_max);

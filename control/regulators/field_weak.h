@@ -40,8 +40,9 @@
  *
  * Formats: every q24_t is Q24 pu (bases in ctrl_params.h); squares and sums
  * of squares are formed in int64_t (Q48) and square-rooted exactly with
- * fx_isqrt64 (floor); three fx_div per period (psi_max, the intersection,
- * MTPV). Error budget: docs/error-budget.md, "Field weakening".
+ * fx_isqrt64 (floor); at most three fx_div per period (psi_max, the
+ * intersection, MTPV; psi_max at its ceiling and the SPMSM's MTPV point need
+ * none). Error budget: docs/error-budget.md, "Field weakening".
  */
 #ifndef CONTROL_FIELD_WEAK_H
 #define CONTROL_FIELD_WEAK_H
@@ -85,6 +86,11 @@ typedef struct {
     uint8_t primed;  /* vdc_acc holds a sample */
     q24_t t_prev;    /* torque reference of the previous period (the Rs term) */
     q24_t psi_d;     /* ctrl_fieldweak_currents: psi_d of the last solution */
+    /* the controller's own flux reference (ctrl_flux_ref) of the last
+       clamped torque, and the inputs it was computed from */
+    const ctrl_params_t *own_p;
+    q24_t own_psi, own_t, own_cmd, own_psi_pm, own_mtpa_k, own_psi_ref;
+    uint8_t own_valid;
 } ctrl_fieldweak_t;
 
 typedef struct {

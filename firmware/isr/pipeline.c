@@ -413,9 +413,12 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * Outside field weakening it decays with the same time constant (smooth
      * exit); bounded by a quarter of the torque limit. */
     const uint8_t weak = lim.weakening;
-    const q24_t trim_lim = fx_rshift32_round(lim.torque_max, 2u);
-    const q24_t trim_in = weak != 0u ? fx_sub(tref, est->now.torque) : fx_neg(fw->trim);
-    fw->trim = fx_clamp(fx_add(fw->trim, fx_mul(fw->trim_k, trim_in)), fx_neg(trim_lim), trim_lim);
+    if (weak != 0u || fw->trim != 0) { /* else it stays 0 */
+        const q24_t trim_lim = fx_rshift32_round(lim.torque_max, 2u);
+        const q24_t trim_in = weak != 0u ? fx_sub(tref, est->now.torque) : fx_neg(fw->trim);
+        fw->trim =
+            fx_clamp(fx_add(fw->trim, fx_mul(fw->trim_k, trim_in)), fx_neg(trim_lim), trim_lim);
+    }
     fw->refs.torque = fx_add(tref, fw->trim);
     fw->refs.psi = weak != 0u ? lim.psi_ref : 0;
     fw->torque_max = lim.torque_max;
