@@ -5,18 +5,109 @@
  */
 #include "fx.h"
 
+/* Count of leading zeros of a non-zero 32-bit value. */
+static unsigned fx_clz32(uint32_t x)
+{
+#if defined(__GNUC__)
+    return (unsigned)__builtin_clz(x);
+#else
+    unsigned n = 0;
+    while ((x & 0x80000000u) == 0u) {
+        x <<= 1;
+        n++;
+    }
+    return n;
+#endif
+}
+
+/*
+ * floor((u1 2^32 + u0) / v) for u1 < v (so the quotient fits 32 bits): long
+ * division in 16-bit digits with 32-bit divisions (Knuth's algorithm D as in
+ * H. S. Warren, "Hacker's Delight", divlu): the divisor shifted so that its
+ * top bit is set, each digit estimated from the top digits and corrected at
+ * most twice. On a Cortex-M4 two UDIV instead of libgcc's 64-bit division.
+ * Products and sums are bounded as in the source: q < 2^16 before q vn0,
+ * rhat < 2^16 before 2^16 rhat; the partial remainder is taken modulo 2^32.
+ */
+static uint32_t fx_divlu(uint32_t u1, uint32_t u0, uint32_t v)
+{
+    const uint32_t b = 65536u;
+    const unsigned s = fx_clz32(v);
+    v <<= s;
+    const uint32_t vn1 = v >> 16;
+    const uint32_t vn0 = v & 0xFFFFu;
+    const uint32_t un32 = s != 0u ? (u1 << s) | (u0 >> (32u - s)) : u1;
+    const uint32_t un10 = u0 << s;
+    const uint32_t un1 = un10 >> 16;
+    const uint32_t un0 = un10 & 0xFFFFu;
+    uint32_t q1 = un32 / vn1;
+    uint32_t rhat = un32 - q1 * vn1;
+    while (q1 >= b || q1 * vn0 > b * rhat + un1) {
+        q1--;
+        rhat += vn1;
+        if (rhat >= b) {
+            break;
+        }
+    }
+    const uint32_t un21 = un32 * b + un1 - q1 * v;
+    uint32_t q0 = un21 / vn1;
+    rhat = un21 - q0 * vn1;
+    while (q0 >= b || q0 * vn0 > b * rhat + un0) {
+        q0--;
+        rhat += vn1;
+        if (rhat >= b) {
+            break;
+        }
+    }
+    return q1 * b + q0;
+}
+
 q24_t fx_div(q24_t num, q24_t den)
 {
     if (den == 0) {
         return num > 0 ? FX_MAX : (num < 0 ? FX_MIN : 0);
     }
-    /* |num| * 2^24 < 2^55 and |den| <= 2^31: magnitudes in uint64_t, rounded
-     * half away from zero so that fx_div(-a, b) == -fx_div(a, b). */
-    const uint64_t un = (uint64_t)(num < 0 ? -(int64_t)num : (int64_t)num) << FX_QBITS;
-    const uint64_t ud = (uint64_t)(den < 0 ? -(int64_t)den : (int64_t)den);
-    const uint64_t q = (un + ud / 2u) / ud; /* < 2^55 + 1 */
-    const int64_t sq = (int64_t)q;
-    return fx_sat32(((num < 0) != (den < 0)) ? -sq : sq);
+    /* round(|num| 2^24 / |den|) = floor((|num| 2^24 + floor(|den| / 2)) / |den|),
+     * half away from zero so that fx_div(-a, b) == -fx_div(a, b). The
+     * numerator (< 2^55 + 2^30) as two words n1 2^32 + n0; a quotient of
+     * 2^31 or more (n1 >= |den| means >= 2^32) saturates. */
+    const uint32_t an = num < 0 ? 0u - (uint32_t)num : (uint32_t)num; /* <= 2^31 */
+    const uint32_t ad = den < 0 ? 0u - (uint32_t)den : (uint32_t)den; /* in [1, 2^31] */
+    const int neg = (num < 0) != (den < 0);
+    if (ad < ((uint32_t)1 << FX_QBITS)) {
+        /* |den| < 2^24 (below 1 pu): the integer part, then three 8-bit
+         * digits by 32-bit divisions (the remainder stays below |den|, so
+         * its shift by 8 fits 32 bits); an integer part >= 2^7 is a
+         * quotient >= 2^31. Round: floor((N + floor(d/2)) / d) = q + 1
+         * exactly when the remainder r >= d - floor(d/2). */
+        uint32_t q = an / ad;
+        uint32_t r = an - q * ad;
+        if (q >= ((uint32_t)1 << (31u - FX_QBITS))) {
+            return neg ? FX_MIN : FX_MAX;
+        }
+        for (int k = 0; k < 3; k++) {
+            r <<= 8;
+            const uint32_t dgt = r / ad;
+            r -= dgt * ad;
+            q = (q << 8) | dgt;
+        }
+        q += r >= ad - (ad >> 1) ? 1u : 0u;
+        if (q > (uint32_t)INT32_MAX) {
+            return neg ? FX_MIN : FX_MAX;
+        }
+        return neg ? -(q24_t)q : (q24_t)q;
+    }
+    const uint32_t lo = an << FX_QBITS;
+    const uint32_t n0 = lo + (ad >> 1);
+    const uint32_t n1 = (an >> (32u - FX_QBITS)) + (n0 < lo ? 1u : 0u);
+    if (n1 >= ad) {
+        return neg ? FX_MIN : FX_MAX;
+    }
+    const uint32_t q = fx_divlu(n1, n0, ad);
+    if (q > (uint32_t)INT32_MAX) {
+        return neg ? FX_MIN : FX_MAX;
+    }
+    return neg ? -(q24_t)q : (q24_t)q;
 }
 
 /* Count of leading zeros of a non-zero 64-bit value. */

@@ -275,8 +275,8 @@ static inline int fx_sign(q24_t a)
 /* ---- Implemented in fx.c (integer-only) ---- */
 
 /* num / den in Q24, rounded, saturated; den == 0 saturates to the sign of num
- * (0 / 0 gives 0). Uses a 64-by-32 division: costly on Cortex-M, keep it out of
- * inner loops where a precomputed reciprocal serves. */
+ * (0 / 0 gives 0). A 64-by-32 division (two 32-bit divisions, fx.c): costly
+ * on Cortex-M, keep it out of inner loops where a precomputed reciprocal serves. */
 q24_t fx_div(q24_t num, q24_t den);
 
 /* floor(sqrt(x)) for a 64-bit unsigned argument (result fits 32 bits). */
