@@ -8,6 +8,15 @@
 
 #define FW_NEWTON_STEPS 3 /* per call of ctrl_fieldweak_currents */
 
+/* Forced inlining of the per-period body into its two entry points (the
+ * interrupt's and the tests'): an out-of-line call costs the interrupt more
+ * than it saves in code (measured, tools/bench). */
+#if defined(__GNUC__)
+#define FW_ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define FW_ALWAYS_INLINE inline
+#endif
+
 void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
 {
     s->vdc_acc = 0;
@@ -90,8 +99,39 @@ q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_
     return fx_min(fx_max(t, 0), fx_mul(s->t_margin, t_v));
 }
 
-void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
-                         q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
+/* psi_max >= b (b > 0, w > 0) without the root and the division: when
+ * x >= c^2, c = ceil(b w / 2^24) (< 2^31: c^2 < 2^62), floor(sqrt(x)) 2^24
+ * >= b w, so the rounded quotient floor(sqrt(x)) / w is >= b. Sufficient
+ * only: 0 leaves the question to the division. */
+static int fw_flux_at_least(int64_t x, q24_t w, q24_t b)
+{
+    const uint64_t c = ((uint64_t)(uint32_t)b * (uint32_t)w + (FX_ONE - 1u)) >> FX_QBITS;
+    return c < ((uint64_t)1 << 31) && x >= (int64_t)(c * c);
+}
+
+/* The controller's own flux reference of t (ctrl_flux_ref), recomputed only
+ * when an input moved (the torque at the speed loop's rate or on a command,
+ * psi_pm with the PM-flux tracking; the MTPA table is fixed between resets). */
+static FW_ALWAYS_INLINE q24_t fw_flux_own(ctrl_fieldweak_t *s, const ctrl_params_t *p,
+                                          q24_t psi_cmd, q24_t t)
+{
+    if (s->own_valid == 0u || t != s->own_t || psi_cmd != s->own_cmd || p != s->own_p ||
+        p->psi_pm != s->own_psi_pm || p->mtpa_k != s->own_mtpa_k || p->psi_ref != s->own_psi_ref) {
+        s->own_psi = ctrl_flux_ref(p, psi_cmd, t);
+        s->own_t = t;
+        s->own_cmd = psi_cmd;
+        s->own_p = p;
+        s->own_psi_pm = p->psi_pm;
+        s->own_mtpa_k = p->mtpa_k;
+        s->own_psi_ref = p->psi_ref;
+        s->own_valid = 1u;
+    }
+    return s->own_psi;
+}
+
+static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
+                                     q24_t omega, q24_t t_req, q24_t psi_cmd,
+                                     ctrl_fieldweak_out_t *out, int lazy)
 {
     /* DC link: first-order low pass (the ADC's noise, not its dips: vdc_k is
      * set for ~1 kHz). */
@@ -110,22 +150,33 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
     int64_t x = fw_sq48(v) - s->rs_i2;
     x -= (int64_t)s->two_rs * fx_mul(omega, s->t_prev); /* |.| < 2^62 */
     const q24_t w = fx_abs(omega);
-    q24_t psi_max = s->psi_ceil;
-    if (w != 0) {
-        /* At the ceiling without a root or a division where x >= c^2,
-         * c = ceil(psi_ceil w / 2^24) (< 2^31: c^2 < 2^62): then
-         * floor(sqrt(x)) 2^24 >= psi_ceil w, so the rounded quotient is
-         * >= psi_ceil - exactly the value below (below ~0.75 x base speed
-         * on the thesis SPMSM). */
-        const uint64_t c = ((uint64_t)s->psi_ceil * (uint32_t)w + (FX_ONE - 1u)) >> FX_QBITS;
-        if (c >= ((uint64_t)1 << 31) || x < (int64_t)(c * c)) {
-            psi_max = fx_min(fx_div(fw_sqrt48(x), w), s->psi_ceil);
+    const q24_t psi_fix = psi_cmd > 0 ? psi_cmd : p->psi_ref;
+    if (lazy != 0 && psi_fix <= 0 && w != 0 && fw_flux_at_least(x, w, s->psi_mtpa)) {
+        /* psi_max >= the MTPA flux at I_max: the current limit, whatever
+         * psi_max is; if it is also >= the flux reference of the clamped
+         * torque, neither the reference nor "weakening" depends on it. */
+        const q24_t t = fx_clamp(t_req, fx_neg(s->t_mtpa), s->t_mtpa);
+        const q24_t psi_own = fw_flux_own(s, p, psi_cmd, t);
+        if (psi_own <= s->psi_mtpa || (psi_own <= s->psi_ceil && fw_flux_at_least(x, w, psi_own))) {
+            out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
+            out->torque_max = s->t_mtpa;
+            out->torque = t;
+            out->psi_ref = psi_own;
+            out->limit = CTRL_FW_LIMIT_CURRENT;
+            out->clipped = t != t_req ? 1u : 0u;
+            out->weakening = 0u;
+            s->t_prev = t;
+            return;
         }
+    }
+    q24_t psi_max = s->psi_ceil;
+    if (w != 0 && !fw_flux_at_least(x, w, s->psi_ceil)) {
+        /* (at the ceiling - low speed - without the root and the division) */
+        psi_max = fx_min(fx_div(fw_sqrt48(x), w), s->psi_ceil);
     }
     out->psi_max = psi_max;
 
     /* Torque limit at the flux the controller will hold. */
-    const q24_t psi_fix = psi_cmd > 0 ? psi_cmd : p->psi_ref;
     q24_t t_lim;
     uint8_t lim;
     if (psi_fix <= 0 && psi_max >= s->psi_mtpa) {
@@ -139,21 +190,7 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
         }
     }
     const q24_t t = fx_clamp(t_req, fx_neg(t_lim), t_lim);
-    /* The flux reference of t, recomputed only when an input moved (the
-     * torque at the speed loop's rate or on a command, psi_pm with the
-     * PM-flux tracking; the MTPA table is fixed between resets). */
-    if (s->own_valid == 0u || t != s->own_t || psi_cmd != s->own_cmd || p != s->own_p ||
-        p->psi_pm != s->own_psi_pm || p->mtpa_k != s->own_mtpa_k || p->psi_ref != s->own_psi_ref) {
-        s->own_psi = ctrl_flux_ref(p, psi_cmd, t);
-        s->own_t = t;
-        s->own_cmd = psi_cmd;
-        s->own_p = p;
-        s->own_psi_pm = p->psi_pm;
-        s->own_mtpa_k = p->mtpa_k;
-        s->own_psi_ref = p->psi_ref;
-        s->own_valid = 1u;
-    }
-    const q24_t psi_own = s->own_psi;
+    const q24_t psi_own = fw_flux_own(s, p, psi_cmd, t);
     out->torque_max = t_lim;
     out->torque = t;
     out->psi_ref = fx_min(psi_own, psi_max);
@@ -161,6 +198,18 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
     out->clipped = t != t_req ? 1u : 0u;
     out->weakening = psi_max < psi_own ? 1u : 0u;
     s->t_prev = t;
+}
+
+void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
+                         q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
+{
+    fw_step(s, p, vdc, omega, t_req, psi_cmd, out, 0);
+}
+
+void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
+                              q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
+{
+    fw_step(s, p, vdc, omega, t_req, psi_cmd, out, 1);
 }
 
 void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t t, q24_t psi_ref,

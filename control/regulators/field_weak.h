@@ -115,6 +115,21 @@ void ctrl_fieldweak_reset(ctrl_fieldweak_t *s);
 void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
                          q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out);
 
+/* ctrl_fieldweak_out_t.psi_max of ctrl_fieldweak_step_lazy where it was not
+ * computed. */
+#define CTRL_FW_PSI_MAX_NOT_BINDING ((q24_t)-1)
+
+/*
+ * ctrl_fieldweak_step for the interrupt: the same outputs, except that
+ * psi_max is CTRL_FW_PSI_MAX_NOT_BINDING where the comparison of squares
+ * shows it at least the MTPA flux at the current limit and the flux
+ * reference of the clamped torque (below base speed: then neither the
+ * torque limit nor the flux reference depends on its value), which saves
+ * its square root and division.
+ */
+void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
+                              q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out);
+
 /* Torque limit and its kind at flux amplitude psi in field weakening (the
  * flux-circle part above); for tests and tools. */
 q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_t *limit);

@@ -403,7 +403,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * weakened to what the voltage allows (0 = the controller's own below
      * base speed, so nothing changes there). */
     ctrl_fieldweak_out_t lim;
-    ctrl_fieldweak_step(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, 0, &lim);
+    ctrl_fieldweak_step_lazy(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, 0, &lim);
     tref = lim.torque;
     /* Mean-torque trim in field weakening: with the flux at the voltage's
      * limit the torque rises slowly (little voltage beyond the back-EMF) and

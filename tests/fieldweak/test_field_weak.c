@@ -337,6 +337,70 @@ static void test_vdc_filter(void)
     TEST_ASSERT_EQUAL_INT32(0, o.torque);
 }
 
+/* ctrl_fieldweak_step_lazy against ctrl_fieldweak_step on the same inputs
+ * (speed swept from standstill to 2.5 x rated and back, DC link +-20 %,
+ * torque requests up to 1.5 x rated held for a few periods, psi_pm moved as
+ * the PM-flux tracking does): identical outputs, psi_max excepted where the
+ * lazy form did not compute it - and there the exact one is at least the
+ * MTPA flux at the current limit and the flux reference. */
+static void check_lazy(const ctrl_machine_t *m, double psi_ref_wb)
+{
+    ctrl_machine_t mm = *m;
+    mm.psi_ref_wb = psi_ref_wb;
+    setup(&mm, -1.0);
+    ctrl_fieldweak_t lazy = S;
+    ctrl_params_t pl = P;
+    uint32_t r = 12345u;
+    unsigned n_lazy = 0u;
+    unsigned n_exact = 0u;
+    q24_t t_req = 0;
+    const int n = 20000;
+    for (int k = 0; k < n; k++) {
+        r = r * 1664525u + 1013904223u;
+        const double ramp = k < n / 2 ? (double)k / (n / 2) : (double)(n - k) / (n / 2);
+        const double rpm = 2.5 * M.speed_rated_rpm * ramp * ((k / 5000) % 2 == 0 ? 1.0 : -1.0);
+        const q24_t vdc = q(d(vdc_pu()) * (0.8 + 0.4 * (double)(r >> 16) / 65536.0));
+        if ((r & 15u) == 0u) {
+            t_req = q((double)(int32_t)(r - 2147483648u) / 2147483648.0 * 1.5 * M.torque_rated_nm /
+                      B.torque_nm);
+        }
+        if ((r & 255u) == 1u) {
+            P.psi_pm = pl.psi_pm = fx_add(P.psi_pm, (q24_t)((r >> 8) % 4001u) - 2000);
+        }
+        ctrl_fieldweak_out_t oe;
+        ctrl_fieldweak_out_t ol;
+        ctrl_fieldweak_step(&S, &P, vdc, omega_pu(rpm), t_req, 0, &oe);
+        ctrl_fieldweak_step_lazy(&lazy, &pl, vdc, omega_pu(rpm), t_req, 0, &ol);
+        TEST_ASSERT_EQUAL_INT32(oe.vdc, ol.vdc);
+        TEST_ASSERT_EQUAL_INT32(oe.torque_max, ol.torque_max);
+        TEST_ASSERT_EQUAL_INT32(oe.torque, ol.torque);
+        TEST_ASSERT_EQUAL_INT32(oe.psi_ref, ol.psi_ref);
+        TEST_ASSERT_EQUAL_UINT8(oe.limit, ol.limit);
+        TEST_ASSERT_EQUAL_UINT8(oe.clipped, ol.clipped);
+        TEST_ASSERT_EQUAL_UINT8(oe.weakening, ol.weakening);
+        if (ol.psi_max == CTRL_FW_PSI_MAX_NOT_BINDING) {
+            n_lazy++;
+            TEST_ASSERT_TRUE(oe.psi_max >= S.psi_mtpa && oe.psi_max >= oe.psi_ref);
+        } else {
+            n_exact++;
+            TEST_ASSERT_EQUAL_INT32(oe.psi_max, ol.psi_max);
+        }
+    }
+    if (psi_ref_wb > 0.0) {
+        TEST_ASSERT_EQUAL_UINT(0u, n_lazy); /* a fixed reference: always computed */
+    } else {
+        TEST_ASSERT_TRUE(n_lazy > 0u && n_exact > 0u);
+    }
+}
+
+static void test_lazy(void)
+{
+    check_lazy(&ini_thesis_spmsm, 0.0);
+    check_lazy(&ini_thesis_ipmsm80, 0.0);
+    check_lazy(&ini_thesis_ipmsm80, 0.1837);
+    check_lazy(&ini_chapter_ipmsm, 0.0);
+}
+
 /* The 80 kW IPMSM's fixed reference 0.1837 Wb (section 6.5.1) bounds the torque
  * below base speed: the flux circle at 0.1837 Wb meets the 400 A circle, or its
  * MTPV point with the margin. */
@@ -430,5 +494,6 @@ int main(void)
     RUN_TEST(test_vdc_filter);
     RUN_TEST(test_fixed_flux);
     RUN_TEST(test_currents);
+    RUN_TEST(test_lazy);
     return UNITY_END();
 }
