@@ -597,7 +597,8 @@ void fw_isr(fw_t *fw)
     hal_adc_read(hal, &raw);
     hal_encoder_read(hal, &enc);
 
-    if ((fw->req_clear | fw->req_disarm | fw->req_arm | fw->req_cm) != 0) {
+    if (fw->req_any != 0u) {
+        fw->req_any = 0u;
         fw_apply_commands(fw, tm);
     }
     /* Running: one predictable branch to the straight path; boot,
@@ -651,6 +652,7 @@ void fw_cmd_arm(fw_t *fw)
 {
     if (fw != NULL) {
         fw->req_arm = 1u;
+        fw->req_any = 1u;
     }
 }
 
@@ -658,6 +660,7 @@ void fw_cmd_disarm(fw_t *fw)
 {
     if (fw != NULL) {
         fw->req_disarm = 1u;
+        fw->req_any = 1u;
     }
 }
 
@@ -665,6 +668,7 @@ void fw_cmd_clear(fw_t *fw)
 {
     if (fw != NULL) {
         fw->req_clear = 1u;
+        fw->req_any = 1u;
     }
 }
 

@@ -237,8 +237,10 @@ typedef struct {
     cm_t cm;
     const char *cm_what; /* quantity the commissioning limits could not represent */
     uint8_t cm_gates;    /* gates enabled by a commissioning step */
-    /* commands from the main loop, applied at the next period start */
-    volatile uint8_t req_arm, req_disarm, req_clear, req_cm;
+    /* commands from the main loop, applied at the next period start; req_any
+       is set after the flag (and cleared by the interrupt before it reads
+       them), so that one test per period covers all four */
+    volatile uint8_t req_arm, req_disarm, req_clear, req_cm, req_any;
     bool busy; /* re-entry flag */
     uint32_t period;
     /* Telemetry ring: the interrupt writes each period's record into slot

@@ -327,6 +327,7 @@ int fw_commission_start(fw_t *fw, const uint8_t *steps, uint8_t n, uint8_t *miss
         return FW_ENOENT;
     }
     fw->req_cm = 1u;
+    fw->req_any = 1u;
     return FW_OK;
 }
 
