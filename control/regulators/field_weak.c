@@ -109,21 +109,24 @@ static int fw_flux_at_least(int64_t x, q24_t w, q24_t b)
     return c < ((uint64_t)1 << 31) && x >= (int64_t)(c * c);
 }
 
-/* The controller's own flux reference of t (ctrl_flux_ref), recomputed only
- * when an input moved (the torque at the speed loop's rate or on a command,
- * psi_pm with the PM-flux tracking; the MTPA table is fixed between resets). */
+/* The controller's own flux reference of t (ctrl_flux_ref): the fixed one
+ * psi_fix (the command, else p->psi_ref) if > 0, else MTPA (4.15) of t,
+ * recomputed only when an input moved (the torque at the speed loop's rate
+ * or on a command, psi_pm with the PM-flux tracking; the MTPA table is fixed
+ * between resets). */
 static FW_ALWAYS_INLINE q24_t fw_flux_own(ctrl_fieldweak_t *s, const ctrl_params_t *p,
-                                          q24_t psi_cmd, q24_t t)
+                                          q24_t psi_fix, q24_t t)
 {
-    if (s->own_valid == 0u || t != s->own_t || psi_cmd != s->own_cmd || p != s->own_p ||
-        p->psi_pm != s->own_psi_pm || p->mtpa_k != s->own_mtpa_k || p->psi_ref != s->own_psi_ref) {
-        s->own_psi = ctrl_flux_ref(p, psi_cmd, t);
+    if (psi_fix > 0) {
+        return psi_fix;
+    }
+    if (s->own_valid == 0u || t != s->own_t || p != s->own_p || p->psi_pm != s->own_psi_pm ||
+        p->mtpa_k != s->own_mtpa_k) {
+        s->own_psi = ctrl_mtpa_psi(p, t);
         s->own_t = t;
-        s->own_cmd = psi_cmd;
         s->own_p = p;
         s->own_psi_pm = p->psi_pm;
         s->own_mtpa_k = p->mtpa_k;
-        s->own_psi_ref = p->psi_ref;
         s->own_valid = 1u;
     }
     return s->own_psi;
@@ -139,10 +142,11 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
         s->vdc_acc = (int64_t)vdc * FX_ONE;
         s->primed = 1u;
     } else {
-        const q24_t vf = fx_round_sat(s->vdc_acc, FX_QBITS);
-        s->vdc_acc += (int64_t)fx_sub(vdc, vf) * s->vdc_k; /* |.| < 2^31 * 2^24 */
+        /* vdc_r: the accumulator rounded, as left by the last period */
+        s->vdc_acc += (int64_t)fx_sub(vdc, s->vdc_r) * s->vdc_k; /* |.| < 2^31 * 2^24 */
     }
-    const q24_t vdc_f = fx_max(fx_round_sat(s->vdc_acc, FX_QBITS), 0);
+    s->vdc_r = fx_round_sat(s->vdc_acc, FX_QBITS);
+    const q24_t vdc_f = fx_max(s->vdc_r, 0);
     out->vdc = vdc_f;
 
     /* Flux the voltage allows: psi_max = sqrt(V^2 - (Rs I)^2 - 2 Rs w T) / |w|. */
@@ -156,7 +160,7 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
          * psi_max is; if it is also >= the flux reference of the clamped
          * torque, neither the reference nor "weakening" depends on it. */
         const q24_t t = fx_clamp(t_req, fx_neg(s->t_mtpa), s->t_mtpa);
-        const q24_t psi_own = fw_flux_own(s, p, psi_cmd, t);
+        const q24_t psi_own = fw_flux_own(s, p, 0, t);
         if (psi_own <= s->psi_mtpa || (psi_own <= s->psi_ceil && fw_flux_at_least(x, w, psi_own))) {
             out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
             out->torque_max = s->t_mtpa;
@@ -190,7 +194,7 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
         }
     }
     const q24_t t = fx_clamp(t_req, fx_neg(t_lim), t_lim);
-    const q24_t psi_own = fw_flux_own(s, p, psi_cmd, t);
+    const q24_t psi_own = fw_flux_own(s, p, psi_fix, t);
     out->torque_max = t_lim;
     out->torque = t;
     out->psi_ref = fx_min(psi_own, psi_max);

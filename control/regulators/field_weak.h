@@ -86,10 +86,11 @@ typedef struct {
     uint8_t primed;  /* vdc_acc holds a sample */
     q24_t t_prev;    /* torque reference of the previous period (the Rs term) */
     q24_t psi_d;     /* ctrl_fieldweak_currents: psi_d of the last solution */
-    /* the controller's own flux reference (ctrl_flux_ref) of the last
-       clamped torque, and the inputs it was computed from */
+    q24_t vdc_r;     /* vdc_acc rounded to Q24 (saturated), as of the last period */
+    /* the MTPA flux reference (4.15) of the last clamped torque, and the
+       inputs it was computed from */
     const ctrl_params_t *own_p;
-    q24_t own_psi, own_t, own_cmd, own_psi_pm, own_mtpa_k, own_psi_ref;
+    q24_t own_psi, own_t, own_psi_pm, own_mtpa_k;
     uint8_t own_valid;
 } ctrl_fieldweak_t;
 
