@@ -4,6 +4,7 @@
 #include "angle_source.h"
 
 #define SL_QUARTER_TURN 0x40000000u /* 90 deg */
+#define SL_HALF_TURN 0x80000000u    /* 180 deg */
 
 void ctrl_sl_reset(ctrl_sl_t *s)
 {
@@ -14,6 +15,12 @@ void ctrl_sl_reset(ctrl_sl_t *s)
     s->omega_f = 0;
     s->obs.primed = 0u;
     s->obs.kappa_ts = s->kappa_start;
+    s->phase = (uint8_t)(s->ia_on != 0u ? CTRL_SL_PH_D1 : CTRL_SL_PH_NONE);
+    s->mode = (uint8_t)(s->ia_on != 0u ? CTRL_SL_DETECT : CTRL_SL_FORCED);
+    s->reached = (uint8_t)(s->ia_on != 0u ? 0u : 1u);
+    s->dir = 1;
+    s->th1 = 0u;
+    ctrl_ia_start(&s->ia);
 }
 
 /* omega_f one step towards target (at most ramp_dw). */
@@ -63,6 +70,84 @@ static void sl_forced_out(ctrl_sl_t *s, ctrl_sl_out_t *out, q24_t w_obs)
     out->theta = s->theta_f + sl_damp(s, w_obs);
     out->omega = s->omega_f;
     out->torque_ref = s->t_start;
+    out->v_alpha = 0;
+    out->v_beta = 0;
+}
+
+/* The observer from angle theta at standstill, its angle from this period
+ * on; the caller's speed loop takes over (handover). */
+static void sl_observe_from(ctrl_sl_t *s, const ctrl_params_t *p, fx_angle_t theta, q24_t i_alpha,
+                            q24_t i_beta, ctrl_sl_out_t *out)
+{
+    ctrl_fobs_reset(&s->obs, p, theta, 0, i_alpha, i_beta);
+    s->obs.kappa_ts = s->kappa_ts;
+    s->mode = CTRL_SL_OBSERVER;
+    s->phase = CTRL_SL_PH_NONE;
+    s->count = 0u;
+    out->mode = CTRL_SL_OBSERVER;
+    out->theta = theta;
+    out->omega = 0;
+    out->torque_ref = 0;
+    out->handover = 1u;
+}
+
+/* The salient machine's start (sensorless.h): angle modulo pi, polarity
+ * pulse, angle again, then the observer from the measured angle. */
+static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
+                       q24_t i_alpha, q24_t i_beta, q24_t speed_ref, ctrl_sl_out_t *out)
+{
+    out->theta = s->theta_f;
+    out->omega = 0;
+    out->torque_ref = 0;
+    out->v_alpha = 0;
+    out->v_beta = 0;
+    if (s->phase == CTRL_SL_PH_POL) {
+        out->mode = CTRL_SL_FORCED;
+        const q24_t t = s->dir > 0 ? s->t_start : fx_neg(s->t_start);
+        out->torque_ref = s->count < s->pol_n ? t : (s->count < 2u * s->pol_n ? fx_neg(t) : 0);
+        /* the MTPA current's angle from q turns with the torque's sign */
+        out->theta = out->torque_ref < 0 ? s->th1 + s->pol_shift : s->th1 - s->pol_shift;
+        s->count++;
+        if (s->count >= 2u * s->pol_n + s->zero_n) {
+            s->phase = CTRL_SL_PH_D2;
+            s->mode = CTRL_SL_DETECT;
+            s->count = 0u;
+            ctrl_ia_start(&s->ia);
+        }
+        return;
+    }
+    out->mode = CTRL_SL_DETECT;
+    if (ctrl_ia_step(&s->ia, v_alpha, v_beta, i_alpha, i_beta, &out->v_alpha, &out->v_beta) != 0u) {
+        return;
+    }
+    const fx_angle_t th = ctrl_ia_angle(&s->ia);
+    if (s->phase == CTRL_SL_PH_D1) {
+        /* the polarity pulse on the measured axis, the way the speed is wanted */
+        s->th1 = th;
+        s->theta_f = th;
+        s->dir = speed_ref < 0 ? -1 : 1;
+        s->phase = CTRL_SL_PH_POL;
+        s->mode = CTRL_SL_FORCED;
+        s->count = 0u;
+        return;
+    }
+    /* Displacement within +-90 deg (both angles modulo pi): in doubled angles
+     * the wrap is the integer one; halved without shifting a negative value. */
+    const int32_t d2 = (int32_t)(uint32_t)((th << 1) - (s->th1 << 1));
+    const int32_t disp = d2 / 2;
+    const uint32_t mag = disp < 0 ? (uint32_t)0 - (uint32_t)disp : (uint32_t)disp;
+    if (mag < s->pol_min) {
+        /* polarity unknown (a load as large as t_start, a blocked rotor):
+         * the blind forced start */
+        s->phase = CTRL_SL_PH_NONE;
+        s->mode = CTRL_SL_FORCED;
+        s->reached = 1u;
+        s->theta_f = s->theta0;
+        s->count = 0u;
+        return;
+    }
+    const fx_angle_t north = ((disp < 0) == (s->dir < 0)) ? th : th + SL_HALF_TURN;
+    sl_observe_from(s, p, north, i_alpha, i_beta, out);
 }
 
 void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
@@ -75,12 +160,21 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
     out->handover = 0u;
     out->theta_obs = th_obs;
 
+    if (s->phase != CTRL_SL_PH_NONE) {
+        sl_initial(s, p, v_alpha, v_beta, i_alpha, i_beta, speed_ref, out);
+        return;
+    }
     if (s->mode == CTRL_SL_OBSERVER) {
         out->mode = CTRL_SL_OBSERVER;
         out->theta = th_obs;
         out->omega = w_obs;
         out->torque_ref = 0;
-        s->count = fx_abs(w_obs) < s->w_off ? s->count + 1u : 0u;
+        out->v_alpha = 0;
+        out->v_beta = 0;
+        if (fx_abs(w_obs) >= s->w_on) {
+            s->reached = 1u;
+        }
+        s->count = fx_abs(w_obs) < s->w_off && s->reached != 0u ? s->count + 1u : 0u;
         if (s->count < s->low_n) {
             return;
         }
@@ -126,6 +220,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
         out->omega = w_obs;
         out->torque_ref = 0;
         out->handover = 1u;
+        s->reached = 1u;
     }
 }
 
@@ -138,9 +233,11 @@ static void angle_sl_reset(void *state, const ctrl_params_t *p)
     ctrl_sl_reset(&s->sl);
     s->v_alpha = 0;
     s->v_beta = 0;
-    s->out.mode = CTRL_SL_FORCED;
+    s->out.mode = s->sl.mode;
     s->out.handover = 0u;
     s->out.torque_ref = 0;
+    s->out.v_alpha = 0;
+    s->out.v_beta = 0;
 }
 
 static void angle_sl_update(void *state, const ctrl_params_t *p, const ctrl_angle_in_t *in,

@@ -30,6 +30,22 @@
  *           omega_f = omega^, with cos(gamma) = T^/t_start so that the torque
  *           does not jump.
  *
+ * A salient machine (|Lq - Ld| large enough, ia_on) starts instead from its
+ * measured angle (docs/algorithms.md, "Initial angle"):
+ *   DETECT  the angle modulo pi from voltage pulses (initial_angle.h), the
+ *           caller applying the pulses instead of its controller's output;
+ *   POLARITY forced mode on that axis (turned back by the MTPA current's
+ *           angle: the current on the measured q axis), no ramp: t_start for pol_n periods,
+ *           -t_start for pol_n (the rotor turns by about a t^2 and stops),
+ *           no torque for zero_n; then the angle modulo pi again. The rotor
+ *           turned the way the torque pushed it: the measured d axis is the
+ *           magnet's north if it turned forwards (dir = the speed
+ *           reference's sign, + at 0), its south if backwards. A displacement
+ *           under pol_min leaves the polarity unknown: the blind forced start.
+ *   OBSERVER primed at that angle at standstill, the speed loop from the
+ *           start (handover = 1 in that period); the low-speed fallback
+ *           waits until |omega^| has once reached w_on.
+ *
  * Integer-only per period; the configuration in sensorless_config.h.
  */
 #ifndef CONTROL_SENSORLESS_H
@@ -41,9 +57,17 @@
 #include "ctrl_params.h"
 #include "flux_observer.h"
 #include "fx.h"
+#include "initial_angle.h"
 
 #define CTRL_SL_FORCED 0u   /* forced angle (start-up, low speed) */
 #define CTRL_SL_OBSERVER 1u /* the observer's angle */
+#define CTRL_SL_DETECT 2u   /* initial angle: the caller applies out.v_alpha, v_beta */
+
+/* Start of a salient machine (ia_on): the phases before the observer. */
+#define CTRL_SL_PH_NONE 0u /* the blind forced start (or started) */
+#define CTRL_SL_PH_D1 1u   /* angle modulo pi (initial_angle.h) */
+#define CTRL_SL_PH_POL 2u  /* polarity pulse: +t_start, -t_start, 0 on that axis */
+#define CTRL_SL_PH_D2 3u   /* angle modulo pi again: the displacement's sign */
 
 typedef struct {
     ctrl_fobs_t obs; /* the observer (CTRL_FOBS_SENSORLESS) */
@@ -58,29 +82,41 @@ typedef struct {
     q24_t kappa_start; /* observer gain while forced, Q24 (kappa Ts_pu) */
     fx_angle_t theta0; /* forced angle at the start */
 #define CTRL_SL_KD_MAX ((int64_t)1 << 38) /* bound on kd (the product in 64 bits) */
-    int64_t kd; /* damping of the forced start: the forced angle shifted by
-                 * -kd (omega^ - omega_f) >> 24, fx_angle_t units per pu of
-                 * speed (0: off); the shift within +-45 deg */
+    int64_t kd;           /* damping of the forced start: the forced angle shifted by
+                           * -kd (omega^ - omega_f) >> 24, fx_angle_t units per pu of
+                           * speed (0: off); the shift within +-45 deg */
+    uint8_t ia_on;        /* salient machine: the start from the measured angle */
+    uint32_t pol_n;       /* periods of each half of the polarity pulse */
+    uint32_t zero_n;      /* periods without torque after it */
+    fx_angle_t pol_min;   /* smallest displacement that tells the polarity */
+    fx_angle_t pol_shift; /* the pulse's frame behind the measured axis: current on q */
+    ctrl_ia_t ia;         /* the angle modulo pi */
     /* ---- state ---- */
     uint8_t mode;       /* CTRL_SL_* */
     uint8_t ramping;    /* the forced ramp has started (observer restarted) */
     uint32_t count;     /* periods at w_on (forced) or under w_off (observer) */
     fx_angle_t theta_f; /* forced angle at the next update */
     q24_t omega_f;      /* forced speed, Q24 pu */
+    uint8_t phase;      /* CTRL_SL_PH_* */
+    int8_t dir;         /* polarity pulse's sign */
+    uint8_t reached;    /* |omega^| reached w_on since the start: fallback armed */
+    fx_angle_t th1;     /* first angle modulo pi */
 } ctrl_sl_t;
 
 /* What the sensorless angle gives at sample k. */
 typedef struct {
-    fx_angle_t theta;     /* the angle for the estimator */
-    q24_t omega;          /* the speed for the estimator and the speed loop, Q24 pu */
-    uint8_t mode;         /* CTRL_SL_* */
-    uint8_t handover;     /* 1 in the period the observer took over */
-    q24_t torque_ref;     /* forced mode: the torque reference to apply, Q24 pu */
-    fx_angle_t theta_obs; /* the observer's angle (also while forced) */
+    fx_angle_t theta;      /* the angle for the estimator */
+    q24_t omega;           /* the speed for the estimator and the speed loop, Q24 pu */
+    uint8_t mode;          /* CTRL_SL_* */
+    uint8_t handover;      /* 1 in the period the observer took over */
+    q24_t torque_ref;      /* forced mode: the torque reference to apply, Q24 pu */
+    fx_angle_t theta_obs;  /* the observer's angle (also while forced) */
+    q24_t v_alpha, v_beta; /* CTRL_SL_DETECT: the voltage to apply, Q24 pu */
 } ctrl_sl_out_t;
 
-/* Back to the forced start: theta_f = theta0, omega_f = 0, observer not
- * primed (it is restarted when the ramp starts). Keeps the configuration. */
+/* Back to the start: theta_f = theta0, omega_f = 0, observer not primed
+ * (restarted when the ramp starts); a salient machine measures its angle
+ * first (ia_on). Keeps the configuration. */
 void ctrl_sl_reset(ctrl_sl_t *s);
 
 /*

@@ -21,6 +21,71 @@ void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m)
     c->theta0_rad = 0.0;
     c->damp_zeta = 0.7;
     c->inertia_kgm2 = m->inertia_kgm2;
+    c->ia_saliency_min = 0.1;
+    c->ia_i_frac = 0.1;
+    c->ia_rounds = 2.0;
+    c->pol_deg = 10.0;
+    c->pol_min_frac = 0.25;
+}
+
+/* The initial angle's settings (sensorless.h): the pulse amplitude that
+ * changes the current by ia_i_frac of the rated current in one period
+ * through the mean inverse inductance S = (1/Ld + 1/Lq) / 2 (within 0.45
+ * Vdc, inside the modulator's circle Vdc / sqrt 3), the polarity pulse's
+ * halves t with (t_start p / J) t^2 = pol (accelerated for t, braked for t). */
+static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *b,
+                      const ctrl_sl_config_t *c, ctrl_diag_t *why)
+{
+    if (!ctrl_diag_in_range(why, "ia_saliency_min", "", c->ia_saliency_min, 0.0, 1e3) ||
+        !ctrl_diag_in_range(why, "ia_i_frac", "", c->ia_i_frac, 0.005, 0.5) ||
+        !ctrl_diag_in_range(why, "ia_rounds", "", c->ia_rounds, 1.0, (double)CTRL_IA_ROUNDS_MAX) ||
+        !ctrl_diag_in_range(why, "pol_deg", "deg", c->pol_deg, 0.5, 90.0) ||
+        !ctrl_diag_in_range(why, "pol_min_frac", "", c->pol_min_frac, 0.0, 1.0)) {
+        return CTRL_EINVAL;
+    }
+    const double ld = (double)p->ld * b->l_h / (double)FX_ONE;
+    const double lq = (double)p->lq * b->l_h / (double)FX_ONE;
+    const double sal = 2.0 * fabs(lq - ld) / (lq + ld);
+    n->ia_on = (c->inertia_kgm2 > 0.0 && sal >= c->ia_saliency_min) ? 1u : 0u;
+    if (n->ia_on == 0u) {
+        return CTRL_OK;
+    }
+    const double fs = (double)p->fs_hz;
+    const double i_rated = (double)p->current_rated * b->i_a / (double)FX_ONE;
+    const double l_mean = 2.0 * ld * lq / (ld + lq);
+    const double vdc = (double)p->vdc_nom * b->v_v / (double)FX_ONE;
+    const double v = fmin(c->ia_i_frac * i_rated * l_mean * fs, 0.45 * vdc);
+    const q24_t v_q = ctrl_q24_from_double(v / b->v_v);
+    if (ctrl_ia_init(&n->ia, v_q, (uint32_t)llround(c->ia_rounds), lq > ld ? 1 : -1) != 0) {
+        (void)ctrl_diag_in_range(why, "ia_i_frac", "", c->ia_i_frac, 1.0, 0.0);
+        return CTRL_EINVAL;
+    }
+    const double pol = c->pol_deg * CTRL_TWO_PI / 360.0;
+    const double t = sqrt(pol * c->inertia_kgm2 / (c->t_start_nm * (double)p->pole_pairs));
+    if (!ctrl_diag_in_range(why, "polarity pulse half (from pol_deg, t_start_nm, inertia_kgm2)",
+                            "s", t, 1.0 / fs, 1.0)) {
+        return CTRL_EINVAL;
+    }
+    n->pol_n = (uint32_t)ceil(t * fs);
+    {
+        /* The controller puts t_start's MTPA current (i_d, i_q) in the frame
+         * it is given; that frame turned back by the current's angle beta
+         * from the q axis puts the current on the measured q axis, so the
+         * pulse's torque is the magnet's alone and changes sign with the
+         * polarity (the reluctance torque, the same for both, could
+         * outweigh it at large currents). */
+        const double tq = fmin(c->t_start_nm / b->torque_nm, (double)p->mtpa_t_max / FX_ONE);
+        const double pos = tq * ((double)p->mtpa_scale / 65536.0) * (double)FX_ONE;
+        const int k = (int)fmin(floor(pos), (double)CTRL_MTPA_N - 1.0);
+        const double f = pos - (double)k;
+        const double id = (1.0 - f) * p->mtpa_id[k] + f * p->mtpa_id[k + 1];
+        const double iq = (1.0 - f) * p->mtpa_iq[k] + f * p->mtpa_iq[k + 1];
+        const double beta = atan2(-id, iq);
+        n->pol_shift = (fx_angle_t)(uint32_t)(int32_t)llround(beta / CTRL_TWO_PI * 4294967296.0);
+    }
+    n->zero_n = (uint32_t)ceil(1e-3 * fs); /* the current back to zero: 1 ms */
+    n->pol_min = (fx_angle_t)(uint32_t)llround(c->pol_min_frac * c->pol_deg / 360.0 * 4294967296.0);
+    return CTRL_OK;
 }
 
 int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
@@ -85,6 +150,9 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
             return CTRL_EINVAL;
         }
         n.kd = (int64_t)llround(kd);
+    }
+    if (sl_ia_init(&n, p, b, c, why) != CTRL_OK) {
+        return CTRL_EINVAL;
     }
     double th = fmod(c->theta0_rad, CTRL_TWO_PI);
     if (th < 0.0) {

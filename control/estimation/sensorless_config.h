@@ -22,6 +22,13 @@ typedef struct {
     double theta0_rad;      /* forced angle at the start, electrical rad */
     double damp_zeta;       /* damping ratio of the forced start's swing (0: off) */
     double inertia_kgm2;    /* rotor (and load) inertia the damping is sized for (0: off) */
+    /* Salient machines: the start from the measured angle (sensorless.h) when
+     * 2 |Lq - Ld| / (Lq + Ld) >= ia_saliency_min (> 2: never). */
+    double ia_saliency_min;
+    double ia_i_frac;    /* current change of one pulse, share of the rated current */
+    double ia_rounds;    /* rounds of the six pulse directions per measurement */
+    double pol_deg;      /* polarity pulse: displacement of the bare rotor, electrical deg */
+    double pol_min_frac; /* displacement under which the polarity is unknown, share of pol_deg */
 } ctrl_sl_config_t;
 
 /*
@@ -31,7 +38,10 @@ typedef struct {
  * load; handover at 5 % of the rated speed after 6 time constants of the
  * observer at critical damping (kappa_start = 2: 6 / w_on); forced again
  * under 2.5 % for 50 ms (the time a 10 % resistance error at rated current
- * takes to turn the thesis SPMSM's flux by 10 deg).
+ * takes to turn the thesis SPMSM's flux by 10 deg). Salient machines
+ * (saliency >= 0.1) measure their angle: pulses of 10 % of the rated
+ * current, 2 rounds; a polarity pulse that turns the bare rotor by 10 deg
+ * electrical, a quarter of which tells the polarity.
  */
 void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m);
 

@@ -40,7 +40,7 @@ typedef struct {
 } ctrl_angle_out_t;
 
 #define CTRL_ANGLE_STATE_MAX                                                                       \
-    256 /* bytes of a source's state (estimator.h): the sensorless one, 232 */
+    320 /* bytes of a source's state (estimator.h): the sensorless one, 296 */
 
 typedef struct ctrl_angle_src {
     const char *name;     /* "encoder", "forced", ... */

@@ -3,6 +3,7 @@
 
 #include "fw_pwm.h"
 #include "plan.h"
+#include "svpwm.h"
 
 /* Plausible ADC offset: within 1/16 of full scale from mid-scale. */
 #define FW_CALIB_OFFSET_TOL_SHIFT 4u
@@ -356,9 +357,9 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     uint32_t f = fw_protect_overspeed(&fw->prot, est->omega_e);
 
     q24_t tref;
-    if (sl != NULL && sl->out.mode == CTRL_SL_FORCED) {
-        /* Forced start: the start-up current along the forced q axis; the
-         * speed loop waits (sensorless.h). */
+    if (sl != NULL && sl->out.mode != CTRL_SL_OBSERVER) {
+        /* Forced start (or the initial angle's pulses): the start-up current
+         * along the forced q axis; the speed loop waits (sensorless.h). */
         tref = sl->out.torque_ref;
         fw->speed_cnt = 0u;
     } else if (fw->ref_mode == FW_REF_SPEED) {
@@ -433,6 +434,11 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     ctrl_out_t out;
     out.plan.n_seg = 0u;
     fw->ctrl->step(fw->ctrl_state.bytes, &ctx, &out);
+    if (sl != NULL && sl->out.mode == CTRL_SL_DETECT) {
+        /* the initial angle's voltage pulse instead (initial_angle.h) */
+        ctrl_svpwm_duties(sl->out.v_alpha, sl->out.v_beta, m->vdc, &out.legs);
+        out.plan.n_seg = 0u;
+    }
     fw_pwm_out(fw, hal, tm, &out.legs);
     /* The duties written now act during [k+1, k+2): they are "applied" for
      * the estimator's prediction at k+1. */

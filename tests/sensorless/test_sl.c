@@ -203,7 +203,10 @@ static void test_config(void)
     for (int i = 0; i < 3; i++) {
         ctrl_sl_t s;
         setup(ms[i], &s);
-        TEST_ASSERT_EQUAL_UINT8(CTRL_SL_FORCED, s.mode);
+        /* the IPMSMs measure their angle first (saliency >= 0.1) */
+        const int salient = fabs(ms[i].lq_h - ms[i].ld_h) > 0.05 * (ms[i].lq_h + ms[i].ld_h);
+        TEST_ASSERT_EQUAL_UINT8(salient, s.ia_on);
+        TEST_ASSERT_EQUAL_UINT8(salient ? CTRL_SL_DETECT : CTRL_SL_FORCED, s.mode);
         TEST_ASSERT_TRUE(s.ramp_dw > 0 && s.w_on > s.w_off && s.settle_n > 0u);
     }
     ctrl_sl_config_t c0;
@@ -223,6 +226,11 @@ static void test_config(void)
         {"theta0_rad", offsetof(ctrl_sl_config_t, theta0_rad), NAN},
         {"damp_zeta", offsetof(ctrl_sl_config_t, damp_zeta), 3.0},
         {"inertia_kgm2", offsetof(ctrl_sl_config_t, inertia_kgm2), -1.0},
+        {"ia_saliency_min", offsetof(ctrl_sl_config_t, ia_saliency_min), -0.1},
+        {"ia_i_frac", offsetof(ctrl_sl_config_t, ia_i_frac), 0.9},
+        {"ia_rounds", offsetof(ctrl_sl_config_t, ia_rounds), 0.0},
+        {"pol_deg", offsetof(ctrl_sl_config_t, pol_deg), 180.0},
+        {"pol_min_frac", offsetof(ctrl_sl_config_t, pol_min_frac), 2.0},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         ctrl_sl_config_t c = c0;
