@@ -20,7 +20,9 @@ void ctrl_sl_reset(ctrl_sl_t *s)
     s->reached = (uint8_t)(s->ia_on != 0u ? 0u : 1u);
     s->dir = 1;
     s->th1 = 0u;
+#if CTRL_SL_INITIAL_ANGLE
     ctrl_ia_start(&s->ia);
+#endif
 }
 
 /* omega_f one step towards target (at most ramp_dw). */
@@ -74,6 +76,7 @@ static void sl_forced_out(ctrl_sl_t *s, ctrl_sl_out_t *out, q24_t w_obs)
     out->v_beta = 0;
 }
 
+#if CTRL_SL_INITIAL_ANGLE
 /* The observer from angle theta at standstill, its angle from this period
  * on; the caller's speed loop takes over (handover). */
 static void sl_observe_from(ctrl_sl_t *s, const ctrl_params_t *p, fx_angle_t theta, q24_t i_alpha,
@@ -84,6 +87,7 @@ static void sl_observe_from(ctrl_sl_t *s, const ctrl_params_t *p, fx_angle_t the
     s->mode = CTRL_SL_OBSERVER;
     s->phase = CTRL_SL_PH_NONE;
     s->count = 0u;
+    s->w_f = 0;
     out->mode = CTRL_SL_OBSERVER;
     out->theta = theta;
     out->omega = 0;
@@ -149,6 +153,7 @@ static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_
     const fx_angle_t north = ((disp < 0) == (s->dir < 0)) ? th : th + SL_HALF_TURN;
     sl_observe_from(s, p, north, i_alpha, i_beta, out);
 }
+#endif
 
 void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
                     q24_t i_alpha, q24_t i_beta, q24_t speed_ref, q24_t torque_est,
@@ -160,19 +165,23 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
     out->handover = 0u;
     out->theta_obs = th_obs;
 
+#if CTRL_SL_INITIAL_ANGLE
     if (s->phase != CTRL_SL_PH_NONE) {
         sl_initial(s, p, v_alpha, v_beta, i_alpha, i_beta, speed_ref, out);
         return;
     }
+#endif
     if (s->mode == CTRL_SL_OBSERVER) {
         out->mode = CTRL_SL_OBSERVER;
         out->theta = th_obs;
-        out->omega = w_obs;
+        s->w_f = fx_add(s->w_f, fx_mul(p->speed_lpf_k, fx_sub(w_obs, s->w_f)));
+        out->omega = s->w_f;
         out->torque_ref = 0;
         out->v_alpha = 0;
         out->v_beta = 0;
-        if (fx_abs(w_obs) >= s->w_on) {
-            s->reached = 1u;
+        if (fx_abs(s->w_f) >= s->w_on) {
+            s->reached = 1u; /* on the filtered speed: the PLL's noise near standstill
+                              * reaches w_on */
         }
         s->count = fx_abs(w_obs) < s->w_off && s->reached != 0u ? s->count + 1u : 0u;
         if (s->count < s->low_n) {
@@ -221,6 +230,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
         out->torque_ref = 0;
         out->handover = 1u;
         s->reached = 1u;
+        s->w_f = w_obs;
     }
 }
 

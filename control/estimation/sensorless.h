@@ -22,7 +22,8 @@
  *           torque estimate of that period (bumpless: the current does not
  *           jump, only the frame it is described in), and the observer's
  *           gain falls to kappa.
- *   OBSERVER the observer's angle and speed. Passing through zero in a
+ *   OBSERVER the observer's angle, and its speed through the encoder
+ *           speed's first-order filter (params speed_lpf_k). Passing through zero in a
  *           reversal keeps it (the flux integral holds the angle for the
  *           few milliseconds the rotor spends at low speed); if |omega^| stays
  *           below w_off for low_n periods (a low speed reference, a stall),
@@ -44,7 +45,7 @@
  *           under pol_min leaves the polarity unknown: the blind forced start.
  *   OBSERVER primed at that angle at standstill, the speed loop from the
  *           start (handover = 1 in that period); the low-speed fallback
- *           waits until |omega^| has once reached w_on.
+ *           waits until the filtered |omega^| (w_f) has once reached w_on.
  *
  * Integer-only per period; the configuration in sensorless_config.h.
  */
@@ -58,6 +59,12 @@
 #include "flux_observer.h"
 #include "fx.h"
 #include "initial_angle.h"
+
+/* 0: the initial angle left out (a flash-tight image, CMake option
+ * PMSM_SL_INITIAL_ANGLE): every machine takes the forced start. */
+#ifndef CTRL_SL_INITIAL_ANGLE
+#define CTRL_SL_INITIAL_ANGLE 1
+#endif
 
 #define CTRL_SL_FORCED 0u   /* forced angle (start-up, low speed) */
 #define CTRL_SL_OBSERVER 1u /* the observer's angle */
@@ -99,8 +106,11 @@ typedef struct {
     q24_t omega_f;      /* forced speed, Q24 pu */
     uint8_t phase;      /* CTRL_SL_PH_* */
     int8_t dir;         /* polarity pulse's sign */
-    uint8_t reached;    /* |omega^| reached w_on since the start: fallback armed */
+    uint8_t reached;    /* the filtered |omega^| (w_f) reached w_on: fallback armed */
     fx_angle_t th1;     /* first angle modulo pi */
+    q24_t w_f;          /* observer mode: the observer's speed through the encoder
+                         * speed's filter (params speed_lpf_k), Q24 pu - what the
+                         * speed loop gets (the PLL's own is too noisy for it) */
 } ctrl_sl_t;
 
 /* What the sensorless angle gives at sample k. */

@@ -43,6 +43,12 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
         !ctrl_diag_in_range(why, "pol_min_frac", "", c->pol_min_frac, 0.0, 1.0)) {
         return CTRL_EINVAL;
     }
+#if !CTRL_SL_INITIAL_ANGLE
+    (void)p;
+    (void)b;
+    n->ia_on = 0u;
+    return CTRL_OK;
+#else
     const double ld = (double)p->ld * b->l_h / (double)FX_ONE;
     const double lq = (double)p->lq * b->l_h / (double)FX_ONE;
     const double sal = 2.0 * fabs(lq - ld) / (lq + ld);
@@ -86,6 +92,7 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
     n->zero_n = (uint32_t)ceil(1e-3 * fs); /* the current back to zero: 1 ms */
     n->pol_min = (fx_angle_t)(uint32_t)llround(c->pol_min_frac * c->pol_deg / 360.0 * 4294967296.0);
     return CTRL_OK;
+#endif
 }
 
 int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
