@@ -13,6 +13,66 @@ static void svpwm_phases(q24_t va, q24_t vb, q24_t ph[3], q24_t *mx, q24_t *mn)
     *mn = fx_min(ph[0], fx_min(ph[1], ph[2]));
 }
 
+/* (v_alpha, v_beta) scaled by vdc / span < 1 onto the hexagon (span > vdc > 0). */
+static void svpwm_scale(q24_t vdc, int64_t span, q24_t *v_alpha, q24_t *v_beta)
+{
+    /* k = vdc / span < 1 in Q30 (span < 2^32, vdc < 2^31: the quotient fits),
+     * truncated so the scaled vector does not land outside by rounding. */
+    const int64_t k = ((int64_t)vdc * ((int64_t)1 << 30)) / span;
+    *v_alpha = fx_sat32(fx_rshift64_round((int64_t)*v_alpha * k, 30u));
+    *v_beta = fx_sat32(fx_rshift64_round((int64_t)*v_beta * k, 30u));
+}
+
+/* For 2^17 < vdc < 2^26 by long division in 32-bit steps, four UDIV
+ * instead of a 64-bit division: 2^32 = q vdc + r, then 6 + 6 + 4 more
+ * quotient bits (the remainder stays below vdc < 2^26, so r 2^6 < 2^32);
+ * q = floor(2^48 / vdc) < 2^31 there. Elsewhere fx_div itself. */
+q24_t ctrl_svpwm_inv_vdc(q24_t vdc)
+{
+    const uint32_t d = (uint32_t)vdc;
+    if (d <= ((uint32_t)1 << 17) || d >= ((uint32_t)1 << 26)) {
+        return fx_div(FX_ONE, vdc);
+    }
+    uint32_t q = UINT32_MAX / d; /* 2^32 - 1 = q d + (r - 1) */
+    uint32_t r = UINT32_MAX - q * d + 1u;
+    if (r == d) {
+        q++;
+        r = 0u;
+    }
+    static const unsigned digits[3] = {6u, 6u, 4u};
+    for (unsigned k = 0u; k < 3u; k++) {
+        r <<= digits[k];
+        const uint32_t g = r / d;
+        r -= g * d;
+        q = (q << digits[k]) + g;
+    }
+    /* rounded as fx_div: + 1 when r + floor(d / 2) >= d */
+    return (q24_t)(r >= d - d / 2u ? q + 1u : q);
+}
+
+/* Leg duties from the phase voltages, their max and min and vdc > 0. */
+static void svpwm_legs(const q24_t ph[3], q24_t mx, q24_t mn, q24_t vdc, ctrl_legs_t *legs)
+{
+    const q24_t inv_vdc = ctrl_svpwm_inv_vdc(vdc); /* Q24, one division per period */
+    for (unsigned x = 0u; x < 3u; x++) {
+        /* d_x = 1/2 + (2 v_x - max - min) / (2 Vdc). The difference is clamped
+         * to 2^30 (64 pu: beyond any hexagon) so that times |inv_vdc| < 2^31 the
+         * product stays below 2^61. */
+        int64_t diff = 2 * (int64_t)ph[x] - mx - mn;
+        const int64_t lim = (int64_t)1 << 30;
+        diff = diff > lim ? lim : (diff < -lim ? -lim : diff);
+        const int64_t d = fx_rshift64_round(diff * inv_vdc, FX_QBITS + 1u) + FX_ONE / 2;
+        legs->duty[x] = (q24_t)(d < 0 ? 0 : (d > FX_ONE ? FX_ONE : d));
+    }
+}
+
+static void svpwm_legs_off(ctrl_legs_t *legs)
+{
+    legs->duty[0] = 0;
+    legs->duty[1] = 0;
+    legs->duty[2] = 0;
+}
+
 uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
 {
     if (vdc <= 0) {
@@ -28,42 +88,44 @@ uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
     if (span <= (int64_t)vdc) {
         return 0u;
     }
-    /* k = vdc / span < 1 in Q30 (span < 2^32, vdc < 2^31: the quotient fits),
-     * truncated so the scaled vector does not land outside by rounding. */
-    const int64_t k = ((int64_t)vdc * ((int64_t)1 << 30)) / span;
-    *v_alpha = fx_sat32(fx_rshift64_round((int64_t)*v_alpha * k, 30u));
-    *v_beta = fx_sat32(fx_rshift64_round((int64_t)*v_beta * k, 30u));
+    svpwm_scale(vdc, span, v_alpha, v_beta);
     return 1u;
 }
 
 void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs)
 {
     if (vdc <= 0) {
-        legs->duty[0] = 0;
-        legs->duty[1] = 0;
-        legs->duty[2] = 0;
+        svpwm_legs_off(legs);
         return;
     }
     q24_t ph[3];
     q24_t mx;
     q24_t mn;
     svpwm_phases(v_alpha, v_beta, ph, &mx, &mn);
-    const q24_t inv_vdc = fx_div(FX_ONE, vdc); /* Q24, one division per period */
-    for (unsigned x = 0u; x < 3u; x++) {
-        /* d_x = 1/2 + (2 v_x - max - min) / (2 Vdc). The difference is clamped
-         * to 2^30 (64 pu: beyond any hexagon) so that times |inv_vdc| < 2^31 the
-         * product stays below 2^61. */
-        int64_t diff = 2 * (int64_t)ph[x] - mx - mn;
-        const int64_t lim = (int64_t)1 << 30;
-        diff = diff > lim ? lim : (diff < -lim ? -lim : diff);
-        const int64_t d = fx_rshift64_round(diff * inv_vdc, FX_QBITS + 1u) + FX_ONE / 2;
-        legs->duty[x] = (q24_t)(d < 0 ? 0 : (d > FX_ONE ? FX_ONE : d));
-    }
+    svpwm_legs(ph, mx, mn, vdc, legs);
 }
 
 uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs)
 {
-    const uint8_t lim = ctrl_svpwm_limit(vdc, v_alpha, v_beta);
-    ctrl_svpwm_duties(*v_alpha, *v_beta, vdc, legs);
+    /* ctrl_svpwm_limit then ctrl_svpwm_duties, bit for bit; the phase
+     * voltages formed once when the vector is inside the hexagon. */
+    if (vdc <= 0) {
+        *v_alpha = 0;
+        *v_beta = 0;
+        svpwm_legs_off(legs);
+        return 1u;
+    }
+    q24_t ph[3];
+    q24_t mx;
+    q24_t mn;
+    svpwm_phases(*v_alpha, *v_beta, ph, &mx, &mn);
+    const int64_t span = (int64_t)mx - mn;
+    uint8_t lim = 0u;
+    if (span > (int64_t)vdc) {
+        svpwm_scale(vdc, span, v_alpha, v_beta);
+        svpwm_phases(*v_alpha, *v_beta, ph, &mx, &mn);
+        lim = 1u;
+    }
+    svpwm_legs(ph, mx, mn, vdc, legs);
     return lim;
 }

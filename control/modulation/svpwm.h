@@ -37,8 +37,13 @@ uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
  * first; residual rounding is clamped. vdc <= 0 gives 0, 0, 0 (V0). */
 void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs);
 
-/* Limit + duties in one call. Returns the ctrl_svpwm_limit result; the
- * limited reference is written back to *v_alpha, *v_beta. */
+/* 1 / vdc in Q24 for vdc > 0: the value of fx_div(FX_ONE, vdc) (rounded half
+ * up, saturated), without a 64-bit division for a DC link between 1/128 and
+ * 4 pu (the duties' one division per period). */
+q24_t ctrl_svpwm_inv_vdc(q24_t vdc);
+
+/* Limit + duties in one call (the phase voltages formed once unless limited). Returns the
+ * ctrl_svpwm_limit result; the limited reference is written back to *v_alpha, *v_beta. */
 uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs);
 
 #endif /* CONTROL_SVPWM_H */

@@ -153,6 +153,54 @@ static void test_bad_vdc(void)
     }
 }
 
+/* 1/vdc without a 64-bit division is fx_div(FX_ONE, vdc) bit for bit: at
+ * every power of two and its neighbours, densely at the low end of the fast
+ * range (where the quotient nears 2^31), strided across it, and beyond. */
+static void test_inv_vdc_equals_fx_div(void)
+{
+    for (int k = 0; k <= 30; k++) {
+        for (int32_t e = -8; e <= 8; e++) {
+            const int64_t v = ((int64_t)1 << k) + e;
+            if (v > 0 && v <= INT32_MAX) {
+                TEST_ASSERT_EQUAL_INT32(fx_div(FX_ONE, (q24_t)v), ctrl_svpwm_inv_vdc((q24_t)v));
+            }
+        }
+    }
+    for (q24_t v = (1 << 17) - 16; v < (1 << 17) + 65536; v++) {
+        TEST_ASSERT_EQUAL_INT32(fx_div(FX_ONE, v), ctrl_svpwm_inv_vdc(v));
+    }
+    for (q24_t v = 1 << 17; v < (1 << 26) + 4096; v += 997) {
+        TEST_ASSERT_EQUAL_INT32(fx_div(FX_ONE, v), ctrl_svpwm_inv_vdc(v));
+    }
+    TEST_ASSERT_EQUAL_INT32(fx_div(FX_ONE, FX_MAX), ctrl_svpwm_inv_vdc(FX_MAX));
+}
+
+/* ctrl_svpwm (phases formed once when not limited) equals ctrl_svpwm_limit
+ * followed by ctrl_svpwm_duties bit for bit, inside the hexagon and beyond. */
+static void test_svpwm_equals_limit_then_duties(void)
+{
+    uint64_t seed = 0x5eed5678u;
+    for (int n = 0; n < 20000; n++) {
+        const q24_t vdc = ctrl_q24_from_double(0.05 + 2.0 * chapter_rand(&seed));
+        const double a = 2.0 * PI * chapter_rand(&seed);
+        const double r = 1.5 * chapter_rand(&seed) * q(vdc);
+        q24_t va = ctrl_q24_from_double(r * cos(a));
+        q24_t vb = ctrl_q24_from_double(r * sin(a));
+        q24_t wa = va;
+        q24_t wb = vb;
+        ctrl_legs_t one;
+        ctrl_legs_t two;
+        const uint8_t lim = ctrl_svpwm(&va, &vb, vdc, &one);
+        TEST_ASSERT_EQUAL_UINT8(ctrl_svpwm_limit(vdc, &wa, &wb), lim);
+        ctrl_svpwm_duties(wa, wb, vdc, &two);
+        TEST_ASSERT_EQUAL_INT32(wa, va);
+        TEST_ASSERT_EQUAL_INT32(wb, vb);
+        for (int x = 0; x < 3; x++) {
+            TEST_ASSERT_EQUAL_INT32(two.duty[x], one.duty[x]);
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -160,5 +208,7 @@ int main(void)
     RUN_TEST(test_duties_random);
     RUN_TEST(test_overmodulation_on_hexagon_same_angle);
     RUN_TEST(test_bad_vdc);
+    RUN_TEST(test_inv_vdc_equals_fx_div);
+    RUN_TEST(test_svpwm_equals_limit_then_duties);
     return UNITY_END();
 }
