@@ -12,20 +12,30 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 
     /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
     const q24_t num = fx_sub(in.t_ref, in.b.t0);
+    /* argmin of (6.13) over V1..V6, the lowest index among equal costs. The
+     * last period's vector goes first: usually the best or near it, so more
+     * of the others' torque terms alone reach its cost and their square roots
+     * are skipped (ctrl_mpc_cost_weighted); the decision is that of the
+     * search in index order. */
+    const uint8_t first = s->last_vec >= 1u && s->last_vec <= 6u ? s->last_vec : 1u;
     int64_t best_g = INT64_MAX;
-    uint8_t best_v = 1u;
+    uint8_t best_v = 0u; /* none yet */
     q24_t best_d = 0;
-    for (uint8_t i = 1u; i <= 6u; i++) {
+    for (uint8_t k = 0u; k < 6u; k++) {
+        /* first, then 1..6 without it */
+        const uint8_t i = k == 0u ? first : (k < first ? k : (uint8_t)(k + 1u));
         q24_t vd;
         q24_t vq;
         ctrl_mpc_vec_dq(&in.b, i, &vd, &vq);
         const q24_t t_full = ctrl_mpc_torque(&s->model, in.b.d0 + vd, in.b.q0 + vq);
         const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, in.b.t0)); /* (5.18) */
-        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty, in.t_ref,
-                                                 in.psi_ref, s->zeta, best_g); /* (6.13) */
         s->trace.vec[i - 1u] = i;
         s->trace.duty[i - 1u] = duty;
-        if (g < best_g) {
+        /* wins when below best_g, or equal to it with a lower index */
+        const int64_t bound = best_v != 0u && i < best_v ? best_g + 1 : best_g;
+        const int64_t g = ctrl_mpc_cost_weighted(&s->model, &in.b, vd, vq, duty, in.t_ref,
+                                                 in.psi_ref, s->zeta, bound); /* (6.13) */
+        if (g < bound) {
             best_g = g;
             best_v = i;
             best_d = duty;
