@@ -10,14 +10,15 @@
 #include "st_tables.h"
 #include "vectors.h"
 
-/* Inputs of the duty formulas are clamped to +-4 pu (rated torque is ~0.3 pu,
- * flux ~1 pu, rated speed ~0.5 pu for the shipped machines): with that bound
- * every int64 intermediate below stays under 2^62. */
+/* Inputs of the duty formulas are clamped to [-4, 4) pu (rated torque is
+ * ~0.3 pu, flux ~1 pu, rated speed ~0.5 pu for the shipped machines): with
+ * that bound every int64 intermediate below stays under 2^62. One SSAT. */
 #define DRR_LIM (4 * FX_ONE)
+_Static_assert(DRR_LIM == (q24_t)1 << 26, "FX_SAT(x, 27) is the +-DRR_LIM clamp");
 
-static q24_t drr_lim(q24_t x)
+static inline q24_t drr_lim(q24_t x)
 {
-    return fx_clamp(x, -DRR_LIM, DRR_LIM);
+    return FX_SAT(x, 27);
 }
 
 uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err)
@@ -61,6 +62,9 @@ void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q2
 /* Bits needed for x > 0 (x < 2^62). */
 static unsigned drr_bitlen(uint64_t x)
 {
+#if defined(__GNUC__)
+    return 64u - (unsigned)__builtin_clzll(x); /* two CLZ on a Cortex-M4 */
+#else
     unsigned n = 0;
     for (unsigned step = 32u; step > 0u; step /= 2u) {
         if ((x >> step) != 0u) {
@@ -69,13 +73,19 @@ static unsigned drr_bitlen(uint64_t x)
         }
     }
     return n + (x != 0u ? 1u : 0u);
+#endif
 }
 
 /*
  * num / den clamped to [0, FX_ONE] (Q24), with |num|, |den| < 2^62 in any
  * common scale. den == 0 counts as +0: the result is FX_ONE for num > 0, else 0.
- * Both are scaled by the same power of two so den lies in [2^29, 2^30) before
- * the single fx_div: about 29 significant bits whatever the input scale.
+ * Both are scaled by the same power of two so den lies in [2^25, 2^26]
+ * (26 significant bits: each rounding of the scaling at most 2^-26 of den,
+ * together at most half an LSB of the Q24 result), then the quotient is
+ * exactly rounded: with the quotient's own rounding at most 1 LSB, as the
+ * single fx_div on 30 bits this replaces. Long division in four 6-bit digits
+ * (the remainder stays below d <= 2^26, so r 2^6 < 2^32): four UDIV, no
+ * 64-bit division.
  */
 static q24_t drr_ratio01(int64_t num, int64_t den)
 {
@@ -92,20 +102,34 @@ static q24_t drr_ratio01(int64_t num, int64_t den)
     const unsigned bl = drr_bitlen((uint64_t)den);
     int64_t n;
     int64_t d;
-    if (bl > 30u) {
-        n = fx_rshift64_round(num, bl - 30u);
-        d = fx_rshift64_round(den, bl - 30u);
+    if (bl > 26u) {
+        n = fx_rshift64_round(num, bl - 26u);
+        d = fx_rshift64_round(den, bl - 26u);
     } else {
-        n = num * ((int64_t)1 << (30u - bl)); /* num < den < 2^bl: no overflow */
-        d = den * ((int64_t)1 << (30u - bl));
+        n = num * ((int64_t)1 << (26u - bl)); /* num < den < 2^bl: no overflow */
+        d = den * ((int64_t)1 << (26u - bl));
     }
-    return fx_clamp(fx_div((q24_t)n, (q24_t)d), 0, FX_ONE);
+    /* 0 <= n <= d (rounding keeps the order), 2^25 <= d <= 2^26 */
+    const uint32_t ud = (uint32_t)d;
+    uint32_t r = (uint32_t)n;
+    uint32_t q = 0u;
+    for (unsigned k = 0u; k < 4u; k++) {
+        r <<= 6;
+        const uint32_t digit = r / ud;
+        r -= digit * ud;
+        q = (q << 6) + digit;
+    }
+    if (r >= ud - r) {
+        q++; /* remainder >= d/2: round half up (fx_div's rounding for n, d > 0) */
+    }
+    return q > (uint32_t)FX_ONE ? FX_ONE : (q24_t)q;
 }
 
-q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
-                    q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e)
+/* ctrl_drr_duty with (cn, dc) = ctrl_drr_c_parts(s, omega_e). */
+static q24_t drr_duty_c(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                        q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e, q24_t cn, q24_t dc)
 {
-    if (s == NULL || vec < 1u || vec > 6u || psi_amp <= 0) {
+    if (vec < 1u || vec > 6u || psi_amp <= 0) {
         return 0;
     }
     const q24_t e = drr_lim(t_err);
@@ -118,9 +142,6 @@ q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24
      * negative for V_{x+4}, V_{x+5} in sector x, so A (psi x v_hat) / |psi| is
      * the A |sin(.)| term of (5.6) with the sign of (5.7). */
     const q24_t cross = fx_cross(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
-    q24_t cn;
-    q24_t dc;
-    ctrl_drr_c_parts(s, w, &cn, &dc);
 
     /*
      * (5.14) with C = cn / dc and Delta T = A cross / |psi| - kb w, numerator and
@@ -145,6 +166,18 @@ q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24
         return FX_ONE;
     }
     return drr_ratio01(num, den);
+}
+
+q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
+                    q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e)
+{
+    if (s == NULL) {
+        return 0;
+    }
+    q24_t cn;
+    q24_t dc;
+    ctrl_drr_c_parts(s, omega_e, &cn, &dc);
+    return drr_duty_c(s, vec, psi_alpha, psi_beta, psi_amp, t_err, gamma, omega_e, cn, dc);
 }
 
 q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
@@ -178,19 +211,25 @@ void ctrl_drr_reset(void *state)
     s->last_vec_51 = 0u;
 }
 
-q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e)
+/* ctrl_drr_t_start with (cn, dc) = ctrl_drr_c_parts(s, omega_e). */
+static q24_t drr_t_start_c(const ctrl_drr_state_t *s, q24_t t_k1, q24_t cn, q24_t dc)
 {
     /* (1 - D)/2 of zero vector precede the active vector in a centre-aligned
      * period; D: the last duty (steady state, D(k+1) ~ D(k)). */
     const q24_t half_zero = fx_rshift32_round(FX_ONE - fx_clamp(s->last_duty, 0, FX_ONE), 1u);
-    q24_t cn;
-    q24_t dc;
-    ctrl_drr_c_parts(s, omega_e, &cn, &dc);
     /* Zero-vector torque deviation per period by (5.12): C gamma = cn gamma / dc
      * (dc <= dc_max < 0: never a zero divisor). */
     const q24_t cg = fx_mul(cn, drr_lim(s->gamma));
     const q24_t dt0 = s->dc_fixed != 0 ? fx_neg(cg) : fx_div(cg, dc);
     return fx_add(t_k1, fx_mul(half_zero, dt0));
+}
+
+q24_t ctrl_drr_t_start(const ctrl_drr_state_t *s, q24_t t_k1, q24_t omega_e)
+{
+    q24_t cn;
+    q24_t dc;
+    ctrl_drr_c_parts(s, omega_e, &cn, &dc);
+    return drr_t_start_c(s, t_k1, cn, dc);
 }
 
 /* (5.16): T(k+1) = T(k) + D(k) Delta T(k) - (1 - D(k)) B w / w_rn, with D(k) and
@@ -243,7 +282,11 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     /* Resistive zero-vector deviation (4.10) at the predicted torque. */
     s->rt = fx_mul(s->r_ts, drr_lim(t_k1));
     const q24_t tref = ctx->ref->torque;
-    const q24_t te = s->centre != 0u ? ctrl_drr_t_start(s, t_k1, w) : t_k1;
+    /* C of (5.13) once for the start torque and the duty (both after s->rt). */
+    q24_t cn;
+    q24_t dc;
+    ctrl_drr_c_parts(s, w, &cn, &dc);
+    const q24_t te = s->centre != 0u ? drr_t_start_c(s, t_k1, cn, dc) : t_k1;
 
     /* Virtual reference (5.3)-(5.4): gamma = EMA of T_ref - T_min, T_min being
      * the torque where the active vector starts (see ctrl_drr_t_start). */
@@ -264,8 +307,8 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     if (ctrl_drr_vreplace_active(s, psierr)) {
         vec = ctrl_vreplace(&s->vr, vec, nx->sector, nx->psi_alpha, nx->psi_beta); /* §5.3.5 */
     }
-    const q24_t duty =
-        ctrl_drr_duty(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, terr, g, w); /* (5.14) */
+    const q24_t duty = drr_duty_c(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, terr, g, w, cn,
+                                  dc); /* (5.14) */
     if (s->pred_516 != 0u) {
         s->dt_sel = ctrl_drr_delta_t(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, w);
     }

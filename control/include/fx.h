@@ -256,6 +256,15 @@ static inline q24_t fx_clamp(q24_t x, q24_t lo, q24_t hi)
     return x < lo ? lo : (x > hi ? hi : x);
 }
 
+/* x within [-2^(bits-1), 2^(bits-1) - 1] for a constant bits in 2..31: one
+ * SSAT on a Cortex-M4 (the compiler's ACLE builtin; fx_clamp with these
+ * bounds costs four compares and moves there), the same value elsewhere. */
+#if defined(__ARM_FEATURE_SAT) && defined(__GNUC__)
+#define FX_SAT(x, bits) ((q24_t)__builtin_arm_ssat((int)(x), (bits##u)))
+#else
+#define FX_SAT(x, bits) fx_clamp((x), -((q24_t)1 << ((bits)-1)), ((q24_t)1 << ((bits)-1)) - 1)
+#endif
+
 static inline q24_t fx_min(q24_t a, q24_t b)
 {
     return a < b ? a : b;

@@ -15,16 +15,9 @@
 #define MPC_ALWAYS_INLINE
 #endif
 
-/* x within [-2^(bits-1), 2^(bits-1) - 1]: one SSAT on a Cortex-M4 (the
- * compiler's ACLE __ssat builtin; a symmetric clamp costs four compares and
- * moves), the same value elsewhere. */
-#if defined(__ARM_FEATURE_SAT) && defined(__GNUC__)
-#define MPC_SAT(x, bits) ((q24_t)__builtin_arm_ssat((int)(x), (bits##u)))
-#else
-#define MPC_SAT(x, bits) fx_clamp((x), -((q24_t)1 << ((bits)-1)), ((q24_t)1 << ((bits)-1)) - 1)
-#endif
-_Static_assert(CTRL_MPC_PSI_CLAMP == (q24_t)1 << 27, "MPC_SAT(x, 28) is the psi0 clamp");
-_Static_assert(CTRL_MPC_I_CLAMP == (q24_t)1 << 30, "MPC_SAT(x, 31) is the current clamp");
+/* The clamps of the basis as FX_SAT (fx.h): one SSAT each on a Cortex-M4. */
+_Static_assert(CTRL_MPC_PSI_CLAMP == (q24_t)1 << 27, "FX_SAT(x, 28) is the psi0 clamp");
+_Static_assert(CTRL_MPC_I_CLAMP == (q24_t)1 << 30, "FX_SAT(x, 31) is the current clamp");
 
 /* The part of the basis common to ctrl_mpc_basis and ctrl_mpc_basis3:
  * d0, q0, t0 and Ts V1 = (w[0], w[1]), Ts V2 = (w[2], w[3]) in the rotor
@@ -38,12 +31,12 @@ static inline MPC_ALWAYS_INLINE void mpc_basis_core(const ctrl_mpc_model_t *m,
      * The clamps only act on states far outside any machine's range; they
      * give the fast arithmetic its bounds (ctrl_mpc_basis_t): |Ts Rs i| <=
      * 64 pu and |psi| <= 8 pu, the differences fit an int32_t. */
-    const q24_t id = MPC_SAT(n->i_d, 31);
-    const q24_t iq = MPC_SAT(n->i_q, 31);
-    const q24_t fd = MPC_SAT(n->psi_d, 28);
-    const q24_t fq = MPC_SAT(n->psi_q, 28);
-    const q24_t ad = MPC_SAT(fd - fx_mul_nosat(m->ts_rs, id), 28);
-    const q24_t aq = MPC_SAT(fq - fx_mul_nosat(m->ts_rs, iq), 28);
+    const q24_t id = FX_SAT(n->i_d, 31);
+    const q24_t iq = FX_SAT(n->i_q, 31);
+    const q24_t fd = FX_SAT(n->psi_d, 28);
+    const q24_t fq = FX_SAT(n->psi_q, 28);
+    const q24_t ad = FX_SAT(fd - fx_mul_nosat(m->ts_rs, id), 28);
+    const q24_t aq = FX_SAT(fq - fx_mul_nosat(m->ts_rs, iq), 28);
     /* The frame at k+2 is the frame at k+1 turned by delta = omega Ts (the
      * estimator's rotation, Q30, |.| <= 1): psi e^{-j delta}; |sum| < 2^34 2^30. */
     const int32_t rc = est->rot_c;
