@@ -28,6 +28,7 @@ void st_hyst_reset(void *state)
     ctrl_hyst2_reset(&s->flux);
     ctrl_hyst3_reset(&s->torque3);
     ctrl_hyst2_reset(&s->torque2);
+    s->flux_ref.valid = 0u;
 }
 
 void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
@@ -35,7 +36,8 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     st_hyst_state_t *s = state;
     /* Delay compensation: decide on the state predicted for k+1. */
     const ctrl_mstate_t *nx = &ctx->est->next;
-    const q24_t psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+    const q24_t psi_ref =
+        ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, ctx->ref->torque);
     const q24_t t_err = fx_sub(ctx->ref->torque, nx->torque);
     const int e_psi = ctrl_hyst2_update(&s->flux, fx_sub(psi_ref, nx->psi_amp));
     uint8_t n;
@@ -100,6 +102,7 @@ void st_fst_reset(void *state)
     s->prev_vec = 0u;
     s->g = 0;
     st_fst_logic_reset(&s->logic);
+    s->flux_ref.valid = 0u;
 }
 
 void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
@@ -110,7 +113,8 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t tref = ctx->ref->torque;
     const q24_t t_err = fx_sub(fx_add(tref, s->g), nx->torque); /* g = 0 when off */
-    const q24_t psi_err = fx_sub(ctrl_flux_ref(ctx->params, ctx->ref->psi, tref), nx->psi_amp);
+    const q24_t psi_err =
+        fx_sub(ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, tref), nx->psi_amp);
     /* Step detection on the reference itself, not on T_vref. */
     const st_fst_mode_t mode = st_fst_logic_update(&s->logic, tref, t_err, ctx->est->omega_e);
     if (mode != ST_FST_DYNAMIC) {

@@ -23,6 +23,7 @@
 #include "controller.h"
 #include "fx.h"
 #include "hysteresis.h"
+#include "mtpa.h"
 #include "st_tables.h"
 #include "vreplace.h"
 
@@ -31,11 +32,12 @@ typedef enum { ST_KIND_BST = 0, ST_KIND_MBST, ST_KIND_AST, ST_KIND_ZST } st_kind
 
 /* Runtime state of BST/MBST/AST/ZST. */
 typedef struct {
-    uint8_t kind;         /* st_kind_t */
-    uint8_t prev_vec;     /* vector chosen at k-1, 0..7 */
-    ctrl_hyst2_t flux;    /* two-level flux regulator, band h_psi (Q24 pu) */
-    ctrl_hyst3_t torque3; /* three-level torque regulator (BST, MBST), band h_T */
-    ctrl_hyst2_t torque2; /* two-level torque regulator (AST, ZST), band h_T */
+    uint8_t kind;              /* st_kind_t */
+    uint8_t prev_vec;          /* vector chosen at k-1, 0..7 */
+    ctrl_hyst2_t flux;         /* two-level flux regulator, band h_psi (Q24 pu) */
+    ctrl_hyst3_t torque3;      /* three-level torque regulator (BST, MBST), band h_T */
+    ctrl_hyst2_t torque2;      /* two-level torque regulator (AST, ZST), band h_T */
+    ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h) */
 } st_hyst_state_t;
 
 /* Operating-state logic of FST, §4.5.3 / Fig. 4.6. */
@@ -57,9 +59,10 @@ typedef struct {
     st_fst_logic_t logic;
     ctrl_vreplace_t vr;
     uint8_t prev_vec;
-    q24_t ki;    /* integrator gain per period (2 pi f_i Ts), Q24; 0 = off */
-    q24_t g_max; /* |g| limit: the rated torque, Q24 pu */
-    q24_t g;     /* integrator, Q24 pu torque */
+    q24_t ki;                  /* integrator gain per period (2 pi f_i Ts), Q24; 0 = off */
+    q24_t g_max;               /* |g| limit: the rated torque, Q24 pu */
+    q24_t g;                   /* integrator, Q24 pu torque */
+    ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h) */
 } st_fst_state_t;
 
 /* Clear the FST logic (flag 0, T_ref[k-1] = 0, T_err[k-1] >= 0), keep dt_step. */

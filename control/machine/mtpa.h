@@ -36,4 +36,49 @@ static inline q24_t ctrl_flux_ref(const ctrl_params_t *p, q24_t psi_cmd, q24_t t
     return ctrl_mtpa_psi(p, torque);
 }
 
+/* A flux reference memoised by a controller whose references are piecewise
+ * constant (a torque command; the speed loop holds its output between its
+ * runs): the inputs it was formed from and its value. The keys are every
+ * input of ctrl_flux_ref that can move at run time: the torque, the command,
+ * the params, and in them psi_pm with mtpa_k (the pipeline tracks the PM
+ * flux, fw_config_t.psi_adapt) and psi_ref; the MTPA table is fixed between
+ * resets. valid == 0 (after reset): nothing memoised. */
+typedef struct {
+    const ctrl_params_t *p;
+    q24_t torque, psi_cmd;         /* Q24 pu */
+    q24_t psi_pm, mtpa_k, psi_ref; /* of *p, Q24 */
+    int32_t value;                 /* the owner's function of the inputs */
+    uint8_t valid;
+} ctrl_flux_memo_t;
+
+/* 1 when m holds the value of these inputs; else 0 with the inputs recorded
+ * as the new keys (the caller then stores the value). */
+static inline int ctrl_flux_memo_hit(ctrl_flux_memo_t *m, const ctrl_params_t *p, q24_t psi_cmd,
+                                     q24_t torque)
+{
+    if (m->valid != 0u && m->p == p && m->torque == torque && m->psi_cmd == psi_cmd &&
+        m->psi_pm == p->psi_pm && m->mtpa_k == p->mtpa_k && m->psi_ref == p->psi_ref) {
+        return 1;
+    }
+    m->p = p;
+    m->torque = torque;
+    m->psi_cmd = psi_cmd;
+    m->psi_pm = p->psi_pm;
+    m->mtpa_k = p->mtpa_k;
+    m->psi_ref = p->psi_ref;
+    m->valid = 1u;
+    return 0;
+}
+
+/* ctrl_flux_ref(p, psi_cmd, torque), formed only when an input moved (the
+ * SPMSM's MTPA is a square root, fx_mag). */
+static inline q24_t ctrl_flux_ref_memo(ctrl_flux_memo_t *m, const ctrl_params_t *p, q24_t psi_cmd,
+                                       q24_t torque)
+{
+    if (ctrl_flux_memo_hit(m, p, psi_cmd, torque) == 0) {
+        m->value = ctrl_flux_ref(p, psi_cmd, torque);
+    }
+    return m->value;
+}
+
 #endif /* CONTROL_MTPA_H */

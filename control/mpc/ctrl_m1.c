@@ -8,7 +8,7 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m1_t *s = state;
     ctrl_mpc_in_t in;
-    ctrl_mpc_in(&s->model, ctx, &in);
+    ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
 
     /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
     const q24_t num = fx_sub(in.t_ref, in.b.t0);

@@ -18,13 +18,14 @@ void ctrl_m2_reset(void *state)
     ctrl_m2_t *s = state;
     s->trace.n = 0u;
     s->last_vec = 0u;
+    s->flux.valid = 0u;
 }
 
 void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m2_t *s = state;
     ctrl_mpc_in_t in;
-    ctrl_mpc_in(&s->model, ctx, &in);
+    ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
 
     const int32_t r2 = ctrl_mpc_amp2(in.psi_ref, 0);
     const uint8_t vec = ctrl_m2_table(ctx->est->next.sector, in.t_ref >= in.b.t0,

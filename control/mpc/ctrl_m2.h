@@ -24,6 +24,7 @@ typedef struct {
     q24_t d_nu[CTRL_M2_Y_MAX + 1]; /* nu / y, Q24 */
     uint8_t last_vec;              /* segment 0 of the last plan (0 after reset) */
     ctrl_mpc_trace_t trace;        /* y + 1 entries: the table vector with D_nu */
+    ctrl_flux_memo_t flux;         /* the flux reference (ctrl_mpc_in) */
 } ctrl_m2_t;
 
 extern const ctrl_desc_t ctrl_desc_m2;

@@ -48,20 +48,16 @@ void ctrl_m2ptfc_reset(void *state)
     ctrl_m2ptfc_t *s = state;
     s->sigma = 0;
     s->trace.n = 0u;
-    s->psi2_params = NULL; /* no valid psi_ref^2 cached */
+    s->psi2.valid = 0u; /* no psi_ref^2 memoised */
 }
 
-/* psi_ref^2 of (6.9) (MTPA (4.15) squared, ctrl_mpc_psi_ref2), from the cache
- * when params and the references are those it was computed for. */
+/* psi_ref^2 of (6.9) (MTPA (4.15) squared, ctrl_mpc_psi_ref2), memoised. */
 static int32_t m2ptfc_psi2(ctrl_m2ptfc_t *s, const ctrl_params_t *p, const ctrl_refs_t *ref)
 {
-    if (s->psi2_params != p || s->psi2_torque != ref->torque || s->psi2_psi != ref->psi) {
-        s->psi2 = ctrl_mpc_psi_ref2(p, ref);
-        s->psi2_params = p;
-        s->psi2_torque = ref->torque;
-        s->psi2_psi = ref->psi;
+    if (ctrl_flux_memo_hit(&s->psi2, p, ref->psi, ref->torque) == 0) {
+        s->psi2.value = ctrl_mpc_psi_ref2(p, ref);
     }
-    return s->psi2;
+    return s->psi2.value;
 }
 
 void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)

@@ -27,14 +27,10 @@ typedef struct {
     q24_t sigma;    /* sigma_T of (6.8), Q24 pu */
     uint8_t centre; /* 1: Te_c (**) in (6.5), (6.7), (6.8); 0: Te(k+1) */
     ctrl_mpc_trace_t trace;
-    /* Cache of ctrl_mpc_psi_ref2(params, ref), recomputed only when its inputs
-     * change (the reference is piecewise constant): valid when params,
-     * ref->torque and ref->psi equal the keys. The params pointed to are not
-     * modified between init/reset and step (as for model). */
-    const ctrl_params_t *psi2_params; /* key; NULL after init/reset: none cached */
-    q24_t psi2_torque;                /* key: ref->torque, Q24 pu */
-    q24_t psi2_psi;                   /* key: ref->psi, Q24 pu */
-    int32_t psi2;                     /* psi_ref^2, Q24 pu^2 (ctrl_mpc_amp2 units) */
+    /* ctrl_mpc_psi_ref2(params, ref), psi_ref^2 in Q24 pu^2 (ctrl_mpc_amp2
+     * units), formed only when its inputs move (mtpa.h: the references, the
+     * params and the PM flux tracked in them). */
+    ctrl_flux_memo_t psi2;
 } ctrl_m2ptfc_t;
 
 extern const ctrl_desc_t ctrl_desc_m2ptfc;

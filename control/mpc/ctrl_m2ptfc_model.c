@@ -103,6 +103,7 @@ void ctrl_mpc_wreset(void *state)
     ctrl_mpc_wstate_t *s = state;
     s->trace.n = 0u;
     s->last_vec = 0u;
+    s->flux.valid = 0u;
 }
 
 int32_t ctrl_mpc_psi_ref2(const ctrl_params_t *p, const ctrl_refs_t *ref)

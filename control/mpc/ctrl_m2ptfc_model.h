@@ -81,6 +81,7 @@ typedef struct {
     q24_t zeta;             /* Q24 pu (T_base / psi_base) */
     uint8_t last_vec;       /* segment 0 of the last plan (0 after reset) */
     ctrl_mpc_trace_t trace; /* candidates of the last step (see each controller) */
+    ctrl_flux_memo_t flux;  /* the flux reference (ctrl_mpc_in) */
 } ctrl_mpc_wstate_t;
 
 /* ---- per sample (ctrl_m2ptfc_model.c, integer only) ---- */
@@ -108,19 +109,20 @@ void ctrl_mpc_basis(const ctrl_mpc_model_t *m, const ctrl_estimate_t *est, ctrl_
 
 /* What the six-candidate steps (M1, M2, M3, FS-MPTFC) start from: the model
  * following psi_pm (ctrl_mpc_model_track), the basis and the references, the flux one from
- * ctrl_flux_ref (MTPA (4.15) when the command is 0). */
+ * ctrl_flux_ref (MTPA (4.15) when the command is 0), memoised in flux. */
 typedef struct {
     ctrl_mpc_basis_t b;
     q24_t t_ref;   /* torque reference, Q24 pu */
     q24_t psi_ref; /* flux reference, Q24 pu */
 } ctrl_mpc_in_t;
 
-static inline void ctrl_mpc_in(ctrl_mpc_model_t *m, const ctrl_ctx_t *ctx, ctrl_mpc_in_t *in)
+static inline void ctrl_mpc_in(ctrl_mpc_model_t *m, ctrl_flux_memo_t *flux, const ctrl_ctx_t *ctx,
+                               ctrl_mpc_in_t *in)
 {
     ctrl_mpc_model_track(m, ctx->params);
     ctrl_mpc_basis(m, ctx->est, &in->b);
     in->t_ref = ctx->ref->torque;
-    in->psi_ref = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+    in->psi_ref = ctrl_flux_ref_memo(flux, ctx->params, ctx->ref->psi, ctx->ref->torque);
 }
 
 /* ctrl_mpc_basis() with V1..V3 only (no V4..V6): the same d0, q0, t0 and

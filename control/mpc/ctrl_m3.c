@@ -9,7 +9,7 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m3_t *s = state;
     ctrl_mpc_in_t in;
-    ctrl_mpc_in(&s->model, ctx, &in);
+    ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
     const ctrl_mstate_t *n = &ctx->est->next;
 
     /* (6.1) by the sign of the torque error. */

@@ -8,7 +8,7 @@ void ctrl_mptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_mptfc_t *s = state;
     ctrl_mpc_in_t in;
-    ctrl_mpc_in(&s->model, ctx, &in);
+    ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
 
     /* Zero vector (V0 = V7): duty 0 of any active vector. */
     int64_t best_g =

@@ -715,7 +715,7 @@ static void test_m2ptfc_psi2_cache(void)
     ctrl_m2ptfc_t s;
     ctrl_desc_m2ptfc.cfg_default(&c, &ini_thesis_spmsm);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &pa));
-    TEST_ASSERT_NULL(s.psi2_params);
+    TEST_ASSERT_EQUAL_UINT8(0, s.psi2.valid);
     ctrl_estimate_t est;
     ctrl_refs_t ref;
     ctrl_plan_t applied;
@@ -730,12 +730,15 @@ static void test_m2ptfc_psi2_cache(void)
         if (i % 11 == 0) {
             ref.psi = (rng_u32() & 1u) ? 0 : q24(rng_uniform(0.8, 1.2) * d24(pa.psi_pm));
         }
+        if (i % 13 == 5) {
+            /* the PM flux tracked in place (the pipeline's psi_adapt) */
+            pa.psi_pm = q24(rng_uniform(0.9, 1.1) * d24(pb.psi_pm));
+            pa.mtpa_k = fx_mul(pa.lq, fx_div(FX_ONE, pa.psi_pm));
+        }
         est.next.theta_e += 0x01000000u; /* the machine moves on */
         ctrl_m2ptfc_t fresh = s;
-        fresh.psi2_params = NULL;
-        const ctrl_params_t *cached = s.psi2_params;
-        const q24_t cached_t = s.psi2_torque;
-        const q24_t cached_psi = s.psi2_psi;
+        fresh.psi2.valid = 0u;
+        const ctrl_flux_memo_t held = s.psi2;
         const ctrl_ctx_t ctx = {p, &est, &ref};
         ctrl_out_t o1;
         ctrl_out_t o2;
@@ -745,13 +748,14 @@ static void test_m2ptfc_psi2_cache(void)
         TEST_ASSERT_EQUAL_UINT8_ARRAY(o2.plan.vec, o1.plan.vec, o1.plan.n_seg);
         TEST_ASSERT_EQUAL_INT32_ARRAY(o2.plan.dur, o1.plan.dur, o1.plan.n_seg);
         TEST_ASSERT_EQUAL_INT32(fresh.sigma, s.sigma);
-        TEST_ASSERT_EQUAL_INT32(ctrl_mpc_psi_ref2(p, &ref), s.psi2);
-        TEST_ASSERT_TRUE(s.psi2_params == p);
-        recomputed += cached != p || cached_t != ref.torque || cached_psi != ref.psi;
+        TEST_ASSERT_EQUAL_INT32(ctrl_mpc_psi_ref2(p, &ref), s.psi2.value);
+        TEST_ASSERT_TRUE(s.psi2.p == p);
+        recomputed += held.p != p || held.torque != ref.torque || held.psi_cmd != ref.psi ||
+                      held.psi_pm != p->psi_pm;
     }
     TEST_ASSERT_TRUE(recomputed > 20 && recomputed < 200); /* held and changed */
     ctrl_desc_m2ptfc.reset(&s);
-    TEST_ASSERT_NULL(s.psi2_params);
+    TEST_ASSERT_EQUAL_UINT8(0, s.psi2.valid);
 }
 
 static void test_sigma_ema(void)
