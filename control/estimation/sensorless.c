@@ -150,7 +150,10 @@ static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_
         s->count = 0u;
         return;
     }
-    const fx_angle_t north = ((disp < 0) == (s->dir < 0)) ? th : th + SL_HALF_TURN;
+    /* th1 moved on by the displacement (th itself may have wrapped across
+     * the ends of [0, pi)), or turned by pi if the rotor went backwards */
+    const fx_angle_t moved = s->th1 + (fx_angle_t)(uint32_t)disp;
+    const fx_angle_t north = ((disp < 0) == (s->dir < 0)) ? moved : moved + SL_HALF_TURN;
     sl_observe_from(s, p, north, i_alpha, i_beta, out);
 }
 #endif
