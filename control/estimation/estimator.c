@@ -183,9 +183,13 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
             in->v_alpha = fx_mul_nosat(vdc, ua);
             in->v_beta = fx_mul_nosat(vdc, ub);
         }
+        est->u_alpha = ua;
+        est->u_beta = ub;
     } else {
         in->v_alpha = 0;
         in->v_beta = 0;
+        est->u_alpha = 0;
+        est->u_beta = 0;
     }
 
     /* k+1: the frame turned by delta = omega Ts, psi(k+1) = psi' e^{-j delta}

@@ -46,6 +46,9 @@ typedef struct {
     int32_t dtheta;       /* omega_e Ts: the angle one period turns, fx_angle_t units, signed */
     int32_t rot_c, rot_s; /* cos and sin of dtheta, Q30 (fx_rot_q30): the frame at
                            * k+1 is the frame at k turned by dtheta */
+    /* Stator-frame voltage of the duties applied in [k, k+1) per unit of DC
+     * link (4.4), Q24 (0 without duties). */
+    q24_t u_alpha, u_beta;
 } ctrl_estimate_t;
 
 /* References from the outer loop / command interface. */

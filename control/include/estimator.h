@@ -28,7 +28,7 @@
 
 /* Optional outputs (bit set = computed). Always computed: now and next
  * i_d, i_q, psi_d, psi_q, torque, theta_e; now.sin_theta, now.cos_theta,
- * now.i_alpha, now.i_beta; omega_e, vdc, dtheta, rot_c, rot_s. A field not
+ * now.i_alpha, now.i_beta; omega_e, vdc, dtheta, rot_c, rot_s, u_alpha, u_beta. A field not
  * computed is not written (it keeps the caller's value, zero from an
  * initialised ctrl_estimate_t). Costs on a Cortex-M4: a square root ~60
  * instructions, a sector ~20, a rotation ~10. */

@@ -212,8 +212,7 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             /* Fresh dynamic state; the first gated period is k+1. */
             fw->ctrl->reset(fw->ctrl_state.bytes);
             ctrl_estimator_reset(&fw->est, &fw->params);
-            fw->fobs.primed = 0u; /* restarted from the current model at the first period */
-            fw->fobs_va = fw->fobs_vb = 0;
+            ctrl_psi_track_reset(&fw->psi_track); /* from the current model at the first period */
             ctrl_speed_pi_reset(&fw->speed_pi, 0);
             ctrl_fieldweak_reset(&fw->fwk);
             fw->torque_max = fw->torque_ref_max;
@@ -286,25 +285,18 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
 }
 
 /* PM flux from the voltage model (fw_config_t.psi_adapt): the encoder-mode
- * observer over [k-1, k) with the estimator's rotor frame at k (its sin/cos
- * and i_dq: no second look-up), then its estimate - which it only moves
- * where the voltage model is reliable - once it has left the 2 % band
- * around the configured value into the parameters every consumer reads,
+ * observer on the estimator's frame (psi_track.h); its estimate - which it
+ * only moves where the voltage model is reliable - once it has left the 2 %
+ * band around the configured value into the parameters every consumer reads,
  * with 1/psi_pm by a Newton step (y (2 - psi y)) and the SPMSM's MTPA slope
- * Lq/psi_pm. The voltage of [k, k+1) for the next period. */
+ * Lq/psi_pm. */
 static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estimate_t *est)
 {
-    ctrl_fobs_t *const o = &fw->fobs;
     ctrl_params_t *const p = &fw->params;
-    const ctrl_mstate_t *n = &est->now;
-    if (o->primed == 0u) {
-        ctrl_fobs_reset(o, p, n->theta_e, est->omega_e, n->i_alpha, n->i_beta);
-    } else {
-        (void)ctrl_fobs_integrate(o, p, fw->fobs_va, fw->fobs_vb, n->i_alpha, n->i_beta);
-        ctrl_fobs_correct(o, p, n->theta_e, n->sin_theta, n->cos_theta, n->i_d, n->i_q);
+    if (!ctrl_psi_track_step(&fw->psi_track, p, est, &fw->applied, m->i_a, m->i_b)) {
+        return; /* no new estimate in this period */
     }
-    ctrl_fobs_voltage(o, &fw->applied, m->vdc, m->i_a, m->i_b, &fw->fobs_va, &fw->fobs_vb);
-    const q24_t psi = ctrl_fobs_psi_pm(o);
+    const q24_t psi = ctrl_psi_track_psi_pm(&fw->psi_track);
     if (!fw->psi_engaged) {
         if (fx_abs(fx_sub(psi, fw->psi_pm_cfg)) <= fw->psi_band) {
             return; /* agrees with the configured value: nothing changes */

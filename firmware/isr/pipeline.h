@@ -57,6 +57,7 @@
 #include "fw_state.h"
 #include "hal.h"
 #include "protect.h"
+#include "psi_track.h"
 #include "sensorless.h"
 #include "speed_pi.h"
 #include "speed_pi_config.h"
@@ -183,10 +184,8 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
-    /* PM-flux tracking (fw_config_t.psi_adapt): the encoder-mode observer,
-     * the mean voltage of [k-1, k) it integrates (Q24 pu). */
-    ctrl_fobs_t fobs;
-    q24_t fobs_va, fobs_vb;
+    /* PM-flux tracking (fw_config_t.psi_adapt, estimation/psi_track.h). */
+    ctrl_psi_track_t psi_track;
     q24_t psi_pm_cfg;    /* the configured psi_pm, Q24 pu */
     q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
     bool psi_engaged;    /* the estimate has left the band: params follow it */
