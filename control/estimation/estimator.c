@@ -101,7 +101,8 @@ static void estimator_options(unsigned outputs, q24_t hd, q24_t hq, ctrl_estimat
 }
 
 /* Range of the per-period arithmetic (estimator.h): phase currents within
- * +-CTRL_EST_I_LIM, leg duties in [0, FX_ONE], the DC link in [0, 64 pu]. */
+ * [-CTRL_EST_I_LIM, CTRL_EST_I_LIM), leg duties in [0, FX_ONE], the DC link
+ * in [0, 64 pu). */
 #define EST_VDC_LIM ((q24_t)1 << 30) /* 64 pu */
 #define EST_PSI_LIM ((q24_t)1 << 30) /* 64 pu */
 
@@ -112,12 +113,12 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     ctrl_mstate_t *nx = &est->next;
     /* Clarke (3.3): beta = (a + 2 b)/sqrt(3); |a|, |b| <= 2^29: |beta| <= 55.5 pu,
      * the products < 2^60, no saturation. */
-    const q24_t i_a = fx_clamp(m->i_a, -CTRL_EST_I_LIM, CTRL_EST_I_LIM);
-    const q24_t i_b = fx_clamp(m->i_b, -CTRL_EST_I_LIM, CTRL_EST_I_LIM);
+    const q24_t i_a = fx_clamp(m->i_a, -CTRL_EST_I_LIM, CTRL_EST_I_LIM - 1); /* one SSAT */
+    const q24_t i_b = fx_clamp(m->i_b, -CTRL_EST_I_LIM, CTRL_EST_I_LIM - 1);
     const q24_t i_alpha = i_a;
     const q24_t i_beta =
         fx_round_nosat((int64_t)i_a * FX_Q30_INV_SQRT3 + (int64_t)i_b * FX_Q30_2_SQRT3, 30u);
-    const q24_t vdc = fx_clamp(m->vdc, 0, EST_VDC_LIM);
+    const q24_t vdc = fx_clamp(m->vdc, 0, EST_VDC_LIM - 1); /* one USAT */
 
     /* theta(k), omega(k) from the angle source. */
     ctrl_angle_in_t *in = &e->in;

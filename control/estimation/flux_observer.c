@@ -115,11 +115,10 @@ void ctrl_fobs_voltage(ctrl_fobs_t *o, const ctrl_legs_t *legs, q24_t vdc, q24_t
     if (o->v_fwd != 0) {
         /* Leg voltage - v_fwd sign(i), through Clarke (3.3):
          * alpha = (2 a - b - c) / 3, beta = (b - c) / sqrt(3). */
-        const int64_t sa64 = sa;
-        const int64_t sb64 = sb;
-        const int64_t sc64 = sc;
-        const q24_t fa = fx_round_sat((2 * sa64 - sb64 - sc64) * FX_Q30_1_3, 30u);
-        const q24_t fb = fx_round_sat((sb64 - sc64) * FX_Q30_INV_SQRT3, 30u);
+        /* soft signs in [-1, 1]: |2 sa - sb - sc| <= 2^26, the products
+         * below 2^56 and the results below 2^25, no saturation */
+        const q24_t fa = fx_round_nosat((int64_t)(2 * sa - sb - sc) * FX_Q30_1_3, 30u);
+        const q24_t fb = fx_round_nosat((int64_t)(sb - sc) * FX_Q30_INV_SQRT3, 30u);
         va = fx_sub(va, fx_mul(o->v_fwd, fa));
         vb = fx_sub(vb, fx_mul(o->v_fwd, fb));
     }

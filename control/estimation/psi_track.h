@@ -14,21 +14,17 @@
  *                  duty voltage (or ctrl_fobs_voltage where the inverter's
  *                  dead time and drop are compensated);
  *   period 0 of N  the correction psi += k_N (psi_cm - psi) in the rotor frame
- *                  of the estimator (its sin/cos, i_dq and current-model flux:
- *                  no table look-up, no angle), k_N = 1 - (1 - w_c Ts)^N, the
- *                  N per-period corrections in one;
- *   period 1 of N  the EMA with the PM flux of period 0 and 1 - exp(-N Ts / tau)
- *                  (spread over two periods, so the worst period carries one
- *                  of the two).
+ *                  of the estimator (its sin/cos, i_dq: no table look-up, no
+ *                  angle), k_N = 1 - (1 - w_c Ts)^N, the N per-period
+ *                  corrections in one, and the EMA with 1 - exp(-N Ts / tau):
+ *                  the observer's ctrl_fobs_correct with these gains.
  * N is the largest divider (<= CTRL_PSI_TRACK_DIV_MAX) with which the flux
- * turns at most a quarter turn between two corrections at the highest speed
- * given: the rotating current-model error the correction filters is then
- * sampled well above its frequency (N w Ts near 2 pi would alias it to DC),
- * and the attenuation (w_c / w) of the per-period filter changes by less than
- * 3 % (|e^{j x} - 1| against x, x <= pi/2).
- * The speed gate reads the estimator's (encoder) speed; the observer's PLL
- * and flux angle are not needed here and do not run.
- * Integer-only per period.
+ * turns at most a quarter turn between two corrections at twice the rated
+ * speed (beyond the machines' maximum speeds): the rotating current-model error the correction
+ * filters is then sampled well above its frequency (N w Ts near 2 pi would alias it to DC), and the
+ * attenuation (w_c / w) of the per-period filter changes by less than 3 % (|e^{j x} - 1| against x,
+ * x <= pi/2). The speed gate reads the estimator's (encoder) speed; the observer's PLL and flux
+ * angle are not needed here and do not run. Integer-only per period.
  */
 #ifndef CONTROL_PSI_TRACK_H
 #define CONTROL_PSI_TRACK_H
@@ -40,42 +36,85 @@
 #include "ctrl_types.h"
 #include "flux_observer.h"
 
-/* Largest divider: the Q49 flux is clamped at the corrections only, and N
- * unclamped increments (each below 2^57: 2 Ts Vdc <= 128 pu times |u| <= 1,
- * plus Ts Rs <= 1 pu times two currents < 128 pu) stay far inside int64_t. */
+/* Largest divider: the observer's Q48 flux is clamped (127 pu) at the
+ * corrections only, and N unclamped increments (each below 2^56: Ts Vdc <=
+ * 64 pu times |u| <= 1, plus Ts Rs <= 1 pu times the mean of two currents
+ * < 64 pu) stay far inside int64_t. */
 #define CTRL_PSI_TRACK_DIV_MAX 8u
 
 typedef struct {
-    ctrl_fobs_t obs; /* CTRL_FOBS_ENCODER: gains, voltage compensation (with the
-                      * duties of the period before), the PM-flux EMA (Q48) */
-    /* Stator flux (alpha, beta), Q49 pu: the observer's Q48 with one more
-     * bit, so that the trapezoid's half is exact. */
-    int64_t acc[2];
-    q24_t i_prev[2];   /* i(k-1) (alpha, beta), Q24 pu */
-    q24_t vs_scale;    /* volt-seconds of the period before, Q48 per axis: */
-    q24_t vs[2];       /* vs_scale x vs[axis], each Q24 */
-    q24_t k_n;         /* correction per update, Q24: 1 - (1 - w_c Ts)^N (< 1 - 2^-8) */
-    q24_t psi_k_n;     /* EMA coefficient per update, Q24: 1 - exp(-N Ts / tau) */
-    q24_t psi_raw;     /* PM flux psi_d - Ld i_d at the last correction, Q24 pu */
-    uint8_t div;       /* N: one correction every N periods */
-    uint8_t phase;     /* period within the N, 0..N-1 */
-    uint8_t raw_valid; /* psi_raw awaits the EMA (the speed gate was open) */
+    ctrl_fobs_t obs; /* CTRL_FOBS_ENCODER: voltage compensation (with the duties
+                      * of the period before), the correction (kenc_ts = k_N =
+                      * 1 - (1 - w_c Ts)^N, < 1 - 2^-8), the PM-flux EMA (Q48) */
+    q24_t i_prev[2]; /* i(k-1) (alpha, beta), Q24 pu */
+    q24_t vs_scale;  /* volt-seconds of the period before, Q48 per axis: */
+    q24_t vs[2];     /* vs_scale x vs[axis], each Q24 */
+    q24_t psi_k_n;   /* EMA coefficient per update, Q24: 1 - exp(-N Ts / tau) */
+    q24_t speed_min; /* the EMA runs where |omega| >= this, Q24 pu */
+    uint8_t div;     /* N: one correction every N periods */
+    uint8_t phase;   /* period within the N, 0..N-1 */
 } ctrl_psi_track_t;
 
 /* Restart from the current model at the next step (keeps the settings and
  * the PM-flux estimate's gains; the estimate restarts from p->psi_pm). */
 void ctrl_psi_track_reset(ctrl_psi_track_t *t);
 
+/* Turn an observer set up by ctrl_fobs_init in CTRL_FOBS_ENCODER (its kenc_ts
+ * and psi_k per period, psi_speed_min) into the tracker: N from twice the
+ * rated speed, the gains of N periods. Returns CTRL_OK, or CTRL_EINVAL (not
+ * encoder mode, no rated speed) with *t unchanged. Configuration time. */
+int ctrl_psi_track_setup(ctrl_psi_track_t *t, const ctrl_params_t *p);
+
+/* Parts of ctrl_psi_track_step out of line: the first period after a reset
+ * (the flux from the current model) and the work of period 0 of N (returns
+ * whether the PM-flux estimate moved). */
+void ctrl_psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est);
+bool ctrl_psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                            const ctrl_estimate_t *est);
+
 /* One period at sample k, after ctrl_estimator_update: est its estimate at k
  * (now.*: i_alpha/beta, sin/cos, i_d/q, psi_d/q, theta_e; omega_e, vdc,
  * u_alpha/beta), applied the leg duties acting in [k, k+1) and i_a, i_b the
  * measured phase currents (Q24 pu; read only with dead-time or drop
  * compensation). Returns true when the PM-flux estimate has moved
- * (ctrl_psi_track_psi_pm). */
-bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                         const ctrl_legs_t *applied, q24_t i_a, q24_t i_b);
-
-/* The PM-flux estimate, Q24 pu. */
-q24_t ctrl_psi_track_psi_pm(const ctrl_psi_track_t *t);
+ * (ctrl_fobs_psi_pm of t->obs). Inline: what every period does - the voltage
+ * model over [k-1, k) (flux_observer.c's fobs_axis, without its clamp,
+ * which the correction applies) in the observer's Q48, Ts v - Ts Rs (i(k-1)
+ * + i(k)) / 2 (the half truncated: 2^-49 pu per period, bounded by the
+ * correction), and the voltage of [k, k+1) kept for the next period. The currents are the
+ * estimator's (|i_alpha| <= 32 pu, |i_beta| < 56 pu): their sums fit an
+ * int32_t. */
+static inline bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                                       const ctrl_estimate_t *est, const ctrl_legs_t *applied,
+                                       q24_t i_a, q24_t i_b)
+{
+    ctrl_fobs_t *const o = &t->obs;
+    const ctrl_mstate_t *n = &est->now;
+    const q24_t i_now[2] = {n->i_alpha, n->i_beta};
+    if (o->primed != 0u) {
+        int64_t *const acc[2] = {&o->psi_alpha_acc, &o->psi_beta_acc};
+        for (unsigned x = 0u; x < 2u; x++) {
+            const int32_t i_sum = t->i_prev[x] + i_now[x];
+            *acc[x] += (int64_t)t->vs_scale * t->vs[x] - (int64_t)p->ts_rs * i_sum / 2;
+        }
+    } else {
+        ctrl_psi_track_prime(t, p, est);
+    }
+    t->i_prev[0] = i_now[0];
+    t->i_prev[1] = i_now[1];
+    if (o->dt_frac == 0 && o->v_fwd == 0) {
+        /* The estimator's duty voltage per unit of DC link: Ts Vdc <= 64 pu,
+         * the product below 2^55 (no saturation). */
+        t->vs_scale = fx_mul_nosat(p->ts, est->vdc);
+        t->vs[0] = est->u_alpha;
+        t->vs[1] = est->u_beta;
+    } else {
+        ctrl_fobs_voltage(o, applied, est->vdc, i_a, i_b, &t->vs[0], &t->vs[1]);
+        t->vs_scale = p->ts;
+    }
+    const unsigned ph = t->phase;
+    t->phase = (uint8_t)(ph + 1u >= t->div ? 0u : ph + 1u);
+    return ph == 0u ? ctrl_psi_track_correct(t, p, est) : false;
+}
 
 #endif /* CONTROL_PSI_TRACK_H */

@@ -1,41 +1,40 @@
-/* PM-flux tracking: SI configuration -> gains and divider (configuration). */
-#include <math.h>
-#include <string.h>
+/* PM-flux tracking: the observer's per-period gains -> N periods (configuration). */
+#include "psi_track.h"
 
-#include "ctrl_units.h"
-#include "psi_track_config.h"
-
-int ctrl_psi_track_init(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_bases_t *b,
-                        const ctrl_fobs_config_t *c, double w_max_rad_s, ctrl_diag_t *why)
+int ctrl_psi_track_setup(ctrl_psi_track_t *t, const ctrl_params_t *p)
 {
-    if (t == NULL || p == NULL || b == NULL || c == NULL || p->fs_hz == 0u) {
+    ctrl_fobs_t *const o = &t->obs;
+    if (o->mode != CTRL_FOBS_ENCODER || p->speed_rated_e <= 0) {
         return CTRL_EINVAL;
     }
-    const double ts = 1.0 / (double)p->fs_hz;
-    if (!ctrl_diag_in_range(why, "w_max_rad_s", "rad/s", w_max_rad_s, 1e-3, 1e9)) {
-        return CTRL_EINVAL;
+    /* At most a quarter turn (2^30) between two corrections at twice the
+     * rated speed, the angle of one period from omega_to_dangle (not wrapped:
+     * below 2^31 times 2^31, shifted). */
+    const uint64_t step =
+        ((uint64_t)(2u * (uint32_t)p->speed_rated_e) * (uint32_t)p->omega_to_dangle) >> FX_QBITS;
+    uint32_t div =
+        step >= ((uint64_t)1 << 30)
+            ? 1u
+            : (step == 0u ? CTRL_PSI_TRACK_DIV_MAX : ((uint32_t)1 << 30) / (uint32_t)step);
+    if (div > CTRL_PSI_TRACK_DIV_MAX) {
+        div = CTRL_PSI_TRACK_DIV_MAX;
     }
-    ctrl_fobs_config_t enc = *c;
-    enc.mode = CTRL_FOBS_ENCODER;
-    ctrl_psi_track_t n;
-    memset(&n, 0, sizeof n);
-    if (ctrl_fobs_init(&n.obs, p, b, &enc, why) != CTRL_OK) {
-        return CTRL_EINVAL;
+    /* N periods in one: 1 - (1 - w_c Ts)^N and 1 - (1 - (1 - exp(-Ts / tau)))^N
+     * = 1 - exp(-N Ts / tau), the powers in Q24 (factors in [0, 1]: no
+     * saturation; N roundings of half an LSB). */
+    q24_t keep_c = FX_ONE;
+    q24_t keep_e = FX_ONE;
+    for (uint32_t k = 0u; k < div; k++) {
+        keep_c = fx_mul_nosat(keep_c, FX_ONE - o->kenc_ts);
+        keep_e = fx_mul_nosat(keep_e, FX_ONE - o->psi_k);
     }
-    /* At most a quarter turn between two corrections at w_max (psi_track.h);
-     * every period (N = 1) where one period turns further. */
-    unsigned div = 1u;
-    while (div < CTRL_PSI_TRACK_DIV_MAX && (double)(div + 1u) * w_max_rad_s * ts <= 0.5 * CTRL_PI) {
-        div++;
-    }
-    n.div = (uint8_t)div;
-    const double nts = (double)n.div * ts;
-    double keep = 1.0; /* (1 - w_c Ts)^N, without pow (flash on the board) */
-    for (unsigned k = 0u; k < n.div; k++) {
-        keep *= 1.0 - c->kenc_rad_s * ts;
-    }
-    n.k_n = ctrl_q24_from_double(1.0 - keep);
-    n.psi_k_n = c->psi_tau_s > 0.0 ? ctrl_q24_from_double(1.0 - exp(-nts / c->psi_tau_s)) : 0;
-    *t = n;
+    o->kenc_ts = FX_ONE - keep_c;
+    t->psi_k_n = o->psi_k != 0 ? FX_ONE - keep_e : 0;
+    /* the EMA's speed gate is the tracker's (the encoder's speed) */
+    t->speed_min = o->psi_speed_min;
+    o->psi_speed_min = 0;
+    o->psi_k = 0;
+    t->div = (uint8_t)div;
+    ctrl_psi_track_reset(t);
     return CTRL_OK;
 }

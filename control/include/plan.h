@@ -159,7 +159,8 @@ static inline void ctrl_legs_uab(const ctrl_legs_t *legs, q24_t *u_alpha, q24_t 
     *u_beta = fx_round_sat((db - dc) * FX_Q30_INV_SQRT3, 30u);
 }
 
-/* Period-average alpha/beta voltage of leg duties (each in [0, FX_ONE]) at DC
+/* Period-average alpha/beta voltage of leg duties (each in [0, FX_ONE], or
+ * a dead-time-corrected duty slightly beyond; taken within [-2, 2)) at DC
  * link vdc: vdc times ctrl_legs_uab; for the duties of a plan whose on-times
  * sum to at most FX_ONE this equals the sum over its segments of dur_i V_i. */
 void ctrl_legs_voltage(const ctrl_legs_t *legs, q24_t vdc, q24_t *v_alpha, q24_t *v_beta);

@@ -296,7 +296,7 @@ static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estim
     if (!ctrl_psi_track_step(&fw->psi_track, p, est, &fw->applied, m->i_a, m->i_b)) {
         return; /* no new estimate in this period */
     }
-    const q24_t psi = ctrl_psi_track_psi_pm(&fw->psi_track);
+    const q24_t psi = ctrl_fobs_psi_pm(&fw->psi_track.obs);
     if (!fw->psi_engaged) {
         if (fx_abs(fx_sub(psi, fw->psi_pm_cfg)) <= fw->psi_band) {
             return; /* agrees with the configured value: nothing changes */

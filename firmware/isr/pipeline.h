@@ -184,8 +184,6 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
-    /* PM-flux tracking (fw_config_t.psi_adapt, estimation/psi_track.h). */
-    ctrl_psi_track_t psi_track;
     q24_t psi_pm_cfg;    /* the configured psi_pm, Q24 pu */
     q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
     bool psi_engaged;    /* the estimate has left the band: params follow it */
@@ -255,6 +253,9 @@ typedef struct {
     uint32_t tm_count;             /* periods until the next publication */
     uint32_t tm_dropped;           /* records not published: ring full */
     ctrl_diag_t why;               /* why the core refused the last configuration (fw_explain) */
+    /* PM-flux tracking (fw_config_t.psi_adapt, estimation/psi_track.h); last,
+     * so that its size moves no other field's offset (code size). */
+    ctrl_psi_track_t psi_track;
 } fw_t;
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),

@@ -11,7 +11,6 @@
 
 #include "flux_observer_config.h"
 #include "plan.h"
-#include "psi_track_config.h"
 #include "sensorless_config.h"
 #include "speed_loop.h"
 #include "speed_pi_config.h"
@@ -119,6 +118,32 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         ctrl_q24_from_double(1.0 - exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
+    /* PM-flux tracking: the encoder-mode observer, its estimate adopted above
+     * 10 % of rated speed with a 20 ms time constant (docs/algorithms.md,
+     * "PM flux from the voltage model"), corrected every N periods
+     * (psi_track.h). */
+    {
+        ctrl_fobs_config_t oc;
+        ctrl_fobs_config_default(&oc, fw->machine);
+        oc.mode = CTRL_FOBS_ENCODER;
+        oc.psi_tau_s = 0.02;
+        oc.psi_speed_min = 0.1;
+        /* its PLL does not run (psi_track.h); within the discrete loop's range */
+        oc.pll_hz = fmin(oc.pll_hz, 0.4 * (double)in->pwm_freq_hz / (4.0 * CTRL_PI));
+        oc.dead_time_s = cfg->dead_time_s;
+        oc.v_fwd_v = cfg->v_fwd_v;
+        if (ctrl_fobs_init(&fw->psi_track.obs, &fw->params, &fw->bases, &oc, &fw->why) != CTRL_OK ||
+            ctrl_psi_track_setup(&fw->psi_track, &fw->params) != CTRL_OK) {
+            return FW_EINVAL;
+        }
+        /* The configured value stays while the estimate agrees with it within
+         * 2 %: about its own uncertainty (a 10 % resistance error moves it by
+         * dR i / (w psi_pm), 1.3 % on the thesis SPMSM at 750 r/min and rated
+         * current), and a 2 % torque error at most. */
+        fw->psi_pm_cfg = fw->params.psi_pm;
+        fw->psi_band = fx_mul(fw->params.psi_pm, ctrl_q24_from_double(0.02));
+        fw->psi_engaged = false;
+    }
     if (cfg->sensorless) {
         /* The sensorless angle source with its defaults (sensorless_config.h)
          * and the inverter's dead time and drop; its PLL within the discrete
@@ -190,34 +215,6 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     }
     if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
         return FW_ERANGE;
-    }
-    /* PM-flux tracking: the encoder-mode observer, its estimate adopted above
-     * 10 % of rated speed with a 20 ms time constant (docs/algorithms.md,
-     * "PM flux from the voltage model"), its correction at a rate set by the
-     * overspeed trip (psi_track.h). */
-    {
-        ctrl_fobs_config_t oc;
-        ctrl_fobs_config_default(&oc, fw->machine);
-        oc.mode = CTRL_FOBS_ENCODER;
-        oc.psi_tau_s = 0.02;
-        oc.psi_speed_min = 0.1;
-        /* its PLL does not run (psi_track.h); within the discrete loop's range */
-        oc.pll_hz = fmin(oc.pll_hz, 0.4 * (double)in->pwm_freq_hz / (4.0 * CTRL_PI));
-        oc.dead_time_s = cfg->dead_time_s;
-        oc.v_fwd_v = cfg->v_fwd_v;
-        const double w_trip =
-            ctrl_rpm_to_elec(fw->speed_info.overspeed_rpm, fw->machine->pole_pairs);
-        if (ctrl_psi_track_init(&fw->psi_track, &fw->params, &fw->bases, &oc, w_trip, &fw->why) !=
-            CTRL_OK) {
-            return FW_EINVAL;
-        }
-        /* The configured value stays while the estimate agrees with it within
-         * 2 %: about its own uncertainty (a 10 % resistance error moves it by
-         * dR i / (w psi_pm), 1.3 % on the thesis SPMSM at 750 r/min and rated
-         * current), and a 2 % torque error at most. */
-        fw->psi_pm_cfg = fw->params.psi_pm;
-        fw->psi_band = fx_mul(fw->params.psi_pm, ctrl_q24_from_double(0.02));
-        fw->psi_engaged = false;
     }
 
     /* Speed loop rate: fs / speed_div, speed_div >= 1 rounded to the nearest. */

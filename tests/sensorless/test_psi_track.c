@@ -9,7 +9,8 @@
 
 #include "../core/machines.h"
 #include "estimator.h"
-#include "psi_track_config.h"
+#include "flux_observer_config.h"
+#include "psi_track.h"
 #include "unity.h"
 
 void setUp(void)
@@ -42,12 +43,15 @@ static void track_config(ctrl_fobs_config_t *c)
     c->mode = CTRL_FOBS_ENCODER;
     c->psi_tau_s = 0.02;
     c->psi_speed_min = 0.1;
+    c->pll_hz = fmin(c->pll_hz, 0.4 * (double)P.fs_hz / (4.0 * PI)); /* as the firmware */
 }
 
-/* The highest electrical speed of the tests: 1.5 x rated. */
-static double w_max_rad_s(void)
+/* The tracker as the firmware sets it up: the observer, then the N periods. */
+static int track_init(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_fobs_config_t *c,
+                      ctrl_diag_t *why)
 {
-    return 1.5 * M.speed_rated_rpm * M.pole_pairs * 2.0 * PI / 60.0;
+    const int rc = ctrl_fobs_init(&t->obs, p, &B, c, why);
+    return rc != CTRL_OK ? rc : ctrl_psi_track_setup(t, p);
 }
 
 /* Leg duties around 1/2 that apply the stator voltage (ua, ub) per unit of
@@ -129,7 +133,7 @@ static double run_track(ctrl_psi_track_t *t, double w, double scale, long n, lon
         const double vb = (pb2 - pb[1]) / ts + rs * 0.5 * (ib[1] + ib2);
         legs_for(va / vdc, vb / vdc, &legs);
     }
-    return d(ctrl_psi_track_psi_pm(t));
+    return d(ctrl_fobs_psi_pm(&t->obs));
 }
 
 /*
@@ -157,8 +161,7 @@ static void test_steady_state_matches_sampled_filter(void)
             ctrl_psi_track_t t;
             ctrl_params_t po = P;
             po.psi_pm = q(scales[b] * d(P.psi_pm));
-            TEST_ASSERT_EQUAL_INT(CTRL_OK,
-                                  ctrl_psi_track_init(&t, &po, &B, &c, w_max_rad_s(), NULL));
+            TEST_ASSERT_EQUAL_INT(CTRL_OK, track_init(&t, &po, &c, NULL));
             const double w = speeds[a] * d(P.speed_rated_e);
             const double ts = d(P.ts);
             /* 0.25 s: the corrector (corner 5 % rated) and the EMA (20 ms) settle */
@@ -166,7 +169,7 @@ static void test_steady_state_matches_sampled_filter(void)
             const double est = run_track(&t, w, scales[b], (long)(0.25 * 10000.0), &moves);
             const double psi_pm = d(P.psi_pm);
             const double dpsi = (scales[b] - 1.0) * psi_pm;
-            const double kn = d(t.k_n);
+            const double kn = d(t.obs.kenc_ts);
             const double x = (double)t.div * w * ts;
             const double rr = cos(x);
             const double ri = -sin(x);
@@ -200,41 +203,48 @@ static void test_speed_gate(void)
     ctrl_fobs_config_t c;
     track_config(&c);
     ctrl_psi_track_t t;
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_psi_track_init(&t, &P, &B, &c, w_max_rad_s(), NULL));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, track_init(&t, &P, &c, NULL));
     long moves = 0;
     const double est = run_track(&t, 0.05 * d(P.speed_rated_e), 1.2, 2000, &moves);
     TEST_ASSERT_EQUAL_INT(0, moves);
     TEST_ASSERT_EQUAL_DOUBLE(d(q(1.2 * d(P.psi_pm))), est);
 }
 
-/* The divider: a quarter turn at the highest speed between two corrections,
- * within [1, CTRL_PSI_TRACK_DIV_MAX]; bad configurations named. */
+/* The divider: at most a quarter turn between two corrections at twice the
+ * rated speed, within [1, CTRL_PSI_TRACK_DIV_MAX]; the gains of N periods;
+ * bad configurations refused. */
 static void test_config(void)
 {
-    M = machine_thesis_spmsm();
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &B, &M, 10000u));
+    const uint32_t fss[3] = {2000u, 10000u, 40000u};
+    for (int f = 0; f < 3; f++) {
+        M = machine_thesis_spmsm();
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&P, &B, &M, fss[f]));
+        ctrl_fobs_config_t c;
+        track_config(&c);
+        ctrl_psi_track_t t;
+        TEST_ASSERT_EQUAL_INT(CTRL_OK, track_init(&t, &P, &c, NULL));
+        const double ts = 1.0 / (double)fss[f];
+        const double w2 = 2.0 * M.speed_rated_rpm * M.pole_pairs * 2.0 * PI / 60.0;
+        const double n = floor(0.5 * PI / (w2 * ts));
+        const unsigned expect = n < 1.0 ? 1u : (n > 8.0 ? 8u : (unsigned)n);
+        printf("fs %u Hz: N %u (expected %u)\n", (unsigned)fss[f], (unsigned)t.div, expect);
+        TEST_ASSERT_EQUAL_UINT(expect, t.div);
+        /* k_N = 1 - (1 - w_c Ts)^N, 1 - exp(-N Ts / tau), within the roundings */
+        TEST_ASSERT_FLOAT_WITHIN(1e-6, 1.0 - pow(1.0 - c.kenc_rad_s * ts, (double)t.div),
+                                 d(t.obs.kenc_ts));
+        TEST_ASSERT_FLOAT_WITHIN(1e-6, 1.0 - exp(-(double)t.div * ts / c.psi_tau_s), d(t.psi_k_n));
+    }
     ctrl_fobs_config_t c;
     track_config(&c);
     ctrl_psi_track_t t;
-    const double ts = 1.0 / 10000.0;
-    const double w_q = 0.5 * PI / ts; /* a quarter turn per period */
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_psi_track_init(&t, &P, &B, &c, w_q / 3.5, NULL));
-    TEST_ASSERT_EQUAL_UINT(3u, t.div);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_psi_track_init(&t, &P, &B, &c, w_q, NULL));
-    TEST_ASSERT_EQUAL_UINT(1u, t.div);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_psi_track_init(&t, &P, &B, &c, 1.0, NULL));
-    TEST_ASSERT_EQUAL_UINT(CTRL_PSI_TRACK_DIV_MAX, t.div);
-    /* k_N = 1 - (1 - w_c Ts)^N */
-    TEST_ASSERT_FLOAT_WITHIN(1e-6, 1.0 - pow(1.0 - c.kenc_rad_s * ts, (double)t.div), d(t.k_n));
     ctrl_diag_t why;
     ctrl_fobs_config_t bad = c;
     bad.psi_tau_s = 1e-6; /* the observer's own checks */
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_psi_track_init(&t, &P, &B, &bad, 1.0, &why));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, track_init(&t, &P, &bad, &why));
     TEST_ASSERT_EQUAL_STRING("psi_tau_s", why.quantity);
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_psi_track_init(&t, &P, &B, &c, 3.0 * w_q, &why));
-    TEST_ASSERT_EQUAL_UINT(1u, t.div);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_psi_track_init(&t, &P, &B, &c, 0.0, &why));
-    TEST_ASSERT_EQUAL_STRING("w_max_rad_s", why.quantity);
+    bad = c;
+    bad.mode = CTRL_FOBS_SENSORLESS;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, track_init(&t, &P, &bad, &why));
 }
 
 int main(void)
