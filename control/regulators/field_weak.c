@@ -4,8 +4,6 @@
  */
 #include "field_weak.h"
 
-#include "mtpa.h"
-
 #define FW_NEWTON_STEPS 3 /* per call of ctrl_fieldweak_currents */
 
 /* Forced inlining of the per-period body into its two entry points (the
@@ -23,7 +21,7 @@ void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
     s->primed = 0u;
     s->t_prev = 0;
     s->psi_d = 0;
-    s->own_valid = 0u;
+    s->own.valid = 0u;
 }
 
 /* floor(sqrt(x)) of a Q48 value >= 0 as Q24 (x < 2^62: the result < 2^31). */
@@ -109,29 +107,6 @@ static int fw_flux_at_least(int64_t x, q24_t w, q24_t b)
     return c < ((uint64_t)1 << 31) && x >= (int64_t)(c * c);
 }
 
-/* The controller's own flux reference of t (ctrl_flux_ref): the fixed one
- * psi_fix (the command, else p->psi_ref) if > 0, else MTPA (4.15) of t,
- * recomputed only when an input moved (the torque at the speed loop's rate
- * or on a command, psi_pm with the PM-flux tracking; the MTPA table is fixed
- * between resets). */
-static FW_ALWAYS_INLINE q24_t fw_flux_own(ctrl_fieldweak_t *s, const ctrl_params_t *p,
-                                          q24_t psi_fix, q24_t t)
-{
-    if (psi_fix > 0) {
-        return psi_fix;
-    }
-    if (s->own_valid == 0u || t != s->own_t || p != s->own_p || p->psi_pm != s->own_psi_pm ||
-        p->mtpa_k != s->own_mtpa_k) {
-        s->own_psi = ctrl_mtpa_psi(p, t);
-        s->own_t = t;
-        s->own_p = p;
-        s->own_psi_pm = p->psi_pm;
-        s->own_mtpa_k = p->mtpa_k;
-        s->own_valid = 1u;
-    }
-    return s->own_psi;
-}
-
 static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
                                      q24_t omega, q24_t t_req, q24_t psi_cmd,
                                      ctrl_fieldweak_out_t *out, int lazy)
@@ -160,7 +135,8 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
          * psi_max is; if it is also >= the flux reference of the clamped
          * torque, neither the reference nor "weakening" depends on it. */
         const q24_t t = fx_clamp(t_req, fx_neg(s->t_mtpa), s->t_mtpa);
-        const q24_t psi_own = fw_flux_own(s, p, 0, t);
+        /* psi_fix <= 0: ctrl_flux_ref is the MTPA flux of t */
+        const q24_t psi_own = ctrl_flux_ref_memo(&s->own, p, psi_cmd, t);
         if (psi_own <= s->psi_mtpa || (psi_own <= s->psi_ceil && fw_flux_at_least(x, w, psi_own))) {
             out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
             out->torque_max = s->t_mtpa;
@@ -194,7 +170,7 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
         }
     }
     const q24_t t = fx_clamp(t_req, fx_neg(t_lim), t_lim);
-    const q24_t psi_own = fw_flux_own(s, p, psi_fix, t);
+    const q24_t psi_own = ctrl_flux_ref_memo(&s->own, p, psi_cmd, t);
     out->torque_max = t_lim;
     out->torque = t;
     out->psi_ref = fx_min(psi_own, psi_max);

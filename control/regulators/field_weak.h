@@ -51,6 +51,7 @@
 
 #include "ctrl_params.h"
 #include "fx.h"
+#include "mtpa.h"
 
 /* What bounds the torque at this speed and DC link. */
 typedef enum {
@@ -82,16 +83,12 @@ typedef struct {
     q24_t t_margin; /* fraction of the MTPV torque allowed, Q24 in (0, 1] */
     q24_t vdc_k;    /* DC-link EMA coefficient per period, Q24 */
     /* state */
-    int64_t vdc_acc; /* filtered DC link, Q48 */
-    uint8_t primed;  /* vdc_acc holds a sample */
-    q24_t t_prev;    /* torque reference of the previous period (the Rs term) */
-    q24_t psi_d;     /* ctrl_fieldweak_currents: psi_d of the last solution */
-    q24_t vdc_r;     /* vdc_acc rounded to Q24 (saturated), as of the last period */
-    /* the MTPA flux reference (4.15) of the last clamped torque, and the
-       inputs it was computed from */
-    const ctrl_params_t *own_p;
-    q24_t own_psi, own_t, own_psi_pm, own_mtpa_k;
-    uint8_t own_valid;
+    int64_t vdc_acc;      /* filtered DC link, Q48 */
+    uint8_t primed;       /* vdc_acc holds a sample */
+    q24_t t_prev;         /* torque reference of the previous period (the Rs term) */
+    q24_t psi_d;          /* ctrl_fieldweak_currents: psi_d of the last solution */
+    q24_t vdc_r;          /* vdc_acc rounded to Q24 (saturated), as of the last period */
+    ctrl_flux_memo_t own; /* the controller's flux reference of the last clamped torque */
 } ctrl_fieldweak_t;
 
 typedef struct {
