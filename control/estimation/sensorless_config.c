@@ -161,9 +161,10 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
     if (sl_ia_init(&n, p, b, c, why) != CTRL_OK) {
         return CTRL_EINVAL;
     }
-    double th = fmod(c->theta0_rad, CTRL_TWO_PI);
-    if (th < 0.0) {
-        th += CTRL_TWO_PI;
+    /* into [0, 2 pi) by floor (not fmod: its 0.75 KB do not fit the board's image) */
+    double th = c->theta0_rad - CTRL_TWO_PI * floor(c->theta0_rad / CTRL_TWO_PI);
+    if (th >= CTRL_TWO_PI) {
+        th -= CTRL_TWO_PI;
     }
     n.theta0 =
         (fx_angle_t)(uint32_t)fmin(floor(th / CTRL_TWO_PI * 4294967296.0 + 0.5), 4294967295.0);

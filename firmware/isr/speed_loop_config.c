@@ -62,7 +62,9 @@ int fw_speed_loop_design(fw_speed_design_t *d, const ctrl_machine_t *m, double l
                               pm, 90.0 - atan(FW_SPEED_ZERO_RATIO) / FW_SL_DEG);
         }
     }
-    const double wz = wc * tan((90.0 - pm) * FW_SL_DEG - wc * td);
+    /* tan as sin / cos: libm's tan would add 1 KB to the board's image */
+    const double phi = (90.0 - pm) * FW_SL_DEG - wc * td;
+    const double wz = wc * sin(phi) / cos(phi);
     const double kp = m->inertia_kgm2 * wc / sqrt(1.0 + (wz / wc) * (wz / wc));
     d->bandwidth_hz = wc / (2.0 * CTRL_PI);
     d->phase_margin_deg = pm;
