@@ -112,16 +112,9 @@ static q24_t drr_ratio01(int64_t num, int64_t den)
     /* 0 <= n <= d (rounding keeps the order), 2^25 <= d <= 2^26 */
     const uint32_t ud = (uint32_t)d;
     uint32_t r = (uint32_t)n;
-    uint32_t q = 0u;
-    for (unsigned k = 0u; k < 4u; k++) {
-        r <<= 6;
-        const uint32_t digit = r / ud;
-        r -= digit * ud;
-        q = (q << 6) + digit;
-    }
-    if (r >= ud - r) {
-        q++; /* remainder >= d/2: round half up (fx_div's rounding for n, d > 0) */
-    }
+    /* remainder >= d/2: round half up (fx_div's rounding for n, d > 0) */
+    uint32_t q = fx_udiv_digits(0u, &r, ud, 6u, 4u);
+    q = fx_udiv_round(q, r, ud);
     return q > (uint32_t)FX_ONE ? FX_ONE : (q24_t)q;
 }
 

@@ -85,13 +85,8 @@ q24_t fx_div(q24_t num, q24_t den)
         if (q >= ((uint32_t)1 << (31u - FX_QBITS))) {
             return neg ? FX_MIN : FX_MAX;
         }
-        for (int k = 0; k < 3; k++) {
-            r <<= 8;
-            const uint32_t dgt = r / ad;
-            r -= dgt * ad;
-            q = (q << 8) | dgt;
-        }
-        q += r >= ad - (ad >> 1) ? 1u : 0u;
+        q = fx_udiv_digits(q, &r, ad, 8u, 3u);
+        q = fx_udiv_round(q, r, ad);
         if (q > (uint32_t)INT32_MAX) {
             return neg ? FX_MIN : FX_MAX;
         }

@@ -48,14 +48,8 @@ static const uint32_t fx_atan_tab[FX_ATAN_N + 1u] = {
 static uint32_t fx_ratio24(uint32_t n, uint32_t d)
 {
     uint32_t r = n;
-    uint32_t q = 0u;
-    for (unsigned k = 0u; k < 3u; k++) {
-        r <<= 8;
-        const uint32_t digit = r / d;
-        r -= digit * d;
-        q = (q << 8) + digit;
-    }
-    return r >= d - r ? q + 1u : q; /* remainder >= d/2: round up */
+    const uint32_t q = fx_udiv_digits(0u, &r, d, 8u, 3u);
+    return fx_udiv_round(q, r, d);
 }
 
 /* Number of significant bits of a non-zero value. */

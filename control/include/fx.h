@@ -100,6 +100,34 @@ static inline int32_t fx_lshift_sat(int32_t x, unsigned n)
     return fx_sat32((int64_t)x * ((int64_t)1 << n));
 }
 
+/* Unsigned long division continued by `steps` digits of `bits` bits, each by
+ * one 32-bit division (no 64-bit library division on the Cortex-M): with the
+ * remainder *r <= d < 2^(32 - bits) on entry every shifted remainder fits 32
+ * bits. Returns q 2^(bits steps) + floor(*r 2^(bits steps) / d) and leaves the
+ * new remainder in *r. */
+static inline uint32_t fx_udiv_digits(uint32_t q, uint32_t *r, uint32_t d, unsigned bits,
+                                      unsigned steps)
+{
+    uint32_t rem = *r;
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 4 /* as written out by hand: the digits are few and per period */
+#endif
+    for (unsigned k = 0u; k < steps; k++) {
+        rem <<= bits;
+        const uint32_t digit = rem / d;
+        rem -= digit * d;
+        q = (q << bits) + digit;
+    }
+    *r = rem;
+    return q;
+}
+
+/* A quotient q with remainder r < d rounded half up: q + 1 when r >= d / 2. */
+static inline uint32_t fx_udiv_round(uint32_t q, uint32_t r, uint32_t d)
+{
+    return r >= d - r ? q + 1u : q;
+}
+
 /* a + b saturated. Two's-complement sum of the unsigned images (well defined);
  * it overflowed exactly when a and b have the same sign and the sum another
  * gcc/clang: their overflow builtin, ADDS + a branch on V). */

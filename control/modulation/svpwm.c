@@ -39,15 +39,9 @@ q24_t ctrl_svpwm_inv_vdc(q24_t vdc)
         q++;
         r = 0u;
     }
-    static const unsigned digits[3] = {6u, 6u, 4u};
-    for (unsigned k = 0u; k < 3u; k++) {
-        r <<= digits[k];
-        const uint32_t g = r / d;
-        r -= g * d;
-        q = (q << digits[k]) + g;
-    }
-    /* rounded as fx_div: + 1 when r + floor(d / 2) >= d */
-    return (q24_t)(r >= d - d / 2u ? q + 1u : q);
+    q = fx_udiv_digits(q, &r, d, 6u, 2u);
+    q = fx_udiv_digits(q, &r, d, 4u, 1u);
+    return (q24_t)fx_udiv_round(q, r, d); /* rounded as fx_div */
 }
 
 /* Leg duties from the phase voltages, their max and min and vdc > 0. */

@@ -133,19 +133,9 @@ q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d)
         n >>= 1;
     }
     /* Long division in three 8-bit digits: q = n 2^24 / d. */
-    uint32_t r = n << 8;
-    const uint32_t q1 = r / d;
-    r -= q1 * d;
-    r <<= 8;
-    const uint32_t q2 = r / d;
-    r -= q2 * d;
-    r <<= 8;
-    const uint32_t q3 = r / d;
-    r -= q3 * d;
-    uint32_t q = (q1 << 16) + (q2 << 8) + q3;
-    if (r >= d - r) {
-        q++; /* round to nearest: remainder >= d/2 */
-    }
+    uint32_t r = n;
+    uint32_t q = fx_udiv_digits(0u, &r, d, 8u, 3u);
+    q = fx_udiv_round(q, r, d);
     return q > (uint32_t)FX_ONE ? FX_ONE : (q24_t)q;
 }
 
