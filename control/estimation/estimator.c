@@ -105,6 +105,9 @@ static void estimator_options(unsigned outputs, q24_t hd, q24_t hq, ctrl_estimat
  * in [0, 64 pu). */
 #define EST_VDC_LIM ((q24_t)1 << 30) /* 64 pu */
 #define EST_PSI_LIM ((q24_t)1 << 30) /* 64 pu */
+/* the limits as the bit widths of their SSAT (FX_SAT below) */
+_Static_assert(CTRL_EST_I_LIM == (q24_t)1 << (30 - 1), "FX_SAT(i, 30)");
+_Static_assert(EST_PSI_LIM == (q24_t)1 << (31 - 1), "FX_SAT(psi', 31)");
 
 void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ctrl_meas_t *m,
                            const ctrl_legs_t *applied, ctrl_estimate_t *est)
@@ -113,8 +116,8 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     ctrl_mstate_t *nx = &est->next;
     /* Clarke (3.3): beta = (a + 2 b)/sqrt(3); |a|, |b| <= 2^29: |beta| <= 55.5 pu,
      * the products < 2^60, no saturation. */
-    const q24_t i_a = fx_clamp(m->i_a, -CTRL_EST_I_LIM, CTRL_EST_I_LIM - 1); /* one SSAT */
-    const q24_t i_b = fx_clamp(m->i_b, -CTRL_EST_I_LIM, CTRL_EST_I_LIM - 1);
+    const q24_t i_a = FX_SAT(m->i_a, 30); /* [-CTRL_EST_I_LIM, CTRL_EST_I_LIM) */
+    const q24_t i_b = FX_SAT(m->i_b, 30);
     const q24_t i_alpha = i_a;
     const q24_t i_beta =
         fx_round_nosat((int64_t)i_a * FX_Q30_INV_SQRT3 + (int64_t)i_b * FX_Q30_2_SQRT3, 30u);
@@ -198,8 +201,8 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
      * +-64 pu (EST_PSI_LIM; twice the flux the core's range allows at
      * current_max): the turned flux and its stator-frame image stay below
      * 91 pu, no saturation. */
-    hd = fx_clamp(hd, -EST_PSI_LIM, EST_PSI_LIM - 1);
-    hq = fx_clamp(hq, -EST_PSI_LIM, EST_PSI_LIM - 1);
+    hd = FX_SAT(hd, 31); /* [-EST_PSI_LIM, EST_PSI_LIM) */
+    hq = FX_SAT(hq, 31);
     const q24_t psi1_d = fx_round_nosat((int64_t)hd * rc + (int64_t)hq * rs, 30u);
     const q24_t psi1_q = fx_round_nosat((int64_t)hq * rc - (int64_t)hd * rs, 30u);
     const q24_t i1_d = fx_mul(fx_sub(psi1_d, p->psi_pm), p->inv_ld);
