@@ -146,29 +146,41 @@ static inline void ctrl_mpc_out_zero(ctrl_out_t *out, uint8_t *last_vec)
 }
 
 /* n / d as a Q24 fraction for 0 <= n <= d, d > 0, rounded (<= FX_ONE). Three
- * 32-bit divisions (one UDIV each on a Cortex-M4), no 64-bit division. */
-q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d);
+ * 32-bit divisions (one UDIV each on a Cortex-M4), no 64-bit division; inline
+ * (one call site per step). */
+static inline q24_t ctrl_mpc_ratio(uint32_t n, uint32_t d)
+{
+    if (d == 0u || n >= d) {
+        return FX_ONE;
+    }
+    /* Keep d below 2^24 so that r * 2^8 < 2^32 below (never taken for
+     * realistic torque deviations, which are far below 1 pu = 2^24). */
+    while (d >= ((uint32_t)1 << 24)) {
+        d >>= 1;
+        n >>= 1;
+    }
+    /* Long division in three 8-bit digits: q = n 2^24 / d, n < d. Then
+     * q < 2^24 and the rounded q <= 2^24 = FX_ONE: no clamp. */
+    uint32_t r = n;
+    const uint32_t q = fx_udiv_digits(0u, &r, d, 8u, 3u);
+    return (q24_t)fx_udiv_round(q, r, d);
+}
 
 /* num / den clamped to [0, FX_ONE] (duty of (5.18)); den == 0 gives FX_ONE for
- * num > 0, else 0. */
-q24_t ctrl_mpc_duty_sat(q24_t num, q24_t den);
-
-/* -1 when |r - a| < |r - b|, +1 when greater, 0 when equal, for amplitudes
- * a, b >= 0 and reference r >= 0 given by their squares (Q24 pu^2 as returned
- * by ctrl_mpc_amp2, r2 <= 16 pu^2). Exact integer test of
- * sign((a - b)(a + b - 2r)) = sign(|r - a| - |r - b|): no square root. */
-int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2);
-
-/* Weighted cost (6.13) of a candidate: the active vector with Ts V = (vd, vq)
- * on for duty, the zero vector the rest: |T_ref - Te(k+2)| + zeta |psi_ref - |psi(k+2)||,
- * Q24 pu (64-bit, no overflow); the amplitude needs one fx_mag (square
- * root). INT64_MAX instead when the torque term alone is at least bound:
- * the flux term is >= 0 (zeta >= 0), so that cost is not below bound and a
- * search that keeps the strictly smallest cost (bound = the best so far)
- * decides exactly as with the full cost, without the square root. */
-int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b, q24_t vd,
-                               q24_t vq, q24_t duty, q24_t t_ref, q24_t psi_ref, q24_t zeta,
-                               int64_t bound);
+ * num > 0, else 0. Inline: per candidate of the six-vector searches. */
+static inline q24_t ctrl_mpc_duty_sat(q24_t num, q24_t den)
+{
+    if (den == 0) {
+        return num > 0 ? FX_ONE : 0;
+    }
+    if (num == 0 || (num < 0) != (den < 0)) {
+        return 0; /* num / den <= 0 */
+    }
+    /* Magnitudes as uint32_t (exact also for INT32_MIN); n >= d gives FX_ONE. */
+    const uint32_t n = num < 0 ? 0u - (uint32_t)num : (uint32_t)num;
+    const uint32_t d = den < 0 ? 0u - (uint32_t)den : (uint32_t)den;
+    return ctrl_mpc_ratio(n, d);
+}
 
 /* ---- bounded fast arithmetic of the k+2 model ----
  * With the ranges of ctrl_mpc_basis_t and the model limits every product
@@ -205,13 +217,37 @@ static inline q24_t ctrl_mpc_torque(const ctrl_mpc_model_t *m, q24_t psi_d, q24_
     return fx_mul(psi_q, m->a + fx_mul_nosat(m->b, psi_d));
 }
 
-/* |psi|^2 in Q24 pu^2, rounded, clamped to [0, 64 pu^2] (|psi| <= 8 pu, far
- * beyond any reachable flux; the clamp keeps ctrl_mpc_closer's products in range). */
+/* Ceiling of ctrl_mpc_amp2: 64 pu^2 in Q24. */
+#define CTRL_MPC_AMP2_MAX ((int32_t)1 << 30)
+
+/* |psi|^2 in Q24 pu^2, rounded, clamped to [0, CTRL_MPC_AMP2_MAX] (|psi| <= 8 pu,
+ * far beyond any reachable flux; the clamp keeps ctrl_mpc_closer's products in range). */
 static inline int32_t ctrl_mpc_amp2(q24_t psi_d, q24_t psi_q)
 {
     const uint64_t sq = (uint64_t)((int64_t)psi_d * psi_d) + (uint64_t)((int64_t)psi_q * psi_q);
     const uint64_t a2 = (sq + ((uint64_t)1 << 23)) >> 24;
-    return a2 > ((uint64_t)1 << 30) ? (int32_t)1 << 30 : (int32_t)a2;
+    return a2 > (uint64_t)CTRL_MPC_AMP2_MAX ? CTRL_MPC_AMP2_MAX : (int32_t)a2;
+}
+
+/* -1 when |r - a| < |r - b|, +1 when greater, 0 when equal, for amplitudes
+ * a, b >= 0 and reference r >= 0 given by their squares, Q24 pu^2 as
+ * ctrl_mpc_amp2 returns them: a2, b2 in [0, CTRL_MPC_AMP2_MAX], r2 >= 0 (taken
+ * at most 16 pu^2). Exact integer test of sign((a - b)(a + b - 2r)) =
+ * sign(|r - a| - |r - b|): no square root. a + b > 2r <=> A + B + 2 sqrt(AB)
+ * > 4R <=> S = 4R - A - B < 0 or 4AB > S^2; with these ranges S lies in
+ * [-2^31, 2^30] (an int32_t) and 4AB = (2A)(2B) <= 2^62, S^2 <= 2^60 are
+ * unsigned 32x32->64 products (one UMULL each on a Cortex-M4). */
+static inline int ctrl_mpc_closer(int32_t a2, int32_t b2, int32_t r2)
+{
+    const int32_t r = r2 < ((int32_t)1 << 28) ? r2 : ((int32_t)1 << 28); /* r <= 4 pu */
+    const int sab = (a2 > b2) - (a2 < b2);                               /* sign(a - b) */
+    const int32_t sum = 4 * r - a2 - b2;
+    if (sab == 0 || sum < 0) {
+        return sab; /* sign(a + b - 2r) = +1 when S < 0 */
+    }
+    const uint64_t lhs = (uint64_t)(2u * (uint32_t)a2) * (2u * (uint32_t)b2);
+    const uint64_t rhs = (uint64_t)(uint32_t)sum * (uint32_t)sum;
+    return lhs > rhs ? sab : (lhs < rhs ? -sab : 0);
 }
 
 /* Flux of a candidate: psi0 + D Ts V, rotor frame, for 0 <= duty <= FX_ONE
@@ -221,6 +257,38 @@ static inline void ctrl_mpc_flux(const ctrl_mpc_basis_t *b, q24_t vd, q24_t vq, 
 {
     *psi_d = b->d0 + fx_mul_nosat(duty, vd);
     *psi_q = b->q0 + fx_mul_nosat(duty, vq);
+}
+
+/* Weighted cost (6.13) of a candidate whose flux psi(k+2) = (pd, pq) and
+ * torque te = Te(k+2) are known: |T_ref - te| + zeta |psi_ref - |psi||, Q24 pu
+ * (64-bit, no overflow); the amplitude needs one fx_mag (square root).
+ * INT64_MAX instead when the torque term alone is at least bound: the flux
+ * term is >= 0 (zeta >= 0), so that cost is not below bound and a search
+ * that keeps the strictly smallest cost (bound = the best so far) decides
+ * exactly as with the full cost, without the square root. */
+static inline int64_t ctrl_mpc_cost_at(q24_t pd, q24_t pq, q24_t te, q24_t t_ref, q24_t psi_ref,
+                                       q24_t zeta, int64_t bound)
+{
+    const int64_t e_t = (int64_t)t_ref - te;
+    const int64_t g_t = e_t < 0 ? -e_t : e_t;
+    if (g_t >= bound) {
+        return INT64_MAX; /* g_t + zeta e_psi >= bound: no square root needed */
+    }
+    const q24_t e_psi = fx_abs(fx_sub(psi_ref, fx_mag(pd, pq)));
+    return g_t + fx_mul(zeta, e_psi);
+}
+
+/* ctrl_mpc_cost_at of a candidate: the active vector with Ts V = (vd, vq) on
+ * for duty, the zero vector the rest (flux ctrl_mpc_flux, torque
+ * ctrl_mpc_torque). Inline: per candidate of the searches. */
+static inline int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b,
+                                             q24_t vd, q24_t vq, q24_t duty, q24_t t_ref,
+                                             q24_t psi_ref, q24_t zeta, int64_t bound)
+{
+    q24_t pd;
+    q24_t pq;
+    ctrl_mpc_flux(b, vd, vq, duty, &pd, &pq);
+    return ctrl_mpc_cost_at(pd, pq, ctrl_mpc_torque(m, pd, pq), t_ref, psi_ref, zeta, bound);
 }
 
 #endif /* CONTROL_CTRL_M2PTFC_MODEL_H */

@@ -231,6 +231,43 @@ static void test_closer_matches_sqrt(void)
     TEST_ASSERT_EQUAL_INT(0, ctrl_mpc_closer(FX_ONE, FX_ONE, FX_ONE));
 }
 
+/* sign((a - b)(a + b - 2r)) on squares in 64-bit arithmetic: the oracle of
+ * ctrl_mpc_closer's 32-bit form (r2 taken at most 2^28, 16 pu^2). */
+static int closer_oracle(int32_t a2, int32_t b2, int32_t r2)
+{
+    const int64_t r = r2 < ((int32_t)1 << 28) ? r2 : ((int32_t)1 << 28);
+    const int sab = (a2 > b2) - (a2 < b2);
+    const int64_t sum = 4 * r - (int64_t)a2 - (int64_t)b2;
+    if (sab == 0 || sum < 0) {
+        return sab;
+    }
+    const int64_t lhs = 4 * (int64_t)a2 * (int64_t)b2;
+    const int64_t rhs = sum * sum;
+    return sab * ((lhs > rhs) - (lhs < rhs));
+}
+
+static void test_closer_full_range(void)
+{
+    /* Every input range ctrl_mpc_amp2 can give, including its ceiling, and
+     * near-ties (the products equal or one apart). */
+    const int32_t top = CTRL_MPC_AMP2_MAX;
+    for (int i = 0; i < 20000; i++) {
+        int32_t a2 = (int32_t)(rng_u32() % ((uint32_t)top + 1u));
+        int32_t b2 = (int32_t)(rng_u32() % ((uint32_t)top + 1u));
+        const int32_t r2 = (int32_t)(rng_u32() % ((uint32_t)top + 1u));
+        if (i % 4 == 1) { /* the scale of real fluxes: near r */
+            a2 = r2 / 2 + (int32_t)(rng_u32() % 64u);
+            b2 = r2 + r2 / 2 - a2 + (int32_t)(rng_u32() % 3u) - 1; /* a + b ~ 2r */
+            b2 = b2 < 0 ? 0 : (b2 > top ? top : b2);
+        }
+        TEST_ASSERT_EQUAL_INT(closer_oracle(a2, b2, r2), ctrl_mpc_closer(a2, b2, r2));
+    }
+    /* a + b = 2r exactly: A = 1, B = 9, R = 4 (1 + 3 = 2 * 2). */
+    TEST_ASSERT_EQUAL_INT(0, ctrl_mpc_closer(1, 9, 4));
+    TEST_ASSERT_EQUAL_INT(closer_oracle(top, top - 1, top), ctrl_mpc_closer(top, top - 1, top));
+    TEST_ASSERT_EQUAL_INT(closer_oracle(top, 0, 0), ctrl_mpc_closer(top, 0, 0));
+}
+
 /* ------------------------------------------------------- brute force */
 
 /* centre: the tunable (1: Te_c = Te(k+1) + dT0/2 in (6.5), (6.7), (6.8), the
@@ -807,6 +844,7 @@ int main(void)
     RUN_TEST(test_t_eval);
     RUN_TEST(test_psi_ref2);
     RUN_TEST(test_basis3_equals_basis);
+    RUN_TEST(test_closer_full_range);
     RUN_TEST(test_m2ptfc_psi2_cache);
     return UNITY_END();
 }
