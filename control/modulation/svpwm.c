@@ -44,20 +44,34 @@ q24_t ctrl_svpwm_inv_vdc(q24_t vdc)
     return (q24_t)fx_udiv_round(q, r, d); /* rounded as fx_div */
 }
 
-/* Leg duties from the phase voltages, their max and min and vdc > 0. */
+/* Leg duties from the phase voltages, their max and min and 0 < vdc < 2^30
+ * (64 pu, svpwm_vdc). */
 static void svpwm_legs(const q24_t ph[3], q24_t mx, q24_t mn, q24_t vdc, ctrl_legs_t *legs)
 {
     const q24_t inv_vdc = ctrl_svpwm_inv_vdc(vdc); /* Q24, one division per period */
     for (unsigned x = 0u; x < 3u; x++) {
-        /* d_x = 1/2 + (2 v_x - max - min) / (2 Vdc). The difference is clamped
-         * to 2^30 (64 pu: beyond any hexagon) so that times |inv_vdc| < 2^31 the
-         * product stays below 2^61. */
-        int64_t diff = 2 * (int64_t)ph[x] - mx - mn;
-        const int64_t lim = (int64_t)1 << 30;
-        diff = diff > lim ? lim : (diff < -lim ? -lim : diff);
-        const int64_t d = fx_rshift64_round(diff * inv_vdc, FX_QBITS + 1u) + FX_ONE / 2;
-        legs->duty[x] = (q24_t)(d < 0 ? 0 : (d > FX_ONE ? FX_ONE : d));
+        /* d_x = 1/2 + (2 v_x - max - min) / (2 Vdc), the difference as
+         * (v_x - max) + (v_x - min): terms of opposite signs, each saturated,
+         * so the sum cannot overflow. Inside the hexagon (after the limit)
+         * neither saturates: span = max - min <= 1.19 vdc + 4 < 2^31 (the
+         * limit scales by vdc / span, rounding adds at most 4 LSB, 1.19
+         * bounds what saturated phases under-report). Where |diff| > 2^30 the
+         * duty is at 0 or 1 either way (inv_vdc >= 2^18 for vdc < 2^30), as
+         * with the clamp of diff to 2^30 this replaced. */
+        const int32_t diff = fx_sub(ph[x], mx) + fx_sub(ph[x], mn);
+        /* |diff inv_vdc| < 2^62: rounded to Q24 and saturated, then the duty
+         * taken in [0, 1]. */
+        const q24_t half = FX_ONE / 2;
+        const q24_t dv = fx_round_sat((int64_t)diff * inv_vdc, FX_QBITS + 1u);
+        legs->duty[x] = fx_clamp(dv, -half, half) + half;
     }
+}
+
+/* The DC link taken below 64 pu (2^30, as the estimator takes it): keeps
+ * the duties' 32-bit argument above. */
+static q24_t svpwm_vdc(q24_t vdc)
+{
+    return vdc < ((q24_t)1 << 30) ? vdc : ((q24_t)1 << 30) - 1;
 }
 
 static void svpwm_legs_off(ctrl_legs_t *legs)
@@ -74,6 +88,7 @@ uint8_t ctrl_svpwm_limit(q24_t vdc, q24_t *v_alpha, q24_t *v_beta)
         *v_beta = 0;
         return 1u;
     }
+    vdc = svpwm_vdc(vdc);
     q24_t ph[3];
     q24_t mx;
     q24_t mn;
@@ -96,7 +111,7 @@ void ctrl_svpwm_duties(q24_t v_alpha, q24_t v_beta, q24_t vdc, ctrl_legs_t *legs
     q24_t mx;
     q24_t mn;
     svpwm_phases(v_alpha, v_beta, ph, &mx, &mn);
-    svpwm_legs(ph, mx, mn, vdc, legs);
+    svpwm_legs(ph, mx, mn, svpwm_vdc(vdc), legs);
 }
 
 uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs)
@@ -109,6 +124,7 @@ uint8_t ctrl_svpwm(q24_t *v_alpha, q24_t *v_beta, q24_t vdc, ctrl_legs_t *legs)
         svpwm_legs_off(legs);
         return 1u;
     }
+    vdc = svpwm_vdc(vdc);
     q24_t ph[3];
     q24_t mx;
     q24_t mn;
