@@ -13,6 +13,14 @@
 #define K_TAN6_Q30 112854813
 #define K_TAN18_Q30 348879867
 
+/* Vector nr + a for nr in 1..6 and |a| <= 2: ctrl_vec_wrap on that range,
+ * one compare each way instead of a division. */
+static uint8_t hpdtc_vec_step(int nr, int a)
+{
+    const int k = nr + a;
+    return (uint8_t)(k > 6 ? k - 6 : (k < 1 ? k + 6 : k));
+}
+
 int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2)
 {
     const int inc_phi = phi != 0;
@@ -34,8 +42,8 @@ int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2)
     }
     /* Reduce n first so that n + a cannot overflow; the wrap of Table 4. */
     const int nr = (int)ctrl_vec_wrap(n);
-    *k1 = ctrl_vec_wrap(nr + a);
-    *k2 = ctrl_vec_wrap(nr + b);
+    *k1 = hpdtc_vec_step(nr, a);
+    *k2 = hpdtc_vec_step(nr, b);
     return inc_phi == inc_tau ? 1 : -1;
 }
 
@@ -44,26 +52,27 @@ int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n)
     const unsigned i = (n >= 1u && n <= 6u) ? (unsigned)n : 1u;
     /* Rotate by -(n-1) 60 deg: the sector centre onto the x axis. V_n / Vdc
      * (Q30, magnitude 2/3) serves as the rotation: the comparisons below are
-     * of y against x tan(b) and do not see the common scale (Q54 sums < 2^62). */
+     * of y against x tan(b) and do not see the common scale. */
     const int32_t c = ctrl_vec_ab_q30[i][0];
     const int32_t sn = ctrl_vec_ab_q30[i][1];
-    const int64_t x = (int64_t)psi_alpha * c + (int64_t)psi_beta * sn;
-    const int64_t y = (int64_t)psi_beta * c - (int64_t)psi_alpha * sn;
-    /* Compare y with x tan(b) in Q24 * Q30 (values back to Q24 first). */
-    const int64_t xq = fx_rshift64_round(x, 30u);
-    const int64_t yq = fx_rshift64_round(y, 30u) * ((int64_t)1 << 30);
-    const int64_t b6 = xq * K_TAN6_Q30;
-    const int64_t b18 = xq * K_TAN18_Q30;
-    if (yq >= b18) {
+    /* Back in Q24 (rounded): |(c, sn)| = 2/3 and |psi| <= sqrt(2) 2^31, so
+     * |x|, |y| <= 0.943 2^61 and the values fit an int32_t unsaturated. */
+    const int32_t x24 = fx_round_nosat((int64_t)psi_alpha * c + (int64_t)psi_beta * sn, 30u);
+    const int32_t y24 = fx_round_nosat((int64_t)psi_beta * c - (int64_t)psi_alpha * sn, 30u);
+    /* Compare y with x tan(b) in Q24 * Q30 (one SMULL each). */
+    const int64_t y54 = (int64_t)y24 * ((int64_t)1 << 30);
+    const int64_t b6 = (int64_t)x24 * K_TAN6_Q30;
+    const int64_t b18 = (int64_t)x24 * K_TAN18_Q30;
+    if (y54 >= b18) {
         return 2;
     }
-    if (yq >= b6) {
+    if (y54 >= b6) {
         return 1;
     }
-    if (yq >= -b6) {
+    if (y54 >= -b6) {
         return 0;
     }
-    if (yq >= -b18) {
+    if (y54 >= -b18) {
         return -1;
     }
     return -2;

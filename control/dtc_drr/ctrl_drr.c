@@ -100,18 +100,20 @@ static q24_t drr_ratio01(int64_t num, int64_t den)
         return FX_ONE;
     }
     const unsigned bl = drr_bitlen((uint64_t)den);
-    int64_t n;
-    int64_t d;
+    uint32_t ud;
+    uint32_t r;
     if (bl > 26u) {
-        n = fx_rshift64_round(num, bl - 26u);
-        d = fx_rshift64_round(den, bl - 26u);
+        /* Both positive: rounded half up by an unsigned shift (the value of
+         * fx_rshift64_round), and the results below 2^27 are their low words. */
+        const unsigned sh = bl - 26u;
+        const uint64_t half = (uint64_t)1 << (sh - 1u);
+        r = (uint32_t)(((uint64_t)num + half) >> sh);
+        ud = (uint32_t)(((uint64_t)den + half) >> sh);
     } else {
-        n = num * ((int64_t)1 << (26u - bl)); /* num < den < 2^bl: no overflow */
-        d = den * ((int64_t)1 << (26u - bl));
+        r = (uint32_t)num << (26u - bl); /* num < den < 2^bl: below 2^26 */
+        ud = (uint32_t)den << (26u - bl);
     }
-    /* 0 <= n <= d (rounding keeps the order), 2^25 <= d <= 2^26 */
-    const uint32_t ud = (uint32_t)d;
-    uint32_t r = (uint32_t)n;
+    /* 0 <= r <= ud (rounding keeps the order), 2^25 <= ud <= 2^26 */
     /* remainder >= d/2: round half up (fx_div's rounding for n, d > 0) */
     uint32_t q = fx_udiv_digits(0u, &r, ud, 6u, 4u);
     q = fx_udiv_round(q, r, ud);
