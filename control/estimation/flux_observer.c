@@ -173,46 +173,62 @@ static void fobs_pll(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r)
     o->pll_theta += ctrl_angle_step(p, omega_i) + (fx_angle_t)(uint32_t)kpe;
 }
 
+/* The flux moved by the correction (corr_d, corr_q) of the frame (s, c). */
+static void fobs_move(ctrl_fobs_t *o, q24_t corr_d, q24_t corr_q, q24_t s, q24_t c)
+{
+    q24_t ca;
+    q24_t cb;
+    ctrl_inv_park(corr_d, corr_q, s, c, &ca, &cb);
+    o->psi_alpha_acc = fobs_clamp(o->psi_alpha_acc + (int64_t)ca * FX_ONE);
+    o->psi_beta_acc = fobs_clamp(o->psi_beta_acc + (int64_t)cb * FX_ONE);
+}
+
+q24_t ctrl_fobs_pull_encoder(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t s, q24_t c, q24_t i_d,
+                             q24_t i_q)
+{
+    /* The flux at k in the measured frame (Park (3.7)), towards the current
+     * model (3.9) there. */
+    const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
+    const q24_t psi_q = fx_cross(c, s, o->psi_alpha, o->psi_beta);
+    const q24_t ld_id = fx_mul(p->ld, i_d);
+    const q24_t e_d = fx_sub(fx_add(ld_id, p->psi_pm), psi_d);
+    const q24_t e_q = fx_sub(fx_mul(p->lq, i_q), psi_q);
+    fobs_move(o, fx_mul(o->kenc_ts, e_d), fx_mul(o->kenc_ts, e_q), s, c);
+    return fx_sub(psi_d, ld_id);
+}
+
+void ctrl_fobs_psi_pm_step(ctrl_fobs_t *o, q24_t pm, q24_t k)
+{
+    const q24_t out = fobs_q24(o->psi_pm_acc);
+    o->psi_pm_acc += (int64_t)fx_sub(pm, out) * k; /* an EMA of Q24 values */
+}
+
 void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r, q24_t s, q24_t c,
                        q24_t i_d, q24_t i_q)
 {
     if (o->primed == 0u) {
         return;
     }
-    /* The flux at k in the reference frame (Park (3.7)). */
-    const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
-    q24_t corr_d;
-    q24_t corr_q;
+    q24_t pm; /* PM flux psi_d - Ld i_d of the flux at k */
     if (o->mode == CTRL_FOBS_ENCODER) {
-        /* Towards the current model (3.9) at the measured angle. */
-        const q24_t psi_q = fx_cross(c, s, o->psi_alpha, o->psi_beta);
-        const q24_t e_d = fx_sub(fx_add(fx_mul(p->ld, i_d), p->psi_pm), psi_d);
-        const q24_t e_q = fx_sub(fx_mul(p->lq, i_q), psi_q);
-        corr_d = fx_mul(o->kenc_ts, e_d);
-        corr_q = fx_mul(o->kenc_ts, e_q);
+        pm = ctrl_fobs_pull_encoder(o, p, s, c, i_d, i_q);
     } else {
         /* Magnitude of the active flux towards psi_a, along (psi_a, -(Ld - Lq) i_q). */
+        const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
         const q24_t eta_d = fx_dot(c, s, o->eta_alpha, o->eta_beta);
         const q24_t psi_a = fx_add(p->psi_pm, fx_mul(o->dl, i_d));
         const q24_t w = fx_abs(o->omega);
         const q24_t kts = fx_min(fx_add(o->k0_ts, fx_mul(o->kappa_ts, w)), CTRL_FOBS_KTS_MAX);
         const q24_t g = fx_mul(fx_mul(kts, fx_sub(psi_a, eta_d)), p->inv_psi_pm);
-        corr_d = fx_mul(g, psi_a);
-        corr_q = fx_neg(fx_mul(g, fx_mul(o->dl, i_q)));
+        fobs_move(o, fx_mul(g, psi_a), fx_neg(fx_mul(g, fx_mul(o->dl, i_q))), s, c);
+        pm = o->psi_k != 0 ? fx_sub(psi_d, fx_mul(p->ld, i_d)) : 0;
     }
-    q24_t ca;
-    q24_t cb;
-    ctrl_inv_park(corr_d, corr_q, s, c, &ca, &cb);
-    o->psi_alpha_acc = fobs_clamp(o->psi_alpha_acc + (int64_t)ca * FX_ONE);
-    o->psi_beta_acc = fobs_clamp(o->psi_beta_acc + (int64_t)cb * FX_ONE);
 
     fobs_pll(o, p, theta_r);
 
-    /* PM flux psi_d - Ld i_d where the voltage model is reliable. */
+    /* PM flux where the voltage model is reliable. */
     if (o->psi_k != 0 && fx_abs(o->omega) >= o->psi_speed_min) {
-        const q24_t raw = fx_sub(psi_d, fx_mul(p->ld, i_d));
-        const q24_t out = fobs_q24(o->psi_pm_acc);
-        o->psi_pm_acc += (int64_t)fx_sub(raw, out) * o->psi_k; /* an EMA of Q24 values */
+        ctrl_fobs_psi_pm_step(o, pm, o->psi_k);
     }
 }
 

@@ -136,6 +136,17 @@ fx_angle_t ctrl_fobs_integrate(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_a
 void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r, q24_t s, q24_t c,
                        q24_t i_d, q24_t i_q);
 
+/* The encoder-mode correction of ctrl_fobs_correct alone (no PLL, no
+ * PM-flux EMA): the flux at k (psi_alpha/beta) pulled towards the current
+ * model at the measured angle (s, c its sine and cosine, i_d, i_q the current
+ * in that frame). Returns the PM flux psi_d - Ld i_d of the flux at k, the
+ * EMA's input. */
+q24_t ctrl_fobs_pull_encoder(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t s, q24_t c, q24_t i_d,
+                             q24_t i_q);
+
+/* One step of the PM-flux EMA towards pm (Q24 pu) with coefficient k (Q24). */
+void ctrl_fobs_psi_pm_step(ctrl_fobs_t *o, q24_t pm, q24_t k);
+
 /* ctrl_fobs_integrate, fx_sincos of the reference angle (the flux angle, or
  * theta_enc in CTRL_FOBS_ENCODER), Park of i, ctrl_fobs_correct. Returns the
  * flux angle. */

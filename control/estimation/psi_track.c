@@ -8,31 +8,31 @@
 void ctrl_psi_track_reset(ctrl_psi_track_t *t)
 {
     t->obs.primed = 0u;
-    t->vs_scale = 0;
-    t->vs[0] = 0;
-    t->vs[1] = 0;
     t->phase = 0u;
 }
 
 /* Correction towards the current model (3.9) at the measured angle in the
  * estimator's frame at k, and the PM-flux EMA where the voltage model is
  * reliable (the encoder's speed above the threshold): the observer's own
- * (ctrl_fobs_correct, encoder mode, its gains set to the N periods' k_N and
- * 1 - exp(-N Ts / tau), its speed gate left to this function; its PLL turns
- * but is not read). Returns whether the estimate moved. */
-bool ctrl_psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est)
+ * (ctrl_fobs_pull_encoder, ctrl_fobs_psi_pm_step) with the gains of N periods,
+ * k_N and 1 - exp(-N Ts / tau); its PLL is not needed here. Returns whether
+ * the estimate moved. */
+static bool psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                              const ctrl_estimate_t *est)
 {
     ctrl_fobs_t *const o = &t->obs;
     const ctrl_mstate_t *n = &est->now;
     o->psi_alpha = fx_round_sat(o->psi_alpha_acc, FX_QBITS);
     o->psi_beta = fx_round_sat(o->psi_beta_acc, FX_QBITS);
-    const bool gate = fx_abs(est->omega_e) >= t->speed_min;
-    o->psi_k = gate ? t->psi_k_n : 0;
-    ctrl_fobs_correct(o, p, n->theta_e, n->sin_theta, n->cos_theta, n->i_d, n->i_q);
-    return gate && t->psi_k_n != 0;
+    const q24_t pm = ctrl_fobs_pull_encoder(o, p, n->sin_theta, n->cos_theta, n->i_d, n->i_q);
+    if (t->psi_k_n == 0 || fx_abs(est->omega_e) < t->speed_min) {
+        return false;
+    }
+    ctrl_fobs_psi_pm_step(o, pm, t->psi_k_n);
+    return true;
 }
 
-void ctrl_psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est)
+static void psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est)
 {
     /* From the current model at theta(k) (ctrl_fobs_reset's flux, Q48); the
      * correction and the EMA count from here. */
@@ -40,4 +40,50 @@ void ctrl_psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctr
     const ctrl_mstate_t *n = &est->now;
     ctrl_fobs_reset(o, p, n->theta_e, est->omega_e, n->i_alpha, n->i_beta);
     t->phase = (uint8_t)(t->div - 1u);
+}
+
+bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                         const ctrl_legs_t *applied, q24_t i_a, q24_t i_b)
+{
+    ctrl_fobs_t *const o = &t->obs;
+    const ctrl_mstate_t *n = &est->now;
+    /* The estimator's currents (|i_alpha| <= 32 pu, |i_beta| < 56 pu): their
+     * sums fit an int32_t. */
+    const q24_t i_now[2] = {n->i_alpha, n->i_beta};
+    int64_t *const acc[2] = {&o->psi_alpha_acc, &o->psi_beta_acc};
+    if (o->primed != 0u) {
+        /* trunc(Ts Rs s / 2) of the sum s = 2 m + r (m = trunc(s / 2), r in
+         * {-1, 0, 1} with the sign of s) is Ts Rs m + trunc(Ts Rs / 2) r: both
+         * terms have the sign of the product, so the half dropped is the
+         * same; two multiply-accumulates instead of a 64-bit division. */
+        const int32_t ts_rs = p->ts_rs;
+        const int32_t ts_rs_half = ts_rs / 2;
+        for (unsigned x = 0u; x < 2u; x++) {
+            const int32_t i_sum = t->i_prev[x] + i_now[x];
+            const int32_t m = i_sum / 2;
+            *acc[x] -= (int64_t)ts_rs * m + (int64_t)ts_rs_half * (i_sum - 2 * m);
+        }
+    } else {
+        psi_track_prime(t, p, est);
+    }
+    t->i_prev[0] = i_now[0];
+    t->i_prev[1] = i_now[1];
+    const unsigned ph = t->phase;
+    t->phase = (uint8_t)(ph + 1u >= t->div ? 0u : ph + 1u);
+    const bool moved = ph == 0u ? psi_track_correct(t, p, est) : false;
+    /* the voltage of [k, k+1) */
+    if (o->dt_frac == 0 && o->v_fwd == 0) {
+        /* The estimator's duty voltage per unit of DC link: Ts Vdc <= 64 pu,
+         * the product below 2^55 (no saturation). */
+        const q24_t ts_vdc = fx_mul_nosat(p->ts, est->vdc);
+        o->psi_alpha_acc += (int64_t)ts_vdc * est->u_alpha;
+        o->psi_beta_acc += (int64_t)ts_vdc * est->u_beta;
+    } else {
+        q24_t v_alpha;
+        q24_t v_beta;
+        ctrl_fobs_voltage(o, applied, est->vdc, i_a, i_b, &v_alpha, &v_beta);
+        o->psi_alpha_acc += (int64_t)p->ts * v_alpha;
+        o->psi_beta_acc += (int64_t)p->ts * v_beta;
+    }
+    return moved;
 }

@@ -17,7 +17,8 @@
  *                  of the estimator (its sin/cos, i_dq: no table look-up, no
  *                  angle), k_N = 1 - (1 - w_c Ts)^N, the N per-period
  *                  corrections in one, and the EMA with 1 - exp(-N Ts / tau):
- *                  the observer's ctrl_fobs_correct with these gains.
+ *                  the observer's ctrl_fobs_pull_encoder and
+ *                  ctrl_fobs_psi_pm_step with these gains.
  * N is the largest divider (<= CTRL_PSI_TRACK_DIV_MAX) with which the flux
  * turns at most a quarter turn between two corrections at twice the rated
  * speed (beyond the machines' maximum speeds): the rotating current-model error the correction
@@ -47,8 +48,6 @@ typedef struct {
                       * of the period before), the correction (kenc_ts = k_N =
                       * 1 - (1 - w_c Ts)^N, < 1 - 2^-8), the PM-flux EMA (Q48) */
     q24_t i_prev[2]; /* i(k-1) (alpha, beta), Q24 pu */
-    q24_t vs_scale;  /* volt-seconds of the period before, Q48 per axis: */
-    q24_t vs[2];     /* vs_scale x vs[axis], each Q24 */
     q24_t psi_k_n;   /* EMA coefficient per update, Q24: 1 - exp(-N Ts / tau) */
     q24_t speed_min; /* the EMA runs where |omega| >= this, Q24 pu */
     uint8_t div;     /* N: one correction every N periods */
@@ -65,56 +64,20 @@ void ctrl_psi_track_reset(ctrl_psi_track_t *t);
  * encoder mode, no rated speed) with *t unchanged. Configuration time. */
 int ctrl_psi_track_setup(ctrl_psi_track_t *t, const ctrl_params_t *p);
 
-/* Parts of ctrl_psi_track_step out of line: the first period after a reset
- * (the flux from the current model) and the work of period 0 of N (returns
- * whether the PM-flux estimate moved). */
-void ctrl_psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est);
-bool ctrl_psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
-                            const ctrl_estimate_t *est);
-
 /* One period at sample k, after ctrl_estimator_update: est its estimate at k
- * (now.*: i_alpha/beta, sin/cos, i_d/q, psi_d/q, theta_e; omega_e, vdc,
- * u_alpha/beta), applied the leg duties acting in [k, k+1) and i_a, i_b the
- * measured phase currents (Q24 pu; read only with dead-time or drop
- * compensation). Returns true when the PM-flux estimate has moved
- * (ctrl_fobs_psi_pm of t->obs). Inline: what every period does - the voltage
- * model over [k-1, k) (flux_observer.c's fobs_axis, without its clamp,
- * which the correction applies) in the observer's Q48, Ts v - Ts Rs (i(k-1)
- * + i(k)) / 2 (the half truncated: 2^-49 pu per period, bounded by the
- * correction), and the voltage of [k, k+1) kept for the next period. The currents are the
- * estimator's (|i_alpha| <= 32 pu, |i_beta| < 56 pu): their sums fit an
- * int32_t. */
-static inline bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p,
-                                       const ctrl_estimate_t *est, const ctrl_legs_t *applied,
-                                       q24_t i_a, q24_t i_b)
-{
-    ctrl_fobs_t *const o = &t->obs;
-    const ctrl_mstate_t *n = &est->now;
-    const q24_t i_now[2] = {n->i_alpha, n->i_beta};
-    if (o->primed != 0u) {
-        int64_t *const acc[2] = {&o->psi_alpha_acc, &o->psi_beta_acc};
-        for (unsigned x = 0u; x < 2u; x++) {
-            const int32_t i_sum = t->i_prev[x] + i_now[x];
-            *acc[x] += (int64_t)t->vs_scale * t->vs[x] - (int64_t)p->ts_rs * i_sum / 2;
-        }
-    } else {
-        ctrl_psi_track_prime(t, p, est);
-    }
-    t->i_prev[0] = i_now[0];
-    t->i_prev[1] = i_now[1];
-    if (o->dt_frac == 0 && o->v_fwd == 0) {
-        /* The estimator's duty voltage per unit of DC link: Ts Vdc <= 64 pu,
-         * the product below 2^55 (no saturation). */
-        t->vs_scale = fx_mul_nosat(p->ts, est->vdc);
-        t->vs[0] = est->u_alpha;
-        t->vs[1] = est->u_beta;
-    } else {
-        ctrl_fobs_voltage(o, applied, est->vdc, i_a, i_b, &t->vs[0], &t->vs[1]);
-        t->vs_scale = p->ts;
-    }
-    const unsigned ph = t->phase;
-    t->phase = (uint8_t)(ph + 1u >= t->div ? 0u : ph + 1u);
-    return ph == 0u ? ctrl_psi_track_correct(t, p, est) : false;
-}
+ * (now.*: i_alpha/beta, sin/cos, i_d/q, theta_e; omega_e, vdc, u_alpha/beta),
+ * applied the leg duties acting in [k, k+1) and i_a, i_b the measured phase
+ * currents (Q24 pu; read only with dead-time or drop compensation). Returns
+ * true when the PM-flux estimate has moved (ctrl_fobs_psi_pm of t->obs).
+ * Every period: the voltage model (flux_observer.c's fobs_axis, without its
+ * clamp, which the correction applies) in the observer's Q48 - the resistive
+ * drop of [k-1, k), Ts Rs (i(k-1) + i(k)) / 2 (the half truncated: 2^-49 pu
+ * per period, bounded by the correction), before the correction of period 0
+ * of N, and the voltage of [k, k+1), Ts v, after it. The flux is read only
+ * by the corrections and is an exact sum between two (no clamp), so adding
+ * Ts v at k rather than at k+1 gives the correction the same value. Out of
+ * line: inlined, the interrupt spent more on its registers than the call. */
+bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                         const ctrl_legs_t *applied, q24_t i_a, q24_t i_b);
 
 #endif /* CONTROL_PSI_TRACK_H */
