@@ -11,8 +11,10 @@
  * than it saves in code (measured, tools/bench). */
 #if defined(__GNUC__)
 #define FW_ALWAYS_INLINE __attribute__((always_inline)) inline
+#define FW_NOINLINE __attribute__((noinline))
 #else
 #define FW_ALWAYS_INLINE inline
+#define FW_NOINLINE
 #endif
 
 void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
@@ -22,6 +24,9 @@ void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
     s->t_prev = 0;
     s->psi_d = 0;
     s->own.valid = 0u;
+    s->lz_w_max = 0;
+    s->lz_hold = 0u;
+    s->lz_xv = 0u;
 }
 
 /* floor(sqrt(x)) of a Q48 value >= 0 as Q24 (x < 2^62: the result < 2^31). */
@@ -107,6 +112,66 @@ static int fw_flux_at_least(int64_t x, q24_t w, q24_t b)
     return c < ((uint64_t)1 << 31) && x >= (int64_t)(c * c);
 }
 
+/* V^2 - (Rs I_max)^2 - 2 Rs w T (Q48; psi_max = sqrt of it / |w|) with
+ * V = k_mod vdc_f / sqrt(3): every term below 2^62 in magnitude. Out of
+ * line: called from several places, not in the lazy path's usual period. */
+static FW_NOINLINE int64_t fw_volt_sq(const ctrl_fieldweak_t *s, q24_t vdc_f, q24_t omega, q24_t t)
+{
+    const q24_t v = fx_mul_qn(vdc_f, s->v_frac, 30u);
+    return fw_sq48(v) - s->rs_i2 - (int64_t)s->two_rs * fx_mul(omega, t);
+}
+
+/* fw_volt_sq of this period, formed once (lz_xv is cleared as the period
+ * ends). */
+static FW_ALWAYS_INLINE int64_t fw_volt_sq_once(ctrl_fieldweak_t *s, q24_t vdc_f, q24_t omega)
+{
+    if (s->lz_xv == 0u) {
+        s->lz_x = fw_volt_sq(s, vdc_f, omega, s->t_prev);
+        s->lz_xv = 1u;
+    }
+    return s->lz_x;
+}
+
+/* Periods without a new region after a corner failed (near base speed). */
+#define FW_LZ_HOLD 16u
+
+/* A region of the lazy path around (vdc_f, w > 0), where psi_max >= psi_mtpa
+ * has just been shown: the DC link down by 1/32, the speed up by 1/8. At
+ * its corner - the least DC link, the highest speed, the largest motoring
+ * torque t_mtpa - the test passes; everywhere inside it passes too: V is
+ * nondecreasing in vdc_f, |fx_mul(omega, t)| <= fx_mul(|omega|, |t|) (rounding
+ * half up never moves the magnitude past the exact product's rounding) is
+ * nondecreasing in both, and so is c of fw_flux_at_least in w. The speed
+ * stays below FX_MAX, so that |omega| = FX_MAX (omega = FX_MIN saturated)
+ * is never inside. */
+static void fw_lazy_region(ctrl_fieldweak_t *s, q24_t vdc_f, q24_t w)
+{
+    const q24_t w_hi = fx_min(fx_add(w, w >> 3), FX_MAX - 1); /* w > 0 */
+    const q24_t vdc_lo = vdc_f - (vdc_f >> 5);                /* vdc_f >= 0 */
+    if (fw_flux_at_least(fw_volt_sq(s, vdc_lo, w_hi, s->t_mtpa), w_hi, s->psi_mtpa)) {
+        s->lz_vdc_min = vdc_lo;
+        s->lz_w_max = w_hi;
+    } else {
+        s->lz_hold = FW_LZ_HOLD;
+    }
+}
+
+/* The lazy path's first test outside its region: psi_max >= psi_mtpa, and
+ * if so a new region around this point (at most once in FW_LZ_HOLD periods
+ * after one failed). */
+static int fw_lazy_enter(ctrl_fieldweak_t *s, q24_t vdc_f, q24_t omega, q24_t w)
+{
+    if (!fw_flux_at_least(fw_volt_sq_once(s, vdc_f, omega), w, s->psi_mtpa)) {
+        return 0;
+    }
+    if (s->lz_hold == 0u) {
+        fw_lazy_region(s, vdc_f, w);
+    } else {
+        s->lz_hold--;
+    }
+    return 1;
+}
+
 static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
                                      q24_t omega, q24_t t_req, q24_t psi_cmd,
                                      ctrl_fieldweak_out_t *out, int lazy)
@@ -125,19 +190,21 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
     out->vdc = vdc_f;
 
     /* Flux the voltage allows: psi_max = sqrt(V^2 - (Rs I)^2 - 2 Rs w T) / |w|. */
-    const q24_t v = fx_mul_qn(vdc_f, s->v_frac, 30u);
-    int64_t x = fw_sq48(v) - s->rs_i2;
-    x -= (int64_t)s->two_rs * fx_mul(omega, s->t_prev); /* |.| < 2^62 */
     const q24_t w = fx_abs(omega);
     const q24_t psi_fix = psi_cmd > 0 ? psi_cmd : p->psi_ref;
-    if (lazy != 0 && psi_fix <= 0 && w != 0 && fw_flux_at_least(x, w, s->psi_mtpa)) {
-        /* psi_max >= the MTPA flux at I_max: the current limit, whatever
-         * psi_max is; if it is also >= the flux reference of the clamped
-         * torque, neither the reference nor "weakening" depends on it. */
+    if (lazy != 0 && psi_fix <= 0 && w != 0 &&
+        ((w <= s->lz_w_max && vdc_f >= s->lz_vdc_min && fx_abs(s->t_prev) <= s->t_mtpa) ||
+         fw_lazy_enter(s, vdc_f, omega, w))) {
+        /* psi_max >= the MTPA flux at I_max (inside the region, or by the
+         * test): the current limit, whatever psi_max is; if it is also >=
+         * the flux reference of the clamped torque, neither the reference
+         * nor "weakening" depends on it. */
         const q24_t t = fx_clamp(t_req, fx_neg(s->t_mtpa), s->t_mtpa);
         /* psi_fix <= 0: ctrl_flux_ref is the MTPA flux of t */
         const q24_t psi_own = ctrl_flux_ref_memo(&s->own, p, psi_cmd, t);
-        if (psi_own <= s->psi_mtpa || (psi_own <= s->psi_ceil && fw_flux_at_least(x, w, psi_own))) {
+        if (psi_own <= s->psi_mtpa ||
+            (psi_own <= s->psi_ceil &&
+             fw_flux_at_least(fw_volt_sq_once(s, vdc_f, omega), w, psi_own))) {
             out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
             out->torque_max = s->t_mtpa;
             out->torque = t;
@@ -146,9 +213,11 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
             out->clipped = t != t_req ? 1u : 0u;
             out->weakening = 0u;
             s->t_prev = t;
+            s->lz_xv = 0u;
             return;
         }
     }
+    const int64_t x = fw_volt_sq_once(s, vdc_f, omega);
     q24_t psi_max = s->psi_ceil;
     if (w != 0 && !fw_flux_at_least(x, w, s->psi_ceil)) {
         /* (at the ceiling - low speed - without the root and the division) */
@@ -178,6 +247,7 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
     out->clipped = t != t_req ? 1u : 0u;
     out->weakening = psi_max < psi_own ? 1u : 0u;
     s->t_prev = t;
+    s->lz_xv = 0u;
 }
 
 void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,

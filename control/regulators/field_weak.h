@@ -89,6 +89,15 @@ typedef struct {
     q24_t psi_d;          /* ctrl_fieldweak_currents: psi_d of the last solution */
     q24_t vdc_r;          /* vdc_acc rounded to Q24 (saturated), as of the last period */
     ctrl_flux_memo_t own; /* the controller's flux reference of the last clamped torque */
+    /* ctrl_fieldweak_step_lazy: a region of the filtered DC link and the
+     * speed, vdc_r >= lz_vdc_min and 0 < |omega| <= lz_w_max, in which
+     * psi_max >= psi_mtpa for every previous torque within +-t_mtpa (its
+     * corner passed the test); lz_w_max = 0: none, lz_hold periods until the
+     * next attempt after a corner failed */
+    q24_t lz_vdc_min, lz_w_max;
+    uint8_t lz_hold;
+    uint8_t lz_xv; /* lz_x holds V^2 - (Rs I)^2 - 2 Rs w T of this period (Q48) */
+    int64_t lz_x;
 } ctrl_fieldweak_t;
 
 typedef struct {
@@ -123,7 +132,8 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
  * shows it at least the MTPA flux at the current limit and the flux
  * reference of the clamped torque (below base speed: then neither the
  * torque limit nor the flux reference depends on its value), which saves
- * its square root and division.
+ * its square root and division; the first comparison is skipped inside a
+ * region of DC link and speed where its worst case has passed (lz_*).
  */
 void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
                               q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out);
