@@ -25,7 +25,7 @@ void st_hyst_reset(void *state)
 {
     st_hyst_state_t *s = state;
     s->prev_vec = 0u;
-    ctrl_hyst2_reset(&s->flux);
+    ctrl_hyst2_reset(&s->flux.h);
     ctrl_hyst3_reset(&s->torque3);
     ctrl_hyst2_reset(&s->torque2);
     s->flux_ref.valid = 0u;
@@ -39,7 +39,7 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const q24_t psi_ref =
         ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, ctx->ref->torque);
     const q24_t t_err = fx_sub(ctx->ref->torque, nx->torque);
-    const int e_psi = ctrl_hyst2_update(&s->flux, fx_sub(psi_ref, nx->psi_amp));
+    const int e_psi = ctrl_hyst2_sq_update(&s->flux, psi_ref, nx->psi_amp_sq);
     uint8_t n;
     switch ((st_kind_t)s->kind) {
     case ST_KIND_BST:
@@ -113,8 +113,9 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t tref = ctx->ref->torque;
     const q24_t t_err = fx_sub(fx_add(tref, s->g), nx->torque); /* g = 0 when off */
-    const q24_t psi_err =
-        fx_sub(ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, tref), nx->psi_amp);
+    /* psi_ref - |psi| >= 0, by the squares (fx.h) */
+    const q24_t psi_ref = ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, tref);
+    const int psi_inc = nx->psi_amp_sq < fx_mag_le_lim(psi_ref);
     /* Step detection on the reference itself, not on T_vref. */
     const st_fst_mode_t mode = st_fst_logic_update(&s->logic, tref, t_err, ctx->est->omega_e);
     if (mode != ST_FST_DYNAMIC) {
@@ -123,7 +124,7 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         s->g = fx_clamp(fx_add(s->g, inc), fx_neg(s->g_max), s->g_max);
     }
     const uint8_t x = nx->sector;
-    uint8_t n = st_lookup_fst(x, t_err >= 0, psi_err >= 0, mode);
+    uint8_t n = st_lookup_fst(x, t_err >= 0, psi_inc, mode);
     if (n != ST_ZVV) {
         n = ctrl_vreplace(&s->vr, n, x, nx->psi_alpha, nx->psi_beta); /* (4.19)-(4.21) */
     }

@@ -6,7 +6,9 @@
  * Delay compensation (docs/conventions.md, thesis §4.6.2): the vector chosen at
  * sample k acts during [k+1, k+2), so every decision uses the one-step-ahead
  * prediction est->next (torque, flux amplitude, flux vector -> sector), i.e.
- * the state at the instant the vector starts to act.
+ * the state at the instant the vector starts to act. The flux amplitude is
+ * compared by its square (psi_amp_sq against the squared reference and band
+ * edges): the decisions of |psi| = fx_mag, without the square root.
  *
  * Flux reference: ctrl_flux_ref (mtpa.h) of the torque reference.
  *
@@ -34,7 +36,7 @@ typedef enum { ST_KIND_BST = 0, ST_KIND_MBST, ST_KIND_AST, ST_KIND_ZST } st_kind
 typedef struct {
     uint8_t kind;              /* st_kind_t */
     uint8_t prev_vec;          /* vector chosen at k-1, 0..7 */
-    ctrl_hyst2_t flux;         /* two-level flux regulator, band h_psi (Q24 pu) */
+    ctrl_hyst2_sq_t flux;      /* two-level flux regulator on |psi|^2, band h_psi (Q24 pu) */
     ctrl_hyst3_t torque3;      /* three-level torque regulator (BST, MBST), band h_T */
     ctrl_hyst2_t torque2;      /* two-level torque regulator (AST, ZST), band h_T */
     ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h) */

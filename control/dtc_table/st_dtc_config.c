@@ -89,7 +89,7 @@ static int st_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su, st
         return CTRL_ERANGE;
     }
     s->kind = (uint8_t)kind;
-    ctrl_hyst2_init(&s->flux, h_psi);
+    ctrl_hyst2_sq_init(&s->flux, h_psi);
     ctrl_hyst3_init(&s->torque3, h_t);
     ctrl_hyst2_init(&s->torque2, h_t);
     st_hyst_reset(s);
@@ -148,16 +148,16 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
                      st_hyst_cfg_default, initfn, st_hyst_reset, st_hyst_step, est)
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init,
-             CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+             CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 /* MBST's speed limit at 220 V: docs/algorithms.md, "MBST". */
 ST_HYST_DESC(mbst, "ST-DTC, modified basic table, sectors (4.18) (thesis Table 4.3)", st_mbst_init,
-             CTRL_EST_AMP_NEXT | CTRL_EST_PSI_AB_NEXT);
+             CTRL_EST_AMP_SQ_NEXT | CTRL_EST_PSI_AB_NEXT);
 ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4.4)", st_ast_init,
-             CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+             CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (Table 4.5)",
-             st_zst_init, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+             st_zst_init, CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 
 CTRL_DESC_DEFINE(
     fst, "ST-DTC, flexible switching table + voltage replacement (thesis sec. 4.5, Table 4.6)",
     ST_FS_HZ, st_fst_state_t, st_fst_cfg_t, fst_tunables, st_fst_cfg_default, st_fst_init,
-    st_fst_reset, st_fst_step, CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+    st_fst_reset, st_fst_step, CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);

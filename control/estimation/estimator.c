@@ -53,29 +53,39 @@ void ctrl_estimator_set_outputs(ctrl_estimator_t *e, unsigned outputs)
     if (outputs & CTRL_EST_I_AB_NEXT) {
         outputs |= CTRL_EST_SC_NEXT;
     }
-    e->outputs = (uint8_t)(outputs & CTRL_EST_ALL);
+    e->outputs = (uint16_t)(outputs & CTRL_EST_ALL);
 }
 
-/* The optional outputs (estimator.h). (hd, hq): the predicted flux in the
- * frame at theta(k), psi' of (5.15); its stator-frame image is psi(k+1). */
+/* The optional outputs (estimator.h), tested in groups (the outputs at k
+ * and the two amplitudes at k+1), as most controllers read none of a group.
+ * (hd, hq): the predicted flux in the frame at theta(k), psi' of (5.15); its
+ * stator-frame image is psi(k+1). */
 static void estimator_options(unsigned outputs, q24_t hd, q24_t hq, ctrl_estimate_t *est)
 {
     ctrl_mstate_t *now = &est->now;
     ctrl_mstate_t *nx = &est->next;
     const q24_t s = now->sin_theta;
     const q24_t c = now->cos_theta;
-    if (outputs & CTRL_EST_AMP_NOW) {
-        now->psi_amp = fx_mag(now->psi_d, now->psi_q); /* (4.3), rotation-invariant */
-    }
-    if (outputs & CTRL_EST_PSI_AB_NOW) {
-        now->psi_alpha = fx_cross(c, s, now->psi_q, now->psi_d); /* inverse Park */
-        now->psi_beta = fx_dot(s, c, now->psi_d, now->psi_q);
-        if (outputs & CTRL_EST_SECTOR_NOW) {
-            now->sector = ctrl_sector(now->psi_alpha, now->psi_beta); /* (4.5) */
+    if (outputs & (CTRL_EST_AMP_NOW | CTRL_EST_PSI_AB_NOW)) {
+        if (outputs & CTRL_EST_AMP_NOW) {
+            now->psi_amp = fx_mag(now->psi_d, now->psi_q); /* (4.3), rotation-invariant */
+        }
+        if (outputs & CTRL_EST_PSI_AB_NOW) {
+            now->psi_alpha = fx_cross(c, s, now->psi_q, now->psi_d); /* inverse Park */
+            now->psi_beta = fx_dot(s, c, now->psi_d, now->psi_q);
+            if (outputs & CTRL_EST_SECTOR_NOW) {
+                now->sector = ctrl_sector(now->psi_alpha, now->psi_beta); /* (4.5) */
+            }
         }
     }
-    if (outputs & CTRL_EST_AMP_NEXT) {
-        nx->psi_amp = fx_mag(hd, hq); /* = |psi(k+1)|, one rounding less */
+    if (outputs & (CTRL_EST_AMP_NEXT | CTRL_EST_AMP_SQ_NEXT)) {
+        if (outputs & CTRL_EST_AMP_NEXT) {
+            nx->psi_amp = fx_mag(hd, hq); /* = |psi(k+1)|, one rounding less */
+        }
+        if (outputs & CTRL_EST_AMP_SQ_NEXT) {
+            /* psi_amp's S: |hd|, |hq| <= 2^30, the sum <= 2^61, exact */
+            nx->psi_amp_sq = (uint64_t)((int64_t)hd * hd + (int64_t)hq * hq);
+        }
     }
     if (outputs & CTRL_EST_PSI_AB_NEXT) {
         /* |psi'| <= 91 pu (clamped), |(s, c)| <= 1: no saturation */

@@ -70,7 +70,7 @@ typedef struct ctrl_desc {
     void (*step)(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
     /* Optional estimator outputs (CTRL_EST_* of estimator.h) this controller never
      * reads, so the pipeline can skip computing them; 0 = it may read all. */
-    uint8_t est_unused;
+    uint16_t est_unused;
 } ctrl_desc_t;
 
 /* Size of the caller's state and configuration blocks (the firmware's fw_t):

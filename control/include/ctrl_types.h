@@ -35,6 +35,8 @@ typedef struct {
     q24_t psi_alpha, psi_beta;  /* stator flux linkage, stator frame, pu */
     q24_t psi_amp;              /* |psi_s|, pu (4.3) */
     uint8_t sector;             /* stator-flux sector 1..6 (4.5) */
+    uint64_t psi_amp_sq;        /* |psi_s|^2, Q48 pu, exact: psi_amp without its square root
+                                 * (compare through fx_mag_le_lim / fx_mag_ge_lim) */
 } ctrl_mstate_t;
 
 /* What the estimator hands every controller at sample k. */

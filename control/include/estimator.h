@@ -31,18 +31,19 @@
  * now.i_alpha, now.i_beta; omega_e, vdc, dtheta, rot_c, rot_s, u_alpha, u_beta. A field not
  * computed is not written (it keeps the caller's value, zero from an
  * initialised ctrl_estimate_t). Costs on a Cortex-M4: a square root ~60
- * instructions, a sector ~20, a rotation ~10. */
-#define CTRL_EST_AMP_NOW 0x01u     /* now.psi_amp (4.3) */
-#define CTRL_EST_SECTOR_NOW 0x02u  /* now.sector (4.5), with now.psi_alpha/beta */
-#define CTRL_EST_PSI_AB_NOW 0x04u  /* now.psi_alpha, now.psi_beta */
-#define CTRL_EST_AMP_NEXT 0x08u    /* next.psi_amp */
-#define CTRL_EST_SECTOR_NEXT 0x10u /* next.sector, with next.psi_alpha/beta */
-#define CTRL_EST_PSI_AB_NEXT 0x20u /* next.psi_alpha, next.psi_beta */
-#define CTRL_EST_SC_NEXT 0x40u     /* next.sin_theta, next.cos_theta */
-#define CTRL_EST_I_AB_NEXT 0x80u   /* next.i_alpha, next.i_beta, with next sin/cos */
-#define CTRL_EST_ALL 0xFFu
+ * instructions, a sector ~20, a rotation ~10, a square ~5. */
+#define CTRL_EST_AMP_NOW 0x01u      /* now.psi_amp (4.3) */
+#define CTRL_EST_SECTOR_NOW 0x02u   /* now.sector (4.5), with now.psi_alpha/beta */
+#define CTRL_EST_PSI_AB_NOW 0x04u   /* now.psi_alpha, now.psi_beta */
+#define CTRL_EST_AMP_NEXT 0x08u     /* next.psi_amp */
+#define CTRL_EST_SECTOR_NEXT 0x10u  /* next.sector, with next.psi_alpha/beta */
+#define CTRL_EST_PSI_AB_NEXT 0x20u  /* next.psi_alpha, next.psi_beta */
+#define CTRL_EST_SC_NEXT 0x40u      /* next.sin_theta, next.cos_theta */
+#define CTRL_EST_I_AB_NEXT 0x80u    /* next.i_alpha, next.i_beta, with next sin/cos */
+#define CTRL_EST_AMP_SQ_NEXT 0x100u /* next.psi_amp_sq (two multiplies, no root) */
+#define CTRL_EST_ALL 0x1FFu
 /* For a descriptor's est_unused (controller.h): it reads no optional output but x. */
-#define CTRL_EST_ONLY(x) ((uint8_t)(CTRL_EST_ALL & ~(unsigned)(x)))
+#define CTRL_EST_ONLY(x) ((uint16_t)(CTRL_EST_ALL & ~(unsigned)(x)))
 
 /* Range of the phase currents the estimator takes (beyond: taken as the
  * limit): 32 pu, twice the largest trip level the core accepts
@@ -54,7 +55,7 @@
 
 typedef struct {
     const ctrl_angle_src_t *src; /* angle source; init: ctrl_angle_encoder */
-    uint8_t outputs;             /* CTRL_EST_* (with what they imply), set by
+    uint16_t outputs;            /* CTRL_EST_* (with what they imply), set by
                                   * ctrl_estimator_set_outputs; init: all */
     ctrl_angle_in_t in;          /* what the source sees; v_alpha, v_beta: the
                                   * mean voltage of the last period (for a

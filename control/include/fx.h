@@ -322,6 +322,36 @@ uint32_t fx_isqrt64(uint64_t x);
 /* |(x, y)| in Q24, saturated. */
 q24_t fx_mag(q24_t x, q24_t y);
 
+/* fx_mag(x, y) compared with t (any int64_t) through S = x^2 + y^2 (Q48,
+ * exact in a uint64_t), without the square root: fx_mag <= t exactly when
+ * S < fx_mag_le_lim(t), fx_mag >= t exactly when S >= fx_mag_ge_lim(t).
+ * fx_mag = min(round(sqrt(S)), FX_MAX) and sqrt(S) of an integer S is never
+ * a half-integer, so round(sqrt(S)) <= t <=> sqrt(S) < t + 1/2 <=>
+ * S < t^2 + t + 1/4 <=> S < t^2 + t + 1, and round(sqrt(S)) >= t <=>
+ * S >= t^2 - t + 1 for t >= 1; the cap: fx_mag <= t for every t >= FX_MAX,
+ * fx_mag >= t for none above FX_MAX (S <= 2^63 < UINT64_MAX). */
+static inline uint64_t fx_mag_le_lim(int64_t t)
+{
+    if (t < 0) {
+        return 0u;
+    }
+    if (t >= FX_MAX) {
+        return UINT64_MAX;
+    }
+    return (uint64_t)t * (uint64_t)t + (uint64_t)t + 1u;
+}
+
+static inline uint64_t fx_mag_ge_lim(int64_t t)
+{
+    if (t <= 0) {
+        return 0u;
+    }
+    if (t > FX_MAX) {
+        return UINT64_MAX;
+    }
+    return (uint64_t)t * (uint64_t)t - (uint64_t)t + 1u;
+}
+
 /* sin and cos of an angle in Q24: the nearest point of a Q30 quarter-wave
  * table turned by the remainder; maximum error 0.5 LSB + 2e-9 = 3.2e-8
  * (docs/fixed-point.md). Either output may be NULL. */

@@ -44,6 +44,41 @@ void ctrl_hyst2_reset(ctrl_hyst2_t *h);
 /* One sample; returns +1 or -1 (NULL h: sign of err, +1 for 0). */
 int8_t ctrl_hyst2_update(ctrl_hyst2_t *h, q24_t err);
 
+/* The two-level regulator of an amplitude known by its square S = x^2 + y^2
+ * (Q48, e.g. ctrl_mstate_t.psi_amp_sq): the outputs of
+ * ctrl_hyst2_update(&h, ref - fx_mag(x, y)) without the square root, S
+ * compared with the band edges as limits on S (fx_mag_le_lim, fx_mag_ge_lim;
+ * exact, as ref - fx_mag never overflows for ref >= 0 and band >= 0). The
+ * limits are formed again only when the reference or the band moved. */
+typedef struct {
+    ctrl_hyst2_t h;      /* band and last output, as ctrl_hyst2_update's */
+    q24_t ref, band;     /* what the limits below are of */
+    uint64_t inc_lim;    /* S < inc_lim: ref - |.| >= +band (output +1) */
+    uint64_t dec_lim;    /* S >= dec_lim: ref - |.| <= -band (output -1) */
+    uint64_t nonneg_lim; /* S < nonneg_lim: ref - |.| >= 0 */
+} ctrl_hyst2_sq_t;
+
+/* Band (negative taken as 0), output reset, limits for ref = 0. NULL-safe. */
+void ctrl_hyst2_sq_init(ctrl_hyst2_sq_t *h, q24_t band);
+/* The limits for ref and h->h.band (the update's rare path). */
+void ctrl_hyst2_sq_limits(ctrl_hyst2_sq_t *h, q24_t ref);
+
+/* One sample with the reference ref (>= 0) and S; returns +1 or -1. */
+static inline int8_t ctrl_hyst2_sq_update(ctrl_hyst2_sq_t *h, q24_t ref, uint64_t amp_sq)
+{
+    if (ref != h->ref || h->h.band != h->band) {
+        ctrl_hyst2_sq_limits(h, ref);
+    }
+    if (amp_sq < h->inc_lim) {
+        h->h.out = 1;
+    } else if (amp_sq >= h->dec_lim) {
+        h->h.out = -1;
+    } else if (h->h.out == 0) {
+        h->h.out = amp_sq < h->nonneg_lim ? (int8_t)1 : (int8_t)-1; /* no history: the sign */
+    }
+    return h->h.out;
+}
+
 void ctrl_hyst3_init(ctrl_hyst3_t *h, q24_t band);
 void ctrl_hyst3_reset(ctrl_hyst3_t *h);
 /* One sample; returns +1, 0 or -1 (NULL h: 0). */

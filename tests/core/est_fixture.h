@@ -28,6 +28,12 @@
 #include "transforms.h"
 #include "vectors.h"
 
+/* x^2 + y^2 exact (Q48 for Q24 inputs), ctrl_mstate_t.psi_amp_sq */
+static inline uint64_t fixture_amp_sq(q24_t x, q24_t y)
+{
+    return (uint64_t)((int64_t)x * x) + (uint64_t)((int64_t)y * y);
+}
+
 static inline void fixture_state_from_flux(const ctrl_params_t *p, q24_t pa, q24_t pb,
                                            fx_angle_t th, ctrl_mstate_t *o)
 {
@@ -43,6 +49,7 @@ static inline void fixture_state_from_flux(const ctrl_params_t *p, q24_t pa, q24
     ctrl_inv_park(o->i_d, o->i_q, s, c, &o->i_alpha, &o->i_beta);
     o->torque = fx_cross(o->psi_d, o->psi_q, o->i_d, o->i_q);
     o->psi_amp = fx_mag(pa, pb);
+    o->psi_amp_sq = fixture_amp_sq(pa, pb);
     o->sector = ctrl_sector(pa, pb);
     o->theta_e = th;
     o->sin_theta = s;
@@ -64,6 +71,7 @@ static inline void fixture_state_from_current(const ctrl_params_t *p, q24_t ia, 
     ctrl_inv_park(o->psi_d, o->psi_q, s, c, &o->psi_alpha, &o->psi_beta);
     o->torque = fx_cross(o->psi_d, o->psi_q, o->i_d, o->i_q);
     o->psi_amp = fx_mag(o->psi_d, o->psi_q);
+    o->psi_amp_sq = fixture_amp_sq(o->psi_d, o->psi_q);
     o->sector = ctrl_sector(o->psi_alpha, o->psi_beta);
     o->theta_e = th;
     o->sin_theta = s;
@@ -88,6 +96,7 @@ static inline void fixture_state_dq(const ctrl_params_t *p, q24_t i_d, q24_t i_q
     ctrl_inv_park(i_d, i_q, s, c, &o->i_alpha, &o->i_beta);
     o->torque = fx_cross(o->psi_d, o->psi_q, i_d, i_q);
     o->psi_amp = fx_mag(o->psi_d, o->psi_q);
+    o->psi_amp_sq = fixture_amp_sq(o->psi_d, o->psi_q);
     o->sector = ctrl_sector(o->psi_alpha, o->psi_beta);
     o->theta_e = th;
     o->sin_theta = s;
@@ -134,6 +143,7 @@ static inline void fixture_predict_dq(const ctrl_params_t *p, const ctrl_mstate_
     ctrl_inv_park(pd, pq, s1, c1, &next->psi_alpha, &next->psi_beta);
     ctrl_inv_park(next->i_d, next->i_q, s1, c1, &next->i_alpha, &next->i_beta);
     next->psi_amp = fx_mag(pd, pq);
+    next->psi_amp_sq = fixture_amp_sq(pd, pq);
     next->sector = ctrl_sector(next->psi_alpha, next->psi_beta);
     next->theta_e = th1;
     next->sin_theta = s1;

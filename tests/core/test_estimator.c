@@ -229,21 +229,24 @@ static void test_prediction(void)
  * caller's values, the mandatory ones are always equal; the implications. */
 static void test_optional_outputs(void)
 {
-    static const unsigned bits[8] = {CTRL_EST_AMP_NOW,  CTRL_EST_SECTOR_NOW,  CTRL_EST_PSI_AB_NOW,
-                                     CTRL_EST_AMP_NEXT, CTRL_EST_SECTOR_NEXT, CTRL_EST_PSI_AB_NEXT,
-                                     CTRL_EST_SC_NEXT,  CTRL_EST_I_AB_NEXT};
+    enum { NB = 9 };
+    static const unsigned bits[NB] = {
+        CTRL_EST_AMP_NOW,  CTRL_EST_SECTOR_NOW,  CTRL_EST_PSI_AB_NOW,
+        CTRL_EST_AMP_NEXT, CTRL_EST_SECTOR_NEXT, CTRL_EST_PSI_AB_NEXT,
+        CTRL_EST_SC_NEXT,  CTRL_EST_I_AB_NEXT,   CTRL_EST_AMP_SQ_NEXT};
     ctrl_estimator_t full;
     ctrl_estimator_init(&full, &P);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_EST_ALL, full.outputs);
-    ctrl_estimator_t lean[9];
-    for (int b = 0; b < 9; b++) {
+    TEST_ASSERT_EQUAL_UINT16(CTRL_EST_ALL, full.outputs);
+    ctrl_estimator_t lean[NB + 1];
+    for (int b = 0; b <= NB; b++) {
         ctrl_estimator_init(&lean[b], &P);
-        ctrl_estimator_set_outputs(&lean[b], b < 8 ? bits[b] : 0u);
+        ctrl_estimator_set_outputs(&lean[b], b < NB ? bits[b] : 0u);
     }
-    TEST_ASSERT_EQUAL_UINT8(CTRL_EST_SECTOR_NOW | CTRL_EST_PSI_AB_NOW, lean[1].outputs);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_EST_SECTOR_NEXT | CTRL_EST_PSI_AB_NEXT, lean[4].outputs);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_EST_I_AB_NEXT | CTRL_EST_SC_NEXT, lean[7].outputs);
-    TEST_ASSERT_EQUAL_UINT8(0u, lean[8].outputs);
+    TEST_ASSERT_EQUAL_UINT16(CTRL_EST_SECTOR_NOW | CTRL_EST_PSI_AB_NOW, lean[1].outputs);
+    TEST_ASSERT_EQUAL_UINT16(CTRL_EST_SECTOR_NEXT | CTRL_EST_PSI_AB_NEXT, lean[4].outputs);
+    TEST_ASSERT_EQUAL_UINT16(CTRL_EST_I_AB_NEXT | CTRL_EST_SC_NEXT, lean[7].outputs);
+    TEST_ASSERT_EQUAL_UINT16(CTRL_EST_AMP_SQ_NEXT, lean[8].outputs);
+    TEST_ASSERT_EQUAL_UINT16(0u, lean[NB].outputs);
     ctrl_plan_t plan;
     ctrl_legs_t legs;
     ctrl_plan_active_zero(&plan, 2u, FX_ONE / 3);
@@ -255,13 +258,14 @@ static void test_optional_outputs(void)
         meas_from_dq(0.1 * sin(0.3 * k), 0.25 * cos(0.17 * k), th, &m);
         ctrl_estimate_t ef;
         ctrl_estimator_update(&full, &P, &m, &legs, &ef);
-        for (int b = 0; b < 9; b++) {
+        for (int b = 0; b <= NB; b++) {
             ctrl_estimate_t el;
             ctrl_mstate_t *x[2] = {&el.now, &el.next};
             for (int j = 0; j < 2; j++) {
                 x[j]->psi_amp = x[j]->psi_alpha = x[j]->psi_beta = mark;
                 x[j]->i_alpha = x[j]->i_beta = x[j]->sin_theta = x[j]->cos_theta = mark;
                 x[j]->sector = 0xA5u;
+                x[j]->psi_amp_sq = 0x5A5A5A5A5A5Au;
             }
             ctrl_estimator_update(&lean[b], &P, &m, &legs, &el);
             const unsigned o = lean[b].outputs;
@@ -281,6 +285,9 @@ static void test_optional_outputs(void)
                 TEST_ASSERT_EQUAL_INT32(o & pab[j] ? a[j]->psi_alpha : mark, x[j]->psi_alpha);
                 TEST_ASSERT_EQUAL_INT32(o & pab[j] ? a[j]->psi_beta : mark, x[j]->psi_beta);
             }
+            const int sq = (o & CTRL_EST_AMP_SQ_NEXT) != 0u;
+            TEST_ASSERT_TRUE(el.next.psi_amp_sq == (sq ? ef.next.psi_amp_sq : 0x5A5A5A5A5A5Au));
+            TEST_ASSERT_TRUE(el.now.psi_amp_sq == 0x5A5A5A5A5A5Au); /* no such output at k */
             TEST_ASSERT_EQUAL_INT32(ef.now.sin_theta, el.now.sin_theta);
             TEST_ASSERT_EQUAL_INT32(ef.now.i_alpha, el.now.i_alpha);
             const int sc = (o & CTRL_EST_SC_NEXT) != 0u;
@@ -297,13 +304,16 @@ static void test_optional_outputs(void)
         TEST_ASSERT_EQUAL_INT32(fx_mag(ef.now.psi_d, ef.now.psi_q), ef.now.psi_amp);
         TEST_ASSERT_EQUAL_UINT8(ctrl_sector(ef.now.psi_alpha, ef.now.psi_beta), ef.now.sector);
         TEST_ASSERT_EQUAL_UINT8(ctrl_sector(ef.next.psi_alpha, ef.next.psi_beta), ef.next.sector);
+        /* the square is the one of the amplitude: fx_mag(S) == psi_amp (fx.h) */
+        TEST_ASSERT_TRUE(ef.next.psi_amp_sq < fx_mag_le_lim(ef.next.psi_amp));
+        TEST_ASSERT_TRUE(ef.next.psi_amp_sq >= fx_mag_ge_lim(ef.next.psi_amp));
         /* outputs survive a reset */
         if (k == 100) {
             ctrl_estimator_reset(&full, &P);
-            for (int b = 0; b < 9; b++) {
+            for (int b = 0; b <= NB; b++) {
                 ctrl_estimator_reset(&lean[b], &P);
             }
-            TEST_ASSERT_EQUAL_UINT8(0u, lean[8].outputs);
+            TEST_ASSERT_EQUAL_UINT16(0u, lean[NB].outputs);
         }
     }
 }

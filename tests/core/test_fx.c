@@ -344,6 +344,63 @@ static void test_mag(void)
     }
 }
 
+/* fx_mag_le_lim / fx_mag_ge_lim: S = x^2 + y^2 against them decides
+ * fx_mag(x, y) <= t and >= t exactly as fx_mag itself, for t at and around
+ * the amplitude (where the rounding decides), far from it, and at the ends
+ * (negative, 0, FX_MAX, beyond). */
+static void check_mag_lims(q24_t x, q24_t y)
+{
+    const q24_t m = fx_mag(x, y);
+    const uint64_t s = (uint64_t)((int64_t)x * x) + (uint64_t)((int64_t)y * y);
+    const int64_t ts[] = {(int64_t)m - 2,
+                          (int64_t)m - 1,
+                          m,
+                          (int64_t)m + 1,
+                          (int64_t)m + 2,
+                          -1,
+                          0,
+                          1,
+                          FX_MAX - 1,
+                          FX_MAX,
+                          (int64_t)FX_MAX + 1,
+                          (int64_t)1 << 33,
+                          -((int64_t)1 << 33),
+                          (int64_t)m / 2,
+                          (int64_t)m * 2};
+    for (size_t i = 0; i < sizeof ts / sizeof ts[0]; i++) {
+        const int64_t t = ts[i];
+        TEST_ASSERT_EQUAL_INT_MESSAGE(m <= t, s < fx_mag_le_lim(t), "fx_mag <= t");
+        TEST_ASSERT_EQUAL_INT_MESSAGE(m >= t, s >= fx_mag_ge_lim(t), "fx_mag >= t");
+    }
+}
+
+static void test_mag_lims(void)
+{
+    static const q24_t e[] = {0,
+                              1,
+                              -1,
+                              2,
+                              3,
+                              46340,
+                              46341,
+                              FX_ONE,
+                              -FX_ONE,
+                              (q24_t)1 << 30,
+                              -((q24_t)1 << 30),
+                              FX_MAX,
+                              FX_MIN,
+                              FX_MIN + 1,
+                              1518500249,
+                              1518500250};
+    const size_t ne = sizeof e / sizeof e[0];
+    for (size_t i = 0; i < ne * ne; i++) {
+        check_mag_lims(e[i % ne], e[i / ne]);
+    }
+    for (int i = 0; i < 50000; i++) {
+        check_mag_lims(rnd_i32((unsigned)(rng() % 32u)), rnd_i32((unsigned)(rng() % 32u)));
+    }
+}
+
 static void test_sincos(void)
 {
     q24_t s;
@@ -453,6 +510,7 @@ int main(void)
     RUN_TEST(test_div);
     RUN_TEST(test_isqrt_exact);
     RUN_TEST(test_mag);
+    RUN_TEST(test_mag_lims);
     RUN_TEST(test_sincos);
     RUN_TEST(test_rot_q30);
     return UNITY_END();

@@ -346,6 +346,8 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
         est.next.psi_beta = q24(amp * std::sin(th));
         est.next.sector = ctrl_sector(est.next.psi_alpha, est.next.psi_beta); /* (4.5) */
         est.next.psi_amp = q24(psi_amp);
+        est.next.psi_amp_sq =
+            static_cast<uint64_t>(static_cast<int64_t>(est.next.psi_amp) * est.next.psi_amp);
         est.next.torque = q24(torque);
         est.omega_e = q24(omega);
         est.vdc = FX_ONE;
@@ -393,7 +395,7 @@ void run_kind(Kind kind, std::mt19937_64 &rng, Stats &st)
                 ref.terr_nonneg_prev = s->logic.terr_nonneg_prev;
             } else {
                 const st_hyst_state_t *s = reinterpret_cast<const st_hyst_state_t *>(state);
-                ref.flux.out = s->flux.out;
+                ref.flux.out = s->flux.h.out;
                 ref.torque2.out = s->torque2.out;
                 ref.torque3.out = s->torque3.out;
             }

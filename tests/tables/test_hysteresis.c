@@ -4,6 +4,7 @@
  * including the hold inside the band and the inclusive band edges.
  */
 #include <stddef.h>
+#include <stdint.h>
 
 #include "hysteresis.h"
 #include "unity.h"
@@ -123,6 +124,60 @@ static void test_zero_band_and_null(void)
     TEST_ASSERT_EQUAL_INT(0, ctrl_hyst3_update(NULL, 3));
 }
 
+/* The regulator on |.|^2 (ctrl_hyst2_sq_t) gives the outputs of
+ * ctrl_hyst2_update(ref - fx_mag(x, y)) step for step: amplitudes walking
+ * through and around the band edges (where the rounding of the root decides),
+ * references and bands that move (the limits formed again), a zero band, the
+ * first sample after a reset (the sign), and large values. */
+static uint64_t hs_rng = 0x2545F4914F6CDD1Dull;
+static uint32_t hs_next(void)
+{
+    hs_rng ^= hs_rng << 13;
+    hs_rng ^= hs_rng >> 7;
+    hs_rng ^= hs_rng << 17;
+    return (uint32_t)(hs_rng >> 11);
+}
+
+static void test_flux_on_square_equals_root(void)
+{
+    ctrl_hyst2_t ref_h;
+    ctrl_hyst2_sq_t sq;
+    const q24_t bands[] = {H, 0, 1, 7, FX_ONE, (q24_t)1 << 29};
+    const q24_t refs[] = {FX_ONE, FX_ONE + 3, 1, 0, 40 * FX_ONE, (q24_t)1 << 30};
+    for (size_t bi = 0; bi < sizeof bands / sizeof bands[0]; bi++) {
+        ctrl_hyst2_init(&ref_h, bands[bi]);
+        ctrl_hyst2_sq_init(&sq, bands[bi]);
+        for (int k = 0; k < 20000; k++) {
+            if (k % 5000 == 2500) {
+                ctrl_hyst2_reset(&ref_h);
+                ctrl_hyst2_reset(&sq.h);
+            }
+            const q24_t ref = refs[(k / 700) % (sizeof refs / sizeof refs[0])];
+            /* an amplitude near an edge (ref - band, ref, ref + band) or anywhere */
+            const int64_t edge[4] = {(int64_t)ref - bands[bi], ref, (int64_t)ref + bands[bi],
+                                     (int64_t)(hs_next() >> 1)};
+            const int64_t a = edge[hs_next() % 4u] + (int64_t)(hs_next() % 9u) - 4;
+            const int64_t am = a < 0 ? -a : (a > ((int64_t)1 << 30) ? ((int64_t)1 << 30) : a);
+            /* (x, y) of that amplitude: on an axis, or split with a rounding */
+            const q24_t x = (q24_t)(hs_next() % 2u ? am : (am * 3) / 5);
+            const q24_t y =
+                (q24_t)(hs_next() % 2u ? 0 : -((am * 4) / 5 + (int64_t)(hs_next() % 3u)));
+            const uint64_t s = (uint64_t)((int64_t)x * x) + (uint64_t)((int64_t)y * y);
+            const int8_t want = ctrl_hyst2_update(&ref_h, fx_sub(ref, fx_mag(x, y)));
+            TEST_ASSERT_EQUAL_INT_MESSAGE(want, ctrl_hyst2_sq_update(&sq, ref, s), "on |.|^2");
+        }
+    }
+    /* the band written directly (as a tuning would): the limits follow it */
+    ctrl_hyst2_init(&ref_h, H);
+    ctrl_hyst2_sq_init(&sq, H);
+    sq.h.band = 0;
+    ref_h.band = 0;
+    const uint64_t s1 = (uint64_t)FX_ONE * FX_ONE + 1u; /* just above 1 pu: rounds to 1 pu */
+    TEST_ASSERT_EQUAL_INT(ctrl_hyst2_update(&ref_h, 0), ctrl_hyst2_sq_update(&sq, FX_ONE, s1));
+    TEST_ASSERT_EQUAL_INT(1, sq.h.out); /* err == 0 with band 0: +1 */
+    ctrl_hyst2_sq_init(NULL, H);        /* NULL is not a crash */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -130,5 +185,6 @@ int main(void)
     RUN_TEST(test_flux_two_level_start_below);
     RUN_TEST(test_torque_three_level_walk);
     RUN_TEST(test_zero_band_and_null);
+    RUN_TEST(test_flux_on_square_equals_root);
     return UNITY_END();
 }

@@ -76,6 +76,7 @@ static void set_next(double theta, double amp, double te, double omega)
     R.est.next.psi_alpha = q24(amp * cos(theta));
     R.est.next.psi_beta = q24(amp * sin(theta));
     R.est.next.psi_amp = q24(amp);
+    R.est.next.psi_amp_sq = (uint64_t)((int64_t)R.est.next.psi_amp * R.est.next.psi_amp);
     R.est.next.torque = q24(te);
     R.est.now.psi_alpha = q24(-amp * cos(theta));
     R.est.now.psi_beta = q24(-amp * sin(theta));
@@ -222,7 +223,7 @@ static uint8_t hyst_decide(double theta, int e_psi, int e_t, int three_level)
 {
     const st_hyst_state_t *s = (const st_hyst_state_t *)R.state;
     const double h_t = (double)s->torque3.band / 16777216.0;
-    const double h_psi = (double)s->flux.band / 16777216.0;
+    const double h_psi = (double)s->flux.h.band / 16777216.0;
     const double tref = 0.3;
     const double psi_ref = 1.05;
     R.ref.torque = q24(tref);
@@ -313,7 +314,7 @@ static void test_zero_vector_one_leg(void)
             TEST_ASSERT_TRUE(a >= 1u && a <= 6u);
             /* now maintain: Te hits Tref */
             const st_hyst_state_t *s = (const st_hyst_state_t *)R.state;
-            const double h_psi = (double)s->flux.band / 16777216.0;
+            const double h_psi = (double)s->flux.h.band / 16777216.0;
             set_next(theta, 1.05 - 3.0 * h_psi * (r == 0 ? 1 : -1), 0.3, 0.1);
             const uint8_t z = step();
             TEST_ASSERT_TRUE(z == 0u || z == 7u);
