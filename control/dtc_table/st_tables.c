@@ -36,7 +36,7 @@ static uint8_t entry(uint8_t x, uint8_t n)
     if (x < 1u || x > 6u || n == Z) {
         return ST_ZVV;
     }
-    return ctrl_vec_wrap((int)x + (int)n);
+    return ctrl_vec_offset(x, n); /* every offset in the tables is 0..5 */
 }
 
 static unsigned col3(int e_t)

@@ -139,16 +139,22 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     in->i_alpha = i_alpha;
     in->i_beta = i_beta;
     in->vdc = vdc;
-    ctrl_angle_out_t ang;
+    fx_angle_t th;
+    q24_t omega;
     if (e->src == &ctrl_angle_encoder) {
-        /* the usual source, called directly (inline) */
+        /* the usual source, called directly (inline; its own output record,
+         * which the compiler keeps in registers) */
+        ctrl_angle_out_t ang;
         ctrl_angle_encoder_step((ctrl_angle_encoder_t *)(void *)e->src_state.bytes, p, m->theta_e,
                                 &ang);
+        th = ang.theta;
+        omega = ang.omega;
     } else {
+        ctrl_angle_out_t ang;
         e->src->update(e->src_state.bytes, p, in, &ang);
+        th = ang.theta;
+        omega = ang.omega;
     }
-    const fx_angle_t th = ang.theta;
-    const q24_t omega = ang.omega;
 
     /* The one table sine/cosine of the period; the turn over the period. */
     q24_t s;
@@ -158,6 +164,14 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     int32_t rc;
     int32_t rs;
     fx_rot_q30_inline(dth, &rc, &rs);
+    /* stored where formed: fewer values live across the period's arithmetic */
+    est->omega_e = omega;
+    est->vdc = vdc;
+    est->dtheta = dth;
+    est->rot_c = rc;
+    est->rot_s = rs;
+    now->theta_e = th;
+    nx->theta_e = th + (fx_angle_t)dth;
 
     /* k: Park (3.7) (|i| <= 64 pu: no saturation), current model (3.9),
      * torque (3.10). */
@@ -170,7 +184,6 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     now->psi_d = psi_d;
     now->psi_q = psi_q;
     now->torque = fx_cross(psi_d, psi_q, i_d, i_q);
-    now->theta_e = th;
     now->sin_theta = s;
     now->cos_theta = c;
     now->i_alpha = i_alpha;
@@ -222,13 +235,6 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     nx->psi_d = psi1_d;
     nx->psi_q = psi1_q;
     nx->torque = fx_cross(psi1_d, psi1_q, i1_d, i1_q);
-    nx->theta_e = th + (fx_angle_t)dth;
-
-    est->omega_e = omega;
-    est->vdc = vdc;
-    est->dtheta = dth;
-    est->rot_c = rc;
-    est->rot_s = rs;
     if (e->outputs != 0u) {
         estimator_options(e->outputs, hd, hq, est);
     }

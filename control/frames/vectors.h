@@ -40,6 +40,14 @@ void ctrl_vector_ab(uint8_t idx, q24_t vdc, q24_t *v_alpha, q24_t *v_beta);
  * ((x - 1) mod 6) + 1, also for negative x. */
 uint8_t ctrl_vec_wrap(int x);
 
+/* V_{x+n} for an active vector x (1..6) and an offset n in 0..6, the tables'
+ * case of ctrl_vec_wrap(x + n): the sum wraps at most once (no division). */
+static inline uint8_t ctrl_vec_offset(uint8_t x, unsigned n)
+{
+    const unsigned v = (unsigned)x + n;
+    return (uint8_t)(v > 6u ? v - 6u : v);
+}
+
 /* Zero vector that switches one leg after vec: V0 after V0, V1, V3, V5;
  * V7 after V7, V2, V4, V6 (thesis §5.4, docs/conventions.md). Other idx: V0. */
 uint8_t ctrl_zero_after(uint8_t vec);
