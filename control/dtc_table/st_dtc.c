@@ -36,10 +36,14 @@ void st_hyst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     st_hyst_state_t *s = state;
     /* Delay compensation: decide on the state predicted for k+1. */
     const ctrl_mstate_t *nx = &ctx->est->next;
-    const q24_t psi_ref =
-        ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, ctx->ref->torque);
+    /* The flux reference (mtpa.h) and, where it moved, the flux regulator's
+     * band edges on |psi|^2. */
+    if (ctrl_flux_memo_hit(&s->flux_ref, ctx->params, ctx->ref->psi, ctx->ref->torque) == 0) {
+        s->flux_ref.value = ctrl_flux_ref(ctx->params, ctx->ref->psi, ctx->ref->torque);
+        ctrl_hyst2_sq_limits(&s->flux, s->flux_ref.value);
+    }
     const q24_t t_err = fx_sub(ctx->ref->torque, nx->torque);
-    const int e_psi = ctrl_hyst2_sq_update(&s->flux, psi_ref, nx->psi_amp_sq);
+    const int e_psi = ctrl_hyst2_sq_update(&s->flux, nx->psi_amp_sq);
     uint8_t n;
     switch ((st_kind_t)s->kind) {
     case ST_KIND_BST:
@@ -113,9 +117,13 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *nx = &ctx->est->next;
     const q24_t tref = ctx->ref->torque;
     const q24_t t_err = fx_sub(fx_add(tref, s->g), nx->torque); /* g = 0 when off */
-    /* psi_ref - |psi| >= 0, by the squares (fx.h) */
-    const q24_t psi_ref = ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, tref);
-    const int psi_inc = nx->psi_amp_sq < fx_mag_le_lim(psi_ref);
+    /* psi_ref - |psi| >= 0 by the squares (fx.h), the limit formed where the
+     * flux reference (mtpa.h) moved */
+    if (ctrl_flux_memo_hit(&s->flux_ref, ctx->params, ctx->ref->psi, tref) == 0) {
+        s->flux_ref.value = ctrl_flux_ref(ctx->params, ctx->ref->psi, tref);
+        s->psi_le_lim = fx_mag_le_lim(s->flux_ref.value);
+    }
+    const int psi_inc = nx->psi_amp_sq < s->psi_le_lim;
     /* Step detection on the reference itself, not on T_vref. */
     const st_fst_mode_t mode = st_fst_logic_update(&s->logic, tref, t_err, ctx->est->omega_e);
     if (mode != ST_FST_DYNAMIC) {

@@ -39,7 +39,7 @@ typedef struct {
     ctrl_hyst2_sq_t flux;      /* two-level flux regulator on |psi|^2, band h_psi (Q24 pu) */
     ctrl_hyst3_t torque3;      /* three-level torque regulator (BST, MBST), band h_T */
     ctrl_hyst2_t torque2;      /* two-level torque regulator (AST, ZST), band h_T */
-    ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h) */
+    ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h); flux's limits follow it */
 } st_hyst_state_t;
 
 /* Operating-state logic of FST, §4.5.3 / Fig. 4.6. */
@@ -65,6 +65,7 @@ typedef struct {
     q24_t g_max;               /* |g| limit: the rated torque, Q24 pu */
     q24_t g;                   /* integrator, Q24 pu torque */
     ctrl_flux_memo_t flux_ref; /* the flux reference (mtpa.h) */
+    uint64_t psi_le_lim;       /* |psi|^2 below it: |psi| <= the reference (fx_mag_le_lim) */
 } st_fst_state_t;
 
 /* Clear the FST logic (flag 0, T_ref[k-1] = 0, T_err[k-1] >= 0), keep dt_step. */

@@ -38,8 +38,6 @@ int8_t ctrl_hyst2_update(ctrl_hyst2_t *h, q24_t err)
 void ctrl_hyst2_sq_limits(ctrl_hyst2_sq_t *h, q24_t ref)
 {
     const q24_t band = h->h.band;
-    h->ref = ref;
-    h->band = band;
     /* err >= band <=> |.| <= ref - band; err <= -band <=> |.| >= ref + band */
     h->inc_lim = fx_mag_le_lim((int64_t)ref - band);
     h->dec_lim = fx_mag_ge_lim((int64_t)ref + band);

@@ -49,10 +49,10 @@ int8_t ctrl_hyst2_update(ctrl_hyst2_t *h, q24_t err);
  * ctrl_hyst2_update(&h, ref - fx_mag(x, y)) without the square root, S
  * compared with the band edges as limits on S (fx_mag_le_lim, fx_mag_ge_lim;
  * exact, as ref - fx_mag never overflows for ref >= 0 and band >= 0). The
- * limits are formed again only when the reference or the band moved. */
+ * owner forms the limits again when the reference moves (it knows when:
+ * ctrl_flux_memo_hit of mtpa.h); the band is fixed by the init. */
 typedef struct {
     ctrl_hyst2_t h;      /* band and last output, as ctrl_hyst2_update's */
-    q24_t ref, band;     /* what the limits below are of */
     uint64_t inc_lim;    /* S < inc_lim: ref - |.| >= +band (output +1) */
     uint64_t dec_lim;    /* S >= dec_lim: ref - |.| <= -band (output -1) */
     uint64_t nonneg_lim; /* S < nonneg_lim: ref - |.| >= 0 */
@@ -60,15 +60,12 @@ typedef struct {
 
 /* Band (negative taken as 0), output reset, limits for ref = 0. NULL-safe. */
 void ctrl_hyst2_sq_init(ctrl_hyst2_sq_t *h, q24_t band);
-/* The limits for ref and h->h.band (the update's rare path). */
+/* The limits for the reference ref (>= 0) and the band. */
 void ctrl_hyst2_sq_limits(ctrl_hyst2_sq_t *h, q24_t ref);
 
-/* One sample with the reference ref (>= 0) and S; returns +1 or -1. */
-static inline int8_t ctrl_hyst2_sq_update(ctrl_hyst2_sq_t *h, q24_t ref, uint64_t amp_sq)
+/* One sample with S; returns +1 or -1. */
+static inline int8_t ctrl_hyst2_sq_update(ctrl_hyst2_sq_t *h, uint64_t amp_sq)
 {
-    if (ref != h->ref || h->h.band != h->band) {
-        ctrl_hyst2_sq_limits(h, ref);
-    }
     if (amp_sq < h->inc_lim) {
         h->h.out = 1;
     } else if (amp_sq >= h->dec_lim) {

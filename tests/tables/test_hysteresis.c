@@ -127,7 +127,7 @@ static void test_zero_band_and_null(void)
 /* The regulator on |.|^2 (ctrl_hyst2_sq_t) gives the outputs of
  * ctrl_hyst2_update(ref - fx_mag(x, y)) step for step: amplitudes walking
  * through and around the band edges (where the rounding of the root decides),
- * references and bands that move (the limits formed again), a zero band, the
+ * references that move (the limits formed again), bands from 0 up, the
  * first sample after a reset (the sign), and large values. */
 static uint64_t hs_rng = 0x2545F4914F6CDD1Dull;
 static uint32_t hs_next(void)
@@ -153,6 +153,9 @@ static void test_flux_on_square_equals_root(void)
                 ctrl_hyst2_reset(&sq.h);
             }
             const q24_t ref = refs[(k / 700) % (sizeof refs / sizeof refs[0])];
+            if (k % 700 == 0) {
+                ctrl_hyst2_sq_limits(&sq, ref); /* the owner's part: the reference moved */
+            }
             /* an amplitude near an edge (ref - band, ref, ref + band) or anywhere */
             const int64_t edge[4] = {(int64_t)ref - bands[bi], ref, (int64_t)ref + bands[bi],
                                      (int64_t)(hs_next() >> 1)};
@@ -164,18 +167,17 @@ static void test_flux_on_square_equals_root(void)
                 (q24_t)(hs_next() % 2u ? 0 : -((am * 4) / 5 + (int64_t)(hs_next() % 3u)));
             const uint64_t s = (uint64_t)((int64_t)x * x) + (uint64_t)((int64_t)y * y);
             const int8_t want = ctrl_hyst2_update(&ref_h, fx_sub(ref, fx_mag(x, y)));
-            TEST_ASSERT_EQUAL_INT_MESSAGE(want, ctrl_hyst2_sq_update(&sq, ref, s), "on |.|^2");
+            TEST_ASSERT_EQUAL_INT_MESSAGE(want, ctrl_hyst2_sq_update(&sq, s), "on |.|^2");
         }
     }
-    /* the band written directly (as a tuning would): the limits follow it */
-    ctrl_hyst2_init(&ref_h, H);
-    ctrl_hyst2_sq_init(&sq, H);
-    sq.h.band = 0;
-    ref_h.band = 0;
-    const uint64_t s1 = (uint64_t)FX_ONE * FX_ONE + 1u; /* just above 1 pu: rounds to 1 pu */
-    TEST_ASSERT_EQUAL_INT(ctrl_hyst2_update(&ref_h, 0), ctrl_hyst2_sq_update(&sq, FX_ONE, s1));
-    TEST_ASSERT_EQUAL_INT(1, sq.h.out); /* err == 0 with band 0: +1 */
-    ctrl_hyst2_sq_init(NULL, H);        /* NULL is not a crash */
+    /* band 0, |.| just above 1 pu but rounding to it: err == 0 gives +1 */
+    ctrl_hyst2_init(&ref_h, 0);
+    ctrl_hyst2_sq_init(&sq, -3); /* negative band taken as 0 */
+    ctrl_hyst2_sq_limits(&sq, FX_ONE);
+    const uint64_t s1 = (uint64_t)FX_ONE * FX_ONE + 1u;
+    TEST_ASSERT_EQUAL_INT(ctrl_hyst2_update(&ref_h, 0), ctrl_hyst2_sq_update(&sq, s1));
+    TEST_ASSERT_EQUAL_INT(1, sq.h.out);
+    ctrl_hyst2_sq_init(NULL, H); /* NULL is not a crash */
 }
 
 int main(void)
