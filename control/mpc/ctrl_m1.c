@@ -4,6 +4,13 @@
 #include "mtpa.h"
 #include "plan.h"
 
+/* The search order: the last period's vector first, then 1..6 without it
+ * (row: the last vector - 1). */
+static const uint8_t m1_order[6][6] = {
+    {1, 2, 3, 4, 5, 6}, {2, 1, 3, 4, 5, 6}, {3, 1, 2, 4, 5, 6},
+    {4, 1, 2, 3, 5, 6}, {5, 1, 2, 3, 4, 6}, {6, 1, 2, 3, 4, 5},
+};
+
 void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
     ctrl_m1_t *s = state;
@@ -22,14 +29,12 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     int64_t best_g = INT64_MAX;
     uint8_t best_v = 0u; /* none yet */
     q24_t best_d = 0;
-    /* A candidate with duty 0 or 1 has the flux and torque at k+2 already
-     * formed: psi0 and t0, or psi0 + Ts V and t_full (ctrl_mpc_flux and
-     * ctrl_mpc_torque give exactly these). Every duty-0 candidate has the same
-     * cost, formed at most once (g_zero, -1 until then). */
+    /* Every duty-0 candidate has the flux psi0 and the torque t0, the same
+     * cost: formed at most once (g_zero, -1 until then; a value >= bound
+     * instead of INT64_MAX decides the same, see ctrl_mpc_cost_at). */
     int64_t g_zero = -1;
     for (uint8_t k = 0u; k < 6u; k++) {
-        /* first, then 1..6 without it */
-        const uint8_t i = k == 0u ? first : (k < first ? k : (uint8_t)(k + 1u));
+        const uint8_t i = m1_order[first - 1u][k];
         q24_t vd;
         q24_t vq;
         ctrl_mpc_vec_dq(b, i, &vd, &vq);
@@ -39,20 +44,16 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         s->trace.duty[i - 1u] = duty;
         /* wins when below best_g, or equal to it with a lower index */
         const int64_t bound = best_v != 0u && i < best_v ? best_g + 1 : best_g;
-        int64_t g; /* (6.13), or a value >= bound when not below it */
-        if (duty == 0) {
-            if (g_zero < 0) {
-                g = ctrl_mpc_cost_at(b->d0, b->q0, b->t0, in.t_ref, in.psi_ref, s->zeta, bound);
-                g_zero = g != INT64_MAX ? g : -1;
-            } else {
-                g = g_zero;
-            }
-        } else if (duty == FX_ONE) {
-            g = ctrl_mpc_cost_at(b->d0 + vd, b->q0 + vq, t_full, in.t_ref, in.psi_ref, s->zeta,
-                                 bound);
+        /* (6.13), or a value >= bound when not below it */
+        int64_t g;
+        if (duty == 0 && g_zero >= 0) {
+            g = g_zero;
         } else {
-            g = ctrl_mpc_cost_weighted(&s->model, b, vd, vq, duty, in.t_ref, in.psi_ref, s->zeta,
-                                       bound);
+            g = ctrl_mpc_cost_duty(&s->model, b, vd, vq, duty, t_full, in.t_ref, in.psi_ref,
+                                   s->zeta, bound);
+            if (duty == 0 && g != INT64_MAX) {
+                g_zero = g;
+            }
         }
         if (g < bound) {
             best_g = g;

@@ -41,20 +41,15 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 
     int64_t best_g = INT64_MAX; /* best feasible |T_ref - Te| (6.16) */
     unsigned best = 0u;
-    unsigned best_flux = 0u; /* fallback: smallest |in.psi_ref - |psi|| */
-    int32_t best_flux_a2 = 0;
+    int32_t a2[CTRL_M2_Y_MAX + 1]; /* |psi(k+2)|^2 of each duty */
     for (unsigned nu = 0; nu <= s->y; nu++) {
         q24_t pd;
         q24_t pq;
         ctrl_mpc_flux(&in.b, vd, vq, s->d_nu[nu], &pd, &pq);
-        const int32_t a2 = ctrl_mpc_amp2(pd, pq);
-        if (nu == 0u || ctrl_mpc_closer(a2, best_flux_a2, r2) < 0) {
-            best_flux = nu;
-            best_flux_a2 = a2;
-        }
+        a2[nu] = ctrl_mpc_amp2(pd, pq);
         s->trace.vec[nu] = vec;
         s->trace.duty[nu] = s->d_nu[nu];
-        if (a2 < lo2 || a2 > hi2) {
+        if (a2[nu] < lo2 || a2[nu] > hi2) {
             continue; /* phi = infinity (6.17) */
         }
         const int64_t e_t = (int64_t)in.t_ref - ctrl_mpc_torque(&s->model, pd, pq);
@@ -66,7 +61,12 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     s->trace.n = (uint8_t)(s->y + 1u);
     if (best_g == INT64_MAX) {
-        best = best_flux;
+        /* None in the band: the smallest |psi_ref - |psi|| (the first on ties). */
+        for (unsigned nu = 1u; nu <= s->y; nu++) {
+            if (ctrl_mpc_closer(a2[nu], a2[best], r2) < 0) {
+                best = nu;
+            }
+        }
     }
     if (best == 0u) {
         ctrl_mpc_out_zero(out, &s->last_vec);

@@ -214,7 +214,8 @@ static inline void ctrl_mpc_vec3_dq(const ctrl_mpc_basis3_t *b, uint8_t i, q24_t
  * the last product saturates. */
 static inline q24_t ctrl_mpc_torque(const ctrl_mpc_model_t *m, q24_t psi_d, q24_t psi_q)
 {
-    return fx_mul(psi_q, m->a + fx_mul_nosat(m->b, psi_d));
+    /* b = 0 (SPMSM): b psi_d is 0, the same value without the product */
+    return fx_mul(psi_q, m->b != 0 ? m->a + fx_mul_nosat(m->b, psi_d) : m->a);
 }
 
 /* Ceiling of ctrl_mpc_amp2: 64 pu^2 in Q24. */
@@ -289,6 +290,23 @@ static inline int64_t ctrl_mpc_cost_weighted(const ctrl_mpc_model_t *m, const ct
     q24_t pq;
     ctrl_mpc_flux(b, vd, vq, duty, &pd, &pq);
     return ctrl_mpc_cost_at(pd, pq, ctrl_mpc_torque(m, pd, pq), t_ref, psi_ref, zeta, bound);
+}
+
+/* ctrl_mpc_cost_weighted of the candidate (vd, vq) with duty (5.18), t_full
+ * its Te(k+2) with the duty 1: a duty of 0 or FX_ONE takes the flux and torque
+ * already formed (psi0 and t0, or psi0 + Ts V and t_full: what ctrl_mpc_flux
+ * and ctrl_mpc_torque give for them, bit for bit). */
+static inline int64_t ctrl_mpc_cost_duty(const ctrl_mpc_model_t *m, const ctrl_mpc_basis_t *b,
+                                         q24_t vd, q24_t vq, q24_t duty, q24_t t_full, q24_t t_ref,
+                                         q24_t psi_ref, q24_t zeta, int64_t bound)
+{
+    if (duty == 0) {
+        return ctrl_mpc_cost_at(b->d0, b->q0, b->t0, t_ref, psi_ref, zeta, bound);
+    }
+    if (duty == FX_ONE) {
+        return ctrl_mpc_cost_at(b->d0 + vd, b->q0 + vq, t_full, t_ref, psi_ref, zeta, bound);
+    }
+    return ctrl_mpc_cost_weighted(m, b, vd, vq, duty, t_ref, psi_ref, zeta, bound);
 }
 
 #endif /* CONTROL_CTRL_M2PTFC_MODEL_H */

@@ -43,7 +43,7 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     /* The zero vector all period. */
     const int64_t g0 =
-        ctrl_mpc_cost_weighted(&s->model, &in.b, 0, 0, 0, in.t_ref, in.psi_ref, s->zeta, best_g);
+        ctrl_mpc_cost_at(in.b.d0, in.b.q0, in.b.t0, in.t_ref, in.psi_ref, s->zeta, best_g);
     s->trace.vec[2] = 0u;
     s->trace.duty[2] = 0;
     s->trace.n = 3u;
