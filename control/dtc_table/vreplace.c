@@ -24,26 +24,18 @@ uint8_t ctrl_vreplace(const ctrl_vreplace_t *c, uint8_t vec, uint8_t sector, q24
     if ((int64_t)dx * psi_alpha + (int64_t)dy * psi_beta <= 0) {
         return vec;
     }
-    /* n of V_{x+n}, 0..5 */
-    const int n = ((int)vec - (int)sector + 6) % 6;
-    if (n == 0 || n == 3) {
+    /* n of V_{x+n}, 0..5 (vec - x in -5..5) */
+    const int d = (int)vec - (int)sector;
+    const unsigned n = (unsigned)(d < 0 ? d + 6 : d);
+    if (n == 0u || n == 3u) {
         return vec;
     }
-    /* u = d e^{-+j(pi/6 - sigma)}: (dx cb +- dy sb, dy cb -+ dx sb), one rounding each. */
-    if (n == 2 || n == 5) {
-        /* Subsector I, (4.20): theta_s <= a + sigma. */
-        const q24_t ux = fx_dot(dx, dy, c->cos_b, c->sin_b);
-        const q24_t uy = fx_cross(dy, dx, c->sin_b, c->cos_b);
-        if (cross_sign(ux, uy, psi_alpha, psi_beta) <= 0) {
-            return ctrl_vec_wrap((int)sector + n - 1);
-        }
-    } else {
-        /* Subsector II, (4.21): theta_s > b - sigma. */
-        const q24_t ux = fx_cross(dx, dy, c->sin_b, c->cos_b);
-        const q24_t uy = fx_dot(dy, dx, c->cos_b, c->sin_b);
-        if (cross_sign(ux, uy, psi_alpha, psi_beta) > 0) {
-            return ctrl_vec_wrap((int)sector + n + 1);
-        }
+    const q24_t *u = (n == 2u || n == 5u) ? c->u_lo[sector - 1u] : c->u_hi[sector - 1u];
+    const int side = cross_sign(u[0], u[1], psi_alpha, psi_beta);
+    if (n == 2u || n == 5u) {
+        /* Subsector I, (4.20): theta_s <= a + sigma: V_{x+n} -> V_{x+n-1}. */
+        return side <= 0 ? ctrl_vec_offset(sector, n - 1u) : vec;
     }
-    return vec;
+    /* Subsector II, (4.21): theta_s > b - sigma: V_{x+n} -> V_{x+n+1}. */
+    return side > 0 ? ctrl_vec_offset(sector, n + 1u) : vec;
 }

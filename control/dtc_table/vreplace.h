@@ -27,7 +27,10 @@
 
 typedef struct {
     q24_t cos_b, sin_b; /* of pi/6 - sigma, sigma the subsector width in (0, pi/6], Q24 */
-    uint8_t enabled;    /* 0 (sigma == 0): ctrl_vreplace returns vec unchanged */
+    /* per sector x (index x - 1): u(a + sigma) and u(b - sigma), Q24, the
+     * direction of V_x turned as above (formed by ctrl_vreplace_config) */
+    q24_t u_lo[6][2], u_hi[6][2];
+    uint8_t enabled; /* 0 (sigma == 0): ctrl_vreplace returns vec unchanged */
 } ctrl_vreplace_t;
 
 /*

@@ -1,9 +1,11 @@
 /* Configuration of the voltage replacement (4.19) from sigma in radians. */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "ctrl_params.h"
 #include "ctrl_units.h"
+#include "vectors.h"
 #include "vreplace.h"
 #include "vreplace_config.h"
 
@@ -17,9 +19,7 @@ int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad)
     if (c == NULL) {
         return CTRL_EINVAL;
     }
-    c->cos_b = 0;
-    c->sin_b = 0;
-    c->enabled = 0u;
+    memset(c, 0, sizeof *c);
     if (!isfinite(sigma_rad) || sigma_rad < 0.0 || sigma_rad > sigma_max + 1e-9) {
         return CTRL_EINVAL;
     }
@@ -30,5 +30,15 @@ int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad)
     c->cos_b = ctrl_q24_from_double(cos(b));
     c->sin_b = ctrl_q24_from_double(sin(b));
     c->enabled = ctrl_q24_from_double(sin(sigma_rad)) > 0 ? 1u : 0u;
+    /* u = d e^{-+j(pi/6 - sigma)}: (dx cb +- dy sb, dy cb -+ dx sb), one
+     * rounding each (vreplace.h) */
+    for (unsigned x = 1u; x <= 6u; x++) {
+        const q24_t dx = ctrl_vec_dir_q24[x][0];
+        const q24_t dy = ctrl_vec_dir_q24[x][1];
+        c->u_lo[x - 1u][0] = fx_dot(dx, dy, c->cos_b, c->sin_b);
+        c->u_lo[x - 1u][1] = fx_cross(dy, dx, c->sin_b, c->cos_b);
+        c->u_hi[x - 1u][0] = fx_cross(dx, dy, c->sin_b, c->cos_b);
+        c->u_hi[x - 1u][1] = fx_dot(dy, dx, c->cos_b, c->sin_b);
+    }
     return CTRL_OK;
 }
