@@ -25,15 +25,12 @@ static q24_t fobs_q24(int64_t acc)
     return fx_round_sat(acc, FX_QBITS);
 }
 
-void ctrl_fobs_reset(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta, q24_t omega,
-                     q24_t i_alpha, q24_t i_beta)
+/* ctrl_fobs_reset in the frame (theta, s, c) with the current's i_d there. */
+static void fobs_reset_at(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta, q24_t s,
+                          q24_t c, q24_t i_d, q24_t omega, q24_t i_alpha, q24_t i_beta)
 {
-    q24_t s;
-    q24_t c;
-    fx_sincos(theta, &s, &c);
     /* Current model (3.9) at theta: psi = Lq i + psi_a e^{j theta},
      * psi_a = psi_pm + (Ld - Lq) i_d. */
-    const q24_t i_d = fx_dot(c, s, i_alpha, i_beta);
     const q24_t psi_a = fx_add(p->psi_pm, fx_mul(o->dl, i_d));
     const q24_t ea = fx_mul(psi_a, c);
     const q24_t eb = fx_mul(psi_a, s);
@@ -53,6 +50,22 @@ void ctrl_fobs_reset(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta, q
     o->omega = omega;
     o->psi_pm_acc = (int64_t)p->psi_pm * FX_ONE;
     o->primed = 1u;
+}
+
+void ctrl_fobs_reset(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta, q24_t omega,
+                     q24_t i_alpha, q24_t i_beta)
+{
+    q24_t s;
+    q24_t c;
+    fx_sincos(theta, &s, &c);
+    fobs_reset_at(o, p, theta, s, c, fx_dot(c, s, i_alpha, i_beta), omega, i_alpha, i_beta);
+}
+
+void ctrl_fobs_reset_frame(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_mstate_t *n,
+                           q24_t omega)
+{
+    fobs_reset_at(o, p, n->theta_e, n->sin_theta, n->cos_theta, n->i_d, omega, n->i_alpha,
+                  n->i_beta);
 }
 
 /* i / band clamped to [-1, 1], Q24. */

@@ -112,6 +112,11 @@ typedef struct {
  * psi_pm; i(k) as the previous current. */
 void ctrl_fobs_reset(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta, q24_t omega,
                      q24_t i_alpha, q24_t i_beta);
+/* The same at the frame n of an estimate (its theta_e, sin_theta, cos_theta,
+ * i_d, i_alpha, i_beta): no sine and cosine of its own; the same values where
+ * n's are fx_sincos's and fx_dot's (the estimator's). */
+void ctrl_fobs_reset_frame(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_mstate_t *n,
+                           q24_t omega);
 
 /* Period-average alpha/beta voltage of the leg duties at the measured DC
  * link, Q24 pu, with the inverter's voltage error removed: per leg, dead

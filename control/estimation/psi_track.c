@@ -34,11 +34,10 @@ static bool psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
 
 static void psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est)
 {
-    /* From the current model at theta(k) (ctrl_fobs_reset's flux, Q48); the
-     * correction and the EMA count from here. */
-    ctrl_fobs_t *const o = &t->obs;
-    const ctrl_mstate_t *n = &est->now;
-    ctrl_fobs_reset(o, p, n->theta_e, est->omega_e, n->i_alpha, n->i_beta);
+    /* From the current model at theta(k) in the estimator's frame
+     * (ctrl_fobs_reset's flux, Q48); the correction and the EMA count from
+     * here. */
+    ctrl_fobs_reset_frame(&t->obs, p, &est->now, est->omega_e);
     t->phase = (uint8_t)(t->div - 1u);
 }
 
