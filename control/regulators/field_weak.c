@@ -257,9 +257,9 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
 }
 
 void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
-                              q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
+                              q24_t t_req, ctrl_fieldweak_out_t *out)
 {
-    fw_step(s, p, vdc, omega, t_req, psi_cmd, out, 1);
+    fw_step(s, p, vdc, omega, t_req, 0, out, 1);
 }
 
 void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t t, q24_t psi_ref,

@@ -127,16 +127,16 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
 #define CTRL_FW_PSI_MAX_NOT_BINDING ((q24_t)-1)
 
 /*
- * ctrl_fieldweak_step for the interrupt: the same outputs, except that
- * psi_max is CTRL_FW_PSI_MAX_NOT_BINDING where the comparison of squares
- * shows it at least the MTPA flux at the current limit and the flux
+ * ctrl_fieldweak_step for the interrupt, with psi_cmd = 0: the same outputs,
+ * except that psi_max is CTRL_FW_PSI_MAX_NOT_BINDING where the comparison of
+ * squares shows it at least the MTPA flux at the current limit and the flux
  * reference of the clamped torque (below base speed: then neither the
  * torque limit nor the flux reference depends on its value), which saves
  * its square root and division; the first comparison is skipped inside a
  * region of DC link and speed where its worst case has passed (lz_*).
  */
 void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
-                              q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out);
+                              q24_t t_req, ctrl_fieldweak_out_t *out);
 
 /* Torque limit and its kind at flux amplitude psi in field weakening (the
  * flux-circle part above); for tests and tools. */

@@ -396,7 +396,7 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * weakened to what the voltage allows (0 = the controller's own below
      * base speed, so nothing changes there). */
     ctrl_fieldweak_out_t lim;
-    ctrl_fieldweak_step_lazy(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, 0, &lim);
+    ctrl_fieldweak_step_lazy(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, &lim);
     tref = lim.torque;
     /* Mean-torque trim in field weakening: with the flux at the voltage's
      * limit the torque rises slowly (little voltage beyond the back-EMF) and
@@ -588,7 +588,7 @@ void fw_isr(fw_t *fw)
     fw->busy = true;
     fw->period++;
     /* This period's record: the ring slot after the published ones. */
-    fw_telemetry_t *const tm = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
+    fw_telemetry_t *const tm = fw->tm_slot;
 
     hal_adc_raw_t raw;
     hal_encoder_raw_t enc;
@@ -639,6 +639,7 @@ void fw_isr(fw_t *fw)
         fw->tm_count = every;
         if (fw->tm_head - fw->tm_tail < FW_TM_RING - 1u) {
             fw->tm_head++;
+            fw->tm_slot = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
         } else {
             fw->tm_dropped++;
         }

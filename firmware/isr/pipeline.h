@@ -246,6 +246,7 @@ typedef struct {
      * (fw_tm_peek / fw_tm_release). Single producer, single consumer: the
      * interrupt never writes a slot in [tm_tail, tm_head). */
     fw_telemetry_t tm_ring[FW_TM_RING];
+    fw_telemetry_t *tm_slot;       /* &tm_ring[tm_head mod FW_TM_RING], kept with tm_head */
     const fw_telemetry_t *tm_last; /* the last complete record */
     volatile uint32_t tm_head;     /* records published (interrupt) */
     volatile uint32_t tm_tail;     /* records taken (main loop) */

@@ -275,6 +275,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     }
     memset(fw, 0, sizeof *fw);
     fw->tm_last = &fw->tm_ring[0];
+    fw->tm_slot = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
     fw->hal = hal;
     hal_gate_enable(hal, false);
     hal_info_get(hal, &fw->info);

@@ -375,7 +375,7 @@ static void check_lazy(const ctrl_machine_t *m, double psi_ref_wb)
             n_region++;
         }
         ctrl_fieldweak_step(&S, &P, vdc, omega_pu(rpm), t_req, 0, &oe);
-        ctrl_fieldweak_step_lazy(&lazy, &pl, vdc, omega_pu(rpm), t_req, 0, &ol);
+        ctrl_fieldweak_step_lazy(&lazy, &pl, vdc, omega_pu(rpm), t_req, &ol);
         TEST_ASSERT_EQUAL_INT32(oe.vdc, ol.vdc);
         TEST_ASSERT_EQUAL_INT32(oe.torque_max, ol.torque_max);
         TEST_ASSERT_EQUAL_INT32(oe.torque, ol.torque);
