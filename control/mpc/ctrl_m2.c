@@ -28,8 +28,8 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
 
     const int32_t r2 = ctrl_mpc_amp2(in.psi_ref, 0);
-    const uint8_t vec = ctrl_m2_table(ctx->est->next.sector, in.t_ref >= in.b.t0,
-                                      r2 >= ctrl_mpc_amp2(in.b.d0, in.b.q0));
+    const int32_t a2_zero = ctrl_mpc_amp2(in.b.d0, in.b.q0); /* |psi0|^2 */
+    const uint8_t vec = ctrl_m2_table(ctx->est->next.sector, in.t_ref >= in.b.t0, r2 >= a2_zero);
     q24_t vd;
     q24_t vq;
     ctrl_mpc_vec_dq(&in.b, vec, &vd, &vq);
@@ -43,16 +43,25 @@ void ctrl_m2_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     unsigned best = 0u;
     int32_t a2[CTRL_M2_Y_MAX + 1]; /* |psi(k+2)|^2 of each duty */
     for (unsigned nu = 0; nu <= s->y; nu++) {
-        q24_t pd;
-        q24_t pq;
-        ctrl_mpc_flux(&in.b, vd, vq, s->d_nu[nu], &pd, &pq);
-        a2[nu] = ctrl_mpc_amp2(pd, pq);
+        /* D_0 = 0: psi0, its square and t0 as formed (ctrl_mpc_flux and
+         * ctrl_mpc_torque give exactly these); D_y = 1: psi0 + Ts V. */
+        const q24_t d = s->d_nu[nu];
+        q24_t pd = in.b.d0;
+        q24_t pq = in.b.q0;
+        if (d == FX_ONE) {
+            pd += vd;
+            pq += vq;
+        } else if (d != 0) {
+            ctrl_mpc_flux(&in.b, vd, vq, d, &pd, &pq);
+        }
+        a2[nu] = d != 0 ? ctrl_mpc_amp2(pd, pq) : a2_zero;
         s->trace.vec[nu] = vec;
         s->trace.duty[nu] = s->d_nu[nu];
         if (a2[nu] < lo2 || a2[nu] > hi2) {
             continue; /* phi = infinity (6.17) */
         }
-        const int64_t e_t = (int64_t)in.t_ref - ctrl_mpc_torque(&s->model, pd, pq);
+        const q24_t te = d != 0 ? ctrl_mpc_torque(&s->model, pd, pq) : in.b.t0;
+        const int64_t e_t = (int64_t)in.t_ref - te;
         const int64_t g = e_t < 0 ? -e_t : e_t;
         if (g < best_g) {
             best_g = g;
