@@ -17,6 +17,14 @@
  * scaled by Vdc / (max - min): the result lies on the hexagon and keeps its
  * angle (one division, only when limiting).
  *
+ * Arithmetic: v is taken in units of the DC link once (two products with
+ * 1/Vdc, ctrl_svpwm_inv_vdc, the period's one division), in Q28 (Q16 for
+ * a reference of 4 Vdc or more, only to limit it); the phases, the limit
+ * test and the duties follow in 32 bits. Duties within about 1 LSB of the
+ * exact formula for the vector realised. Below 1/128 pu, where 1/Vdc
+ * saturates in Q24, the vector realised is the reference times Vdc 2^7
+ * (the drive's under-voltage trip lies far above).
+ *
  * All voltages Q24 per-unit (v_base = nominal Vdc, ctrl_params.h).
  */
 #ifndef CONTROL_SVPWM_H
