@@ -81,7 +81,7 @@ int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n)
 void ctrl_hpdtc_reset(void *state)
 {
     ctrl_hpdtc_state_t *s = state;
-    ctrl_hyst2_reset(&s->flux);
+    ctrl_hyst2_reset(&s->flux.h);
     ctrl_hyst2_reset(&s->torque);
     s->last_level = 0u;
     s->last_section = 2u;
@@ -93,7 +93,7 @@ void ctrl_hpdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *nx = &ctx->est->next; /* delay compensation */
     const q24_t psi_ref = ctx->ref->psi > 0 ? ctx->ref->psi : s->psi_ref;
     const q24_t t_err = fx_sub(ctx->ref->torque, nx->torque);
-    const int phi = ctrl_hyst2_update(&s->flux, fx_sub(psi_ref, nx->psi_amp)) > 0;
+    const int phi = ctrl_s1_flux_phi(&s->flux, &s->flux_lim_ref, psi_ref, nx->psi_amp_sq) > 0;
     const int tau = ctrl_hyst2_update(&s->torque, t_err) > 0;
     const uint8_t n = nx->sector;
     uint8_t k1;

@@ -31,7 +31,10 @@
 
 typedef struct {
     q24_t psi_ref; /* Q24 pu, > 0 */
-    ctrl_hyst2_t flux;
+    /* flux regulator on |psi(k+1)|^2 (no square root), its limits formed
+     * for the reference flux_lim_ref (Q24 pu; 0 after init: none yet) */
+    ctrl_hyst2_sq_t flux;
+    q24_t flux_lim_ref;
     ctrl_hyst3_t torque;
     uint8_t prev_vec;
 } ctrl_hdtc_state_t;
@@ -49,8 +52,11 @@ typedef struct {
 } ctrl_svm_dtc_state_t;
 
 typedef struct {
-    q24_t psi_ref;                                /* Q24 pu, > 0 */
-    ctrl_hyst2_t flux, torque;                    /* phi, tau of Table 4 (two-level) */
+    q24_t psi_ref; /* Q24 pu, > 0 */
+    /* phi, tau of Table 4 (two-level); phi on |psi(k+1)|^2 as hdtc's */
+    ctrl_hyst2_sq_t flux;
+    q24_t flux_lim_ref;
+    ctrl_hyst2_t torque;
     q24_t lvl_thr[HPDTC_LEVELS - 1];              /* |T_err| thresholds l e_fs / 5, Q24 pu */
     uint8_t pts[HPDTC_LEVELS][HPDTC_SECTIONS][2]; /* (t_k1, t_k2) in points */
     q24_t dur[HPDTC_LEVELS][HPDTC_SECTIONS][2];   /* the same, Q24 fraction of Ts */
@@ -67,6 +73,19 @@ int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2);
  * (psi_alpha, psi_beta) from the centre of its sector n (4.5), in [-30, 30) deg:
  * S1(40) with lambda_s measured from the start of the sector. */
 int ctrl_hpdtc_section(q24_t psi_alpha, q24_t psi_beta, uint8_t n);
+
+/* phi of hdtc and hpdtc: the flux regulator's output for the reference
+ * psi_ref (> 0) and the predicted |psi(k+1)|^2 (ctrl_mstate_t.psi_amp_sq),
+ * its limits formed again only when psi_ref moved. */
+static inline int8_t ctrl_s1_flux_phi(ctrl_hyst2_sq_t *h, q24_t *lim_ref, q24_t psi_ref,
+                                      uint64_t psi_amp_sq)
+{
+    if (psi_ref != *lim_ref) {
+        ctrl_hyst2_sq_limits(h, psi_ref);
+        *lim_ref = psi_ref;
+    }
+    return ctrl_hyst2_sq_update(h, psi_amp_sq);
+}
 
 extern const ctrl_desc_t ctrl_desc_hdtc;
 extern const ctrl_desc_t ctrl_desc_svm_dtc;

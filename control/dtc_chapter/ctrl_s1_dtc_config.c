@@ -113,7 +113,8 @@ static int hdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
         memset(s, 0, sizeof *s);
         return rc;
     }
-    ctrl_hyst2_init(&s->flux, hp);
+    ctrl_hyst2_sq_init(&s->flux, hp); /* limits for 0: formed at the first step */
+    s->flux_lim_ref = 0;
     ctrl_hyst3_init(&s->torque, ht);
     ctrl_hdtc_reset(s);
     return CTRL_OK;
@@ -234,7 +235,8 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
             }
         }
     }
-    ctrl_hyst2_init(&s->flux, hp);
+    ctrl_hyst2_sq_init(&s->flux, hp); /* limits for 0: formed at the first step */
+    s->flux_lim_ref = 0;
     ctrl_hyst2_init(&s->torque, ht);
     ctrl_hpdtc_reset(s);
     return CTRL_OK;
@@ -246,10 +248,10 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 
 S1_DESC(hdtc, "HDTC, hysteresis DTC with the optimum switching table (S1 sec. 3, Table 3)",
         ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step,
-        CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+        CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 sec. 4, S1(17)-(20))",
         ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step,
         CTRL_EST_AMP_NEXT | CTRL_EST_PSI_AB_NEXT | CTRL_EST_I_AB_NEXT);
 S1_DESC(hpdtc, "HP-DTC, two adjacent vectors + 20-point timing table (S1 sec. 5, Table 4)",
         ctrl_hpdtc_state_t, hpdtc_tunables, hpdtc_init, ctrl_hpdtc_reset, ctrl_hpdtc_step,
-        CTRL_EST_AMP_NEXT | CTRL_EST_SECTOR_NEXT);
+        CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);

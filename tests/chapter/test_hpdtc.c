@@ -152,6 +152,7 @@ static void set_next(double lam, double t)
     nx->psi_alpha = ctrl_q24_from_double(cos(lam));
     nx->psi_beta = ctrl_q24_from_double(sin(lam));
     nx->psi_amp = FX_ONE;
+    nx->psi_amp_sq = (uint64_t)FX_ONE * FX_ONE; /* its root: psi_amp */
     nx->torque = ctrl_q24_from_double(t);
     nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta); /* (4.5), as the estimator */
 }

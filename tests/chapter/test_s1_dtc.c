@@ -47,6 +47,7 @@ static void set_next(double lam, double amp, double t)
     nx->psi_alpha = ctrl_q24_from_double(amp * cos(lam));
     nx->psi_beta = ctrl_q24_from_double(amp * sin(lam));
     nx->psi_amp = ctrl_q24_from_double(amp);
+    nx->psi_amp_sq = (uint64_t)((int64_t)nx->psi_amp * nx->psi_amp); /* its root: psi_amp */
     nx->torque = ctrl_q24_from_double(t);
     nx->cos_theta = FX_ONE;
     nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta); /* (4.5), as the estimator */
