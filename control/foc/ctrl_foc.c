@@ -12,7 +12,6 @@
 #include "transforms.h"
 #include "vectors.h"
 
-#define FOC_INTEG_SHIFT 16u /* integrator Q40 = Q24 + 16 */
 #define FOC_KP_QBITS 20u
 
 void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q24_t *i_d,
@@ -28,25 +27,19 @@ void ctrl_foc_iref(const ctrl_params_t *p, const ctrl_foc_iref_t *r, q24_t t, q2
     *i_q = t < 0 ? fx_neg(q) : q;
 }
 
-q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
+/* The integrator in Q24: integ / 2^n rounded (ties up), n = ki_shift in
+ * 17..30; |integ| <= lim <= 2^59 puts the result within 2^29, so it is the
+ * low word of the rounded shift (fx_round_nosat's value), formed in 32-bit
+ * halves (the compiler's variable 64-bit shift costs ~15 instructions). */
+static inline q24_t foc_integ_q24(int64_t integ, unsigned n)
 {
-    /* |integ| <= lim <= 2^45 (Q40; the nominal DC link is at most 32 pu),
-     * so I in Q24 lies within 2^29: rounded without saturation. */
-    return fx_add(fx_mul_qn(err, pi->kp, FOC_KP_QBITS), fx_round_nosat(pi->integ, FOC_INTEG_SHIFT));
+    const uint64_t u = (uint64_t)integ + ((uint32_t)1 << (n - 1u));
+    return fx_u2i(((uint32_t)u >> n) | ((uint32_t)(u >> 32) << (32u - n)));
 }
 
-/* x / 2^n rounded (ties up), for 1 <= n <= 31 and |x| < 2^62: the value of
- * fx_rshift64_round(x, n), formed in 32-bit halves (a variable 64-bit shift
- * costs ~30 Cortex-M4 instructions in the compiler's general form): x
- * moved to offset binary u = x + 2^63 + 2^(n-1), shifted, the offset
- * 2^(63-n) taken from the high word. */
-static inline int64_t foc_rshift_round(int64_t x, unsigned n)
+q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
 {
-    const uint64_t u = (uint64_t)x + (((uint64_t)1 << 63) | ((uint32_t)1 << (n - 1u)));
-    const uint32_t hi = (uint32_t)(u >> 32);
-    const uint32_t lo = ((uint32_t)u >> n) | (hi << (32u - n));
-    const int32_t r_hi = fx_u2i((hi >> n) - ((uint32_t)1 << (31u - n)));
-    return (int64_t)r_hi * ((int64_t)1 << 32) + lo;
+    return fx_add(fx_mul_qn(err, pi->kp, FOC_KP_QBITS), foc_integ_q24(pi->integ, pi->ki_shift));
 }
 
 void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
@@ -54,12 +47,11 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
     if (limited != 0u && ((err > 0 && v > 0) || (err < 0 && v < 0))) {
         return; /* conditional integration: hold while pushing into the limit */
     }
-    /* err Q24 * ki_ts Q(ki_shift) -> Q40 (ki_shift 17..30: a shift of 1..14);
-     * |product| < 2^62. */
-    const int64_t inc =
-        foc_rshift_round((int64_t)err * pi->ki_ts, (unsigned)pi->ki_shift - FOC_INTEG_SHIFT);
+    /* err Q24 * ki_ts Q(ki_shift): the increment in the integrator's own
+     * Q(24 + ki_shift), exact (no rounding per period); |integ| <= 2^59,
+     * |product| < 2^62: the sum cannot overflow. */
     const int64_t lim = pi->lim;
-    int64_t i = pi->integ + inc; /* |integ| <= 2^45 (lim <= 32 pu), |inc| < 2^48 */
+    int64_t i = pi->integ + (int64_t)err * pi->ki_ts;
     i = i > lim ? lim : (i < -lim ? -lim : i);
     pi->integ = i;
 }

@@ -32,8 +32,8 @@
 typedef struct {
     int32_t kp;    /* V pu per A pu, Q20 (up to 2047: Kp ~ L wc / w_base grows with fs) */
     int32_t ki_ts; /* Ki Ts, V pu per (A pu * period), Q(ki_shift) */
-    int64_t integ; /* integrator, V pu, Q40, within +-lim */
-    int64_t lim;   /* the integrator's limit, the nominal DC link, Q40 */
+    int64_t integ; /* integrator, V pu, Q(24 + ki_shift): the sum of err ki_ts, within +-lim */
+    int64_t lim;   /* the integrator's limit, the nominal DC link, Q(24 + ki_shift), <= 2^59 */
     /* Fractional bits of ki_ts, 17..30: 30 while Ki Ts < 2 pu; fewer for a
      * machine whose Rs is many r_base (a gimbal motor: Rs ~ 16 pu, Ki Ts ~ 5). */
     uint8_t ki_shift;

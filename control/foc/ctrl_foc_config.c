@@ -78,8 +78,7 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     }
     /* Ki Ts in Q(ki_shift): Q30 below 2 pu (every thesis machine), fewer bits
      * above (Ki Ts = Rs wc Ts grows with Rs / r_base: a gimbal motor's Rs is
-     * ~16 r_base at its low rated speed); at least 17 (the update shifts by
-     * ki_shift - 16 >= 1). */
+     * ~16 r_base at its low rated speed); at least 17. */
     if (!isfinite(ki_ts) || !(ki_ts >= 0.0) || ki_ts >= FOC_KI_TS_MAX) {
         return ctrl_setup_refuse(su, CTRL_ERANGE, "current PI Ki Ts / (r_base)", "pu", ki_ts, 0.0,
                                  FOC_KI_TS_MAX);
@@ -88,8 +87,9 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     while (ki_shift > 17u && ki_ts * ldexp(1.0, (int)ki_shift) >= 2147483000.0) {
         ki_shift--;
     }
-    pi->kp = (int32_t)llround(kp * 1048576.0);          /* Q20 */
-    pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << 16); /* Q40 */
+    pi->kp = (int32_t)llround(kp * 1048576.0); /* Q20 */
+    /* Q(24 + ki_shift): vdc_nom <= 32 pu (2^29), so lim <= 2^59 */
+    pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << ki_shift);
     pi->ki_ts = (int32_t)llround(ldexp(ki_ts, (int)ki_shift));
     pi->ki_shift = (uint8_t)ki_shift;
     pi->integ = 0;

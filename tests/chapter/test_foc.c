@@ -89,13 +89,13 @@ static void test_iref(void)
 
 static void test_pi_antiwindup(void)
 {
-    /* Kp 1.3 (Q20), Ki Ts 0.02 (Q30), integrator limit 1 pu (Q40). */
+    /* Kp 1.3 (Q20), Ki Ts 0.02 (Q30), integrator limit 1 pu (Q54 = Q(24 + 30)). */
     ctrl_foc_pi_t pi = {(int32_t)(1.3 * 1048576.0), (int32_t)(0.02 * 1073741824.0), 0,
-                        (int64_t)1 << 40, 30u};
+                        (int64_t)1 << 54, 30u};
     const q24_t e = FX_ONE / 10;
     /* Not limited: integrates Ki Ts e = 0.002 pu per step. */
     ctrl_foc_pi_update(&pi, e, FX_ONE, 0u);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.002, (double)pi.integ / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.002, (double)pi.integ / 18014398509481984.0);
     /* Limited and the error pushes the output further: hold. */
     const int64_t held = pi.integ;
     ctrl_foc_pi_update(&pi, e, FX_ONE, 1u);
@@ -104,7 +104,7 @@ static void test_pi_antiwindup(void)
     TEST_ASSERT_EQUAL_INT64(held, pi.integ);
     /* Limited but the error pulls back: integrate. */
     ctrl_foc_pi_update(&pi, -e, FX_ONE, 1u);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, (double)pi.integ / 1099511627776.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, (double)pi.integ / 18014398509481984.0);
     /* Clamped to 1 pu however long it integrates. */
     for (int k = 0; k < 2000; k++) {
         ctrl_foc_pi_update(&pi, FX_ONE, FX_ONE, 0u);
@@ -263,7 +263,8 @@ static void test_saturation_recovery(void)
     step_metrics(rec_q, 0.5, &rise, &over);
     TEST_ASSERT_TRUE(over < 0.10);
     TEST_ASSERT_DOUBLE_WITHIN(1e-4, 0.5, rec_q[NSTEP - 1]);
-    TEST_ASSERT_TRUE(fabs((double)s->pi_q.integ) <= 1099511627776.0);
+    /* within 1 pu (the nominal DC link) in the integrator's Q(24 + ki_shift) */
+    TEST_ASSERT_TRUE(fabs((double)s->pi_q.integ) <= ldexp(1.0, 24 + s->pi_q.ki_shift));
 }
 
 static void test_foc_hyst_decisions(void)
