@@ -31,9 +31,10 @@ uint8_t ctrl_drr_select(uint8_t sector, q24_t t_err, q24_t psi_err)
 q24_t ctrl_drr_ema(q24_t gamma, q24_t chi, q24_t lambda)
 {
     /* (5.4) rewritten gamma[k] = gamma[k-1] + lambda (chi[k] - gamma[k-1]):
-     * |chi - gamma| < 2^32, lambda < 2^25, product < 2^57. */
-    const int64_t d = (int64_t)chi - gamma;
-    return fx_sat32((int64_t)gamma + fx_rshift64_round(d * lambda, FX_QBITS));
+     * |chi - gamma| < 2^32, lambda < 2^25, product < 2^57; formed as
+     * chi lambda - gamma lambda (two 32 x 32 products, each < 2^56). */
+    const int64_t d = (int64_t)chi * lambda - (int64_t)gamma * lambda;
+    return fx_sat32((int64_t)gamma + fx_rshift64_round(d, FX_QBITS));
 }
 
 int ctrl_drr_vreplace_active(const ctrl_drr_state_t *s, q24_t psi_err)
@@ -53,8 +54,9 @@ void ctrl_drr_c_parts(const ctrl_drr_state_t *s, q24_t omega_e, q24_t *c_num, q2
      * clamped to dc_max < 0, i.e. |C| <= CTRL_DRR_C_MAX. */
     /* 2 B |w| / w_rn generalised to twice the magnitude of the zero-vector
      * deviation with its resistive part, |kb w + rt| (s->rt = 0: the thesis). */
-    const q24_t z = s->rt == 0 ? fx_mul(s->kb, fx_abs(drr_lim(omega_e)))
-                               : fx_abs(fx_add(fx_mul(s->kb, drr_lim(omega_e)), drr_lim(s->rt)));
+    const q24_t w = drr_lim(omega_e);
+    const q24_t z = s->rt == 0 ? fx_mul(s->kb, fx_keep32(w < 0 ? -w : w)) /* |w| <= 2^26 */
+                               : fx_abs(fx_add(fx_mul(s->kb, w), drr_lim(s->rt)));
     const q24_t d = fx_sub(fx_lshift_sat(z, 1u), s->sqrt3_a);
     *dc = fx_min(d, s->dc_max);
 }
@@ -136,7 +138,9 @@ static q24_t drr_duty_c(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha,
     /* psi x v_hat = |psi| sin(theta_v - theta_s): positive for V_{x+1}, V_{x+2},
      * negative for V_{x+4}, V_{x+5} in sector x, so A (psi x v_hat) / |psi| is
      * the A |sin(.)| term of (5.6) with the sign of (5.7). */
-    const q24_t cross = fx_cross(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
+    /* |psi| components within 2^26, the unit vector's within 2^24: the
+     * difference of products below 2^51, no saturation */
+    const q24_t cross = fx_cross_nosat(drr_lim(psi_alpha), drr_lim(psi_beta), ux, uy);
 
     /*
      * (5.14) with C = cn / dc and Delta T = A cross / |psi| - kb w, numerator and
@@ -211,11 +215,12 @@ static q24_t drr_t_start_c(const ctrl_drr_state_t *s, q24_t t_k1, q24_t cn, q24_
 {
     /* (1 - D)/2 of zero vector precede the active vector in a centre-aligned
      * period; D: the last duty (steady state, D(k+1) ~ D(k)). */
-    const q24_t half_zero = fx_rshift32_round(FX_ONE - fx_clamp(s->last_duty, 0, FX_ONE), 1u);
+    const uint32_t d0 = (uint32_t)(FX_ONE - fx_clamp(s->last_duty, 0, FX_ONE)); /* [0, 2^24] */
+    const q24_t half_zero = fx_keep32((q24_t)((d0 + 1u) >> 1)); /* rounded half up */
     /* Zero-vector torque deviation per period by (5.12): C gamma = cn gamma / dc
      * (dc <= dc_max < 0: never a zero divisor). */
     const q24_t cg = fx_mul(cn, drr_lim(s->gamma));
-    const q24_t dt0 = s->dc_fixed != 0 ? fx_neg(cg) : fx_div(cg, dc);
+    const q24_t dt0 = fx_keep32(s->dc_fixed != 0 ? fx_neg(cg) : fx_div(cg, dc));
     return fx_add(t_k1, fx_mul(half_zero, dt0));
 }
 
