@@ -78,11 +78,10 @@ void st_fst_logic_reset(st_fst_logic_t *l)
     l->terr_nonneg_prev = 1u;
 }
 
-st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24_t omega)
+/* st_fst_logic_update's body (inline in the step) */
+static inline st_fst_mode_t st_fst_logic_step(st_fst_logic_t *l, q24_t tref, q24_t terr,
+                                              q24_t omega)
 {
-    if (l == NULL) {
-        return ST_FST_DYNAMIC; /* active vectors only: always stable */
-    }
     const uint8_t nonneg = terr >= 0 ? 1u : 0u;
     const uint8_t crossed = nonneg != l->terr_nonneg_prev ? 1u : 0u;
     const int64_t d_tref = (int64_t)tref - l->tref_prev;
@@ -98,6 +97,14 @@ st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24
         return ST_FST_DYNAMIC;
     }
     return omega >= 0 ? ST_FST_STEADY_FWD : ST_FST_STEADY_BWD;
+}
+
+st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24_t omega)
+{
+    if (l == NULL) {
+        return ST_FST_DYNAMIC; /* active vectors only: always stable */
+    }
+    return st_fst_logic_step(l, tref, terr, omega);
 }
 
 void st_fst_reset(void *state)
@@ -125,10 +132,11 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     }
     const int psi_inc = nx->psi_amp_sq < s->psi_le_lim;
     /* Step detection on the reference itself, not on T_vref. */
-    const st_fst_mode_t mode = st_fst_logic_update(&s->logic, tref, t_err, ctx->est->omega_e);
+    const st_fst_mode_t mode = st_fst_logic_step(&s->logic, tref, t_err, ctx->est->omega_e);
     if (mode != ST_FST_DYNAMIC) {
-        /* Integrate in steady state only (a step's error is the dynamics'). */
-        const q24_t inc = fx_mul(s->ki, fx_sub(tref, nx->torque));
+        /* Integrate in steady state only (a step's error is the dynamics').
+         * k_i <= 0.5 (2^23), |error| <= 2^31: |product| <= 2^54, no saturation. */
+        const q24_t inc = fx_mul_nosat(s->ki, fx_sub(tref, nx->torque));
         s->g = fx_clamp(fx_add(s->g, inc), fx_neg(s->g_max), s->g_max);
     }
     const uint8_t x = nx->sector;
