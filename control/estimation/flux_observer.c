@@ -17,6 +17,13 @@
 
 static int64_t fobs_clamp(int64_t x)
 {
+    /* x in [-127 2^48, 127 2^48) - the usual case - exactly when its high
+     * word, floor(x / 2^32), is in [-127 2^16, 127 2^16): one unsigned
+     * compare of the high word moved by 127 2^16. */
+    const uint32_t hi = (uint32_t)((uint64_t)x >> 32);
+    if (hi + (127u << 16) < (254u << 16)) {
+        return x;
+    }
     return x > FOBS_ACC_MAX ? FOBS_ACC_MAX : (x < -FOBS_ACC_MAX ? -FOBS_ACC_MAX : x);
 }
 
