@@ -6,9 +6,9 @@
 
 #define FW_NEWTON_STEPS 3 /* per call of ctrl_fieldweak_currents */
 
-/* Forced inlining of the per-period body into its two entry points (the
- * interrupt's and the tests'): an out-of-line call costs the interrupt more
- * than it saves in code (measured, tools/bench). */
+/* Forced inlining of the per-period body into its two entry points
+ * (ctrl_fieldweak_step and the lazy step's remainder): an out-of-line call
+ * costs the interrupt more than it saves in code (measured, tools/bench). */
 #if defined(__GNUC__)
 #define FW_ALWAYS_INLINE __attribute__((always_inline)) inline
 #define FW_NOINLINE __attribute__((noinline))
@@ -172,29 +172,18 @@ static int fw_lazy_enter(ctrl_fieldweak_t *s, q24_t vdc_f, q24_t omega, q24_t w)
     return 1;
 }
 
-static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
-                                     q24_t omega, q24_t t_req, q24_t psi_cmd,
-                                     ctrl_fieldweak_out_t *out, int lazy)
+/* Everything of a period after the DC-link filter (vdc_f, >= 0). */
+static FW_ALWAYS_INLINE void fw_limits(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc_f,
+                                       q24_t omega, q24_t t_req, q24_t psi_cmd,
+                                       ctrl_fieldweak_out_t *out, int lazy)
 {
-    /* DC link: first-order low pass (the ADC's noise, not its dips: vdc_k is
-     * set for ~1 kHz). */
-    if (s->primed == 0u) {
-        s->vdc_acc = (int64_t)vdc * FX_ONE;
-        s->primed = 1u;
-    } else {
-        /* vdc_r: the accumulator rounded, as left by the last period */
-        s->vdc_acc += (int64_t)fx_sub(vdc, s->vdc_r) * s->vdc_k; /* |.| < 2^31 * 2^24 */
-    }
-    s->vdc_r = fx_round_sat(s->vdc_acc, FX_QBITS);
-    const q24_t vdc_f = fx_max(s->vdc_r, 0);
     out->vdc = vdc_f;
 
     /* Flux the voltage allows: psi_max = sqrt(V^2 - (Rs I)^2 - 2 Rs w T) / |w|. */
     const q24_t w = fx_abs(omega);
     const q24_t psi_fix = psi_cmd > 0 ? psi_cmd : p->psi_ref;
     if (lazy != 0 && psi_fix <= 0 && w != 0 &&
-        ((w <= s->lz_w_max && vdc_f >= s->lz_vdc_min && fx_abs(s->t_prev) <= s->t_mtpa) ||
-         fw_lazy_enter(s, vdc_f, omega, w))) {
+        (ctrl_fieldweak_in_region(s, vdc_f, w) || fw_lazy_enter(s, vdc_f, omega, w))) {
         /* psi_max >= the MTPA flux at I_max (inside the region, or by the
          * test): the current limit, whatever psi_max is; if it is also >=
          * the flux reference of the clamped torque, neither the reference
@@ -205,14 +194,7 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
         if (psi_own <= s->psi_mtpa ||
             (psi_own <= s->psi_ceil &&
              fw_flux_at_least(fw_volt_sq_once(s, vdc_f, omega), w, psi_own))) {
-            out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
-            out->torque_max = s->t_mtpa;
-            out->torque = t;
-            out->psi_ref = psi_own;
-            out->limit = CTRL_FW_LIMIT_CURRENT;
-            out->clipped = t != t_req ? 1u : 0u;
-            out->weakening = 0u;
-            s->t_prev = t;
+            ctrl_fieldweak_current_limit(s, t, t_req, psi_own, out);
             s->lz_xv = 0u;
             return;
         }
@@ -253,13 +235,13 @@ static FW_ALWAYS_INLINE void fw_step(ctrl_fieldweak_t *s, const ctrl_params_t *p
 void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
                          q24_t t_req, q24_t psi_cmd, ctrl_fieldweak_out_t *out)
 {
-    fw_step(s, p, vdc, omega, t_req, psi_cmd, out, 0);
+    fw_limits(s, p, ctrl_fieldweak_vdc_filter(s, vdc), omega, t_req, psi_cmd, out, 0);
 }
 
-void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
-                              q24_t t_req, ctrl_fieldweak_out_t *out)
+void ctrl_fieldweak_limits_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc_f,
+                                q24_t omega, q24_t t_req, ctrl_fieldweak_out_t *out)
 {
-    fw_step(s, p, vdc, omega, t_req, 0, out, 1);
+    fw_limits(s, p, vdc_f, omega, t_req, 0, out, 1);
 }
 
 void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t t, q24_t psi_ref,

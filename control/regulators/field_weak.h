@@ -126,6 +126,48 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
  * computed. */
 #define CTRL_FW_PSI_MAX_NOT_BINDING ((q24_t)-1)
 
+/* The DC link's first-order low pass of a period (the ADC's noise, not its
+ * dips: vdc_k is set for ~1 kHz); returns it, >= 0. */
+static inline q24_t ctrl_fieldweak_vdc_filter(ctrl_fieldweak_t *s, q24_t vdc)
+{
+    if (s->primed == 0u) {
+        s->vdc_acc = (int64_t)vdc * FX_ONE;
+        s->primed = 1u;
+    } else {
+        /* vdc_r: the accumulator rounded, as left by the last period */
+        s->vdc_acc += (int64_t)fx_sub(vdc, s->vdc_r) * s->vdc_k; /* |.| < 2^31 * 2^24 */
+    }
+    s->vdc_r = fx_round_sat(s->vdc_acc, FX_QBITS);
+    return fx_max(s->vdc_r, 0);
+}
+
+/* Inside the lazy step's region (lz_*; speed w = |omega| > 0): there
+ * psi_max >= psi_mtpa (field_weak.c, fw_lazy_region). */
+static inline int ctrl_fieldweak_in_region(const ctrl_fieldweak_t *s, q24_t vdc_f, q24_t w)
+{
+    return w <= s->lz_w_max && vdc_f >= s->lz_vdc_min && fx_abs(s->t_prev) <= s->t_mtpa;
+}
+
+/* The outputs below base speed: the current limit, torque t (t_req
+ * clamped to +-t_mtpa), the controller's own flux reference psi_own, psi_max
+ * not computed. */
+static inline void ctrl_fieldweak_current_limit(ctrl_fieldweak_t *s, q24_t t, q24_t t_req,
+                                                q24_t psi_own, ctrl_fieldweak_out_t *out)
+{
+    out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
+    out->torque_max = s->t_mtpa;
+    out->torque = t;
+    out->psi_ref = psi_own;
+    out->limit = CTRL_FW_LIMIT_CURRENT;
+    out->clipped = t != t_req ? 1u : 0u;
+    out->weakening = 0u;
+    s->t_prev = t;
+}
+
+/* ctrl_fieldweak_step_lazy after its DC-link filter (vdc_f): out of line. */
+void ctrl_fieldweak_limits_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc_f,
+                                q24_t omega, q24_t t_req, ctrl_fieldweak_out_t *out);
+
 /*
  * ctrl_fieldweak_step for the interrupt, with psi_cmd = 0: the same outputs,
  * except that psi_max is CTRL_FW_PSI_MAX_NOT_BINDING where the comparison of
@@ -134,9 +176,27 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
  * torque limit nor the flux reference depends on its value), which saves
  * its square root and division; the first comparison is skipped inside a
  * region of DC link and speed where its worst case has passed (lz_*).
+ * Inline the usual period below base speed - inside the region, the flux
+ * reference within the MTPA flux at the current limit - and out of line
+ * the rest (ctrl_fieldweak_limits_lazy).
  */
-void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc, q24_t omega,
-                              q24_t t_req, ctrl_fieldweak_out_t *out);
+static inline void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
+                                            q24_t omega, q24_t t_req, ctrl_fieldweak_out_t *out)
+{
+    const q24_t vdc_f = ctrl_fieldweak_vdc_filter(s, vdc);
+    const q24_t w = fx_abs(omega);
+    if (p->psi_ref <= 0 && w != 0 && ctrl_fieldweak_in_region(s, vdc_f, w)) {
+        const q24_t t = fx_clamp(t_req, fx_neg(s->t_mtpa), s->t_mtpa);
+        /* psi_ref <= 0, no command: ctrl_flux_ref is the MTPA flux of t */
+        const q24_t psi_own = ctrl_flux_ref_memo(&s->own, p, 0, t);
+        if (psi_own <= s->psi_mtpa) {
+            out->vdc = vdc_f;
+            ctrl_fieldweak_current_limit(s, t, t_req, psi_own, out);
+            return;
+        }
+    }
+    ctrl_fieldweak_limits_lazy(s, p, vdc_f, omega, t_req, out);
+}
 
 /* Torque limit and its kind at flux amplitude psi in field weakening (the
  * flux-circle part above); for tests and tools. */
