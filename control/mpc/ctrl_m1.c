@@ -18,8 +18,18 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     ctrl_mpc_in(&s->model, &s->flux, ctx, &in);
     const ctrl_mpc_basis_t *b = &in.b;
 
-    /* Numerator of (5.18): T_err - dTe[0] = T_ref - Te0(k+2). */
+    /* (5.18) for each vector: D_f = (T_ref - Te0(k+2)) / (Te(k+2) - Te0(k+2)),
+     * Te(k+2) with the vector the whole period (t_full). */
     const q24_t num = fx_sub(in.t_ref, b->t0);
+    q24_t t_full[6];
+    for (uint8_t i = 1u; i <= 6u; i++) {
+        q24_t vd;
+        q24_t vq;
+        ctrl_mpc_vec_dq(b, i, &vd, &vq);
+        t_full[i - 1u] = ctrl_mpc_torque(&s->model, b->d0 + vd, b->q0 + vq);
+        s->trace.vec[i - 1u] = i;
+        s->trace.duty[i - 1u] = ctrl_mpc_duty_sat(num, fx_sub(t_full[i - 1u], b->t0));
+    }
     /* argmin of (6.13) over V1..V6, the lowest index among equal costs. The
      * last period's vector goes first: usually the best or near it, so more
      * of the others' torque terms alone reach its cost and their square roots
@@ -28,20 +38,13 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const uint8_t first = s->last_vec >= 1u && s->last_vec <= 6u ? s->last_vec : 1u;
     int64_t best_g = INT64_MAX;
     uint8_t best_v = 0u; /* none yet */
-    q24_t best_d = 0;
     /* Every duty-0 candidate has the flux psi0 and the torque t0, the same
      * cost: formed at most once (g_zero, -1 until then; a value >= bound
      * instead of INT64_MAX decides the same, see ctrl_mpc_cost_at). */
     int64_t g_zero = -1;
     for (uint8_t k = 0u; k < 6u; k++) {
         const uint8_t i = m1_order[first - 1u][k];
-        q24_t vd;
-        q24_t vq;
-        ctrl_mpc_vec_dq(b, i, &vd, &vq);
-        const q24_t t_full = ctrl_mpc_torque(&s->model, b->d0 + vd, b->q0 + vq);
-        const q24_t duty = ctrl_mpc_duty_sat(num, fx_sub(t_full, b->t0)); /* (5.18) */
-        s->trace.vec[i - 1u] = i;
-        s->trace.duty[i - 1u] = duty;
+        const q24_t duty = s->trace.duty[i - 1u];
         /* wins when below best_g, or equal to it with a lower index */
         const int64_t bound = best_v != 0u && i < best_v ? best_g + 1 : best_g;
         /* (6.13), or a value >= bound when not below it */
@@ -49,7 +52,10 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         if (duty == 0 && g_zero >= 0) {
             g = g_zero;
         } else {
-            g = ctrl_mpc_cost_duty(&s->model, b, vd, vq, duty, t_full, in.t_ref, in.psi_ref,
+            q24_t vd;
+            q24_t vq;
+            ctrl_mpc_vec_dq(b, i, &vd, &vq);
+            g = ctrl_mpc_cost_duty(&s->model, b, vd, vq, duty, t_full[i - 1u], in.t_ref, in.psi_ref,
                                    s->zeta, bound);
             if (duty == 0 && g != INT64_MAX) {
                 g_zero = g;
@@ -58,10 +64,10 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         if (g < bound) {
             best_g = g;
             best_v = i;
-            best_d = duty;
         }
     }
     s->trace.n = 6u;
+    /* best_v >= 1: the first candidate's cost (below 2^34) is below INT64_MAX */
     s->last_vec = best_v;
-    ctrl_out_active_zero(out, best_v, best_d);
+    ctrl_out_active_zero(out, best_v, s->trace.duty[best_v - 1u]);
 }
