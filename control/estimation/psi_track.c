@@ -8,7 +8,7 @@
 void ctrl_psi_track_reset(ctrl_psi_track_t *t)
 {
     t->obs.primed = 0u;
-    t->phase = 0u;
+    t->until = 1u;
 }
 
 /* Correction towards the current model (3.9) at the measured angle in the
@@ -38,7 +38,7 @@ static void psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const c
      * (ctrl_fobs_reset's flux, Q48); the correction and the EMA count from
      * here. */
     ctrl_fobs_reset_frame(&t->obs, p, &est->now, est->omega_e);
-    t->phase = (uint8_t)(t->div - 1u);
+    t->until = (uint8_t)(t->div > 1u ? 2u : 1u); /* the first correction at the next step */
 }
 
 bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
@@ -67,11 +67,13 @@ bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl
     }
     t->i_prev[0] = i_now[0];
     t->i_prev[1] = i_now[1];
-    const unsigned ph = t->phase;
-    t->phase = (uint8_t)(ph + 1u >= t->div ? 0u : ph + 1u);
-    const bool moved = ph == 0u ? psi_track_correct(t, p, est) : false;
+    bool moved = false;
+    if (--t->until == 0u) {
+        t->until = t->div;
+        moved = psi_track_correct(t, p, est);
+    }
     /* the voltage of [k, k+1) */
-    if (o->dt_frac == 0 && o->v_fwd == 0) {
+    if (t->duty_v != 0u) {
         /* The estimator's duty voltage per unit of DC link: Ts Vdc <= 64 pu,
          * the product below 2^55 (no saturation). */
         const q24_t ts_vdc = fx_mul_nosat(p->ts, est->vdc);

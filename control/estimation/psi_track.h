@@ -51,7 +51,8 @@ typedef struct {
     q24_t psi_k_n;   /* EMA coefficient per update, Q24: 1 - exp(-N Ts / tau) */
     q24_t speed_min; /* the EMA runs where |omega| >= this, Q24 pu */
     uint8_t div;     /* N: one correction every N periods */
-    uint8_t phase;   /* period within the N, 0..N-1 */
+    uint8_t until;   /* periods to the next correction, this one counted, 1..N */
+    uint8_t duty_v;  /* 1: the estimator's duty voltage (no dead time, no drop to remove) */
 } ctrl_psi_track_t;
 
 /* Restart from the current model at the next step (keeps the settings and

@@ -35,6 +35,7 @@ int ctrl_psi_track_setup(ctrl_psi_track_t *t, const ctrl_params_t *p)
     o->psi_speed_min = 0;
     o->psi_k = 0;
     t->div = (uint8_t)div;
+    t->duty_v = o->dt_frac == 0 && o->v_fwd == 0 ? 1u : 0u;
     ctrl_psi_track_reset(t);
     return CTRL_OK;
 }
