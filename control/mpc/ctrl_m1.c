@@ -22,6 +22,9 @@ void ctrl_m1_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
      * Te(k+2) with the vector the whole period (t_full). */
     const q24_t num = fx_sub(in.t_ref, b->t0);
     q24_t t_full[6];
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC unroll 6 /* constant vector offsets: 45 instructions less per period (tools/bench) */
+#endif
     for (uint8_t i = 1u; i <= 6u; i++) {
         q24_t vd;
         q24_t vq;
