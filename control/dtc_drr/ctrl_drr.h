@@ -31,6 +31,7 @@
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
+#include "mtpa.h"
 #include "vreplace.h"
 
 #define CTRL_DRR_FS_HZ 10000u /* thesis §5.6: DRR methods at 10 kHz */
@@ -94,6 +95,7 @@ typedef struct {
     q24_t integ;                  /* D_PI integrator (duty units, clamped to [-1, 1]) */
     q24_t last_duty;              /* last duty, Q24 fraction of the period */
     q24_t last_terr, last_psierr; /* T_ref - Te, Q24 pu torque; psi_ref - |psi|, Q24 pu flux */
+    ctrl_flux_memo_t flux_ref;    /* the flux reference of T_ref (mtpa.h) */
 } ctrl_drr_base_state_t;
 
 /* ---------------- per-sample building blocks (ctrl_drr.c, integer-only) ---------------- */

@@ -107,6 +107,7 @@ void ctrl_drr_base_reset(void *state)
     s->last_duty = 0;
     s->last_terr = 0;
     s->last_psierr = 0;
+    s->flux_ref.valid = 0u;
 }
 
 void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
@@ -116,7 +117,9 @@ void ctrl_drr_base_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const q24_t w = ctx->est->omega_e;
     const q24_t tref = ctx->ref->torque;
     const q24_t terr = fx_sub(tref, nx->torque);
-    const q24_t psierr = fx_sub(ctrl_flux_ref(ctx->params, ctx->ref->psi, tref), nx->psi_amp);
+    /* the flux reference of T_ref: formed only when an input moved (mtpa.h) */
+    const q24_t psi_ref = ctrl_flux_ref_memo(&s->flux_ref, ctx->params, ctx->ref->psi, tref);
+    const q24_t psierr = fx_sub(psi_ref, nx->psi_amp);
     const uint8_t vec = ctrl_drr_select(nx->sector, terr, psierr);
     q24_t duty = 0;
     switch ((ctrl_drr_base_kind_t)s->kind) {
