@@ -37,12 +37,13 @@ static inline q24_t foc_integ_q24(int64_t integ, unsigned n)
     return fx_u2i(((uint32_t)u >> n) | ((uint32_t)(u >> 32) << (32u - n)));
 }
 
-q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
+/* The bodies of ctrl_foc_pi_out and ctrl_foc_pi_update, inline in the step. */
+static inline q24_t foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
 {
     return fx_add(fx_mul_qn(err, pi->kp, FOC_KP_QBITS), foc_integ_q24(pi->integ, pi->ki_shift));
 }
 
-void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
+static inline void foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
 {
     if (limited != 0u && ((err > 0 && v > 0) || (err < 0 && v < 0))) {
         return; /* conditional integration: hold while pushing into the limit */
@@ -54,6 +55,16 @@ void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
     int64_t i = pi->integ + (int64_t)err * pi->ki_ts;
     i = i > lim ? lim : (i < -lim ? -lim : i);
     pi->integ = i;
+}
+
+q24_t ctrl_foc_pi_out(const ctrl_foc_pi_t *pi, q24_t err)
+{
+    return foc_pi_out(pi, err);
+}
+
+void ctrl_foc_pi_update(ctrl_foc_pi_t *pi, q24_t err, q24_t v, uint8_t limited)
+{
+    foc_pi_update(pi, err, v, limited);
 }
 
 void ctrl_foc_reset(void *state)
@@ -77,8 +88,8 @@ static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref
     const q24_t e_d = fx_sub(id_ref, nx->i_d);
     const q24_t e_q = fx_sub(iq_ref, nx->i_q);
     /* Decoupling feed-forward of S1(1): -omega Lq i_q and omega (Ld i_d + psi_pm). */
-    const q24_t v_d = fx_add(fx_neg(fx_mul(w, nx->psi_q)), ctrl_foc_pi_out(&s->pi_d, e_d));
-    const q24_t v_q = fx_add(fx_mul(w, nx->psi_d), ctrl_foc_pi_out(&s->pi_q, e_q));
+    const q24_t v_d = fx_add(fx_neg(fx_mul(w, nx->psi_q)), foc_pi_out(&s->pi_d, e_d));
+    const q24_t v_q = fx_add(fx_mul(w, nx->psi_d), foc_pi_out(&s->pi_q, e_q));
     s->v_d = v_d;
     s->v_q = v_q;
     /* Mean rotor angle over [k+1, k+2): theta(k+1) + omega Ts / 2 =
@@ -97,8 +108,8 @@ static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref
     ctrl_inv_park(v_d, v_q, sn, cs, &va, &vb);
     out->plan.n_seg = 0u; /* leg duties (ctrl_types.h) */
     s->limited = ctrl_svpwm(&va, &vb, ctx->est->vdc, &out->legs);
-    ctrl_foc_pi_update(&s->pi_d, e_d, v_d, s->limited);
-    ctrl_foc_pi_update(&s->pi_q, e_q, v_q, s->limited);
+    foc_pi_update(&s->pi_d, e_d, v_d, s->limited);
+    foc_pi_update(&s->pi_q, e_q, v_q, s->limited);
 }
 
 /* foc_hyst: per-phase hysteresis current control, one vector per period. */
