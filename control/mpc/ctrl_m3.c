@@ -3,7 +3,12 @@
 
 #include "mtpa.h"
 #include "plan.h"
-#include "vectors.h"
+
+/* V_{x+1}, V_{x+2}, V_{x+5}, V_{x+4} of (6.1), wrapped into 1..6 as
+ * ctrl_vec_wrap does, for x mod 6 (row): the same for any sector value. */
+static const uint8_t m3_cand_tab[6][4] = {
+    {1, 2, 5, 4}, {2, 3, 6, 5}, {3, 4, 1, 6}, {4, 5, 2, 1}, {5, 6, 3, 2}, {6, 1, 4, 3},
+};
 
 void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 {
@@ -13,15 +18,9 @@ void ctrl_m3_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *n = &ctx->est->next;
 
     /* (6.1) by the sign of the torque error. */
-    const int x = (int)n->sector;
-    uint8_t cand[2];
-    if (in.t_ref >= n->torque) {
-        cand[0] = ctrl_vec_wrap(x + 1);
-        cand[1] = ctrl_vec_wrap(x + 2);
-    } else {
-        cand[0] = ctrl_vec_wrap(x + 5);
-        cand[1] = ctrl_vec_wrap(x + 4);
-    }
+    const uint8_t *row = m3_cand_tab[n->sector % 6u];
+    const unsigned base = in.t_ref >= n->torque ? 0u : 2u;
+    const uint8_t cand[2] = {row[base], row[base + 1u]};
     const q24_t num = fx_sub(in.t_ref, in.b.t0); /* (5.18) numerator */
     int64_t best_g = INT64_MAX;
     unsigned best = 2u;
