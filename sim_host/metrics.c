@@ -2,12 +2,11 @@
  * Performance indices, REFERENCE.md section 5 / thesis Appendix B. See metrics.h.
  */
 #include "metrics.h"
+#include "plant.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define METRICS_PI 3.14159265358979323846
 
 void metrics_init(metrics_acc_t *m, metrics_sampling_t sampling, double f1_hz)
 {
@@ -145,7 +144,7 @@ static int thd_window_open(thd_window_t *win, const double *t, const double *x, 
     }
     win->t_end = t[0] + K * T1;
     win->w = K * T1;
-    win->w1 = 2.0 * METRICS_PI * f1_hz;
+    win->w1 = 2.0 * PLANT_PI * f1_hz;
     win->n_harm = N;
     return 1;
 }

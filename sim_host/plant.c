@@ -23,7 +23,6 @@
 #include <math.h>
 #include <string.h>
 
-#define PLANT_PI 3.14159265358979323846
 #define PLANT_SQRT3 1.73205080756887729353
 #define PLANT_RK4_STEP_DEFAULT 0.5e-6
 /* Time comparisons: instants closer than this are the same instant. */

@@ -35,6 +35,11 @@
 
 #include "plant_filter.h"
 
+/* pi of the host simulator (plant, filters, metrics): its own home, apart from
+ * the control core's CTRL_PI, so that the plant shares no code with what it
+ * checks. */
+#define PLANT_PI 3.14159265358979323846
+
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -35,7 +35,6 @@
 #include "plant_expm.h"
 
 #define PF_SQRT3 1.73205080756887729353
-#define PF_PI 3.14159265358979323846
 #define PF_R_OPEN_DEFAULT 1.0e6
 /* exp(M h) of the cache is reused for a duration within this of h (s): the
  * rounding of instants of the global time grid, far below any time constant
@@ -693,7 +692,7 @@ void plant_filter_event(plant_t *p)
     f->af_next++;
     /* i_sq = T / (1.5 p psi_F), S1 (50), low-passed (exact for a command
      * held over the sample) so that p L_sq i_sq of S1 (52) exists */
-    const double tau = 1.0 / (2.0 * PF_PI * as->ref_cutoff_hz);
+    const double tau = 1.0 / (2.0 * PLANT_PI * as->ref_cutoff_hz);
     const double i_cmd = f->tq_cmd_nm / (1.5 * (double)p->cfg.pole_pairs * p->cfg.psi_pm_wb);
     f->isq_f += (i_cmd - f->isq_f) * (1.0 - exp(-h / tau));
     const double disq = (i_cmd - f->isq_f) / tau;

@@ -3,12 +3,11 @@
  * results back in SI (configuration and reporting time only).
  */
 #include "cm_config.h"
+#include "ctrl_units.h"
 
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
-
-#define CM_PI 3.14159265358979323846
 
 void cm_config_default(cm_config_t *c)
 {
@@ -96,7 +95,8 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
     const double fs = (double)p->fs_hz;
     const double ir = m->current_rated_a / b->i_a;
     const double vn = m->vdc_v / b->v_v;
-    const double wr = m->speed_rated_rpm * 2.0 * CM_PI / 60.0 * (double)m->pole_pairs / b->w_rad_s;
+    const double wr =
+        m->speed_rated_rpm * 2.0 * CTRL_PI / 60.0 * (double)m->pole_pairs / b->w_rad_s;
     if (cm->res.have == 0u) {
         cm->res.bases = *b;
     }

@@ -5,8 +5,6 @@
 #include <stddef.h>
 #include <string.h>
 
-#define HAL_SIM_PI 3.14159265358979323846
-
 void hal_sim_config_default(hal_sim_config_t *c, uint32_t pwm_freq_hz, double current_max_a,
                             double vdc_v)
 {
@@ -52,7 +50,7 @@ static double hal_sim_gauss(uint64_t *s)
 {
     const double u1 = hal_sim_rng_unit(s);
     const double u2 = hal_sim_rng_unit(s);
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * HAL_SIM_PI * u2);
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * PLANT_PI * u2);
 }
 
 int hal_sim_init(hal_t *h, const hal_sim_config_t *cfg, plant_t *plant)
@@ -143,8 +141,8 @@ static void hal_sim_sample(hal_t *h)
     const uint32_t cpr = 4u * c->enc_lines;
     const double theta_m =
         (c->enc_dir == -1 ? -1.0 : 1.0) * (plant_theta_m(h->plant) - c->enc_zero_rad);
-    const double pos = floor(theta_m * (double)cpr / (2.0 * HAL_SIM_PI));
-    const double turns = floor(theta_m / (2.0 * HAL_SIM_PI));
+    const double pos = floor(theta_m * (double)cpr / (2.0 * PLANT_PI));
+    const double turns = floor(theta_m / (2.0 * PLANT_PI));
     /* pos modulo 2^32 without converting an out-of-range double. */
     const double m32 = 4294967296.0;
     const double wrapped = pos - m32 * floor(pos / m32);

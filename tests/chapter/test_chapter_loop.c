@@ -24,10 +24,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "sim_run.h"
 #include "unity.h"
-
-#define PI 3.14159265358979323846
 
 static sim_run_t run;
 
@@ -108,7 +107,7 @@ typedef struct {
     double pp, std, mean, speed;
 } ripple_t;
 
-#define W_RPM (70.0 * 60.0 / (2.0 * PI))
+#define W_RPM (70.0 * 60.0 / (2.0 * CTRL_PI))
 
 static ripple_t chapter_case(const char *name)
 {

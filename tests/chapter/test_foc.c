@@ -25,6 +25,7 @@
 #include "controller.h"
 #include "ctrl_foc.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "plan.h"
 #include "unity.h"
 
@@ -34,8 +35,6 @@ void setUp(void)
 void tearDown(void)
 {
 }
-
-#define PI 3.14159265358979323846
 
 static double q(q24_t x)
 {
@@ -178,7 +177,7 @@ static void check_step(const char *label, double omega_pu, double torque_pu)
     q24_t iqr;
     ctrl_foc_iref(&rig.params, &s->iref, ctrl_q24_from_double(torque_pu), &idr, &iqr);
     run_loop(omega_pu, torque_pu);
-    const double wc_ts = 2.0 * PI / 20.0;
+    const double wc_ts = 2.0 * CTRL_PI / 20.0;
     const double design = 2.2 / wc_ts; /* periods */
     double rise;
     double over;
@@ -206,9 +205,9 @@ static void test_current_step_spmsm(void)
 {
     chapter_rig_init(&rig, "foc", &ini_thesis_spmsm);
     check_step("SPMSM standstill", 0.0, 0.1);
-    check_step("SPMSM 750 r/min", 4.0 * 750.0 * 2.0 * PI / 60.0 / rig.bases.w_rad_s, 0.1);
+    check_step("SPMSM 750 r/min", 4.0 * 750.0 * 2.0 * CTRL_PI / 60.0 / rig.bases.w_rad_s, 0.1);
     check_step("SPMSM -750 r/min, negative torque",
-               -4.0 * 750.0 * 2.0 * PI / 60.0 / rig.bases.w_rad_s, -0.1);
+               -4.0 * 750.0 * 2.0 * CTRL_PI / 60.0 / rig.bases.w_rad_s, -0.1);
 }
 
 static void test_current_step_ipmsm_mtpa(void)
@@ -230,7 +229,7 @@ static void test_current_step_gimbal(void)
     chapter_rig_init(&rig, "foc", &ini_gbm5208_gimbal);
     const ctrl_foc_state_t *s = (const ctrl_foc_state_t *)rig.state;
     const double r_pu = ini_gbm5208_gimbal.rs_ohm / rig.bases.r_ohm;
-    const double ki_ts = r_pu * 2.0 * PI / 20.0;
+    const double ki_ts = r_pu * 2.0 * CTRL_PI / 20.0;
     TEST_ASSERT_DOUBLE_WITHIN(0.1, 16.2, r_pu);
     TEST_ASSERT_EQUAL_UINT8(28, s->pi_q.ki_shift); /* 5.08 x 2^28 < 2^31 <= 5.08 x 2^29 */
     TEST_ASSERT_DOUBLE_WITHIN(ki_ts * 1e-8, ki_ts, ldexp((double)s->pi_q.ki_ts, -28));

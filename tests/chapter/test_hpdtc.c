@@ -16,6 +16,7 @@
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
 #include "ctrl_s1_dtc_config.h"
+#include "ctrl_units.h"
 #include "plan.h"
 #include "unity.h"
 #include "vectors.h"
@@ -27,8 +28,7 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
-#define DEG (PI / 180.0)
+#define DEG (CTRL_PI / 180.0)
 
 static double q(q24_t x)
 {
@@ -128,10 +128,10 @@ static void check_table(double tilt)
 
 static void test_timing_table_synthesis(void)
 {
-    check_table(PI / 30.0); /* default tilt, 6 deg */
+    check_table(CTRL_PI / 30.0); /* default tilt, 6 deg */
     check_table(0.0);
     check_table(12.0 * DEG);
-    check_table(PI / 6.0);
+    check_table(CTRL_PI / 6.0);
     uint8_t pts[HPDTC_LEVELS][HPDTC_SECTIONS][2];
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_hpdtc_timing_table(-0.1, pts));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_hpdtc_timing_table(NAN, pts));

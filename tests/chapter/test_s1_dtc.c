@@ -14,6 +14,7 @@
 #include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
+#include "ctrl_units.h"
 #include "plan.h"
 #include "unity.h"
 #include "vectors.h"
@@ -24,8 +25,6 @@ void setUp(void)
 void tearDown(void)
 {
 }
-
-#define PI 3.14159265358979323846
 
 static double q(q24_t x)
 {
@@ -70,7 +69,7 @@ static void test_hdtc_table3(void)
     const double big = 0.05; /* pu, beyond both bands (0.01 Wb = 0.019 pu, 0.01 N*m) */
     for (int ph = 0; ph < 2; ph++) {
         for (int sec = 1; sec <= 6; sec++) {
-            const double lam = (sec - 1) * PI / 3.0 + 0.1;      /* inside sector sec (4.5) */
+            const double lam = (sec - 1) * CTRL_PI / 3.0 + 0.1; /* inside sector sec (4.5) */
             const double amp = ph == 0 ? 1.0 - big : 1.0 + big; /* psi_ref = psi_pm = 1 pu */
             /* tau = +1 */
             rig.d->reset(rig.state);
@@ -144,7 +143,7 @@ static void test_svm_dtc_basics(void)
     for (int k = 0; k < 1000; k++) {
         chapter_rig_step(&rig, &out);
     }
-    TEST_ASSERT_TRUE(fabs(q(s->dd) - 0.3 * ts) <= PI / 3.0 + 1e-6);
+    TEST_ASSERT_TRUE(fabs(q(s->dd) - 0.3 * ts) <= CTRL_PI / 3.0 + 1e-6);
 }
 
 int main(void)

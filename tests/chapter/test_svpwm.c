@@ -10,6 +10,7 @@
 
 #include "chapter_machines.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "plan.h"
 #include "svpwm.h"
 #include "unity.h"
@@ -21,7 +22,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
 
 static double q(q24_t x)
@@ -73,9 +73,9 @@ static void test_duties_all_sectors(void)
      * amplitudes up to the hexagon edge in that direction (97 %). */
     const q24_t vdc = FX_ONE;
     for (int deg = 0; deg < 360; deg++) {
-        const double a = deg * PI / 180.0;
+        const double a = deg * CTRL_PI / 180.0;
         /* hexagon radius in direction a: (Vdc/sqrt(3)) / cos(a mod 60 - 30) */
-        const double off = fmod(a, PI / 3.0) - PI / 6.0;
+        const double off = fmod(a, CTRL_PI / 3.0) - CTRL_PI / 6.0;
         const double rmax = 1.0 / sqrt(3.0) / cos(off);
         for (int s = 1; s <= 4; s++) {
             const double r = 0.97 * rmax * s / 4.0;
@@ -89,8 +89,8 @@ static void test_duties_random(void)
     uint64_t seed = 0x5eed1234u;
     for (int n = 0; n < 20000; n++) {
         const double vdc = 0.5 + 1.0 * chapter_rand(&seed);
-        const double a = 2.0 * PI * chapter_rand(&seed);
-        const double off = fmod(a, PI / 3.0) - PI / 6.0;
+        const double a = 2.0 * CTRL_PI * chapter_rand(&seed);
+        const double off = fmod(a, CTRL_PI / 3.0) - CTRL_PI / 6.0;
         const double r = chapter_rand(&seed) * vdc / sqrt(3.0) / cos(off) * 0.999;
         q24_t va = ctrl_q24_from_double(r * cos(a));
         q24_t vb = ctrl_q24_from_double(r * sin(a));
@@ -105,8 +105,8 @@ static void test_overmodulation_on_hexagon_same_angle(void)
     uint64_t seed = 42u;
     for (int n = 0; n < 20000; n++) {
         const double vdc = 0.5 + chapter_rand(&seed);
-        const double a = 2.0 * PI * chapter_rand(&seed);
-        const double off = fmod(a, PI / 3.0) - PI / 6.0;
+        const double a = 2.0 * CTRL_PI * chapter_rand(&seed);
+        const double off = fmod(a, CTRL_PI / 3.0) - CTRL_PI / 6.0;
         const double rhex = vdc / sqrt(3.0) / cos(off);
         const double r = rhex * (1.001 + 3.0 * chapter_rand(&seed));
         const q24_t va0 = ctrl_q24_from_double(r * cos(a));
@@ -124,7 +124,7 @@ static void test_overmodulation_on_hexagon_same_angle(void)
         /* On the hexagon: radius in its direction within 4 LSB (truncated k,
          * two roundings), never meaningfully outside. */
         const double ang = atan2(q(vb), q(va));
-        const double o2 = fmod(ang + 4.0 * PI, PI / 3.0) - PI / 6.0;
+        const double o2 = fmod(ang + 4.0 * CTRL_PI, CTRL_PI / 3.0) - CTRL_PI / 6.0;
         const double rh = q(vd) / sqrt(3.0) / cos(o2);
         TEST_ASSERT_DOUBLE_WITHIN(4.0 * LSB, rh, hypot(q(va), q(vb)));
         /* Realisable: duties in [0, 1] and the plan gives back the vector. */
@@ -182,7 +182,7 @@ static void test_svpwm_equals_limit_then_duties(void)
     uint64_t seed = 0x5eed5678u;
     for (int n = 0; n < 20000; n++) {
         const q24_t vdc = ctrl_q24_from_double(0.05 + 2.0 * chapter_rand(&seed));
-        const double a = 2.0 * PI * chapter_rand(&seed);
+        const double a = 2.0 * CTRL_PI * chapter_rand(&seed);
         const double r = 1.5 * chapter_rand(&seed) * q(vdc);
         q24_t va = ctrl_q24_from_double(r * cos(a));
         q24_t vb = ctrl_q24_from_double(r * sin(a));

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "angle_source.h"
+#include "ctrl_units.h"
 #include "est_fixture.h"
 #include "estimator.h"
 #include "flux_vm.h"
@@ -28,7 +29,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
 #define SC 3.18e-8  /* fx_sincos error bound: 0.5 LSB + 2e-9 */
 #define EROT 3.0e-9 /* fx_rot_q30 error bound up to pi/2 */
@@ -49,7 +49,7 @@ static ctrl_bases_t B;
 /* Phase currents a, b of a dq current at electrical angle th. */
 static void meas_from_dq(double id, double iq, fx_angle_t th, ctrl_meas_t *m)
 {
-    const double t = (double)th * 2.0 * PI / 4294967296.0;
+    const double t = (double)th * 2.0 * CTRL_PI / 4294967296.0;
     const double al = id * cos(t) - iq * sin(t);
     const double be = id * sin(t) + iq * cos(t);
     m->i_a = q(al);
@@ -438,7 +438,7 @@ static void test_flux_vm(void)
     const q24_t off = q(0.05);
     q24_t k_corr;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_flux_vm_gain(&P, 5.0, &k_corr));
-    TEST_ASSERT_TRUE(fabs(d(k_corr) - 2 * PI * 5.0 / P.fs_hz) <= 0.5 * LSB);
+    TEST_ASSERT_TRUE(fabs(d(k_corr) - 2 * CTRL_PI * 5.0 / P.fs_hz) <= 0.5 * LSB);
     ctrl_flux_vm_t pure;
     ctrl_flux_vm_t cm;
     ctrl_flux_vm_t lp;

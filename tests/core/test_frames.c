@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "ctrl_types.h"
+#include "ctrl_units.h"
 #include "fx.h"
 #include "plan.h"
 #include "transforms.h"
@@ -21,7 +22,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
 #define SINCOS_ERR 3.18e-8
 
@@ -41,9 +41,9 @@ static void test_clarke_balanced(void)
      * invariant). Inputs rounded (0.5 LSB each): beta error <= 0.5 LSB
      * (rounding) + (0.5 + 2 * 0.5)/sqrt(3) LSB (inputs) < 1.4 LSB. */
     for (int k = 0; k < 720; k++) {
-        const double th = 2.0 * PI * k / 720.0;
+        const double th = 2.0 * CTRL_PI * k / 720.0;
         const double a = 1.7 * cos(th);
-        const double b = 1.7 * cos(th - 2.0 * PI / 3.0);
+        const double b = 1.7 * cos(th - 2.0 * CTRL_PI / 3.0);
         q24_t al;
         q24_t be;
         ctrl_clarke(q(a), q(b), &al, &be);
@@ -56,7 +56,7 @@ static void test_clarke_balanced(void)
         /* inverse: 0.5 LSB rounding + sqrt(3)/2 * 1.4 LSB from beta */
         TEST_ASSERT_TRUE(fabs(d(ra) - a) <= 0.5 * LSB);
         TEST_ASSERT_TRUE(fabs(d(rb) - b) <= 2.0 * LSB);
-        TEST_ASSERT_TRUE(fabs(d(rc) - 1.7 * cos(th + 2.0 * PI / 3.0)) <= 2.5 * LSB);
+        TEST_ASSERT_TRUE(fabs(d(rc) - 1.7 * cos(th + 2.0 * CTRL_PI / 3.0)) <= 2.5 * LSB);
     }
     q24_t al;
     q24_t be;
@@ -71,11 +71,12 @@ static void test_park_roundtrip(void)
     /* Park of (cos phi, sin phi) * r at theta: (r cos(phi-theta), r sin(phi-theta)).
      * Error <= 0.5 LSB + SINCOS_ERR * (|al| + |be|) + input rounding. */
     for (int k = 0; k < 500; k++) {
-        const double th = 2.0 * PI * k / 500.0 + 0.1;
+        const double th = 2.0 * CTRL_PI * k / 500.0 + 0.1;
         const double phi = 0.37 * k;
         const double r = 2.5;
-        const uint32_t ang = (uint32_t)llround(fmod(th, 2.0 * PI) / (2.0 * PI) * 4294967296.0);
-        const double thq = (double)ang * 2.0 * PI / 4294967296.0;
+        const uint32_t ang =
+            (uint32_t)llround(fmod(th, 2.0 * CTRL_PI) / (2.0 * CTRL_PI) * 4294967296.0);
+        const double thq = (double)ang * 2.0 * CTRL_PI / 4294967296.0;
         q24_t s;
         q24_t c;
         fx_sincos(ang, &s, &c);
@@ -163,17 +164,17 @@ static void test_vec_wrap_and_zero(void)
 /* sector of an angle by the definitions, for angles away from boundaries */
 static uint8_t sector_def(double th, int mbst)
 {
-    double t = fmod(th, 2.0 * PI);
+    double t = fmod(th, 2.0 * CTRL_PI);
     if (t < 0) {
-        t += 2.0 * PI;
+        t += 2.0 * CTRL_PI;
     }
     if (mbst) { /* (2x-2)pi/6 < t <= 2x pi/6 */
-        int x = (int)ceil(t / (PI / 3.0));
+        int x = (int)ceil(t / (CTRL_PI / 3.0));
         return (uint8_t)(x < 1 ? 6 : x);
     }
     /* (2x-3)pi/6 < t <= (2x-1)pi/6: shift by pi/6 */
-    double u = t + PI / 6.0;
-    int x = (int)ceil(u / (PI / 3.0));
+    double u = t + CTRL_PI / 6.0;
+    int x = (int)ceil(u / (CTRL_PI / 3.0));
     if (x > 6) {
         x -= 6;
     }
@@ -187,8 +188,8 @@ static void test_sectors_boundaries(void)
     for (unsigned ri = 0; ri < 5u; ri++) {
         const double r = radii[ri];
         for (int x = 1; x <= 6; x++) {
-            const double b45 = (2 * x - 1) * PI / 6.0; /* upper bound of sector x (4.5) */
-            const double b418 = 2 * x * PI / 6.0;      /* upper bound of sector x (4.18) */
+            const double b45 = (2 * x - 1) * CTRL_PI / 6.0; /* upper bound of sector x (4.5) */
+            const double b418 = 2 * x * CTRL_PI / 6.0;      /* upper bound of sector x (4.18) */
             /* offset well above the angular resolution LSB / r at this radius */
             const double eps = fmax(1e-5, 10.0 * LSB / r);
             TEST_ASSERT_EQUAL_UINT8(x, ctrl_sector(q(r * cos(b45 - eps)), q(r * sin(b45 - eps))));
@@ -219,7 +220,7 @@ static void test_sectors_boundaries(void)
     TEST_ASSERT_EQUAL_UINT8(2u, ctrl_sector(FX_MAX, FX_MAX)); /* 45 deg */
     /* Sweep away from boundaries. */
     for (int k = 0; k < 3600; k++) {
-        const double th = 2.0 * PI * (k + 0.5) / 3600.0;
+        const double th = 2.0 * CTRL_PI * (k + 0.5) / 3600.0;
         const q24_t x = q(0.8 * cos(th));
         const q24_t y = q(0.8 * sin(th));
         TEST_ASSERT_EQUAL_UINT8(sector_def(th, 0), ctrl_sector(x, y));

@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "ctrl_units.h"
 #include "fx.h"
 #include "unity.h"
 
@@ -426,7 +427,7 @@ static void test_sincos(void)
     for (uint32_t k = 0; k < 65536u; k++) {
         const uint32_t a = (k << 16) + (uint32_t)((k * 2654435761u) & 0xFFFFu);
         fx_sincos(a, &s, &c);
-        const double th = (double)a * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double th = (double)a * (2.0 * CTRL_PI / 4294967296.0);
         const double es = fabs((double)s * LSB - sin(th));
         const double ec = fabs((double)c * LSB - cos(th));
         worst = fmax(worst, fmax(es, ec));
@@ -435,7 +436,7 @@ static void test_sincos(void)
     for (int i = 0; i < 20000; i++) {
         const uint32_t a = (uint32_t)rng();
         fx_sincos(a, &s, &c);
-        const double th = (double)a * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double th = (double)a * (2.0 * CTRL_PI / 4294967296.0);
         worst = fmax(worst, fmax(fabs((double)s * LSB - sin(th)), fabs((double)c * LSB - cos(th))));
     }
     char msg[96];
@@ -456,7 +457,7 @@ static void test_rot_q30(void)
         int32_t c;
         int32_t s;
         fx_rot_q30(step, &c, &s);
-        const double a = (double)step * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double a = (double)step * (2.0 * CTRL_PI / 4294967296.0);
         const double e = fmax(fabs(c / 1073741824.0 - cos(a)), fabs(s / 1073741824.0 - sin(a)));
         const uint32_t mag = step < 0 ? 0u - (uint32_t)step : (uint32_t)step;
         if (mag <= FX_ROT_TAB_MAX) {
@@ -470,7 +471,7 @@ static void test_rot_q30(void)
         int32_t c;
         int32_t s;
         fx_rot_q30(step, &c, &s);
-        const double a = (double)step * (2.0 * 3.14159265358979323846 / 4294967296.0);
+        const double a = (double)step * (2.0 * CTRL_PI / 4294967296.0);
         const double e = fmax(fabs(c / 1073741824.0 - cos(a)), fabs(s / 1073741824.0 - sin(a)));
         const uint32_t mag = step < 0 ? 0u - (uint32_t)step : (uint32_t)step;
         if (mag > FX_ROT_TAB_MAX) {
@@ -493,8 +494,8 @@ static void test_rot_q30(void)
     q24_t xo;
     q24_t yo;
     fx_rotate(FX_ONE, 0, c, s, &xo, &yo);
-    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(cos(3.14159265358979323846 / 8) * FX_ONE), xo);
-    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(sin(3.14159265358979323846 / 8) * FX_ONE), yo);
+    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(cos(CTRL_PI / 8) * FX_ONE), xo);
+    TEST_ASSERT_INT32_WITHIN(1, (int32_t)lround(sin(CTRL_PI / 8) * FX_ONE), yo);
     fx_rotate(FX_MAX, FX_MAX, FX_Q30_ONE, FX_Q30_ONE, &xo, &yo); /* 45 deg x sqrt2 */
     TEST_ASSERT_EQUAL_INT32(0, xo);
     TEST_ASSERT_EQUAL_INT32(FX_MAX, yo);

@@ -10,6 +10,7 @@
 
 #include "controller.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "est_fixture.h"
 #include "estimator.h"
 #include "machines.h"
@@ -25,7 +26,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
 
 static double d(q24_t x)
@@ -51,7 +51,7 @@ static void test_bases_spmsm(void)
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
     /* Bases (ctrl_params.h): psi_pm, the rated electrical speed, V = psi w, Ld. */
-    const double wb = 4 * 3000 * 2 * PI / 60;
+    const double wb = 4 * 3000 * 2 * CTRL_PI / 60;
     const double vb = 0.09427 * wb;
     const double ib = 0.09427 / 6.552e-3;
     TEST_ASSERT_DOUBLE_WITHIN(1e-12 * wb, wb, b.w_rad_s);
@@ -77,15 +77,16 @@ static void test_bases_spmsm(void)
     /* Thesis SPMSM: omega_e psi_pm at 3000 r/min = 118.5 V: the voltage base */
     TEST_ASSERT_DOUBLE_WITHIN(0.05, 118.5, b.v_v);
     /* angle increment per period: Ts_pu / (2 pi) turns, integer rounding */
-    TEST_ASSERT_DOUBLE_WITHIN(0.5, wb * 1e-4 / (2 * PI) * 4294967296.0, (double)p.omega_to_dangle);
+    TEST_ASSERT_DOUBLE_WITHIN(0.5, wb * 1e-4 / (2 * CTRL_PI) * 4294967296.0,
+                              (double)p.omega_to_dangle);
     /* inverse: dtheta * m / 2^26 = dtheta * 2^24 / k_ang, m rounded (0.5 / 2^26) */
     const double inv = ldexp((double)p.dangle_to_omega, -(int)CTRL_DANGLE_SHIFT);
-    const double inv_exact = 16777216.0 / (wb * 1e-4 / (2 * PI) * 4294967296.0);
+    const double inv_exact = 16777216.0 / (wb * 1e-4 / (2 * CTRL_PI) * 4294967296.0);
     TEST_ASSERT_DOUBLE_WITHIN(ldexp(0.5, -(int)CTRL_DANGLE_SHIFT) + inv_exact * 1e-15, inv_exact,
                               inv);
     /* speed filter: 1 - exp(-2 pi fc / fs) */
-    TEST_ASSERT_TRUE(fabs(d(p.speed_lpf_k) -
-                          (1.0 - exp(-2 * PI * CTRL_SPEED_LPF_HZ_DEFAULT / 1e4))) <= 0.5 * LSB);
+    TEST_ASSERT_TRUE(fabs(d(p.speed_lpf_k) - (1.0 - exp(-2 * CTRL_PI * CTRL_SPEED_LPF_HZ_DEFAULT /
+                                                        1e4))) <= 0.5 * LSB);
 }
 
 static void test_bases_ipmsm(void)
@@ -216,13 +217,13 @@ static void test_refusals_explained(void)
     m = spm;
     m.speed_rated_rpm = 30000.0; /* 12.57 rad/s x 10000 rpm / ... = 1.257 rad per period */
     expect_diag(&m, 10000u, CTRL_ERANGE, "rated electrical speed x Ts",
-                30000.0 / 60.0 * 2.0 * PI * 4.0 * 1e-4);
+                30000.0 / 60.0 * 2.0 * CTRL_PI * 4.0 * 1e-4);
     expect_diag(&spm, 500u, CTRL_ERANGE, "rated electrical speed x Ts",
-                3000.0 / 60.0 * 2.0 * PI * 4.0 / 500.0);
+                3000.0 / 60.0 * 2.0 * CTRL_PI * 4.0 / 500.0);
     m = spm;
     m.vdc_v = 5000.0;
     expect_diag(&m, 10000u, CTRL_ERANGE, "vdc_v / rated back-EMF (psi_pm x rated electrical speed)",
-                5000.0 / (0.09427 * 3000.0 / 60.0 * 2.0 * PI * 4.0));
+                5000.0 / (0.09427 * 3000.0 / 60.0 * 2.0 * CTRL_PI * 4.0));
     m = spm;
     m.rs_ohm = 100.0;
     expect_diag(&m, 10000u, CTRL_ERANGE, "Ts Rs / Ld", 1e-4 * 100.0 / 6.552e-3);
@@ -263,12 +264,12 @@ static void test_small_motor_neighbours(void)
     ctrl_machine_t m = ini_mj5208_drone;
     m.speed_rated_rpm = 40000.0;
     expect_diag(&m, 20000u, CTRL_ERANGE, "rated electrical speed x Ts",
-                7.0 * 40000.0 / 60.0 * 2.0 * PI / 20000.0);
+                7.0 * 40000.0 / 60.0 * 2.0 * CTRL_PI / 20000.0);
     /* the gimbal motor rated at 15 r/min: 11 x 15 x 2 pi / 60 x 50 us < 0.001 */
     m = ini_gbm5208_gimbal;
     m.speed_rated_rpm = 15.0;
     expect_diag(&m, 20000u, CTRL_ERANGE, "rated electrical speed x Ts",
-                11.0 * 15.0 / 60.0 * 2.0 * PI / 20000.0);
+                11.0 * 15.0 / 60.0 * 2.0 * CTRL_PI / 20000.0);
     /* its winding with 0.3 mH: Ts Rs / Ld = 50 us x 7.545 / 0.3 mH */
     m = ini_gbm5208_gimbal;
     m.ld_h = 0.3e-3;
@@ -279,7 +280,7 @@ static void test_small_motor_neighbours(void)
     m.vdc_v = 60.0;
     m.speed_rated_rpm = 20.0;
     expect_diag(&m, 20000u, CTRL_ERANGE, "vdc_v / rated back-EMF (psi_pm x rated electrical speed)",
-                60.0 / (0.019655 * 20.0 / 60.0 * 2.0 * PI * 11.0));
+                60.0 / (0.019655 * 20.0 / 60.0 * 2.0 * CTRL_PI * 11.0));
     /* the drone motor with a 2000 A trip: current_max / (psi_pm / Ld) = 20 > 16 */
     m = ini_mj5208_drone;
     m.current_max_a = 2000.0;
@@ -392,7 +393,7 @@ static void test_mtpa_oracle_spmsm(void)
 static void mtpa_search(double lq, double i, double *t_out, double *psi_out)
 {
     double a = 0.0;
-    double c = PI / 2.0 + 0.7; /* beta from +q axis towards -d (and +d for lq<1) */
+    double c = CTRL_PI / 2.0 + 0.7; /* beta from +q axis towards -d (and +d for lq<1) */
     const double g = (sqrt(5.0) - 1.0) / 2.0;
     for (int it = 0; it < 200; it++) {
         const double x1 = c - g * (c - a);
@@ -459,7 +460,8 @@ static void test_speed_lpf_setter(void)
     ctrl_bases_t b;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 20000u));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_set_speed_lpf(&p, 100.0));
-    TEST_ASSERT_TRUE(fabs(d(p.speed_lpf_k) - (1.0 - exp(-2 * PI * 100.0 / 20000.0))) <= 0.5 * LSB);
+    TEST_ASSERT_TRUE(fabs(d(p.speed_lpf_k) - (1.0 - exp(-2 * CTRL_PI * 100.0 / 20000.0))) <=
+                     0.5 * LSB);
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_set_speed_lpf(&p, 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_set_speed_lpf(&p, 10000.0));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_params_set_speed_lpf(&p, NAN));
@@ -484,7 +486,7 @@ static void test_speed_pi(void)
     ctrl_speed_pi_t pr;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_speed_pi_config(&pr, &b, 4, 0.006843, 0.78046,
                                                         CTRL_SPEED_UNIT_RPM, 2.4, 10000u));
-    TEST_ASSERT_DOUBLE_WITHIN(kp_pu * 1e-8, kp_pu * 60.0 / (2 * PI),
+    TEST_ASSERT_DOUBLE_WITHIN(kp_pu * 1e-8, kp_pu * 60.0 / (2 * CTRL_PI),
                               ldexp((double)pr.kp, -(int)pr.kp_shift));
 
     /* Linear region: constant error e for n steps: u = kp e + n ki_ts e.

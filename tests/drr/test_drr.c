@@ -11,12 +11,12 @@
 #include "ctrl_drr.h"
 #include "ctrl_drr_config.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "drr_machines.h"
 #include "plan.h"
 #include "unity.h"
 #include "vectors.h"
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0) /* one Q24 step */
 
 static ctrl_params_t P;
@@ -75,7 +75,7 @@ static void test_ab_thesis_spmsm(void)
      * scale, relative 0.5 LSB / kb). */
     ctrl_drr_state_t *s = make("drr", NULL);
     const double a_nm = d(s->a) * BASES.torque_nm;
-    const double w_rn_pu = 2.0 * PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
+    const double w_rn_pu = 2.0 * CTRL_PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
     const double b_nm = d(s->kb) * w_rn_pu * BASES.torque_nm;
     TEST_ASSERT_DOUBLE_WITHIN(0.5e-3 + 0.5 * LSB * BASES.torque_nm, 1.266, a_nm);
     TEST_ASSERT_DOUBLE_WITHIN(0.5e-3 + 0.5 * LSB * BASES.torque_nm * w_rn_pu, 1.023, b_nm);
@@ -110,7 +110,7 @@ static void test_ema_cutoff(void)
     q24_t g = 0;
     double peak = 0.0;
     for (int k = 0; k < 2000; k++) {
-        const q24_t chi = q(0.1 * sin(2.0 * PI * fc * k / 10000.0));
+        const q24_t chi = q(0.1 * sin(2.0 * CTRL_PI * fc * k / 10000.0));
         g = ctrl_drr_ema(g, chi, s->lambda);
         if (k >= 1000 && fabs(d(g)) > peak) {
             peak = fabs(d(g));
@@ -159,7 +159,7 @@ static void test_duty_limits_monotonic(void)
     for (int x = 1; x <= 6; x++) {
         for (int j = 1; j < 8; j++) {
             /* theta_s inside sector x, (4.5) */
-            const double th = (2 * x - 3) * PI / 6 + j * (PI / 3) / 8;
+            const double th = (2 * x - 3) * CTRL_PI / 6 + j * (CTRL_PI / 3) / 8;
             const q24_t pa = q(1.02 * cos(th));
             const q24_t pb = q(1.02 * sin(th));
             const q24_t amp = fx_mag(pa, pb);
@@ -226,7 +226,7 @@ static void fill_est(ctrl_estimate_t *est, double th_s, double amp, double delta
     memset(est, 0, sizeof *est);
     const double th_r = th_s - delta;
     const fx_angle_t a =
-        (fx_angle_t)(int64_t)llround(fmod(th_r / (2 * PI) + 2.0, 1.0) * 4294967296.0);
+        (fx_angle_t)(int64_t)llround(fmod(th_r / (2 * CTRL_PI) + 2.0, 1.0) * 4294967296.0);
     fixture_state_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->now);
     fixture_state_from_flux(&P, q(amp * cos(th_s)), q(amp * sin(th_s)), a, &est->next);
     est->omega_e = q(w);
@@ -248,7 +248,7 @@ static void test_vreplace_condition(void)
      * T_err > 0 and psi_err slightly < 0 -> (5.1) gives V3 = V_{x+2}, replaced by
      * V2 = V_{x+1} (4.20); with |psi_err| > dpsi_max / 2 V3 stays. */
     ctrl_estimate_t est;
-    fill_est(&est, -25.0 * PI / 180.0, 1.02, 0.1, 0.2);
+    fill_est(&est, -25.0 * CTRL_PI / 180.0, 1.02, 0.1, 0.2);
     ctrl_refs_t ref = {q(0.25), 0};
     ctrl_ctx_t ctx = {&P, &est, &ref};
     ctrl_out_t o;
@@ -267,7 +267,7 @@ static void test_vreplace_condition(void)
     TEST_ASSERT_EQUAL_UINT8(3, o.plan.vec[0]);
 
     /* Subsector II (theta_s = +25 deg), psi_err >= 0: V2 = V_{x+1} -> V3 (4.21). */
-    fill_est(&est, 25.0 * PI / 180.0, 1.02, 0.1, 0.2);
+    fill_est(&est, 25.0 * CTRL_PI / 180.0, 1.02, 0.1, 0.2);
     ref.psi = est.next.psi_amp + s->half_dpsi / 2;
     ctrl_drr_reset(s);
     ctrl_drr_step(s, &ctx, &o);
@@ -292,7 +292,7 @@ static void test_plan_zero_vector(void)
     ctrl_out_t o;
     for (int x = 1; x <= 6; x++) {
         for (int sgn = -1; sgn <= 1; sgn += 2) {
-            fill_est(&est, (x - 1) * PI / 3 + 0.05, 1.0, 0.05 * sgn, 0.1);
+            fill_est(&est, (x - 1) * CTRL_PI / 3 + 0.05, 1.0, 0.05 * sgn, 0.1);
             ref.torque = fx_add(est.next.torque, q(0.02 * sgn));
             ctrl_drr_reset(s);
             ctrl_drr_step(s, &ctx, &o);
@@ -391,7 +391,7 @@ static void test_baselines_thesis_values(void)
     s = make("drr_d2", NULL);
     TEST_ASSERT_INT_WITHIN(64, q(0.5), ctrl_drr_duty_d2(s, q(0.5 / tb), 0));
     TEST_ASSERT_INT_WITHIN(64, q(0.5), ctrl_drr_duty_d2(s, q(-0.5 / tb), 0));
-    const double w1000 = 2 * PI * 1000.0 / 60.0 * 4.0 / BASES.w_rad_s;
+    const double w1000 = 2 * CTRL_PI * 1000.0 / 60.0 * 4.0 / BASES.w_rad_s;
     TEST_ASSERT_INT_WITHIN(256, q(0.6 / 1.4), ctrl_drr_duty_d2(s, 0, q(w1000)));
     /* T_err < 0 at forward speed: numerator > 0, denominator < 0 -> D = 0 (ZVV). */
     TEST_ASSERT_EQUAL_INT32(0, ctrl_drr_duty_d2(s, q(-0.1 / tb), q(w1000)));
@@ -399,7 +399,7 @@ static void test_baselines_thesis_values(void)
     /* D_PI (5.20): 3 w psi_pm / (2 Vdc) = back-EMF over |V_active|: at 3000 r/min
      * 118.5 V / 146.7 V = 0.808 (thesis SPMSM), no error, no integral. */
     s = make("drr_pi", NULL);
-    const double w3000 = 2 * PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
+    const double w3000 = 2 * CTRL_PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
     const double ff = 3.0 * (w3000 * BASES.w_rad_s) * 0.09427 / (2.0 * 220.0);
     TEST_ASSERT_DOUBLE_WITHIN(1e-3, 0.808, ff);
     TEST_ASSERT_INT_WITHIN(64, q(ff), ctrl_drr_duty_pi(s, 0, 0, q(w3000)));
@@ -471,7 +471,7 @@ static void test_tunables_by_name(void)
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(desc, STATE, CFG, &SU));
     const ctrl_drr_state_t *s = (const ctrl_drr_state_t *)STATE;
     TEST_ASSERT_INT_WITHIN(1, q(1.27 / BASES.torque_nm), s->a);
-    const double w_rn_pu = 2.0 * PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
+    const double w_rn_pu = 2.0 * CTRL_PI * 3000.0 / 60.0 * 4.0 / BASES.w_rad_s;
     TEST_ASSERT_INT_WITHIN(1, q(1.02 / BASES.torque_nm / w_rn_pu), s->kb);
     /* fixed C: C = -c_num / 1 at every speed */
     q24_t cn;

@@ -20,9 +20,9 @@
 #include "unity.h"
 
 #include "../plant/ini_machines.h"
+#include "ctrl_units.h"
 
 #define LSB (1.0 / 16777216.0)
-#define PI 3.14159265358979323846
 
 static ctrl_machine_t M;
 static ctrl_params_t P;
@@ -67,7 +67,7 @@ static q24_t vdc_pu(void)
 }
 static q24_t omega_pu(double rpm)
 {
-    return q(rpm * 2.0 * PI / 60.0 * M.pole_pairs / B.w_rad_s);
+    return q(rpm * 2.0 * CTRL_PI / 60.0 * M.pole_pairs / B.w_rad_s);
 }
 
 /* One step at nominal DC link (a fresh filter takes the sample as is). */
@@ -86,7 +86,7 @@ static double v_max(void)
 }
 static double we(double rpm)
 {
-    return rpm * 2.0 * PI / 60.0 * M.pole_pairs;
+    return rpm * 2.0 * CTRL_PI / 60.0 * M.pole_pairs;
 }
 
 static void test_config_refusals(void)
@@ -205,7 +205,7 @@ static void test_spmsm_field_weakening(void)
     const double wmax = V / (psi - L * I);
     for (double x = 0.1; x < 1.0; x += 0.2) {
         const double w = wb + x * (wmax - wb);
-        const double rpm = w / M.pole_pairs * 60.0 / (2.0 * PI);
+        const double rpm = w / M.pole_pairs * 60.0 / (2.0 * CTRL_PI);
         const ctrl_fieldweak_out_t o = step_at(rpm, 10.0, 0);
         const double id = ((V / w) * (V / w) - psi * psi - L * L * I * I) / (2.0 * L * psi);
         const double want = 1.5 * M.pole_pairs * psi * sqrt(I * I - id * id) / B.torque_nm;
@@ -216,7 +216,7 @@ static void test_spmsm_field_weakening(void)
         TEST_ASSERT_EQUAL_UINT8(1u, o.weakening);
         TEST_ASSERT_EQUAL_INT32(o.psi_max, o.psi_ref);
     }
-    const double rpm_hi = 1.02 * wmax / M.pole_pairs * 60.0 / (2.0 * PI);
+    const double rpm_hi = 1.02 * wmax / M.pole_pairs * 60.0 / (2.0 * CTRL_PI);
     const ctrl_fieldweak_out_t o = step_at(rpm_hi, 1.0, 0);
     TEST_ASSERT_EQUAL_INT32(0, o.torque_max);
     TEST_ASSERT_EQUAL_INT32(0, o.torque);
@@ -246,7 +246,7 @@ static void test_ipmsm_mtpv(void)
     /* MTPV is the largest torque on its flux circle: a scan never beats it. */
     double best = 0.0;
     for (int k = 0; k <= 4000; k++) {
-        const double a = PI * k / 4000.0;
+        const double a = CTRL_PI * k / 4000.0;
         const double i_d = (ps * cos(a) - M.psi_pm_wb) / M.ld_h;
         const double i_q = ps * sin(a) / M.lq_h;
         best = fmax(best, 1.5 * M.pole_pairs * (M.psi_pm_wb * i_q + (M.ld_h - M.lq_h) * i_d * i_q));
@@ -325,7 +325,7 @@ static void test_vdc_filter(void)
     ctrl_fieldweak_step(&S, &P, v0, 0, 0, 0, &o);
     TEST_ASSERT_EQUAL_INT32(v0, o.vdc);
     const q24_t v1 = q(0.8 * d(v0));
-    const double k = 1.0 - exp(-2.0 * PI * C.vdc_lpf_hz / 10000.0);
+    const double k = 1.0 - exp(-2.0 * CTRL_PI * C.vdc_lpf_hz / 10000.0);
     for (int n = 1; n <= 20; n++) {
         ctrl_fieldweak_step(&S, &P, v1, 0, 0, 0, &o);
         const double want = d(v1) + (d(v0) - d(v1)) * pow(1.0 - k, n);
@@ -420,7 +420,7 @@ static void test_fixed_flux(void)
     double best = 0.0;
     double best_v = 0.0;
     for (int k = 0; k <= 20000; k++) {
-        const double a = PI * k / 20000.0;
+        const double a = CTRL_PI * k / 20000.0;
         const double i_d = (ps * cos(a) - M.psi_pm_wb) / M.ld_h;
         const double i_q = ps * sin(a) / M.lq_h;
         const double t = 1.5 * M.pole_pairs * (M.psi_pm_wb * i_q + (M.ld_h - M.lq_h) * i_d * i_q);

@@ -35,11 +35,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "sim_run.h"
 #include "unity.h"
 
-#define PI 3.14159265358979323846
-#define W_RPM (70.0 * 60.0 / (2.0 * PI))
+#define W_RPM (70.0 * 60.0 / (2.0 * CTRL_PI))
 
 static sim_run_t run;
 
@@ -71,7 +71,7 @@ static double band_rms(const double *x, size_t n, double dt, double lo, double h
     const double W = (double)n * dt;
     double sum = 0.0;
     for (long k = (long)ceil(lo * W); (double)k <= hi * W; ++k) {
-        const double ph = 2.0 * PI * (double)k / (double)n;
+        const double ph = 2.0 * CTRL_PI * (double)k / (double)n;
         const double cr = cos(ph), ci = -sin(ph);
         double zr = 1.0, zi = 0.0, re = 0.0, im = 0.0;
         for (size_t j = 0; j < n; ++j) {

@@ -9,11 +9,10 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "hal_sim.h"
 #include "sim_machine.h"
 #include "unity.h"
-
-#define PI 3.14159265358979323846
 
 static char path[256];
 
@@ -92,10 +91,10 @@ static void test_plant_encoder(void)
     pc.psi_pm_wb = 0.1;
     pc.vdc_v = 100.0;
     pc.mech = PLANT_MECH_IMPOSED;
-    const double off_e = 100.0 * PI / 180.0;
+    const double off_e = 100.0 * CTRL_PI / 180.0;
     for (int dir = -1; dir <= 1; dir += 2) {
         /* Rotor d axis 0.5 mechanical degrees past the encoder's zero. */
-        pc.theta0_e_rad = off_e + 4.0 * 0.5 * PI / 180.0;
+        pc.theta0_e_rad = off_e + 4.0 * 0.5 * CTRL_PI / 180.0;
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&plant, &pc));
         hal_sim_config_t hc;
         hal_sim_config_default(&hc, 10000u, 10.0, 100.0);

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "controller.h"
+#include "ctrl_units.h"
 #include "estimator.h"
 #include "mpc_machines.h"
 #include "plan.h"
@@ -34,7 +35,6 @@ void tearDown(void)
 }
 
 #define N_SAMPLES 2000
-#define PI 3.14159265358979323846
 
 static uint32_t ticks_per_1000; /* Timer1 ticks of 1000 instructions */
 static uint32_t ticks_empty;    /* two back-to-back reads */
@@ -124,17 +124,18 @@ static void test_instruction_counts(void)
         /* Operating point: speed and torque change every 500 samples. */
         const int seg = k / 500;
         const double rpm = (seg & 1 ? 2250.0 : 750.0) * (seg & 2 ? -1.0 : 1.0);
-        const double w_e = rpm * 2.0 * PI / 60.0 * 4.0;
+        const double w_e = rpm * 2.0 * CTRL_PI / 60.0 * 4.0;
         const double t_nm = 1.8 * sin(0.37 * k);        /* -1.8 .. 1.8 N*m */
         const double iq = t_nm / (1.5 * 4.0 * 0.09427); /* SPMSM, i_d = 0 */
         theta += w_e * 1e-4;
         const double ia = -iq * sin(theta);
-        const double ib = -iq * sin(theta - 2.0 * PI / 3.0);
+        const double ib = -iq * sin(theta - 2.0 * CTRL_PI / 3.0);
         ctrl_meas_t m;
         m.i_a = ctrl_q24_from_double(ia / b.i_a);
         m.i_b = ctrl_q24_from_double(ib / b.i_a);
         m.vdc = p.vdc_nom;
-        m.theta_e = (fx_angle_t)(int64_t)llround(fmod(theta, 2.0 * PI) / (2.0 * PI) * 4294967296.0);
+        m.theta_e = (fx_angle_t)(int64_t)llround(fmod(theta, 2.0 * CTRL_PI) / (2.0 * CTRL_PI) *
+                                                 4294967296.0);
         ctrl_refs_t ref = {ctrl_q24_from_double((t_nm + 0.3 * sin(0.05 * k)) / tb), 0};
         ctrl_estimate_t est;
         uint32_t t0 = timer1_read();

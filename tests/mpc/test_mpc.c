@@ -40,7 +40,6 @@
 #define TOL_PSI (16.0 * LSB)
 #define TOL_T (64.0 * LSB)
 #define N_RANDOM 400
-#define PI 3.14159265358979323846
 
 void setUp(void)
 {

@@ -28,6 +28,7 @@
 #include <string.h>
 
 #include "angle_source.h"
+#include "ctrl_units.h"
 #include "est_fixture.h"
 #include "estimator.h"
 #include "flux_observer.h"
@@ -49,7 +50,6 @@ void tearDown(void)
 }
 
 #define N_IN 256
-#define PI 3.14159265358979323846
 #define CEILING 5000u /* sanity: no core call costs this much */
 
 /* ---- inputs (filled once, outside the measurement) ---- */
@@ -91,14 +91,14 @@ static void make_inputs(void)
     for (int k = 0; k < N_IN; k++) {
         input_t *t = &in[k];
         const double amp = imax * urand();
-        const double gam = 2.0 * PI * urand();
-        const double th = 2.0 * PI * urand();
+        const double gam = 2.0 * CTRL_PI * urand();
+        const double th = 2.0 * CTRL_PI * urand();
         const double ia = amp * cos(gam);
-        const double ib = amp * cos(gam - 2.0 * PI / 3.0);
+        const double ib = amp * cos(gam - 2.0 * CTRL_PI / 3.0);
         t->ia = ctrl_q24_from_double(ia);
         t->ib = ctrl_q24_from_double(ib);
         ctrl_clarke(t->ia, t->ib, &t->al, &t->be);
-        t->th = (fx_angle_t)(uint64_t)llround(th / (2.0 * PI) * 4294967296.0);
+        t->th = (fx_angle_t)(uint64_t)llround(th / (2.0 * CTRL_PI) * 4294967296.0);
         fx_sincos(t->th, &t->s, &t->c);
         /* a flux-sized vector (|psi| ~ 1 pu) for mag / sector */
         const double pa = 1.0 + 0.3 * (urand() - 0.5);

@@ -12,8 +12,6 @@
 
 #include "plant.h"
 
-#define PI 3.14159265358979323846
-
 static double now_s(void)
 {
     struct timespec ts;
@@ -54,10 +52,10 @@ static double run(double sim_s, int with_obs, int track_energy, double *torque_m
     const double t0 = now_s();
     const clock_t c0 = clock();
     for (long k = 0; k < n; ++k) {
-        const double th = plant_theta_e(&p) + 0.5 * PI + 0.2;
+        const double th = plant_theta_e(&p) + 0.5 * PLANT_PI + 0.2;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.45 * cos(th - 2.0 * PI / 3.0 * x);
+            d[x] = 0.5 + 0.45 * cos(th - 2.0 * PLANT_PI / 3.0 * x);
         }
         if (plant_advance_period(&p, T, d) != PLANT_OK) {
             return NAN;

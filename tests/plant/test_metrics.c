@@ -7,9 +7,8 @@
 #include <string.h>
 
 #include "metrics.h"
+#include "plant.h"
 #include "unity.h"
-
-#define PI 3.14159265358979323846
 
 void setUp(void)
 {
@@ -29,8 +28,9 @@ static void test_mean_std_sse(void)
     const int n = 4000; /* 20 ms: 10 periods of 500 Hz, 60 of 3 kHz */
     for (int k = 0; k < n; ++k) {
         const double t = k * h;
-        const double T = 2.0 + 0.3 * sin(2 * PI * 500 * t) + 0.1 * cos(2 * PI * 3000 * t);
-        const double psi = 0.1 + 0.004 * sin(2 * PI * 1000 * t + 0.2);
+        const double T =
+            2.0 + 0.3 * sin(2 * PLANT_PI * 500 * t) + 0.1 * cos(2 * PLANT_PI * 3000 * t);
+        const double psi = 0.1 + 0.004 * sin(2 * PLANT_PI * 1000 * t + 0.2);
         metrics_add(&m, t, T, 2.05, psi, 0.0);
     }
     metrics_result_t r;
@@ -53,7 +53,7 @@ static void test_thd_known(void)
 {
     metrics_acc_t m;
     metrics_init(&m, METRICS_SAMPLING_PLANT, 50.0);
-    const double h = 50e-6, w1 = 2 * PI * 50;
+    const double h = 50e-6, w1 = 2 * PLANT_PI * 50;
     for (int k = 0; k <= 1000; ++k) {   /* 50 ms */
         const double t = 0.013 + k * h; /* window not starting at 0 */
         const double ia = 10 * sin(w1 * t) + 0.5 * sin(5 * w1 * t + 0.3) + 0.2 * cos(7 * w1 * t);
@@ -86,7 +86,7 @@ static void test_thd_known(void)
 /* Harmonics above 10 kHz are excluded from (B.3). */
 static void test_thd_band_limit(void)
 {
-    const double f1 = 100.0, w1 = 2 * PI * f1, h = 1e-6; /* Nyquist 500 kHz */
+    const double f1 = 100.0, w1 = 2 * PLANT_PI * f1, h = 1e-6; /* Nyquist 500 kHz */
     static double t[20001], x[20001];
     for (int k = 0; k <= 20000; ++k) { /* 2 periods */
         t[k] = k * h;

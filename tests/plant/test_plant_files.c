@@ -18,8 +18,6 @@
 #error "PLANT_MACHINES_DIR must point at sim_host/machines"
 #endif
 
-#define PI 3.14159265358979323846
-
 void setUp(void)
 {
 }
@@ -403,7 +401,7 @@ static void test_fluxmap_shipped_and_inverse(void)
         const double th = plant_theta_e(&sat) + 2.0;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.45 * cos(th - 2.0 * PI / 3.0 * x);
+            d[x] = 0.5 + 0.45 * cos(th - 2.0 * PLANT_PI / 3.0 * x);
         }
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&sat, 100e-6, d));
     }
@@ -439,7 +437,7 @@ static void test_fluxmap_rk4_accuracy(void)
         const double th = plant_theta_e(&a) + 2.0;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.4 * cos(th - 2.0 * PI / 3.0 * x);
+            d[x] = 0.5 + 0.4 * cos(th - 2.0 * PLANT_PI / 3.0 * x);
         }
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&a, 50e-6, d));
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&b, 50e-6, d));

@@ -26,8 +26,6 @@
 #include "plant.h"
 #include "unity.h"
 
-#define PI 3.14159265358979323846
-
 void setUp(void)
 {
 }
@@ -108,7 +106,7 @@ static void steady_phasors(const plant_config_t *c, double f_hz, const int *prob
         const uint8_t hold[3] = {1, 1, 1};
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_filter_set_switches(&p, hold));
     }
-    const double w = 2.0 * PI * f_hz, V = 100.0;
+    const double w = 2.0 * PLANT_PI * f_hz, V = 100.0;
     /* slowest mode of Table 5: R1 (C1 + C2) ~ 3.2 s, excited by the switch-on
      * at ~1e-4 of the inverter current at 10 Hz: 20 s (a whole number of
      * periods) leave 2e-7 */
@@ -161,13 +159,13 @@ static void test_rlc_s1_44_unloaded(void)
     TEST_ASSERT_TRUE(q->r3_ohm + q->r3s_ohm > sqrt(4.0 * q->l3_h / q->c3_f));
     const double wc = 1.0 / sqrt(q->l3_h * q->c3_f);
     TEST_ASSERT_DOUBLE_WITHIN(0.5, 1633.0, wc);
-    TEST_ASSERT_DOUBLE_WITHIN(0.1, 259.9, wc / (2.0 * PI));
+    TEST_ASSERT_DOUBLE_WITHIN(0.1, 259.9, wc / (2.0 * PLANT_PI));
     const plant_config_t c = locked_machine(1e9, 1e5, &f); /* no load */
     const int probes[] = {PLANT_FP_V_NODE2, PLANT_FP_V_MOTOR};
     for (size_t k = 0; k < NF; ++k) {
         phasors_t ph;
         steady_phasors(&c, kFreqs[k], probes, 2, &ph);
-        const double complex s = I * 2.0 * PI * kFreqs[k];
+        const double complex s = I * 2.0 * PLANT_PI * kFreqs[k];
         const double complex h44 =
             (q->r3_ohm * q->c3_f * s + 1.0) /
             (q->c3_f * q->l3_h * s * s + (q->r3s_ohm + q->r3_ohm) * q->c3_f * s + 1.0);
@@ -186,7 +184,7 @@ static void test_rlc_s1_44_47_loaded(void)
     for (size_t k = 0; k < NF; ++k) {
         phasors_t ph;
         steady_phasors(&c, kFreqs[k], probes, 5, &ph);
-        const double complex s = I * 2.0 * PI * kFreqs[k];
+        const double complex s = I * 2.0 * PLANT_PI * kFreqs[k];
         const double complex zm = 5.8 + s * 44.8e-3;
         const double complex zsh = q->r3_ohm + 1.0 / (s * q->c3_f);
         const double complex zp = zm * zsh / (zm + zsh);
@@ -227,7 +225,7 @@ static void test_trap_s1_41_43(void)
         const double complex y21 = (i2a * v2b - v2a * i2b) / det;
         const double complex y22 = (v1a * i2b - i2a * v1b) / det;
         const double fk = kFreqs[k];
-        const double w = 2.0 * PI * fk;
+        const double w = 2.0 * PLANT_PI * fk;
         const double complex zl2 = q->r2_ohm + I * w * q->l2_h;
         const double x1 = w * q->l1_h - 1.0 / (w * q->c1_f);
         const double complex z1 =
@@ -259,7 +257,7 @@ static void test_active_s1_58(void)
     for (size_t k = 0; k < NF; ++k) {
         phasors_t ph;
         steady_phasors(&c, kFreqs[k], probes, 4, &ph);
-        const double complex s = I * 2.0 * PI * kFreqs[k];
+        const double complex s = I * 2.0 * PLANT_PI * kFreqs[k];
         const double complex zm = 5.8 + s * 44.8e-3;
         const double complex zrc1 = q->r1_ohm + 1.0 / (s * q->c1_f);
         const double complex zrc2 = q->r2_ohm + 1.0 / (s * q->c2_f);

@@ -12,8 +12,6 @@
 #include "plant.h"
 #include "unity.h"
 
-#define PI 3.14159265358979323846
-
 void setUp(void)
 {
 }
@@ -91,7 +89,7 @@ static void test_locked_rotor_d_axis(void)
 }
 static void test_locked_rotor_q_axis(void)
 {
-    check_locked_rotor(0.5 * PI, 1);
+    check_locked_rotor(0.5 * PLANT_PI, 1);
 }
 
 /* SPMSM in alpha-beta: v = R i + L di/dt + j w psi_pm e^{j theta}. A stator
@@ -104,8 +102,8 @@ static void test_phasor_steady_state_spmsm(void)
     c.theta0_e_rad = 0.3;
     plant_t p;
     TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
-    const double w = 1500.0 / 60.0 * 2.0 * PI * 4.0;
-    const double wv = 2.0 * PI * 70.0, V = 100.0, phi = -0.4, R = c.rs_ohm, L = c.ld_h;
+    const double w = 1500.0 / 60.0 * 2.0 * PLANT_PI * 4.0;
+    const double wv = 2.0 * PLANT_PI * 70.0, V = 100.0, phi = -0.4, R = c.rs_ohm, L = c.ld_h;
     /* 0.25 s = 34 time constants: transient below 1e-14 of the initial one */
     for (int k = 0; k < 250; ++k) {
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_voltage_ab(&p, 1e-3, V, wv, phi));
@@ -143,7 +141,7 @@ static void test_phasor_steady_state_ipmsm_sync(void)
     c.theta0_e_rad = 1.1;
     plant_t p;
     TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
-    const double w = -700.0 / 60.0 * 2.0 * PI * 2.0;
+    const double w = -700.0 / 60.0 * 2.0 * PLANT_PI * 2.0;
     const double V = 90.0, phi = 2.0;
     for (int k = 0; k < 400; ++k) { /* 0.4 s: > 35 of the slowest time constant */
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_voltage_ab(&p, 1e-3, V, w, phi));
@@ -220,7 +218,7 @@ static void check_energy(plant_config_t c, double rpm, double tol, const char *n
         const double th = plant_theta_e(&p) + 1.7;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.3 * cos(th - 2.0 * PI / 3.0 * x) + 0.1 * (urand(&s) - 0.5);
+            d[x] = 0.5 + 0.3 * cos(th - 2.0 * PLANT_PI / 3.0 * x) + 0.1 * (urand(&s) - 0.5);
         }
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&p, 50e-6, d));
     }
@@ -262,7 +260,7 @@ static void test_energy_balance_forward_drop(void)
         const double th = plant_theta_e(&p) + 1.7;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.3 * cos(th - 2.0 * PI / 3.0 * x);
+            d[x] = 0.5 + 0.3 * cos(th - 2.0 * PLANT_PI / 3.0 * x);
         }
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&p, 50e-6, d));
     }
@@ -341,7 +339,7 @@ static void test_free_mechanics_energy(void)
         const double th = plant_theta_e(&p) + 1.75;
         double d[3];
         for (int x = 0; x < 3; ++x) {
-            d[x] = 0.5 + 0.15 * cos(th - 2.0 * PI / 3.0 * x);
+            d[x] = 0.5 + 0.15 * cos(th - 2.0 * PLANT_PI / 3.0 * x);
         }
         TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance_period(&p, 50e-6, d));
     }
@@ -373,7 +371,7 @@ static void test_free_mechanics_friction_load(void)
     plant_t p;
     TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
     const uint8_t v0[3] = {0, 0, 0};
-    const double w0 = 2000.0 / 60.0 * 2.0 * PI, J = c.inertia_kgm2, B = c.friction_nms;
+    const double w0 = 2000.0 / 60.0 * 2.0 * PLANT_PI, J = c.inertia_kgm2, B = c.friction_nms;
     const double tl = c.load_torque_nm;
     double theta_exp = 0.0;
     for (int k = 1; k <= 100; ++k) {
@@ -388,7 +386,7 @@ static void test_free_mechanics_friction_load(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.0, plant_torque(&p));
     /* imposed speed change is honoured in free mode as a state reset */
     plant_set_speed_rpm(&p, 100.0);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 100.0 / 60.0 * 2.0 * PI, plant_omega_m(&p));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 100.0 / 60.0 * 2.0 * PLANT_PI, plant_omega_m(&p));
 }
 
 /* Passive load T_p (no electromagnetic torque: psi_pm = 0, no current):
@@ -406,7 +404,7 @@ static void test_free_mechanics_passive_load(void)
     plant_t p;
     TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
     const uint8_t v0[3] = {0, 0, 0};
-    const double w0 = 500.0 / 60.0 * 2.0 * PI, J = c.inertia_kgm2, tp = c.load_passive_nm;
+    const double w0 = 500.0 / 60.0 * 2.0 * PLANT_PI, J = c.inertia_kgm2, tp = c.load_passive_nm;
     const double t_stop = J * w0 / tp; /* 12.6 ms */
     const double h = 1e-4;
     for (int k = 1; k * h < 2.0 * t_stop; ++k) {

@@ -4,10 +4,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "fw_state.h"
 #include "transforms.h"
-
-#define EV_PI 3.14159265358979323846
 
 void fobs_eval_default(fobs_eval_cfg_t *c)
 {
@@ -89,22 +88,22 @@ static void ev_hook(void *ctx)
         const fx_angle_t th = ctrl_fobs_update(&e->sl, &e->p, e->va, e->vb, ia, ib, m->theta_e);
         (void)ctrl_fobs_update(&e->enc, &e->p, e->va_e, e->vb_e, ia, ib, m->theta_e);
         const double th_d = (double)th * (360.0 / 4294967296.0);
-        const double true_d = plant_theta_e(pl) * 180.0 / EV_PI;
+        const double true_d = plant_theta_e(pl) * 180.0 / CTRL_PI;
         const double ang_err = wrap_deg(th_d - true_d);
         const double w_true = plant_omega_e(pl);
         const double w_est = q2d(ctrl_fobs_omega(&e->sl)) * r->fw.bases.w_rad_s;
         const double pp = (double)r->fw.params.pole_pairs;
-        const double spd_err = (w_est - w_true) / pp * 60.0 / (2.0 * EV_PI);
+        const double spd_err = (w_est - w_true) / pp * 60.0 / (2.0 * CTRL_PI);
         const double tb = r->fw.bases.torque_nm;
         const double tq_true = plant_torque(pl);
         const double tq = q2d(fx_cross(e->sl.psi_alpha, e->sl.psi_beta, ia, ib)) * tb - tq_true;
         const double etq = q2d(fx_cross(e->enc.psi_alpha, e->enc.psi_beta, ia, ib)) * tb - tq_true;
         const double cmtq = q2d(r->fw.estimate.now.torque) * tb - tq_true;
         const double fw_spd_err = (q2d(r->fw.estimate.omega_e) * r->fw.bases.w_rad_s - w_true) /
-                                  pp * 60.0 / (2.0 * EV_PI);
+                                  pp * 60.0 / (2.0 * CTRL_PI);
         if (e->cfg->csv != NULL) {
             fprintf(e->cfg->csv, "%.6f,%.4f,%.4f,%.3f,%.3f,%.5f,%.5f,%.5f,%.6f\n", t, true_d,
-                    ang_err, w_true / pp * 60.0 / (2.0 * EV_PI), spd_err, tq_true, tq, etq,
+                    ang_err, w_true / pp * 60.0 / (2.0 * CTRL_PI), spd_err, tq_true, tq, etq,
                     q2d(ctrl_fobs_psi_pm(&e->enc)) * r->fw.bases.psi_wb);
         }
         if (t >= e->cfg->win_start_s && t <= e->cfg->win_end_s &&
@@ -185,7 +184,7 @@ int fobs_eval_run(const fobs_eval_cfg_t *c, fobs_eval_res_t *res, char *err, siz
         return -1;
     }
     ev_params(&run.fw.params, c->rs_scale, c->l_scale, c->psi_scale, &e.p);
-    e.w_rated_e = mach.speed_rated_rpm * 2.0 * EV_PI / 60.0 * (double)mach.pole_pairs;
+    e.w_rated_e = mach.speed_rated_rpm * 2.0 * CTRL_PI / 60.0 * (double)mach.pole_pairs;
     ctrl_fobs_config_t fc;
     if (c->has_fobs) {
         fc = c->fobs;
@@ -231,7 +230,7 @@ int fobs_eval_run(const fobs_eval_cfg_t *c, fobs_eval_res_t *res, char *err, siz
         res->fw_spd_rms_rpm = sqrt(e.fwspd_sum2 / n);
     }
     res->psi_pm_est_wb = q2d(ctrl_fobs_psi_pm(&e.enc)) * run.fw.bases.psi_wb;
-    res->speed_end_rpm = plant_omega_m(&run.plant) * 60.0 / (2.0 * EV_PI);
+    res->speed_end_rpm = plant_omega_m(&run.plant) * 60.0 / (2.0 * CTRL_PI);
     sim_run_free(&run);
     return 0;
 }

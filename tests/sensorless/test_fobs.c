@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../core/machines.h"
+#include "ctrl_units.h"
 #include "flux_observer.h"
 #include "flux_observer_config.h"
 #include "fx.h"
@@ -24,13 +25,13 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define LSB (1.0 / 16777216.0)
 #define TURN 4294967296.0
 /* fx_atan2 bound: linear interpolation h^2/8 max|atan''| (h = 1/256,
  * max = 3 sqrt(3)/8), ratio rounding after the operands are brought below
  * 2^24 (<= 1.5 2^-23), two roundings of an angle unit. */
-#define ATAN_BOUND (1.0 / 65536.0 / 8.0 * 0.649519052838329 + 1.5 / 8388608.0 + 2.0 * PI / TURN)
+#define ATAN_BOUND                                                                                 \
+    (1.0 / 65536.0 / 8.0 * 0.649519052838329 + 1.5 / 8388608.0 + 2.0 * CTRL_PI / TURN)
 
 static double d(q24_t x)
 {
@@ -44,16 +45,16 @@ static q24_t q(double x)
 
 static double ang_rad(fx_angle_t a)
 {
-    return (double)a * 2.0 * PI / TURN;
+    return (double)a * 2.0 * CTRL_PI / TURN;
 }
 
 static double wrap(double x)
 {
-    while (x >= PI) {
-        x -= 2.0 * PI;
+    while (x >= CTRL_PI) {
+        x -= 2.0 * CTRL_PI;
     }
-    while (x < -PI) {
-        x += 2.0 * PI;
+    while (x < -CTRL_PI) {
+        x += 2.0 * CTRL_PI;
     }
     return x;
 }
@@ -205,8 +206,8 @@ static double traj_run(ctrl_fobs_t *o, const ctrl_params_t *po, const traj_t *t,
         traj_at(t, k, &ia, &ib, &pa, &pb);
         const double va = (pa - pa0) / t->ts + t->rs * 0.5 * (ia0 + ia);
         const double vb = (pb - pb0) / t->ts + t->rs * 0.5 * (ib0 + ib);
-        const fx_angle_t enc =
-            (fx_angle_t)(int64_t)llround(fmod(traj_theta(t, k), 2.0 * PI) / (2.0 * PI) * TURN);
+        const fx_angle_t enc = (fx_angle_t)(int64_t)llround(fmod(traj_theta(t, k), 2.0 * CTRL_PI) /
+                                                            (2.0 * CTRL_PI) * TURN);
         const fx_angle_t th = ctrl_fobs_update(o, po, q(va), q(vb), q(ia), q(ib), enc);
         err = wrap(ang_rad(th) - traj_theta(t, k));
         if (k > 3 * n / 4) {
@@ -227,9 +228,9 @@ static void start(ctrl_fobs_t *o, const ctrl_params_t *po, const traj_t *t, doub
     double pa;
     double pb;
     traj_at(t, 0, &ia, &ib, &pa, &pb);
-    const double th = fmod(t->th0 + th_err + 8.0 * PI, 2.0 * PI);
-    ctrl_fobs_reset(o, po, (fx_angle_t)(int64_t)llround(th / (2.0 * PI) * TURN), q(t->w), q(ia),
-                    q(ib));
+    const double th = fmod(t->th0 + th_err + 8.0 * CTRL_PI, 2.0 * CTRL_PI);
+    ctrl_fobs_reset(o, po, (fx_angle_t)(int64_t)llround(th / (2.0 * CTRL_PI) * TURN), q(t->w),
+                    q(ia), q(ib));
 }
 
 /* ------------------------------------------------- exact trajectories */
@@ -418,15 +419,16 @@ static void test_pll_acceleration(void)
     ctrl_fobs_t o;
     fobs_default(&o, CTRL_FOBS_SENSORLESS, &P);
     const double ts = d(P.ts);
-    const double wn = 2.0 * PI * 300.0 / B.w_rad_s;    /* pu, the default 300 Hz */
-    const double acc = 0.02 * d(P.speed_rated_e) / ts; /* pu speed per pu time */
+    const double wn = 2.0 * CTRL_PI * 300.0 / B.w_rad_s; /* pu, the default 300 Hz */
+    const double acc = 0.02 * d(P.speed_rated_e) / ts;   /* pu speed per pu time */
     o.primed = 1u;
     o.pll_theta = 0u;
     o.pll_omega_acc = 0;
     double th = 0.0;
     double w = 0.0;
     for (int k = 0; k < 2000; k++) {
-        const fx_angle_t tr = (fx_angle_t)(int64_t)llround(fmod(th, 2.0 * PI) / (2.0 * PI) * TURN);
+        const fx_angle_t tr =
+            (fx_angle_t)(int64_t)llround(fmod(th, 2.0 * CTRL_PI) / (2.0 * CTRL_PI) * TURN);
         ctrl_fobs_correct(&o, &P, tr, 0, FX_ONE, 0, 0);
         th += w * ts + 0.5 * acc * ts * ts;
         w += acc * ts;

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 
 #include "../core/machines.h"
+#include "ctrl_units.h"
 #include "initial_angle.h"
 #include "unity.h"
 
@@ -27,7 +28,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define TURN 4294967296.0
 
 static ctrl_params_t P;
@@ -41,8 +41,8 @@ static double d(q24_t x)
 /* error of est (fx angle, modulo pi) against theta (rad), in rad within +-pi/2 */
 static double err_mod_pi(fx_angle_t est, double theta)
 {
-    double e = (double)est * 2.0 * PI / TURN - theta;
-    return e - PI * floor((e + PI / 2.0) / PI);
+    double e = (double)est * 2.0 * CTRL_PI / TURN - theta;
+    return e - CTRL_PI * floor((e + CTRL_PI / 2.0) / CTRL_PI);
 }
 
 static uint32_t rng = 12345u;
@@ -107,7 +107,7 @@ static void test_exact(void)
     TEST_ASSERT_EQUAL_INT(0, ctrl_ia_init(&ib, v, 2u, -1));
     double worst = 0.0;
     for (int k = -60; k < 60; k++) {
-        const double th = k * 7.0 * PI / 180.0 + 0.01;
+        const double th = k * 7.0 * CTRL_PI / 180.0 + 0.01;
         const fx_angle_t e = measure(&ia, th, d(P.inv_ld), d(P.inv_lq), 0.0);
         TEST_ASSERT_TRUE(e < 0x80000000u); /* [0, pi) */
         worst = fmax(worst, fabs(err_mod_pi(e, th)));
@@ -115,8 +115,8 @@ static void test_exact(void)
         const fx_angle_t f = measure(&ib, th, d(P.inv_lq), d(P.inv_ld), 0.0);
         worst = fmax(worst, fabs(err_mod_pi(f, th)));
     }
-    printf("exact currents: worst angle error %.2e deg\n", worst * 180.0 / PI);
-    TEST_ASSERT_TRUE(worst <= 0.01 * PI / 180.0);
+    printf("exact currents: worst angle error %.2e deg\n", worst * 180.0 / CTRL_PI);
+    TEST_ASSERT_TRUE(worst <= 0.01 * CTRL_PI / 180.0);
 }
 
 static void test_noise(void)
@@ -134,11 +134,11 @@ static void test_noise(void)
     const double sigma = 0.5 * sig_sum / signal; /* of theta = (2 theta) / 2 */
     double worst = 0.0;
     for (int k = 0; k < 72; k++) {
-        const double th = k * 5.0 * PI / 180.0 + 0.02;
+        const double th = k * 5.0 * CTRL_PI / 180.0 + 0.02;
         worst = fmax(worst, fabs(err_mod_pi(measure(&ia, th, d(P.inv_ld), d(P.inv_lq), a), th)));
     }
-    printf("noise +-%.4f pu: worst angle error %.3f deg, sigma %.3f deg\n", a, worst * 180.0 / PI,
-           sigma * 180.0 / PI);
+    printf("noise +-%.4f pu: worst angle error %.3f deg, sigma %.3f deg\n", a,
+           worst * 180.0 / CTRL_PI, sigma * 180.0 / CTRL_PI);
     TEST_ASSERT_TRUE(worst <= 5.0 * sigma);
 }
 

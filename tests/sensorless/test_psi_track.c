@@ -8,6 +8,7 @@
 #include <stdio.h>
 
 #include "../core/machines.h"
+#include "ctrl_units.h"
 #include "estimator.h"
 #include "flux_observer_config.h"
 #include "psi_track.h"
@@ -20,7 +21,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define TURN 4294967296.0
 
 static ctrl_params_t P;
@@ -43,7 +43,7 @@ static void track_config(ctrl_fobs_config_t *c)
     c->mode = CTRL_FOBS_ENCODER;
     c->psi_tau_s = 0.02;
     c->psi_speed_min = 0.1;
-    c->pll_hz = fmin(c->pll_hz, 0.4 * (double)P.fs_hz / (4.0 * PI)); /* as the firmware */
+    c->pll_hz = fmin(c->pll_hz, 0.4 * (double)P.fs_hz / (4.0 * CTRL_PI)); /* as the firmware */
 }
 
 /* The tracker as the firmware sets it up: the observer, then the N periods. */
@@ -115,8 +115,8 @@ static double run_track(ctrl_psi_track_t *t, double w, double scale, long n, lon
         m.i_a = q(ia[0]);
         m.i_b = q(-0.5 * ia[0] + 0.5 * sqrt(3.0) * ib[0]);
         m.vdc = P.vdc_nom;
-        m.theta_e =
-            (fx_angle_t)(uint32_t)(uint64_t)llround(fmod(th[0], 2.0 * PI) / (2.0 * PI) * TURN);
+        m.theta_e = (fx_angle_t)(uint32_t)(uint64_t)llround(fmod(th[0], 2.0 * CTRL_PI) /
+                                                            (2.0 * CTRL_PI) * TURN);
         ctrl_estimator_update(&e, &po, &m, &legs, &est);
         if (ctrl_psi_track_step(t, &po, &est, &legs, m.i_a, m.i_b)) {
             (*moves)++;
@@ -224,8 +224,8 @@ static void test_config(void)
         ctrl_psi_track_t t;
         TEST_ASSERT_EQUAL_INT(CTRL_OK, track_init(&t, &P, &c, NULL));
         const double ts = 1.0 / (double)fss[f];
-        const double w2 = 2.0 * M.speed_rated_rpm * M.pole_pairs * 2.0 * PI / 60.0;
-        const double n = floor(0.5 * PI / (w2 * ts));
+        const double w2 = 2.0 * M.speed_rated_rpm * M.pole_pairs * 2.0 * CTRL_PI / 60.0;
+        const double n = floor(0.5 * CTRL_PI / (w2 * ts));
         const unsigned expect = n < 1.0 ? 1u : (n > 8.0 ? 8u : (unsigned)n);
         printf("fs %u Hz: N %u (expected %u)\n", (unsigned)fss[f], (unsigned)t.div, expect);
         TEST_ASSERT_EQUAL_UINT(expect, t.div);

@@ -9,6 +9,7 @@
 
 #include "../core/machines.h"
 #include "angle_source.h"
+#include "ctrl_units.h"
 #include "fx.h"
 #include "sensorless.h"
 #include "sensorless_config.h"
@@ -21,7 +22,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define TURN 4294967296.0
 
 static ctrl_params_t P;
@@ -40,7 +40,7 @@ static q24_t q(double x)
 
 static double wrap(double x)
 {
-    return x - 2.0 * PI * floor((x + PI) / (2.0 * PI));
+    return x - 2.0 * CTRL_PI * floor((x + CTRL_PI) / (2.0 * CTRL_PI));
 }
 
 static void setup(ctrl_machine_t m, ctrl_sl_t *s)
@@ -72,7 +72,7 @@ static long run_locked(ctrl_sl_t *s, double gamma, double speed_ref, long n, dou
     /* torque t_start cos(gamma) from a current of amplitude i_q = t_start /
      * psi_pm along the forced q axis (the SPMSM's MTPA current) */
     const double i_amp = d(s->t_start) / psi;
-    double th_f = (double)s->theta0 * 2.0 * PI / TURN;
+    double th_f = (double)s->theta0 * 2.0 * CTRL_PI / TURN;
     double w = 0.0;
     double th = th_f + gamma;
     double ia0 = -i_amp * sin(th_f);
@@ -89,12 +89,12 @@ static long run_locked(ctrl_sl_t *s, double gamma, double speed_ref, long n, dou
         *last = out;
         if (out.handover) {
             handover = k;
-            *err_rad = wrap((double)out.theta * 2.0 * PI / TURN - th);
+            *err_rad = wrap((double)out.theta * 2.0 * CTRL_PI / TURN - th);
         }
         /* the motion over [k, k+1): forced frame at out.omega while forced */
         if (out.mode == CTRL_SL_FORCED) {
             w = d(out.omega);
-            th_f = (double)out.theta * 2.0 * PI / TURN + w * ts;
+            th_f = (double)out.theta * 2.0 * CTRL_PI / TURN + w * ts;
             th = th_f + gamma;
         } else {
             th += w * ts;
@@ -132,12 +132,12 @@ static void test_ramp_and_handover(void)
     double err = 1.0;
     ctrl_sl_out_t last;
     const long h =
-        run_locked(&s, PI / 6.0, 2.0 * d(s.w_on), ramp_n + (long)s.settle_n + 50, &err, &last);
+        run_locked(&s, CTRL_PI / 6.0, 2.0 * d(s.w_on), ramp_n + (long)s.settle_n + 50, &err, &last);
     TEST_ASSERT_TRUE_MESSAGE(h > 0, "no handover");
     /* the handover comes settle_n periods after w_on is first reached */
     TEST_ASSERT_INT_WITHIN(2, ramp_n + (long)s.settle_n - 1, h);
-    printf("handover after %ld periods, observer error then %.4f deg\n", h, err * 180.0 / PI);
-    TEST_ASSERT_TRUE_MESSAGE(fabs(err) < PI / 180.0, "observer not converged at the handover");
+    printf("handover after %ld periods, observer error then %.4f deg\n", h, err * 180.0 / CTRL_PI);
+    TEST_ASSERT_TRUE_MESSAGE(fabs(err) < CTRL_PI / 180.0, "observer not converged at the handover");
     TEST_ASSERT_EQUAL_UINT8(CTRL_SL_OBSERVER, last.mode);
     TEST_ASSERT_EQUAL_UINT8(0u, last.handover);
 }
@@ -191,8 +191,8 @@ static void test_fallback_bumpless(void)
             k++;
         } while (out.mode == CTRL_SL_OBSERVER && k < 100000);
         TEST_ASSERT_EQUAL_INT32((long)s.low_n, k); /* at rest: w_obs = 0 < w_off */
-        const double g = wrap((double)(out.theta_obs - out.theta) * 2.0 * PI / TURN);
-        TEST_ASSERT_FLOAT_WITHIN(1e-4, wrap(gam[i] * PI / 180.0), g);
+        const double g = wrap((double)(out.theta_obs - out.theta) * 2.0 * CTRL_PI / TURN);
+        TEST_ASSERT_FLOAT_WITHIN(1e-4, wrap(gam[i] * CTRL_PI / 180.0), g);
     }
 }
 
@@ -235,8 +235,8 @@ static int run_initial(ctrl_sl_t *s, double theta, double speed_ref, double turn
         ctrl_sl_update(s, &P, va, vb, q(ia), q(ib), q(speed_ref), 0, last);
         if (s->phase == CTRL_SL_PH_D2 && turned == 0u) {
             /* the pulse is over: the rotor turned the way its torque pushed */
-            const double th1 = (double)s->th1 * 2.0 * PI / TURN;
-            const int north = fabs(wrap(th1 - theta)) < 0.5 * PI;
+            const double th1 = (double)s->th1 * 2.0 * CTRL_PI / TURN;
+            const int north = fabs(wrap(th1 - theta)) < 0.5 * CTRL_PI;
             const double dir = speed_ref < 0.0 ? -1.0 : 1.0;
             theta += (north ? dir : -dir) * turn_rad;
             turned = 1u;
@@ -256,28 +256,29 @@ static void test_initial_angle_start(void)
 {
     double worst = 0.0;
     for (int j = 0; j < 24; j++) {
-        const double theta = wrap(j * 15.0 * PI / 180.0 + 0.05);
+        const double theta = wrap(j * 15.0 * CTRL_PI / 180.0 + 0.05);
         for (int dir = -1; dir <= 1; dir += 2) {
             ctrl_sl_t s;
             setup(machine_thesis_ipmsm80(), &s);
             TEST_ASSERT_EQUAL_UINT8(1u, s.ia_on);
             ctrl_sl_out_t out;
-            const double turn = 10.0 * PI / 180.0;
-            const int k =
-                run_initial(&s, theta, dir * 300.0 / 60.0 * 2.0 * PI * 4.0 / B.w_rad_s, turn, &out);
+            const double turn = 10.0 * CTRL_PI / 180.0;
+            const int k = run_initial(
+                &s, theta, dir * 300.0 / 60.0 * 2.0 * CTRL_PI * 4.0 / B.w_rad_s, turn, &out);
             TEST_ASSERT_TRUE(k > 0);
             TEST_ASSERT_EQUAL_UINT8(CTRL_SL_OBSERVER, out.mode);
             TEST_ASSERT_EQUAL_UINT8(1u, out.handover);
             /* where the rotor is now: theta turned by +-10 deg */
-            const double th1 = (double)s.th1 * 2.0 * PI / TURN;
-            const int north = fabs(wrap(th1 - theta)) < 0.5 * PI;
+            const double th1 = (double)s.th1 * 2.0 * CTRL_PI / TURN;
+            const int north = fabs(wrap(th1 - theta)) < 0.5 * CTRL_PI;
             const double now = theta + (north ? dir : -dir) * turn;
-            const double e = wrap((double)out.theta * 2.0 * PI / TURN - now);
+            const double e = wrap((double)out.theta * 2.0 * CTRL_PI / TURN - now);
             worst = fmax(worst, fabs(e));
         }
     }
-    printf("initial angle and polarity, 48 starts: worst error %.4f deg\n", worst * 180.0 / PI);
-    TEST_ASSERT_TRUE(worst <= 0.1 * PI / 180.0);
+    printf("initial angle and polarity, 48 starts: worst error %.4f deg\n",
+           worst * 180.0 / CTRL_PI);
+    TEST_ASSERT_TRUE(worst <= 0.1 * CTRL_PI / 180.0);
     /* a rotor that does not turn: polarity unknown, the blind forced start */
     ctrl_sl_t s;
     setup(machine_thesis_ipmsm80(), &s);

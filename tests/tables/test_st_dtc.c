@@ -13,6 +13,7 @@
 #include "../plant/ini_machines.h"
 #include "controller.h"
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "mtpa.h"
 #include "st_dtc.h"
 #include "st_dtc_config.h"
@@ -26,8 +27,6 @@ void setUp(void)
 void tearDown(void)
 {
 }
-
-#define PI 3.14159265358979323846
 
 static const ctrl_machine_t SPMSM = {
     "thesis SPMSM", 4,   0.901,  6.552e-3, 6.552e-3, 0.09427, 220.0,
@@ -137,8 +136,8 @@ static void test_registry_and_defaults(void)
             } else if (strcmp(t->name, "h_psi") == 0) {
                 TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.02 * 0.09427, v); /* 2 % psi_pm */
             } else if (strcmp(t->name, "sigma") == 0) {
-                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, v);     /* §4.6.2 */
-                TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 6.0, t->max); /* half sector */
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, CTRL_PI / 12.0, v);     /* §4.6.2 */
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, CTRL_PI / 6.0, t->max); /* half sector */
             } else if (strcmp(t->name, "dT_step") == 0) {
                 TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* Delta T_ref != 0 */
             } else if (strcmp(t->name, "f_i") == 0) {
@@ -202,8 +201,8 @@ static void test_tunables_by_name(void)
 
     rig_open("fst");
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(R.d, R.cfg, "sigma", &v));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-12, PI / 12.0, v);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", PI / 6.0 + 1e-3));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, CTRL_PI / 12.0, v);
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", CTRL_PI / 6.0 + 1e-3));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_tunable_set(R.d, R.cfg, "sigma", NAN));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "sigma", 0.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "dT_step", 0.1));
@@ -248,7 +247,8 @@ static void check_hyst_table(const char *name, const uint8_t (*tab3)[3][6],
     rig_open(name);
     for (int x = 1; x <= 6; x++) {
         /* sector centre: (x-1) pi/3 for (4.5), (2x-1) pi/6 for (4.18) */
-        const double theta = mbst_sectors ? (2.0 * x - 1.0) * PI / 6.0 : (x - 1.0) * PI / 3.0;
+        const double theta =
+            mbst_sectors ? (2.0 * x - 1.0) * CTRL_PI / 6.0 : (x - 1.0) * CTRL_PI / 3.0;
         for (int r = 0; r < 2; r++) {
             const int nc = tab3 != NULL ? 3 : 2;
             for (int c = 0; c < nc; c++) {
@@ -294,11 +294,11 @@ static void test_zst_controller(void)
 static void test_mbst_uses_modified_sectors(void)
 {
     rig_open("mbst");
-    TEST_ASSERT_EQUAL_UINT8(1, hyst_decide(PI / 12.0, 1, -1, 1));
-    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(-PI / 12.0, 1, -1, 1));
+    TEST_ASSERT_EQUAL_UINT8(1, hyst_decide(CTRL_PI / 12.0, 1, -1, 1));
+    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(-CTRL_PI / 12.0, 1, -1, 1));
     rig_open("bst");
-    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(PI / 12.0, 1, -1, 1)); /* V_{x+5}, x = 1 */
-    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(-PI / 12.0, 1, -1, 1));
+    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(CTRL_PI / 12.0, 1, -1, 1)); /* V_{x+5}, x = 1 */
+    TEST_ASSERT_EQUAL_UINT8(6, hyst_decide(-CTRL_PI / 12.0, 1, -1, 1));
 }
 
 /* The zero vector after every vector: walk BST through increase (active) and
@@ -309,7 +309,7 @@ static void test_zero_vector_one_leg(void)
     int zeros = 0;
     for (int x = 1; x <= 6; x++) {
         for (int r = 0; r < 2; r++) {
-            const double theta = (x - 1.0) * PI / 3.0;
+            const double theta = (x - 1.0) * CTRL_PI / 3.0;
             const uint8_t a = hyst_decide(theta, r == 0 ? 1 : -1, 1, 1);
             TEST_ASSERT_TRUE(a >= 1u && a <= 6u);
             /* now maintain: Te hits Tref */
@@ -446,7 +446,7 @@ static void test_fst_controller_all_states(void)
     const double psi_ref = 1.05;
     R.ref.psi = q24(psi_ref);
     for (int x = 1; x <= 6; x++) {
-        const double theta = (x - 1.0) * PI / 3.0; /* centre: outside both subsectors */
+        const double theta = (x - 1.0) * CTRL_PI / 3.0; /* centre: outside both subsectors */
         for (int m = 0; m < 3; m++) {
             for (int t = 0; t < 2; t++) {
                 for (int f = 0; f < 2; f++) {
@@ -497,13 +497,13 @@ static void test_fst_controller_replacement(void)
         }
         R.ref.psi = q24(1.0);
         R.ref.torque = q24(0.4);
-        const double th = -PI / 6.0 + PI / 24.0;
+        const double th = -CTRL_PI / 6.0 + CTRL_PI / 24.0;
         set_next(th, 1.02, 0.45, 0.2);
         (void)step(); /* step from T_ref[k-1] = 0 */
         set_next(th, 1.02, 0.35, 0.2);
         TEST_ASSERT_EQUAL_UINT8(pass == 0 ? 2 : 3, step());
         /* subsector II of sector 1 (theta = pi/6 - pi/24): V_{x+1} = V2 -> V3 (4.21) */
-        set_next(PI / 6.0 - PI / 24.0, 0.98, 0.35, 0.2);
+        set_next(CTRL_PI / 6.0 - CTRL_PI / 24.0, 0.98, 0.35, 0.2);
         TEST_ASSERT_EQUAL_UINT8(pass == 0 ? 3 : 2, step());
     }
 }
@@ -530,7 +530,7 @@ static void test_fst_integrator(void)
     TEST_ASSERT_EQUAL_INT32(0, f->ki);
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_set(R.d, R.cfg, "f_i", 100.0));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_init(R.d, R.state, R.cfg, &R.su));
-    const double ki = 2.0 * PI * 100.0 / 20000.0;
+    const double ki = 2.0 * CTRL_PI * 100.0 / 20000.0;
     TEST_ASSERT_INT32_WITHIN(1, q24(ki), f->ki);
     TEST_ASSERT_EQUAL_INT32(R.params.torque_rated, f->g_max);
     /* outside the tunable's range: refused by name */

@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "ctrl_params.h"
+#include "ctrl_units.h"
 #include "unity.h"
 #include "vectors.h"
 #include "vreplace.h"
@@ -26,7 +27,6 @@ void tearDown(void)
 {
 }
 
-#define PI 3.14159265358979323846
 #define DELTA 1e-5
 
 /* Subsector I (4.20): [x-1][k] = {from, to} */
@@ -76,8 +76,8 @@ static void check_sigma(double sigma)
     TEST_ASSERT_EQUAL_UINT8(1, c.enabled);
     static const double amps[3] = {0.05, 1.0, 3.0};
     for (uint8_t x = 1; x <= 6; x++) {
-        const double a = (2.0 * x - 3.0) * PI / 6.0; /* lower boundary (4.5) */
-        const double b = (2.0 * x - 1.0) * PI / 6.0; /* upper boundary */
+        const double a = (2.0 * x - 3.0) * CTRL_PI / 6.0; /* lower boundary (4.5) */
+        const double b = (2.0 * x - 1.0) * CTRL_PI / 6.0; /* upper boundary */
         for (int k = 0; k < 3; k++) {
             const double m = amps[k];
             const double d = DELTA / fmin(1.0, m) * 2.0; /* keep >> Q24 step at small |psi| */
@@ -94,20 +94,20 @@ static void check_sigma(double sigma)
 
 static void test_subsector_boundaries_sigma_max(void)
 {
-    check_sigma(PI / 12.0);
+    check_sigma(CTRL_PI / 12.0);
 }
 
 /* Beyond (4.19)'s pi/12 up to pi/6, where subsectors I and II meet at the
  * sector centre (the sigma study). */
 static void test_subsector_boundaries_sigma_wide(void)
 {
-    check_sigma(PI / 8.0);
-    check_sigma(PI / 6.0 - 1e-3);
+    check_sigma(CTRL_PI / 8.0);
+    check_sigma(CTRL_PI / 6.0 - 1e-3);
 }
 
 static void test_subsector_boundaries_sigma_small(void)
 {
-    check_sigma(PI / 48.0);
+    check_sigma(CTRL_PI / 48.0);
 }
 
 /* theta = pi/2 exactly (psi on the beta axis) is the end of sector 2 by (4.5):
@@ -127,12 +127,12 @@ static void test_exact_axis_points(void)
 static void test_disabled_and_bad_input(void)
 {
     ctrl_vreplace_t c;
-    const q24_t pa = q24(cos(-PI / 6.0 + 0.01)); /* deep in subsector I of sector 1 */
-    const q24_t pb = q24(sin(-PI / 6.0 + 0.01));
+    const q24_t pa = q24(cos(-CTRL_PI / 6.0 + 0.01)); /* deep in subsector I of sector 1 */
+    const q24_t pb = q24(sin(-CTRL_PI / 6.0 + 0.01));
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 0.0)); /* sigma = 0: off */
     TEST_ASSERT_EQUAL_UINT8(0, c.enabled);
     TEST_ASSERT_EQUAL_UINT8(3, ctrl_vreplace(&c, 3, 1, pa, pb));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, PI / 12.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, CTRL_PI / 12.0));
     TEST_ASSERT_EQUAL_UINT8(2, ctrl_vreplace(&c, 3, 1, pa, pb));
     c.enabled = 0;
     TEST_ASSERT_EQUAL_UINT8(3, ctrl_vreplace(&c, 3, 1, pa, pb));
@@ -148,11 +148,11 @@ static void test_disabled_and_bad_input(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(NULL, 0.1));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, -1e-9));
     TEST_ASSERT_EQUAL_UINT8(0, c.enabled);
-    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, PI / 6.0 + 1e-6));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 30.0 * PI / 180.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, CTRL_PI / 6.0 + 1e-6));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 30.0 * CTRL_PI / 180.0));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, NAN));
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_vreplace_config(&c, INFINITY));
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 15.0 * PI / 180.0));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_vreplace_config(&c, 15.0 * CTRL_PI / 180.0));
     TEST_ASSERT_EQUAL_UINT8(1, c.enabled);
 }
 

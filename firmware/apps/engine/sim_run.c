@@ -1,6 +1,7 @@
 /* Closed loop on the host (see sim_run.h). */
 #include "sim_run.h"
 
+#include "ctrl_units.h"
 #include "speed_loop.h"
 
 #include <math.h>
@@ -8,7 +9,6 @@
 #include <stdint.h>
 #include <string.h>
 
-#define SIM_PI 3.14159265358979323846
 #define SIM_OBS_PER_PERIOD 10u
 
 static int sim_err(char *err, size_t errlen, const char *msg)
@@ -104,7 +104,7 @@ static double sim_run_speed_ref_now(const sim_run_t *r)
         return NAN;
     }
     return ctrl_q24_to_double(r->fw.speed_ref) * r->fw.bases.w_rad_s /
-           (double)r->fw.params.pole_pairs * 60.0 / (2.0 * SIM_PI);
+           (double)r->fw.params.pole_pairs * 60.0 / (2.0 * CTRL_PI);
 }
 
 static void sim_observer(void *ctx, const plant_t *p)
@@ -124,7 +124,7 @@ static void sim_observer(void *ctx, const plant_t *p)
     if (t >= r->cfg.win_start_s && t <= r->cfg.win_end_s) {
         metrics_add(&r->m_plant, t, tq, tref, psi, i_abc[0]);
         metrics_add_voltage(&r->m_plant, t, v_abc[0]);
-        r->speed_sum_rpm += plant_omega_m(p) * 60.0 / (2.0 * SIM_PI);
+        r->speed_sum_rpm += plant_omega_m(p) * 60.0 / (2.0 * CTRL_PI);
         r->speed_n++;
     }
     if (r->cfg.trace != NULL && (r->obs_count % r->cfg.trace_decimation) == 0u &&
@@ -139,7 +139,7 @@ static void sim_observer(void *ctx, const plant_t *p)
                 "%.9g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%u,%.4f,%u,%.6g,%.6g,%.6g,%.6g,"
                 "%.6g,%.6g\n",
                 t, i_abc[0], i_abc[1], i_abc[2], id, iq, psi, tq,
-                plant_omega_m(p) * 60.0 / (2.0 * SIM_PI), tref, (unsigned)r->vec_now, r->duty_now,
+                plant_omega_m(p) * 60.0 / (2.0 * CTRL_PI), tref, (unsigned)r->vec_now, r->duty_now,
                 (unsigned)tm->state, sim_run_speed_ref_now(r), load, v_abc[0], v_abc[1], v_abc[2],
                 i_inv[0]);
     }
@@ -174,7 +174,7 @@ static void sim_scenario_step(sim_run_t *r, double t)
     sim_scenario_t *s = &r->scn;
     while (s->next < s->n) {
         const sim_event_t *e = &s->ev[s->next];
-        const double rpm = plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI);
+        const double rpm = plant_omega_m(&r->plant) * 60.0 / (2.0 * CTRL_PI);
         bool fire = false;
         switch (e->trig) {
         case SIM_TRIG_AT:
@@ -292,17 +292,17 @@ static void sim_observer_update(sim_run_t *r, double t)
 static void sim_est_error_add(sim_run_t *r, double t, double th_true, double w_true)
 {
     const sim_machine_t *m = &r->cfg.plant_machine;
-    const double w_rated = m->speed_rated_rpm * 2.0 * SIM_PI / 60.0 * (double)m->pole_pairs;
+    const double w_rated = m->speed_rated_rpm * 2.0 * CTRL_PI / 60.0 * (double)m->pole_pairs;
     if (t < r->cfg.win_start_s || t > r->cfg.win_end_s || fw_state(&r->fw) != FW_STATE_RUNNING ||
         fabs(w_true) < 0.1 * w_rated) {
         return;
     }
     const ctrl_estimate_t *e = &r->fw.estimate;
-    double d = (double)e->now.theta_e * (2.0 * SIM_PI / 4294967296.0) - th_true;
-    d -= 2.0 * SIM_PI * floor((d + SIM_PI) / (2.0 * SIM_PI)); /* [-pi, pi) */
-    const double deg = d * 180.0 / SIM_PI;
+    double d = (double)e->now.theta_e * (2.0 * CTRL_PI / 4294967296.0) - th_true;
+    d -= 2.0 * CTRL_PI * floor((d + CTRL_PI) / (2.0 * CTRL_PI)); /* [-pi, pi) */
+    const double deg = d * 180.0 / CTRL_PI;
     const double w_est = ctrl_q24_to_double(e->omega_e) * r->fw.bases.w_rad_s;
-    const double rpm = (w_est - w_true) / (double)m->pole_pairs * 60.0 / (2.0 * SIM_PI);
+    const double rpm = (w_est - w_true) / (double)m->pole_pairs * 60.0 / (2.0 * CTRL_PI);
     r->est_ang_sum2 += deg * deg;
     r->est_ang_max = fmax(r->est_ang_max, fabs(deg));
     r->est_spd_sum2 += rpm * rpm;
@@ -759,7 +759,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         c->hal.enc_lines = (uint32_t)c->plant_machine.encoder_lines;
     }
     c->hal.enc_zero_rad =
-        c->plant_machine.encoder_offset_deg * SIM_PI / 180.0 / (double)c->plant_machine.pole_pairs;
+        c->plant_machine.encoder_offset_deg * CTRL_PI / 180.0 / (double)c->plant_machine.pole_pairs;
     c->hal.enc_dir = c->plant_machine.encoder_direction < 0 ? -1 : 1;
     if (engine_hal_init(&r->hal, &c->hal, &r->plant) != 0) {
         return sim_err(err, errlen, "HAL simulation rejected its configuration");
@@ -934,7 +934,7 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
 
 double sim_run_speed_rpm(const sim_run_t *r)
 {
-    return plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI);
+    return plant_omega_m(&r->plant) * 60.0 / (2.0 * CTRL_PI);
 }
 
 static void sim_json_num(FILE *f, const char *key, double v)

@@ -1,10 +1,9 @@
 /* Identification in the host simulator (see sim_ident.h). */
 #include "sim_ident.h"
+#include "ctrl_units.h"
 
 #include <math.h>
 #include <string.h>
-
-#define SIM_PI 3.14159265358979323846
 
 const uint8_t sim_ident_plan[] = {CM_STEP_VBUS, CM_STEP_PROBE, CM_STEP_ENCODER,
                                   CM_STEP_RS,   CM_STEP_LDQ,   CM_STEP_FLUX};
@@ -73,8 +72,8 @@ static void sim_trace_row(const sim_run_t *r, double t, uint64_t k)
     const double vb = fw->bases.v_v / 16777216.0;
     fprintf(sim_trace_f, "%.6f,%u,%u,%.5g,%.5g,%.5g,%.6f,%.6g,%.6f,%.5g,%.5g\n", t,
             (unsigned)cm->step, (unsigned)cm->phase, i[0], i[1], i[2], plant_theta_e(&r->plant),
-            plant_omega_m(&r->plant) * 60.0 / (2.0 * SIM_PI),
-            (double)fw_telemetry(fw)->theta_e / 4294967296.0 * 2.0 * SIM_PI, cm->io.va_al[1] * vb,
+            plant_omega_m(&r->plant) * 60.0 / (2.0 * CTRL_PI),
+            (double)fw_telemetry(fw)->theta_e / 4294967296.0 * 2.0 * CTRL_PI, cm->io.va_al[1] * vb,
             cm->io.va_be[1] * vb);
 }
 
