@@ -27,9 +27,19 @@ static int64_t fobs_clamp(int64_t x)
     return x > FOBS_ACC_MAX ? FOBS_ACC_MAX : (x < -FOBS_ACC_MAX ? -FOBS_ACC_MAX : x);
 }
 
+/* The Q24 view of a Q48 accumulator, rounded and saturated. */
 static q24_t fobs_q24(int64_t acc)
 {
     return fx_round_sat(acc, FX_QBITS);
+}
+
+/* The Q24 view of a flux or PLL accumulator: those are kept within
+ * +-FOBS_ACC_MAX = +-127 2^48 just before each view (fobs_clamp, the PLL's clamp), so
+ * (acc + 2^23) / 2^24 lies within +-(127 2^24 + 1) < 2^31 and the rounding
+ * without saturation gives fobs_q24's value. */
+static q24_t fobs_q24_clamped(int64_t acc)
+{
+    return fx_round_nosat(acc, FX_QBITS);
 }
 
 /* ctrl_fobs_reset in the frame (theta, s, c) with the current's i_d there. */
@@ -167,8 +177,8 @@ fx_angle_t ctrl_fobs_integrate(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_a
     o->psi_beta_acc = fobs_axis(p, o->psi_beta_acc, v_beta, o->i_beta_prev, i_beta);
     o->i_alpha_prev = i_alpha;
     o->i_beta_prev = i_beta;
-    o->psi_alpha = fobs_q24(o->psi_alpha_acc);
-    o->psi_beta = fobs_q24(o->psi_beta_acc);
+    o->psi_alpha = fobs_q24_clamped(o->psi_alpha_acc);
+    o->psi_beta = fobs_q24_clamped(o->psi_beta_acc);
     /* Active flux psi - Lq i: on the d axis whatever the saliency. */
     o->eta_alpha = fx_sub(o->psi_alpha, fx_mul(p->lq, i_alpha));
     o->eta_beta = fx_sub(o->psi_beta, fx_mul(p->lq, i_beta));
@@ -186,7 +196,7 @@ static void fobs_pll(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r)
     const int64_t w = o->pll_omega_acc + (int64_t)e * o->pll_ki; /* |.| < 2^55 + 2^62 */
     o->pll_omega_acc =
         w > FOBS_OMEGA_MAX ? FOBS_OMEGA_MAX : (w < -FOBS_OMEGA_MAX ? -FOBS_OMEGA_MAX : w);
-    const q24_t omega_i = fobs_q24(o->pll_omega_acc);
+    const q24_t omega_i = fobs_q24_clamped(o->pll_omega_acc);
     /* kp e: |e| <= 2^31, 0 <= kp < 2^23 (2 w_n Ts <= 0.5): |kp e| < 2^30. */
     const int32_t kpe = fx_round_sat((int64_t)e * o->pll_kp, FX_QBITS);
     o->omega = fx_add(omega_i, fx_round_sat((int64_t)kpe * p->dangle_to_omega, CTRL_DANGLE_SHIFT));
@@ -196,9 +206,10 @@ static void fobs_pll(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r)
 /* The flux moved by the correction (corr_d, corr_q) of the frame (s, c). */
 static void fobs_move(ctrl_fobs_t *o, q24_t corr_d, q24_t corr_q, q24_t s, q24_t c)
 {
-    q24_t ca;
-    q24_t cb;
-    ctrl_inv_park(corr_d, corr_q, s, c, &ca, &cb);
+    /* Inverse Park (3.7) inline, the same rounded and saturated sums as
+     * ctrl_inv_park: alpha = c d - s q, beta = s d + c q. */
+    const q24_t ca = fx_cross(c, s, corr_q, corr_d);
+    const q24_t cb = fx_dot(s, c, corr_d, corr_q);
     o->psi_alpha_acc = fobs_clamp(o->psi_alpha_acc + (int64_t)ca * FX_ONE);
     o->psi_beta_acc = fobs_clamp(o->psi_beta_acc + (int64_t)cb * FX_ONE);
 }
@@ -260,9 +271,9 @@ fx_angle_t ctrl_fobs_update(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_alph
     q24_t s;
     q24_t c;
     fx_sincos(th_r, &s, &c);
-    q24_t i_d;
-    q24_t i_q;
-    ctrl_park(i_alpha, i_beta, s, c, &i_d, &i_q);
+    /* Park (3.7) inline, the same rounded and saturated sums as ctrl_park. */
+    const q24_t i_d = fx_dot(c, s, i_alpha, i_beta);
+    const q24_t i_q = fx_cross(c, s, i_alpha, i_beta);
     ctrl_fobs_correct(o, p, th_r, s, c, i_d, i_q);
     return th;
 }
