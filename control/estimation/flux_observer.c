@@ -270,7 +270,7 @@ fx_angle_t ctrl_fobs_update(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_alph
     const fx_angle_t th_r = o->mode == CTRL_FOBS_ENCODER ? theta_enc : th;
     q24_t s;
     q24_t c;
-    fx_sincos(th_r, &s, &c);
+    fx_sincos_inline(th_r, &s, &c); /* fx_sincos without the call */
     /* Park (3.7) inline, the same rounded and saturated sums as ctrl_park. */
     const q24_t i_d = fx_dot(c, s, i_alpha, i_beta);
     const q24_t i_q = fx_cross(c, s, i_alpha, i_beta);
