@@ -164,7 +164,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
 {
     ctrl_fobs_t *const o = &s->obs;
     const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
-    const q24_t w_obs = ctrl_fobs_omega(o);
+    const q24_t w_obs = o->omega; /* ctrl_fobs_omega without the call */
     out->handover = 0u;
     out->theta_obs = th_obs;
 
