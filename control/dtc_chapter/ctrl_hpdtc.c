@@ -13,37 +13,31 @@
 #define K_TAN6_Q30 112854813
 #define K_TAN18_Q30 348879867
 
-/* Vector nr + a for nr in 1..6 and |a| <= 2: ctrl_vec_wrap on that range,
- * one compare each way instead of a division. */
-static uint8_t hpdtc_vec_step(int nr, int a)
-{
-    const int k = nr + a;
-    return (uint8_t)(k > 6 ? k - 6 : (k < 1 ? k + 6 : k));
-}
-
 int ctrl_hpdtc_vectors(int phi, int tau, int n, uint8_t *k1, uint8_t *k2)
 {
     const int inc_phi = phi != 0;
     const int inc_tau = tau != 0;
-    int a;
-    int b;
+    /* Offsets modulo 6 (n - 1 = n + 5, n - 2 = n + 4), so that the wrap of
+     * Table 4 is ctrl_vec_offset's. */
+    unsigned a;
+    unsigned b;
     if (inc_phi && inc_tau) { /* Table 4: 1 1 -> n+1, n+2 */
-        a = 1;
-        b = 2;
+        a = 1u;
+        b = 2u;
     } else if (inc_phi) { /* 1 0 -> n-1, n-2 */
-        a = -1;
-        b = -2;
+        a = 5u;
+        b = 4u;
     } else if (inc_tau) { /* 0 1 -> n+2, n+1 */
-        a = 2;
-        b = 1;
+        a = 2u;
+        b = 1u;
     } else { /* 0 0 -> n-2, n-1 */
-        a = -2;
-        b = -1;
+        a = 4u;
+        b = 5u;
     }
-    /* Reduce n first so that n + a cannot overflow; the wrap of Table 4. */
-    const int nr = (int)ctrl_vec_wrap(n);
-    *k1 = hpdtc_vec_step(nr, a);
-    *k2 = hpdtc_vec_step(nr, b);
+    /* n reduced to 1..6 first (any int). */
+    const uint8_t nr = ctrl_vec_wrap(n);
+    *k1 = ctrl_vec_offset(nr, a);
+    *k2 = ctrl_vec_offset(nr, b);
     return inc_phi == inc_tau ? 1 : -1;
 }
 
