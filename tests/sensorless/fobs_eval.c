@@ -36,7 +36,7 @@ typedef struct {
 
 static double q2d(q24_t x)
 {
-    return (double)x / 16777216.0;
+    return ctrl_q24_to_double(x);
 }
 
 /* The firmware's parameters with Rs, L and psi_pm scaled (same bases). */

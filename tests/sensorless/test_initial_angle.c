@@ -35,7 +35,7 @@ static ctrl_bases_t B;
 
 static double d(q24_t x)
 {
-    return (double)x / 16777216.0;
+    return ctrl_q24_to_double(x);
 }
 
 /* error of est (fx angle, modulo pi) against theta (rad), in rad within +-pi/2 */

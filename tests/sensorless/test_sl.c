@@ -30,7 +30,7 @@ static ctrl_machine_t M;
 
 static double d(q24_t x)
 {
-    return (double)x / 16777216.0;
+    return ctrl_q24_to_double(x);
 }
 
 static q24_t q(double x)
