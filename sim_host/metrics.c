@@ -1,5 +1,5 @@
 /*
- * Performance indices, REFERENCE.md section 5 / thesis Appendix B. See metrics.h.
+ * Performance indices of the thesis, Appendix B (definitions made precise in metrics.h). See metrics.h.
  */
 #include "metrics.h"
 #include "plant.h"

@@ -1,5 +1,5 @@
 /*
- * Performance indices of REFERENCE.md section 5 (thesis Appendix B), computed
+ * Performance indices of the thesis, Appendix B, computed
  * over a steady-state window from samples the caller feeds:
  *   - plant-grid sampling: the plant observer (plant_set_observer) at a fixed
  *     step (>= 10 samples per control period) feeds the TRUE signals;

@@ -3,7 +3,7 @@
  * optional flux-map saturation (3.11)-(3.14), mechanics (3.15). Double
  * precision, host only; knows nothing of the controllers.
  *
- * Conventions (REFERENCE.md section 1): amplitude-invariant Clarke (3.3), alpha
+ * Conventions (docs/conventions.md): amplitude-invariant Clarke (3.3), alpha
  * on phase a; Park (3.7) f_dq = f_ab e^{-j theta_e}; theta_e is the electrical
  * angle of the d axis (magnet); positive torque accelerates positive speed.
  *

@@ -15,7 +15,7 @@ grid and refined by golden-section search. The operating point is classified:
   "mtpv"  voltage limit only (maximum torque per voltage, IPMSM with
           psi_pm / Ld < I_max at high speed),
   "none"  no torque possible (above the SPMSM's maximum speed).
-Defaults follow issue 16: I_max = the rated current, V_max = 92 % of Vdc/sqrt(3)
+Defaults (the drive's field-weakening limits): I_max = the rated current, V_max = 92 % of Vdc/sqrt(3)
 (the space-vector modulation's linear limit with a margin for the current control).
 
 Closed forms (Rs = 0) that --selftest checks the numerical solution against:
@@ -39,7 +39,7 @@ import math
 import sys
 from dataclasses import dataclass
 
-V_FRAC_DEFAULT = 0.92  # of Vdc/sqrt(3): the voltage limit of issue 16
+V_FRAC_DEFAULT = 0.92  # of Vdc/sqrt(3): the drive's field-weakening voltage limit
 
 
 @dataclass

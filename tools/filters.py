@@ -307,7 +307,7 @@ def main():
         "grows (500–1500 Hz band ≈ 2×). With Table 5's R1 = 56 kΩ the trap's branches to "
         "the star point carry almost nothing; the trap acts as a capacitive path "
         "L1–C1–C2 in parallel with R2–L2 (|Z12| ≈ 6 Ω at 5 kHz), so the RLC filter does "
-        "the filtering. THD_I falls to ≈ 0.7× (the issue's ≤ 0.8× holds in the mean, not "
+        "the filtering. THD_I falls to ≈ 0.7× (the ≤ 0.8× bound holds in the mean, not "
         "in every realisation, see the range), THD_V to ≈ 0.4×. S1's reported drop would "
         "follow for a controller that does not react to the filter.\n"
         "- **Active filter: the HF ripple vanishes, the low-frequency ripple stays.** The "
@@ -318,7 +318,7 @@ def main():
         "≈ the motor's 150 W, table below); as they fall below the ≈ 260 V the AF needs "
         "(2/3 Vdc + |v*|) it loses track in parts of each electrical period, the speed loop "
         "oscillates at the fundamental, and the torque ripple settles at ≈ 0.35–0.45× "
-        "instead of S1's 0.06× (the issue's ≤ 0.3× is not reached with the capacitors "
+        "instead of S1's 0.06× (the ≤ 0.3× bound is not reached with the capacitors "
         "pre-charged to Vdc; with 400–600 V it is nearly, ≈ 0.25×, see below).\n")
 
     L.append("### HDTC torque ripple by frequency band (RMS, N·m)\n")

@@ -1,5 +1,5 @@
 #!/usr/bin/env -S /usr/bin/python3
-"""Issue 16 "Done when", field weakening on the host simulator (ctest fieldweak_done).
+"""Field-weakening targets on the host simulator (ctest fieldweak_done).
 
   envelope  m2ptfc, drr, fst and foc at 1x, 1.5x and 2x base speed (3000 r/min, Table
             3.1) on the 80 kW IPMSM and at 3000, 3400, 3750 r/min on the thesis SPMSM,

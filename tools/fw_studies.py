@@ -1,5 +1,5 @@
 #!/usr/bin/env -S /usr/bin/python3
-"""Issue 16 studies on the host simulator: the torque-speed envelope of every
+"""Field-weakening studies on the host simulator: the torque-speed envelope of every
 controller against the theoretical one, the voltage-replacement angle sigma, the
 flux-ripple gap to the thesis, and the robustness to parameter errors. Writes
 OUT/fieldweak.md with its plots (linked from OUT/report.md).
@@ -8,7 +8,7 @@ OUT/fieldweak.md with its plots (linked from OUT/report.md).
             Table 3.1 base speed 3000 r/min) and 1.25x rated speed (thesis SPMSM);
             torque request 90 % of the theoretical envelope (tools/envelope.py:
             rated current, 92 % of Vdc/sqrt(3)); achieved mean torque, its
-            shortfall and faults, per controller; the issue's points checked.
+            shortfall and faults, per controller; the targets (90 % held, no fault) checked.
   sigma     FST (20 kHz) and DRR (10 kHz) on the SPMSM at 750 and 2250 r/min,
             1.8 N*m, sigma from 0 (no replacement) to pi/6 (the whole half
             sector): torque and flux ripple, f_av, THD.
@@ -47,7 +47,7 @@ SPMSM = os.path.join(MDIR, "thesis_spmsm.ini")
 IPMSM = os.path.join(MDIR, "thesis_ipmsm_80kw.ini")
 LOAD_NM = 1.8
 SPEEDS = (750, 2250)
-# The controllers the issue's "Done when" names, and every family's members.
+# The controllers the field-weakening targets name, and every family's members.
 DONE_CTRLS = ("m2ptfc", "drr", "fst", "foc")
 PROPOSED = {"fst": ("bst", "mbst", "ast", "zst"),
             "drr": ("bst", "drr_d1", "drr_d2", "drr_pi", "drr_df"),
@@ -171,7 +171,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
              "configured for MTPA below base speed (`psi_ref_wb = 0`), "
              f"{len(jobs)} runs in {wall:.0f} s. Achieved: mean of the plant's torque over the "
              "second half of the run. \"ok\" = within 5 % of the request and no fault "
-             "(the issue's criterion).", ""]
+             "(the field-weakening target).", ""]
     figs = []
     for mname, mfile, base, top, checks, dur, ws in cases:
         m, lim, rpms = envelope_points(mfile, base, top)
@@ -202,8 +202,8 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
                     pts.append((r, got, ok(mm) and abs(got - want) <= 0.05 * max(want, 1e-9)))
             extra[c] = pts
         lines.append("")
-        # Plots: the four of the issue on one figure, every family on its own.
-        groups = [("issue", DONE_CTRLS)] + [
+        # Plots: the four target controllers on one figure, every family on its own.
+        groups = [("targets", DONE_CTRLS)] + [
             (f, tuple(x for x in names if x in fam)) for f, fam in (
                 ("tables", ("bst", "mbst", "ast", "zst", "fst")),
                 ("drr", ("drr", "drr_d1", "drr_d2", "drr_pi", "drr_df")),
@@ -242,7 +242,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
             f"{', '.join(f'{r:.0f}' for r in checks)} r/min: "
             f"{', '.join(f'{0.9 * meta[(mname, r)].torque:.3g}' for r in checks)} N·m): "
             f"{n_ok} of {len(names) * len(checks)} controller-speed points within 5 % without a "
-            f"fault. The issue's four, N·m (✗ = short or fault): {'; '.join(cells)}.")
+            f"fault. The four target controllers, N·m (✗ = short or fault): {'; '.join(cells)}.")
     return lines, res, meta
 
 
@@ -441,7 +441,7 @@ def study_flux(names, fsd, tmp, n_jobs, out):
                      if ok(res[("nominal", c, rpm)]) else math.nan for c in ("drr", "bst"))
           for rpm in SPEEDS}
     FINDINGS.append(
-        f"**Flux ripple, DRR against BST** (thesis −42 % on average, issue: ≤ 0.80): "
+        f"**Flux ripple, DRR against BST** (thesis −42 % on average, target: ≤ 0.80): "
         f"{fmt(r[750][0], '{:.2f}')} at 750 and {fmt(r[2250][0], '{:.2f}')} at 2250 r/min "
         f"({fmt(r[2250][2], '{:.2f}')} with σ = π/12). DRR's flux is corrected only by the "
         f"choice between V_x+1 and V_x+2 (5.1), each applied for the duty the torque needs: at "
@@ -456,7 +456,7 @@ def study_flux(names, fsd, tmp, n_jobs, out):
         f"(the thesis' chapter-5 summary names the same limit of DRR's flux control).")
     FINDINGS.append(
         f"**Flux ripple, M2PTFC against M1** (thesis: −16 % at 2250 r/min, \"roughly similar\" "
-        f"at 750 r/min, §6.6.2; issue: ≤ 0.92 at both): {fmt(r[750][1], '{:.3f}')} at 750 and "
+        f"at 750 r/min, §6.6.2; target: ≤ 0.92 at both): {fmt(r[750][1], '{:.3f}')} at 750 and "
         f"{fmt(r[2250][1], '{:.3f}')} at 2250 r/min with the ideal inverter; with the rig's "
         f"inverter (1 µs dead time, 1.5 V drops) {fmt(r[750][4], '{:.3f}')} / "
         f"{fmt(r[2250][4], '{:.3f}')}. At 750 r/min the thesis itself measured no difference; at "
@@ -587,7 +587,7 @@ def study_robust(names, fsd, tmp, n_jobs, out):
         f"**Robustness** (Rs, L, ψpm ±20 % in the controller, realistic inverter): drr at 2250 "
         f"r/min with ψpm +20 %: torque ripple "
         f"{fmt(d22['torque_ripple_nm'] / n22['torque_ripple_nm'] if ok(d22) and ok(n22) else None, '{:.2f}')}"
-        f"× nominal (issue: ≤ 1.5×). Cases above 1.5× the nominal ripple or faulting: "
+        f"× nominal (target: ≤ 1.5×). Cases above 1.5× the nominal ripple or faulting: "
         f"{'; '.join(bad) if bad else 'none'}. ψpm errors shift T_sse by about ∓20 % of the "
         f"torque in every controller (the estimated torque scales with the model's ψpm).")
     return lines, res
@@ -611,7 +611,7 @@ def main():
     SIM, names, fsd = sim_binary()
     os.makedirs(a.out, exist_ok=True)
     t0 = time.time()
-    lines = ["# Field weakening, σ, flux ripple and robustness (issue 16)", "",
+    lines = ["# Field weakening, σ, flux ripple and robustness", "",
              "Written by `tools/fw_studies.py` (called by `./tools/demo`). Thesis SPMSM and 80 kW "
              "IPMSM of the machine files; every index from the plant's true signals on a Ts/10 "
              "grid unless marked \"ctrl\" (the estimate at the control instants).", ""]

@@ -14,7 +14,7 @@
 /* Largest usable fundamental amplitude of a two-level inverter, as a fraction
  * of Vdc/sqrt(3): six-step operation, (2/pi) Vdc = 1.1027 Vdc/sqrt(3). */
 #define CTRL_FW_VFRAC_MAX 1.1027
-/* Defaults: the voltage limit of issue 16 (92 % of the linear range of
+/* Defaults: the drive's field-weakening voltage limit (92 % of the linear range of
  * space-vector modulation, Vdc/sqrt(3): a margin for the current or flux
  * regulation's own voltage), the DTC load-angle margin of firmware/isr/speed_loop.h,
  * a DC-link filter that removes the ADC's noise but follows a sag within ~0.2 ms. */

@@ -3,7 +3,7 @@
  * rotor spins, and (optional) inertia and friction.
  *
  * Method (VESC takes lambda = (|v| - R|i|)/omega - L|i| in an open-loop spin;
- * here in closed loop, since the encoder offset is known - the issue's "v_q -
+ * here in closed loop, since the encoder offset is known - the rotor-frame voltage equation (3.9) solved for psi_pm, "v_q -
  * Rs i_q - omega Ld i_d over omega"): in the rotor frame of the identified
  * offset,
  *   P1 accelerate with i_q = i_acc to w_flux (or until the voltage reaches

@@ -3,7 +3,7 @@
  * each phase's axis in turn, and the phase-balance check.
  *
  * Method (VESC and ODrive lock the field and take R = V / I at one current;
- * here two levels and the slope, as the issue asks): the current is
+ * here two levels and the slope, which cancels the inverter's voltage drop): the current is
  * regulated along the axis of phase a (0 deg), then of phase b (120 deg),
  * then of phase c (240 deg). On each axis the rotor is first pulled onto the
  * field and let come to rest (cm_hold damps its swing), then the current is

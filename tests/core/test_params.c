@@ -244,7 +244,7 @@ static void test_refusals_explained(void)
     TEST_ASSERT_EQUAL_STRING("ok", msg);
 }
 
-/* The small motors of issue 12 (sim_host/machines/{mj5208_drone,
+/* The small motors (sim_host/machines/{mj5208_drone,
  * gbm5208_gimbal}.ini) are taken at 10, 20 and 40 kHz; their neighbours just
  * outside the core's range are refused with the quantity, its value and the
  * range (the same diagnosis the simulator and the serial link print). */

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Identification accuracy on one shipped machine file (issue 14, "Done when").
+"""Identification accuracy on one shipped machine file against the accuracy bounds of docs/identification.md.
 
 The simulated drive is the machine file with a realistic inverter (1 us dead
 time, 1.2 V device drops - at most 2 % of the DC link: a 12-60 V drive switches
@@ -9,7 +9,7 @@ file's name, direction -1). The firmware is configured with deliberately wrong
 parameters (Rs x 1.3, Ld x 0.7, Lq x 0.8, psi_pm x 1.2, J x 2) and the default
 encoder settings, so nothing it identifies can come from its configuration.
 
-Checks (bounds of the issue): |dRs| <= 3 %, |dLd|, |dLq| <= 5 %,
+Checks (docs/identification.md, "Accuracy required"): |dRs| <= 3 %, |dLd|, |dLq| <= 5 %,
 |dpsi_pm| <= 2 %, encoder offset within 2 deg electrical, the direction and
 the counts per revolution right, at most 10 s of motor time, the true phase
 current never above the rated current; on the thesis SPMSM also m2ptfc and drr

@@ -66,7 +66,7 @@ static void test_identify_and_apply(void)
     TEST_ASSERT_TRUE(id.peak_current_a <= spm.current_rated_a);
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
 
-    /* The drive holds the identified machine (the bounds). */
+    /* The drive holds the identified machine (the identification accuracy bounds, docs/identification.md). */
     const ctrl_machine_t *m = run.fw.machine;
     TEST_ASSERT_TRUE(rel(m->rs_ohm, spm.rs_ohm) <= 0.03);
     TEST_ASSERT_TRUE(rel(m->ld_h, spm.ld_h) <= 0.05);

@@ -1,5 +1,5 @@
 /*
- * Every bad case of issue 14 ends in its named error, the gates off and the
+ * Every bad case of identification ends in its named error, the gates off and the
  * drive latched in fault: motor not connected (open_phase), a-b leads shorted
  * (shorted_phase), encoder not counting (enc_no_motion), encoder counting
  * wrong (enc_cpr), DC link too low for the test (vbus_low). Also: stop in

@@ -57,7 +57,7 @@ expect_fail "scenario missing" "cannot open scenario" --machine "$m" --controlle
 expect_fail "scenario unknown key" "bad_key.scn:2: unknown key" --machine "$m" --controller bst --scenario "$tmp/bad_key.scn"
 expect_fail "scenario time order" "bad_order.scn:2: times must not decrease" --machine "$m" --controller bst --scenario "$tmp/bad_order.scn"
 expect_fail "scenario bad trigger" "bad_trig.scn:1: expected 'at' or 'when'" --machine "$m" --controller bst --scenario "$tmp/bad_trig.scn"
-# Issue 13: every input is validated before the run; errors name quantity, value, range.
+# Every input is validated before the run; errors name quantity, value, range.
 printf '[machine\nname = x\n' >"$tmp/bad_hdr.ini"
 printf 'at 0 load=1\n' >"$tmp/load_dyn.scn"
 printf 'at 0 speed=100\n' >"$tmp/speed_free.scn"
@@ -78,7 +78,7 @@ expect_fail "fixed-point range named" "Lq = 0.3 mH is outside the accepted range
 expect_fail "fs below the Q format" "fs = 1000 Hz is outside the accepted range \(>= [0-9]+ Hz\)" --machine "$m" --controller bst --fs 1000
 expect_fail "speed bandwidth beyond the dead time" "speed loop: bandwidth 200 Hz is out of range \(0, [0-9.]+\) Hz" --machine "$mdir/thesis_ipmsm_80kw.ini" --controller m2ptfc --free --speed-ref-rpm 100 --speed-bw-hz 200
 expect_fail "sizing and gains together" "give either --speed-bw-hz or --speed-kp" --machine "$m" --controller bst --free --speed-ref-rpm 100 --speed-bw-hz 20 --speed-kp 1
-# Issue 12: neighbours of the small motors outside the core's range: the core's
+# Neighbours of the small motors outside the core's range: the core's
 # diagnosis (quantity, value, range) comes first.
 sed 's/^speed_rpm = .*/speed_rpm = 40000/' "$mdir/mj5208_drone.ini" >"$tmp/mj_fast.ini"
 sed 's/^ld_mh = .*/ld_mh = 0.3/; s/^lq_mh = .*/lq_mh = 0.3/' "$mdir/gbm5208_gimbal.ini" >"$tmp/gb_low_l.ini"

@@ -1,10 +1,10 @@
 /*
- * The small motors of issue 12 in closed loop on the host (plant + HAL sim +
+ * The small motors in closed loop on the host (plant + HAL sim +
  * firmware pipeline), each controller with its default configuration for the
  * machine: the mjbots mj5208 drone outrunner on 24 V and the Rctimer GBM5208
  * gimbal motor on 12 V (sim_host/machines/{mj5208_drone,gbm5208_gimbal}.ini).
  *
- * Operating point (issue 12, "Done when"): dynamometer at 20 % of the no-load
+ * Operating point (the small-motor acceptance point): dynamometer at 20 % of the no-load
  * speed, torque reference half the rated torque. The no-load speed follows
  * from the file's psi_pm with the line-to-line peak Kv convention the files
  * use: the back-EMF sqrt(3) p psi_pm w_m reaches Vdc (the largest line-to-line
@@ -12,7 +12,7 @@
  *
  * Bound: no fault and |mean(T) - T_ref| <= 5 % of T_ref over the window
  * (plant torque on the Ts/10 grid). m2ptfc, drr and foc at 20 kHz; the
- * switching table fst at 40 kHz (the issue allows tables up to 40 kHz).
+ * switching table fst at 40 kHz (switching tables are run at up to 40 kHz).
  *
  * Sensors: the files' [sensors] (a 14-bit absolute magnetic encoder, 4096
  * lines x 4 = 16384 counts per turn, as both motors are usually fitted:

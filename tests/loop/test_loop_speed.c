@@ -7,7 +7,7 @@
  *    margin, computed here from the gains; the gains scale with J.
  *  - Thesis 80 kW IPMSM (J = 0.165 kg m^2), m2ptfc, free mechanics, no load,
  *    speed step 0 -> 1000 r/min: overshoot <= 10 % and within 2 % from 2 s on
- *    (issue 13; the SPMSM's fixed gains gave 1900 r/min and a 0.95 s limit
+ *    (the SPMSM's fixed gains gave 1900 r/min and a 0.95 s limit
  *    cycle on this machine).
  *  - Thesis SPMSM declared for at most 3000 r/min, in torque mode, free and
  *    unloaded, 1.8 N*m: the rotor accelerates until the back-EMF meets the DC

@@ -12,7 +12,7 @@
  * controller step, and the plan -> leg duties stage. Reported: mean and worst
  * case of each and of the whole pipeline, for m2ptfc and m1 (and the others).
  *
- * Asserted (regression guard of issue 5, item "performance"): the worst-case
+ * Asserted (regression guard of the thesis's execution-time ranking, M2PTFC 4.6 us against M1 6.96 us): the worst-case
  * m2ptfc pipeline is at most 0.66 x the worst-case m1 pipeline.
  */
 #include <math.h>

@@ -1,7 +1,7 @@
 /*
  * The shipped machine files sim_host/machines/{thesis_spmsm,
  * thesis_ipmsm_80kw, chapter_ipmsm, mj5208_drone, gbm5208_gimbal}.ini
- * (REFERENCE.md section 2; the small motors of issue 12) as
+ * (the thesis's and the chapter's machines and two small motors) as
  * ctrl_machine_t, for the unit tests that configure a controller without the
  * INI loader (also built for the QEMU target, no file access).
  * tests/plant/test_plant_files.c checks every field against the INI files.

@@ -1,5 +1,5 @@
 /*
- * Performance indices (REFERENCE.md section 5) on synthetic signals whose
+ * Performance indices (thesis Appendix B) on synthetic signals whose
  * values are known in closed form.
  */
 #include <math.h>

@@ -15,7 +15,7 @@
  *    two-port admittances, measured with two different loads; Z12 = Z1 in
  *    parallel with R2 + sL2 (S1 Fig. 47);
  *  - S1 (58): the active filter's shunt currents i_CR1 and i_CR2.
- * Bound: 1 % (the issue's); the measured errors are ~1e-9 (exact integration).
+ * Bound: 1 % (a modelling tolerance far above exact integration); the measured errors are ~1e-9 (exact integration).
  * Also: energy balance with the filters, configuration checks, probes.
  */
 #include <complex.h>

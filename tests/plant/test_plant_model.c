@@ -41,7 +41,7 @@ static plant_config_t cfg_spmsm(void)
     return cfg_from_machine(&ini_thesis_spmsm);
 }
 
-/* Book-chapter IPMSM, S1 Table 2 (Ld < Lq per REFERENCE.md). */
+/* Book-chapter IPMSM, S1 Table 2 (S1 prints the labels crossed; for an IPMSM Ld < Lq). */
 static plant_config_t cfg_chapter(void)
 {
     return cfg_from_machine(&ini_chapter_ipmsm);

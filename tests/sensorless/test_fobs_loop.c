@@ -35,7 +35,7 @@ void tearDown(void)
 #define SPMSM PMSM_MACHINES_DIR "/thesis_spmsm.ini"
 #define IPMSM80 PMSM_MACHINES_DIR "/thesis_ipmsm_80kw.ini"
 
-/* Steps of issue 15 on the thesis SPMSM: 300, 800, 1500 r/min from standstill
+/* The sensorless step test on the thesis SPMSM: 300, 800, 1500 r/min from standstill
  * under 0.5 N*m, load step to 1.8 N*m, then -1500 r/min. */
 static const char *const k_steps = "at 0 speed_ref=300 load=0.5\n"
                                    "at 0.1 speed_ref=800\n"

@@ -1,8 +1,8 @@
 /*
- * Issue 15, item 3: with the encoder and the controller's psi_pm off by
+ * PM-flux tracking: with the encoder and the controller's psi_pm off by
  * +-20 %, the PM flux from the voltage model (fw_config_t.psi_adapt, default
  * on) keeps the steady-state torque error of m2ptfc and drr within 3 % of
- * 1.8 N*m at 750 and 2250 r/min (the issue's bound). Without it the current
+ * 1.8 N*m at 750 and 2250 r/min (the drive's torque-accuracy bound for parameter errors). Without it the current
  * model carries the error into the torque: 0.2-0.4 N*m at 750 r/min
  * (checked, so that the test can fail for the right reason).
  *

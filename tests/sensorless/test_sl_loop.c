@@ -1,8 +1,8 @@
 /*
- * Issue 15, item 2: the drive without its encoder (fw_config_t.sensorless),
+ * Sensorless running: the drive without its encoder (fw_config_t.sensorless),
  * free mechanics, from standstill under load through speed steps, a load
  * step and a reversal through zero, for the thesis SPMSM (m2ptfc, drr, fst,
- * foc), the MJ5208 drone motor and the 80 kW IPMSM (m2ptfc). The issue's bounds: no fault, the
+ * foc), the MJ5208 drone motor and the 80 kW IPMSM (m2ptfc). Bounds: no fault, the
  * estimated electrical angle within 3 deg rms of the plant's (where |speed|
  * >= 10 % of rated, the metrics' definition, over the whole run from the
  * arm on), the final speed within 5 % of its reference. The SPMSM profile is
@@ -128,7 +128,7 @@ static void test_mj5208_m2ptfc(void)
 }
 
 /* 80 kW IPMSM (thesis Table 3.1; J 0.165 kg*m^2), m2ptfc at 10 kHz, the
- * issue's run: the start from the angle its saliency gives (initial angle
+ * traction profile: the start from the angle its saliency gives (initial angle
  * and polarity pulse, docs/algorithms.md "Initial angle") under 20 N*m,
  * 300 r/min at 0.3 s, 1000 at 0.8 s, the load stepped to 200 N*m at 1.5 s,
  * -1000 r/min at 2 s (reversal through zero under the overhauling load). */

@@ -38,7 +38,7 @@ MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
 # recording in the flash above the image (hal/qemu_microbit/qemu_microbit.h).
 CM0_BLOB_ADDR = 0x30000
 CM0_BLOB_MAX = 0x10000
-# The question of issue 11: m2ptfc's worst interrupt within one 10 kHz period of
+# Whether a small MCU suffices: m2ptfc's worst interrupt within one 10 kHz period of
 # a 64 MHz Cortex-M0+.
 CM0_FIT = {"ctrl": "m2ptfc", "f_cpu_hz": 64000000, "f_pwm_hz": 10000}
 # Thesis execution times (thesis Fig. 6.14), dSPACE DS1202 at 2 GHz, us.

@@ -18,7 +18,7 @@
 #include "cm_config.h"
 #include "sim_run.h"
 
-/* Injected bad cases (the list). */
+/* Injected bad cases: each must end in its named error with the gates off. */
 typedef enum {
     SIM_BAD_NONE = 0,
     SIM_BAD_OPEN,      /* motor not connected */
