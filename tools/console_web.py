@@ -1,0 +1,477 @@
+"""Live console in the browser: `tools/console --web` (see README, "Live console").
+
+A local web server (python3-aiohttp) between one target (board, QEMU, any
+program speaking firmware/PROTOCOL.md) and any number of pages. The page
+(tools/web/) is served from the repository; nothing is fetched from elsewhere.
+
+Threads: the link worker owns the transport: it writes one command line at a
+time, collects its response (ok / err / `ok N` + N lines, PROTOCOL.md section
+2), decodes telemetry frames and polls `status` (and the commissioning status
+while a step runs) when the line is idle. The asyncio loop serves HTTP and
+WebSockets and pushes to every page, at most 30 times a second, the samples
+decoded since the last push (SI units, scales from the META frame).
+
+Safety:
+- it listens on 127.0.0.1 unless --bind says otherwise; every request carries
+  the token printed at start (a random 128-bit value), or it is refused (403);
+  a WebSocket must also come from a page of this server (Origin);
+- one page controls, the others watch: a watcher's commands are refused, but
+  STOP is obeyed from every page;
+- a command that energises the motor (arm, ident run/resume/step, bringup) is
+  refused unless the page says the user confirmed it;
+- when the controlling page has been silent for --page-timeout seconds (tab
+  closed, network gone, page frozen: its heartbeat stops), the drive gets
+  `stop` (gates off) and control is free again.
+"""
+import asyncio
+import json
+import os
+import queue
+import secrets
+import sys
+import threading
+import time
+
+import console_proto as cp
+
+WEB_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web")
+PUSH_PERIOD_S = 1.0 / 30.0   # samples and status reach the pages 30 times a second
+POLL_PERIOD_S = 0.25         # `status` when the line is idle
+CM_STATES = ("commission",)  # state names in which the commissioning status is polled
+
+# First words (and second, for ident) of commands that put voltage on the motor.
+ENERGISING = {("arm",), ("ident", "run"), ("ident", "resume"), ("ident", "step"), ("bringup",)}
+NOT_ENERGISING_BRINGUP = {"status"}
+
+
+def energises(line):
+    w = line.split()
+    if not w:
+        return False
+    if w[0] == "bringup":
+        return len(w) >= 2 and w[1] not in NOT_ENERGISING_BRINGUP
+    return (w[0],) in ENERGISING or tuple(w[:2]) in ENERGISING
+
+
+def parse_status(lines):
+    """`status` list lines ('  key=value') into a dict."""
+    st = {}
+    for ln in lines:
+        ln = ln.strip()
+        if "=" in ln:
+            k, v = ln.split("=", 1)
+            st[k.strip()] = v.strip()
+    return st
+
+
+def parse_param_line(ln):
+    """'  name value unit [min, max][ ro] help' -> dict (best effort: lines may be cut)."""
+    s = ln.strip()
+    w = s.split(None, 3)
+    if len(w) < 3:
+        return None
+    p = {"name": w[0], "value": w[1], "unit": "" if w[2] == "-" else w[2], "min": "", "max": "",
+         "ro": False, "help": ""}
+    rest = w[3] if len(w) > 3 else ""
+    if rest.startswith("["):
+        end = rest.find("]")
+        if end > 0:
+            lo, _, hi = rest[1:end].partition(",")
+            p["min"], p["max"] = lo.strip(), hi.strip()
+            rest = rest[end + 1:].strip()
+    if rest == "ro" or rest.startswith("ro "):
+        p["ro"] = True
+        rest = rest[2:].strip()
+    p["help"] = rest
+    return p
+
+
+class LinkWorker(threading.Thread):
+    """Owns the transport; see the module's description."""
+
+    def __init__(self, tr, timeout, emit):
+        super().__init__(daemon=True, name="link")
+        self.tr = tr
+        self.timeout = timeout
+        self.emit = emit                  # emit(event dict), thread-safe
+        self.q = queue.Queue()
+        self.dec = cp.StreamDecoder()
+        self.rec = cp.Recorder()
+        self.lock = threading.Lock()
+        self.samples = []                 # [t_s, v...] since the last push
+        self.stop_evt = threading.Event()
+        self.gone = None                  # reason, once the target went away
+        self.inflight = None              # (line, origin, lines, expected, deadline)
+        self.last_poll = 0.0
+        self.state = None
+
+    # ---- called from the asyncio side
+    def submit(self, line, origin):
+        self.q.put((line, origin))
+
+    def take_samples(self):
+        with self.lock:
+            s, self.samples = self.samples, []
+        return s
+
+    def counters(self):
+        return {"frames": self.dec.frames, "bad": self.dec.bad, "lost": self.rec.lost}
+
+    # ---- the thread
+    def run(self):
+        try:
+            while not self.stop_evt.is_set():
+                self._step()
+        except EOFError as e:
+            self._went_away(str(e) or "connection closed")
+        except OSError as e:
+            self._went_away("link error: %s" % e)
+
+    def _went_away(self, why):
+        rc = None
+        for _ in range(10):  # the pipe closes just before the process is reaped
+            rc = self.tr.exit_status()
+            if rc is not None:
+                break
+            time.sleep(0.05)
+        if rc is not None:
+            why = "the target exited with status %d" % rc
+        self.gone = why
+        print("console: target gone: %s" % why, file=sys.stderr, flush=True)
+        if self.inflight is not None:
+            self.emit({"type": "reply", "origin": self.inflight[1], "line": self.inflight[0],
+                       "ok": False, "lines": ["(target gone)"]})
+            self.inflight = None
+        self.emit({"type": "gone", "reason": why})
+
+    def _step(self):
+        now = time.monotonic()
+        if self.inflight is None:
+            try:
+                line, origin = self.q.get_nowait()
+            except queue.Empty:
+                line = None
+                if now - self.last_poll >= POLL_PERIOD_S:
+                    self.last_poll = now
+                    line, origin = "status", "poll"
+                    if self.state in CM_STATES:
+                        self.q.put(("ident status", "poll"))
+                        self.q.put(("bringup status", "poll"))
+            if line is not None:
+                self.tr.write(line.encode("ascii", "replace") + b"\n")
+                self.inflight = [line, origin, [], None, now + self.timeout]
+        data = self.tr.read(0.01)
+        if self.tr.exit_status() is not None and not data:
+            raise EOFError("target exited")
+        for kind, val in self.dec.feed(data):
+            if kind == "frame":
+                self._frame(val)
+            elif kind == "text":
+                self._text(val)
+        if self.inflight is not None and time.monotonic() > self.inflight[4]:
+            line, origin, lines = self.inflight[:3]
+            self.inflight = None
+            self.emit({"type": "reply", "origin": origin, "line": line, "ok": False,
+                       "lines": lines + ["(no response within %g s)" % self.timeout]})
+
+    def _frame(self, f):
+        self.rec.add(f)
+        if f.type == cp.TYPE_META:
+            names = cp.signal_names(f.mask)
+            units = dict(cp.SIGNALS)
+            self.emit({"type": "meta", "signals": names, "units": [units.get(n, "") for n in names],
+                       "fs_hz": f.fs_hz, "every": f.every})
+            return
+        meta = self.rec.meta
+        if meta is None or meta.mask != f.mask or not meta.fs_hz:
+            return
+        t = f.tick / meta.fs_hz
+        row = [t] + [v * (s if s != 0.0 else 1.0) for v, s in zip(f.values, meta.scales)]
+        with self.lock:
+            self.samples.append(row)
+
+    def _text(self, ln):
+        inf = self.inflight
+        if inf is None:
+            self.emit({"type": "text", "line": ln})
+            return
+        line, origin, lines, expected = inf[:4]
+        if expected is None:
+            if not (ln.startswith("ok") or ln.startswith("err ")):
+                self.emit({"type": "text", "line": ln})  # a banner, a boot message
+                return
+            lines.append(ln)
+            w = ln.split()
+            if ln.startswith("ok") and len(w) == 2 and w[1].isdigit() and int(w[1]) > 0:
+                inf[3] = int(w[1])
+                return
+        else:
+            lines.append(ln)
+            if len(lines) - 1 < expected:
+                return
+        self.inflight = None
+        ok = lines[0].startswith("ok")
+        if origin == "poll" and line == "status" and ok:
+            st = parse_status(lines[1:])
+            self.state = st.get("state", self.state)
+            self.emit({"type": "status", "status": st, "counters": self.counters()})
+            return
+        self.emit({"type": "reply", "origin": origin, "line": line, "ok": ok, "lines": lines})
+
+
+class WebConsole:
+    def __init__(self, tr, args, target_label):
+        self.tr = tr
+        self.args = args
+        self.token = secrets.token_hex(16)
+        self.label = target_label
+        self.pages = {}           # ws -> {"id", "last_seen"}
+        self.controller = None    # the controlling ws
+        self.next_id = 1
+        self.loop = None
+        self.link = LinkWorker(tr, args.timeout, self._emit_threadsafe)
+        self.last_status = {}
+        self.meta = None
+        self.stopped_for_page_loss = 0
+
+    # ---- events from the link thread
+    def _emit_threadsafe(self, ev):
+        if self.loop is not None:
+            self.loop.call_soon_threadsafe(self._on_link_event, ev)
+
+    def _on_link_event(self, ev):
+        if ev["type"] == "status":
+            self.last_status = ev["status"]
+        elif ev["type"] == "meta":
+            self.meta = ev
+        if ev["type"] == "reply" and ev["origin"] not in ("poll",):
+            # Replies go to every page (the watchers see what the controller does).
+            pass
+        asyncio.ensure_future(self._broadcast(ev))
+
+    async def _broadcast(self, ev):
+        msg = json.dumps(ev)
+        for ws in list(self.pages):
+            try:
+                await ws.send_str(msg)
+            except (ConnectionError, RuntimeError):
+                pass
+
+    async def _send(self, ws, ev):
+        try:
+            await ws.send_str(json.dumps(ev))
+        except (ConnectionError, RuntimeError):
+            pass
+
+    def _roles(self):
+        return {ws: ("control" if ws is self.controller else "watch") for ws in self.pages}
+
+    async def _announce_roles(self):
+        for ws, role in self._roles().items():
+            await self._send(ws, {"type": "role", "role": role, "page": self.pages[ws]["id"],
+                                  "pages": len(self.pages)})
+
+    # ---- periodic tasks
+    async def _pusher(self):
+        while True:
+            await asyncio.sleep(PUSH_PERIOD_S)
+            rows = self.link.take_samples()
+            if rows:
+                await self._broadcast({"type": "samples", "rows": rows,
+                                       "counters": self.link.counters()})
+
+    async def _watchdog(self):
+        while True:
+            await asyncio.sleep(0.1)
+            ws = self.controller
+            if ws is None:
+                continue
+            silent = time.monotonic() - self.pages.get(ws, {"last_seen": 0})["last_seen"]
+            if silent > self.args.page_timeout:
+                await self._page_lost(ws, "no heartbeat for %.1f s" % silent)
+
+    async def _page_lost(self, ws, why):
+        if ws is not self.controller:
+            return
+        self.controller = None
+        if self.link.gone is None:
+            self.link.submit("stop", "page-loss")
+            self.stopped_for_page_loss += 1
+        text = "console: the controlling page was lost (%s): drive stopped (gates off)" % why
+        print(text, file=sys.stderr, flush=True)
+        await self._broadcast({"type": "text", "line": text})
+        await self._announce_roles()
+
+    # ---- HTTP
+    def _authorised(self, request):
+        return secrets.compare_digest(request.query.get("token", ""), self.token)
+
+    def _host_ok(self, request):
+        # A page of another site that a DNS name points here must not reach us.
+        host = request.host.rsplit(":", 1)[0].strip("[]")
+        return host in self.allowed_hosts
+
+    async def h_index(self, request):
+        from aiohttp import web
+        if not (self._authorised(request) and self._host_ok(request)):
+            return web.Response(status=403, text="console: token missing or wrong\n")
+        with open(os.path.join(WEB_DIR, "console.html"), encoding="utf-8") as fh:
+            html = fh.read().replace("{{TOKEN}}", self.token)  # hex digits only
+        return web.Response(text=html, content_type="text/html",
+                            headers={"Cache-Control": "no-store",
+                                     "Content-Security-Policy":
+                                         "default-src 'self'; img-src 'self' data: blob:; "
+                                         "connect-src 'self'; style-src 'self'; script-src 'self'"})
+
+    async def h_static(self, request):
+        from aiohttp import web
+        if not (self._authorised(request) and self._host_ok(request)):
+            return web.Response(status=403, text="console: token missing or wrong\n")
+        name = request.match_info["name"]
+        types = {"console.js": "application/javascript", "console.css": "text/css",
+                 "plot.js": "application/javascript"}
+        if name not in types:
+            return web.Response(status=404)
+        with open(os.path.join(WEB_DIR, name), encoding="utf-8") as fh:
+            return web.Response(text=fh.read(), content_type=types[name],
+                                headers={"Cache-Control": "no-store"})
+
+    async def h_ws(self, request):
+        from aiohttp import web, WSMsgType
+        if not (self._authorised(request) and self._host_ok(request)):
+            return web.Response(status=403, text="console: token missing or wrong\n")
+        origin = request.headers.get("Origin")
+        if origin is not None and origin != "http://%s" % request.host:
+            return web.Response(status=403, text="console: foreign origin\n")
+        ws = web.WebSocketResponse(heartbeat=None, max_msg_size=1 << 16)
+        await ws.prepare(request)
+        self.pages[ws] = {"id": self.next_id, "last_seen": time.monotonic()}
+        self.next_id += 1
+        if self.controller is None:
+            self.controller = ws
+        await self._send(ws, {"type": "hello", "target": self.label, "token_ok": True,
+                              "page_timeout_s": self.args.page_timeout,
+                              "target_pid": self.tr.proc.pid if self.tr.proc else None,
+                              "status": self.last_status, "meta": self.meta,
+                              "gone": self.link.gone})
+        await self._announce_roles()
+        try:
+            async for msg in ws:
+                if msg.type != WSMsgType.TEXT:
+                    continue
+                self.pages[ws]["last_seen"] = time.monotonic()
+                try:
+                    m = json.loads(msg.data)
+                except ValueError:
+                    continue
+                await self._on_page_msg(ws, m)
+        finally:
+            was_controller = ws is self.controller
+            del self.pages[ws]
+            if was_controller:
+                await self._page_lost(ws, "page closed")
+            else:
+                await self._announce_roles()
+        return ws
+
+    async def _on_page_msg(self, ws, m):
+        kind = m.get("type")
+        page = self.pages[ws]["id"]
+        if kind == "heartbeat":
+            return
+        if kind == "stop":      # from every page, always
+            if self.link.gone is None:
+                self.link.submit("stop", "page%d" % page)
+            await self._broadcast({"type": "text", "line": "console: STOP from page %d" % page})
+            return
+        if kind == "take_control":
+            if self.controller is None:
+                self.controller = ws
+                await self._announce_roles()
+            else:
+                await self._send(ws, {"type": "refused", "line": "",
+                                      "why": "another page controls the drive"})
+            return
+        if kind != "cmd":
+            return
+        line = str(m.get("line", "")).strip()
+        if not line:
+            return
+        if ws is not self.controller:
+            await self._send(ws, {"type": "refused", "line": line,
+                                  "why": "this page watches; another page controls the drive"})
+            return
+        if energises(line) and m.get("confirm") is not True:
+            await self._send(ws, {"type": "refused", "line": line,
+                                  "why": "'%s' energises the motor: confirm it first" % line})
+            return
+        if self.link.gone is not None:
+            await self._send(ws, {"type": "refused", "line": line, "why": "target gone"})
+            return
+        if len(line) > 96 or any(not (0x20 <= ord(c) <= 0x7E) for c in line):
+            await self._send(ws, {"type": "refused", "line": line[:100],
+                                  "why": "a command line is at most 96 printable ASCII characters"})
+            return
+        self.link.submit(line, "page%d" % page)
+
+    async def serve(self):
+        from aiohttp import web
+        self.loop = asyncio.get_running_loop()
+        self.allowed_hosts = {"127.0.0.1", "localhost", "::1", self.args.bind}
+        app = web.Application()
+        app.router.add_get("/", self.h_index)
+        app.router.add_get("/static/{name}", self.h_static)
+        app.router.add_get("/ws", self.h_ws)
+        runner = web.AppRunner(app, access_log=None)
+        await runner.setup()
+        site = web.TCPSite(runner, self.args.bind, self.args.port)
+        await site.start()
+        port = site._server.sockets[0].getsockname()[1]
+        host = self.args.bind if ":" not in self.args.bind else "[%s]" % self.args.bind
+        url = "http://%s:%d/?token=%s" % (host, port, self.token)
+        print("console: web page at %s" % url, flush=True)
+        if self.args.url_file:
+            with open(self.args.url_file, "w") as fh:
+                fh.write(url + "\n")
+        self.link.start()
+        tasks = [asyncio.ensure_future(self._pusher()), asyncio.ensure_future(self._watchdog())]
+        try:
+            while True:
+                await asyncio.sleep(3600)
+        finally:
+            for t in tasks:
+                t.cancel()
+            await runner.cleanup()
+
+
+def serve(tr, args, target_label):
+    """Runs until interrupted (Ctrl-C / SIGTERM). Returns the console's exit status."""
+    try:
+        import aiohttp  # noqa: F401  (python3-aiohttp, tools/setup)
+    except ImportError:
+        print("console: --web needs python3-aiohttp (tools/setup installs it)", file=sys.stderr)
+        return 2
+    wc = WebConsole(tr, args, target_label)
+    import signal
+    loop = asyncio.new_event_loop()
+    main = loop.create_task(wc.serve())
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(sig, main.cancel)
+    try:
+        loop.run_until_complete(main)
+    except asyncio.CancelledError:
+        pass
+    except OSError as e:
+        print("console: cannot listen on %s:%d: %s" % (args.bind, args.port, e), file=sys.stderr)
+        return 2
+    finally:
+        wc.link.stop_evt.set()
+        wc.link.join(1.0)
+        loop.close()
+    if wc.link.gone is None:
+        try:  # leave the drive with its gates off
+            tr.write(b"stop\n")
+        except (EOFError, OSError):
+            pass
+    print("console: web console stopped", file=sys.stderr)
+    return 0

@@ -1,0 +1,331 @@
+#!/usr/bin/python3
+"""The live console page in a real browser (headless Chromium through
+chromedriver, W3C WebDriver over HTTP; Debian's chromium and chromium-driver)
+against the emulated target (QEMU, the interactive image).
+
+usage: console_web_test.py INTERACTIVE.elf [--screenshot PNG]
+
+A person's session, checked from the page's own data (window.consoleState,
+what the page plots and shows):
+  - a request without the token, or with a wrong one, is refused (403);
+  - the page connects, controls, waits for the calibration, streams telemetry
+    and renders at >= 30 frames/s;
+  - speed mode, 1000 r/min, arm through the confirmation dialog: the plotted
+    speed reaches 1000 r/min (within 3 %: the speed loop's ripple and the
+    estimate's quantisation are a few r/min);
+  - a tunable set out of range shows the firmware's own `err 4 range [min, max]`
+    in the parameter's row;
+  - STOP gives state=ready;
+  - a second page watches: its `arm` is refused;
+  - the controlling page lost (browser gone) with the drive armed: the drive is
+    stopped within the page time-out;
+  - QEMU killed: the page says "target gone"; the server neither crashes nor
+    stops serving.
+"""
+import argparse
+import asyncio
+import base64
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.error
+import urllib.request
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+CONSOLE = os.path.join(HERE, "console")
+PAGE_TIMEOUT_S = 1.5
+SPEED_RPM = 1000.0
+
+
+class Fail(Exception):
+    pass
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class WebDriver:
+    """The few W3C WebDriver calls the test needs."""
+
+    def __init__(self, port):
+        self.base = "http://127.0.0.1:%d" % port
+        self.sid = None
+
+    def _req(self, method, path, body=None, timeout=60):
+        data = json.dumps(body).encode() if body is not None else None
+        req = urllib.request.Request(self.base + path, data=data, method=method,
+                                     headers={"Content-Type": "application/json"})
+        try:
+            with urllib.request.urlopen(req, timeout=timeout) as r:
+                return json.loads(r.read().decode())["value"]
+        except urllib.error.HTTPError as e:
+            raise Fail("webdriver %s %s: %s" % (method, path, e.read().decode()[:400])) from e
+
+    def start(self, chromium):
+        caps = {"capabilities": {"alwaysMatch": {"browserName": "chrome", "goog:chromeOptions": {
+            "binary": chromium,
+            "args": ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
+                     "--window-size=1500,1000", "--no-first-run"]}}}}
+        self.sid = self._req("POST", "/session", caps)["sessionId"]
+
+    def quit(self):
+        if self.sid:
+            try:
+                self._req("DELETE", "/session/%s" % self.sid, timeout=30)
+            finally:
+                self.sid = None
+
+    def get(self, url):
+        self._req("POST", "/session/%s/url" % self.sid, {"url": url})
+
+    def js(self, script, *args):
+        return self._req("POST", "/session/%s/execute/sync" % self.sid,
+                         {"script": script, "args": list(args)})
+
+    def find(self, css):
+        v = self._req("POST", "/session/%s/element" % self.sid, {"using": "css selector", "value": css})
+        return next(iter(v.values()))
+
+    def click(self, css):
+        self._req("POST", "/session/%s/element/%s/click" % (self.sid, self.find(css)), {})
+
+    def type(self, css, text):
+        eid = self.find(css)
+        self._req("POST", "/session/%s/element/%s/clear" % (self.sid, eid), {})
+        self._req("POST", "/session/%s/element/%s/value" % (self.sid, eid), {"text": text})
+
+    def screenshot(self, path):
+        png = base64.b64decode(self._req("GET", "/session/%s/screenshot" % self.sid))
+        with open(path, "wb") as fh:
+            fh.write(png)
+
+
+def wait_for(what, fn, timeout, period=0.2):
+    end = time.monotonic() + timeout
+    last = None
+    while time.monotonic() < end:
+        last = fn()
+        if last:
+            return last
+        time.sleep(period)
+    raise Fail("timed out after %g s waiting for %s (last: %r)" % (timeout, what, last))
+
+
+def http_status(url):
+    try:
+        with urllib.request.urlopen(url, timeout=10) as r:
+            return r.status
+    except urllib.error.HTTPError as e:
+        return e.code
+
+
+async def watcher_checks(ws_url, expect_stop_within):
+    """A second page (a plain WebSocket client): it is told it watches, its
+    `arm` is refused, and it sees the drive stopped once the controlling page
+    is gone. Returns the seconds from the browser's end to state=ready."""
+    import aiohttp
+    async with aiohttp.ClientSession() as s:
+        async with s.ws_connect(ws_url, origin=ws_url.replace("ws://", "http://").split("/ws")[0]) as ws:
+            role = refused = None
+            end = time.monotonic() + 20
+            await ws.send_str(json.dumps({"type": "cmd", "line": "arm", "confirm": True}))
+            while time.monotonic() < end and (role is None or refused is None):
+                m = json.loads((await ws.receive(timeout=20)).data)
+                if m["type"] == "role":
+                    role = m["role"]
+                if m["type"] == "refused" and m["line"] == "arm":
+                    refused = m["why"]
+            if role != "watch" or refused is None:
+                raise Fail("second page: role %r, arm refused %r" % (role, refused))
+            print("  watcher: role=watch, arm refused (%s)" % refused)
+            # Hand over to the caller, who ends the controlling browser now.
+            yield_at = time.monotonic()
+            await ws.send_str(json.dumps({"type": "heartbeat"}))
+            armed_seen = False
+            while time.monotonic() - yield_at < expect_stop_within + 15:
+                msg = await ws.receive(timeout=20)
+                m = json.loads(msg.data)
+                await ws.send_str(json.dumps({"type": "heartbeat"}))
+                if m["type"] == "status":
+                    st = m["status"]
+                    if st.get("armed") == "1":
+                        armed_seen = True
+                    if armed_seen and st.get("armed") == "0" and st.get("state") == "ready":
+                        return time.monotonic() - yield_at
+            raise Fail("the drive was not stopped after the controlling page was lost")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("elf")
+    ap.add_argument("--screenshot", help="also save a screenshot of the running page here")
+    a = ap.parse_args()
+
+    chromium = shutil.which("chromium")
+    driver = shutil.which("chromedriver")
+    if not chromium or not driver:
+        raise Fail("chromium and chromedriver are needed (tools/setup installs chromium, "
+                   "chromium-driver)")
+    tmp = tempfile.mkdtemp(prefix="console-web-")
+    url_file = os.path.join(tmp, "url")
+    # The emulated target (QEMU runs flat out) yields to the browser, as a
+    # user's machine would give the page the priority.
+    server = subprocess.Popen(["nice", "-n", "10", CONSOLE, "--web", "--qemu", a.elf, "--port", "0",
+                               "--page-timeout", str(PAGE_TIMEOUT_S), "--url-file", url_file],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    dport = free_port()
+    cd = subprocess.Popen([driver, "--port=%d" % dport], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.DEVNULL)
+    wd = WebDriver(dport)
+    try:
+        url = wait_for("the server's URL", lambda: os.path.exists(url_file) and
+                       open(url_file).read().strip(), 30)
+        base, _, token = url.partition("/?token=")
+        print("server:", base)
+        # Access control.
+        for bad in (base + "/", base + "/?token=0" + token[1:], base + "/?token=",
+                    base + "/static/console.js", base + "/ws?token=x"):
+            code = http_status(bad)
+            if code != 403:
+                raise Fail("%s answered %d, not 403" % (bad, code))
+        if http_status(url) != 200:
+            raise Fail("the page with its token was not served")
+        print("  token: requests without it refused (403)")
+
+        wait_for("chromedriver", lambda: http_status("http://127.0.0.1:%d/status" % dport) == 200, 30)
+        wd.start(chromium)
+        wd.get(url)
+        st = lambda: wd.js("return window.consoleState ? {c: consoleState.connected, role: "
+                           "consoleState.role, state: consoleState.status.state, armed: "
+                           "consoleState.status.armed, gone: consoleState.gone, meta: "
+                           "consoleState.meta && consoleState.meta.signals, fps: "
+                           "consoleState.charts.fps} : null")
+        wait_for("the page to control", lambda: (st() or {}).get("role") == "control", 30)
+        s = wait_for("the calibration", lambda: (st() or {}).get("state") not in (None, "boot", "calib")
+                     and st(), 120)
+        if s["state"] != "ready":
+            raise Fail("state after calibration: %s" % s["state"])
+        wait_for("telemetry with speed", lambda: "speed" in ((st() or {}).get("meta") or []), 60)
+        print("  connected, controlling, calibrated, streaming")
+
+        # Speed mode, 1000 r/min, arm with the confirmation.
+        wd.js("document.getElementById('mode').value = 'speed';")
+        wd.type("#ref", "%g" % SPEED_RPM)
+        wd.click("#ref-set")
+        wd.click("#arm")
+        if wd.js("return document.getElementById('modal').classList.contains('hidden')"):
+            raise Fail("arm did not ask for a confirmation")
+        wd.click("#modal-ok")
+        wait_for("state=running", lambda: (st() or {}).get("state") == "running", 30)
+
+        def speed_tail():
+            return wd.js("const s = consoleState.charts.series; const k = s.names.indexOf('speed');"
+                         "return s.t.length > 20 ? s.v[k].slice(-20) : null")
+        tail = wait_for("the plotted speed at %g r/min" % SPEED_RPM,
+                        lambda: (lambda v: v if v and all(abs(x - SPEED_RPM) <= 0.03 * SPEED_RPM
+                                                          for x in v) else None)(speed_tail()), 180, 0.5)
+        print("  plotted speed reached %g r/min: last %s" % (SPEED_RPM, [round(x, 1) for x in tail[-5:]]))
+
+        if a.screenshot:
+            wd.js("const w = document.getElementById('win'); w.value = '0.4';"
+                  "w.dispatchEvent(new Event('change'));")
+            time.sleep(1.0)
+            wd.screenshot(a.screenshot)
+            print("  screenshot:", a.screenshot)
+        # Rendered frames over 3 s of wall time, counted by the page itself.
+        n0, ms0 = wd.js("return [consoleState.charts.drawn, consoleState.charts.drawMs]")
+        t0 = time.monotonic()
+        time.sleep(3.0)
+        n1, ms1 = wd.js("return [consoleState.charts.drawn, consoleState.charts.drawMs]")
+        fps = (n1 - n0) / (time.monotonic() - t0)
+        lost = wd.js("return document.getElementById('c-lost').textContent")
+        print("  page at %.0f rendered frames/s (plots %.2f ms a frame); frame-loss counter "
+              "shown: %s" % (fps, (ms1 - ms0) / max(1, n1 - n0), lost))
+        if fps < 30:
+            raise Fail("the page renders at %.1f frames/s (< 30)" % fps)
+
+        # A tunable out of range: the firmware's own error in its row.
+        wd.click('button[data-tab="tab-params"]')
+        p = wait_for("a writable tunable with a range", lambda: wd.js(
+            "for (const p of consoleState.params) { const m = /^\\[(\\S+), (\\S+)\\]$/.exec(p.range);"
+            " if (!p.ro && m && isFinite(+m[2])) return {name: p.name, max: +m[2]}; } return null"), 30)
+        bad = p["max"] * 10 + 1 if p["max"] > 0 else p["max"] + 1
+        wd.type('tr[data-param="%s"] input' % p["name"], "%g\ue007" % bad)
+        msg = wait_for("the error in the row of %s" % p["name"], lambda: wd.js(
+            "const t = document.querySelector('tr[data-param=\"%s\"] td.msg');"
+            "return t && t.classList.contains('err') ? t.textContent : null" % p["name"]), 30)
+        if not msg.startswith("err 4 range ["):
+            raise Fail("param set %s %g: %r" % (p["name"], bad, msg))
+        print("  param set %s %g -> %s" % (p["name"], bad, msg))
+
+        wd.click("#stop")
+        wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready" and
+                 (st() or {}).get("armed") == "0", 30)
+        print("  STOP -> state=ready")
+
+        # Second page; then the controlling page is lost with the drive armed.
+        wd.click("#arm")
+        wd.click("#modal-ok")
+        wait_for("armed again", lambda: (st() or {}).get("armed") == "1", 30)
+        ws_url = base.replace("http://", "ws://") + "/ws?token=" + token
+
+        async def loss():
+            gen = watcher_checks(ws_url, PAGE_TIMEOUT_S)
+            task = asyncio.ensure_future(gen)
+            await asyncio.sleep(3.0)     # the watcher has its role and its refusal by then
+            await asyncio.get_running_loop().run_in_executor(None, wd.quit)
+            return await task
+        dt = asyncio.run(loss())
+        print("  controlling page gone: drive stopped %.1f s later (page time-out %.1f s)" %
+              (dt, PAGE_TIMEOUT_S))
+        if dt > PAGE_TIMEOUT_S + 3.0:
+            raise Fail("stopped %.1f s after the page was lost" % dt)
+
+        # A new page takes control; QEMU is killed under it.
+        wd.start(chromium)
+        wd.get(url)
+        wait_for("the new page to control", lambda: (st() or {}).get("role") == "control", 30)
+        pid = wd.js("return consoleState.targetPid")
+        os.kill(pid, signal.SIGKILL)
+        gone = wait_for("'target gone' on the page", lambda: wd.js(
+            "const g = document.getElementById('gone');"
+            "return g.classList.contains('hidden') ? null : g.textContent"), 30)
+        if "target gone" not in gone:
+            raise Fail("banner: %r" % gone)
+        if server.poll() is not None:
+            raise Fail("the console server exited (%s) when QEMU died" % server.returncode)
+        if http_status(url) != 200:
+            raise Fail("the server stopped serving after QEMU died")
+        print("  QEMU killed -> page: %s; server still serving" % gone)
+    finally:
+        wd.quit() if wd.sid else None
+        cd.terminate()
+        if server.poll() is None:
+            server.send_signal(signal.SIGTERM)
+        try:
+            out, _ = server.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            out, _ = server.communicate()
+        print("---- console server output\n" + out.strip())
+        shutil.rmtree(tmp, ignore_errors=True)
+    if server.returncode != 0:
+        raise Fail("the console server exited with %d" % server.returncode)
+    print("console_web: all checks passed")
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except Fail as e:
+        print("console_web: FAILED: %s" % e, file=sys.stderr)
+        sys.exit(1)

@@ -1,0 +1,392 @@
+// The live console page (served by tools/console --web, tools/console_web.py).
+// Everything the page knows is in `S` (also window.consoleState, which the
+// browser test reads): the firmware's status, the telemetry series as plotted,
+// the replies. Commands go to the server as lines; the server owns the link.
+'use strict';
+
+const $ = (id) => document.getElementById(id);
+const TOKEN = new URLSearchParams(location.search).get('token') || '';
+const HEARTBEAT_MS = 250;
+const KEEP_S = 120;           // firmware seconds of telemetry kept for the plots
+const DEFAULT_SIGNALS = ['speed', 'speed_ref', 'torque', 'torque_ref', 'i_d', 'i_q'];
+
+const S = {
+  ws: null, connected: false, role: null, page: null, gone: null, target: '',
+  status: {}, counters: { frames: 0, bad: 0, lost: 0 }, meta: null, signals: [],
+  params: [], ctrls: [], cm: null, replies: [], autostarted: false,
+  recording: null, history: [], histPos: 0, pending: {}, paramMsg: {},
+};
+window.consoleState = S;
+
+const charts = new StripCharts($('plotarea'), (t) => {
+  const r = t === null ? null : charts.valuesAt(t);
+  $('cursor').textContent = r ? 't = ' + fmt(r.t) + ' s' : '';
+});
+S.charts = charts;
+
+// ---------------------------------------------------------------- log
+function log(text, cls) {
+  const el = $('log');
+  const line = document.createElement('div');
+  if (cls) line.className = cls;
+  line.textContent = text;
+  el.appendChild(line);
+  while (el.childNodes.length > 2000) el.removeChild(el.firstChild);
+  el.scrollTop = el.scrollHeight;
+}
+
+// ---------------------------------------------------------------- link to the server
+function connect() {
+  const proto = location.protocol === 'https:' ? 'wss:' : 'ws:';
+  const ws = new WebSocket(proto + '//' + location.host + '/ws?token=' + encodeURIComponent(TOKEN));
+  S.ws = ws;
+  ws.onopen = () => { S.connected = true; render(); };
+  ws.onclose = () => {
+    S.connected = false; S.role = null; render();
+    log('console: connection to the console server lost', 'err');
+  };
+  ws.onmessage = (e) => onMessage(JSON.parse(e.data));
+  setInterval(() => send({ type: 'heartbeat' }), HEARTBEAT_MS);
+}
+
+function send(m) {
+  if (S.ws && S.ws.readyState === WebSocket.OPEN) S.ws.send(JSON.stringify(m));
+}
+
+// Energising commands are confirmed by the user in a dialog first.
+const ENERGISING = /^(arm\b|ident (run|resume|step)\b|bringup (?!status\b)\S)/;
+
+function command(line, opts) {
+  line = line.trim();
+  if (!line) return;
+  if (ENERGISING.test(line) && !(opts && opts.confirmed)) {
+    confirmThen('"' + line + '" puts voltage on the motor. Is the motor free to turn and the ' +
+      'supply current-limited?', () => command(line, { confirmed: true }));
+    return;
+  }
+  send({ type: 'cmd', line: line, confirm: !!(opts && opts.confirmed) });
+  if (!(opts && opts.quiet)) log('> ' + line, 'sent');
+}
+
+function confirmThen(text, action) {
+  $('modal-text').textContent = text;
+  $('modal').classList.remove('hidden');
+  $('modal-ok').onclick = () => { $('modal').classList.add('hidden'); action(); };
+  $('modal-cancel').onclick = () => { $('modal').classList.add('hidden'); };
+}
+
+function onMessage(m) {
+  switch (m.type) {
+    case 'hello':
+      S.target = m.target; S.pageTimeout = m.page_timeout_s; S.targetPid = m.target_pid;
+      if (m.status) S.status = m.status;
+      if (m.meta) onMeta(m.meta);
+      if (m.gone) onGone(m.gone);
+      command('tel list', { quiet: true }); command('ctrl list', { quiet: true });
+      command('param list', { quiet: true });
+      break;
+    case 'role':
+      S.role = m.role; S.page = m.page; S.pages = m.pages;
+      break;
+    case 'status':
+      S.status = m.status; S.counters = m.counters;
+      maybeAutostart();
+      break;
+    case 'meta': onMeta(m); break;
+    case 'samples':
+      S.counters = m.counters;
+      if (charts.series) charts.series.push(m.rows);
+      if (S.recording) for (const r of m.rows) S.recording.rows.push(r);
+      break;
+    case 'reply': onReply(m); break;
+    case 'refused': log('refused: ' + (m.line ? m.line + ': ' : '') + m.why, 'err'); break;
+    case 'text': log(m.line, 'info'); break;
+    case 'gone': onGone(m.reason); break;
+  }
+  render();
+}
+
+function onGone(reason) {
+  S.gone = reason;
+  $('gone').textContent = 'target gone: ' + reason + ' — restart the console to reconnect';
+  $('gone').classList.remove('hidden');
+}
+
+function onMeta(m) {
+  S.meta = m;
+  charts.setSeries(new Series(m.signals, m.units, KEEP_S));
+}
+
+function maybeAutostart() {
+  // The controlling page starts a default stream once the target is past its
+  // calibration and streams nothing; any page can change it afterwards.
+  const st = S.status.state;
+  if (S.autostarted || S.role !== 'control' || !st || st === 'boot' || st === 'calib') return;
+  S.autostarted = true;
+  if ((S.status.tel_mask || '').startsWith('0x00000000')) telStart();
+}
+
+function listLines(m) { return m.lines.slice(1).map((l) => l.replace(/^ {2}/, '')); }
+
+function onReply(m) {
+  const first = m.lines[0] || '';
+  const mine = m.origin === 'page' + S.page;
+  if (m.origin !== 'poll' && mine && !(m.line === 'tel list' || m.line === 'ctrl list' ||
+      m.line === 'param list')) {
+    for (const l of m.lines) log(l, m.ok ? '' : 'err');
+  } else if (m.origin !== 'poll' && !mine && m.origin !== 'page-loss') {
+    log('[' + m.origin + '] > ' + m.line + '  → ' + first, m.ok ? 'info' : 'err');
+  }
+  S.replies.push({ line: m.line, ok: m.ok, lines: m.lines, origin: m.origin });
+  if (S.replies.length > 200) S.replies.shift();
+  const w = m.line.split(/\s+/);
+  if (w[0] === 'param' && w[1] === 'set') markParam(w[2], m.ok, first);
+  if (!m.ok) {
+    const pending = S.pending[m.line];
+    if (pending) { pending(m); delete S.pending[m.line]; }
+    return;
+  }
+  if (m.line === 'tel list') {
+    S.signals = listLines(m).map((l) => {
+      const p = l.trim().split(/\s+/);
+      return { bit: +p[0], name: p[1], unit: p[2] === '-' ? '' : p[2] };
+    });
+    buildSignals();
+  } else if (m.line === 'ctrl list') {
+    S.ctrls = listLines(m).map((l) => { const p = l.trim().split(/\s+/); return { sel: p[0] === '*', name: p[1] }; });
+    buildCtrls();
+  } else if (m.line === 'param list') {
+    S.params = listLines(m).map(parseParam).filter((p) => p);
+    buildParams();
+  } else if (w[0] === 'param' && w[1] === 'set') {
+    command('param list', { quiet: true });
+  } else if ((w[0] === 'ctrl' && w[1] === 'select') || m.line === 'ident apply') {
+    command('param list', { quiet: true }); command('ctrl list', { quiet: true });
+  } else if (m.line === 'ident status' || m.line === 'bringup status') {
+    onCmStatus(m.line, first);
+  } else if (m.line === 'ident result') {
+    buildResults(listLines(m));
+  }
+  const pending = S.pending[m.line];
+  if (pending) { pending(m); delete S.pending[m.line]; }
+}
+
+function parseParam(l) {
+  const w = l.trim().split(/\s+/);
+  if (w.length < 3) return null;
+  const p = { name: w[0], value: w[1], unit: w[2] === '-' ? '' : w[2], range: '', ro: false };
+  const rest = l.trim().split(/\s+/).slice(3).join(' ');
+  const mr = rest.match(/^\[([^\]]*)\]\s*(ro\b)?\s*(.*)$/);
+  if (mr) { p.range = '[' + mr[1] + ']'; p.ro = !!mr[2]; p.help = mr[3]; } else p.help = rest;
+  return p;
+}
+
+// ---------------------------------------------------------------- building the panels
+function buildSignals() {
+  const box = $('signals');
+  box.textContent = '';
+  const active = S.meta ? S.meta.signals : DEFAULT_SIGNALS;
+  for (const s of S.signals) {
+    const lab = document.createElement('label');
+    const cb = document.createElement('input');
+    cb.type = 'checkbox'; cb.value = s.name; cb.checked = active.includes(s.name);
+    lab.appendChild(cb);
+    lab.appendChild(document.createTextNode(' ' + s.name + (s.unit ? ' (' + s.unit + ')' : '')));
+    box.appendChild(lab);
+  }
+}
+
+function buildCtrls() {
+  const sel = $('ctrl');
+  sel.textContent = '';
+  for (const c of S.ctrls) {
+    const o = document.createElement('option');
+    o.value = o.textContent = c.name; o.selected = c.sel;
+    sel.appendChild(o);
+  }
+}
+
+function buildParams() {
+  const tb = $('params').tBodies[0];
+  tb.textContent = '';
+  for (const p of S.params) {
+    const tr = document.createElement('tr');
+    tr.dataset.param = p.name;
+    const cells = [p.name, null, p.unit, p.range + (p.ro ? ' ro' : ''), ''];
+    cells.forEach((c, i) => {
+      const td = document.createElement('td');
+      if (i === 1) {
+        const inp = document.createElement('input');
+        inp.value = p.value; inp.disabled = p.ro; inp.title = p.help || '';
+        inp.addEventListener('keydown', (e) => {
+          if (e.key === 'Enter') command('param set ' + p.name + ' ' + inp.value.trim());
+        });
+        td.appendChild(inp);
+      } else td.textContent = c;
+      if (i === 4) td.className = 'msg';
+      tr.appendChild(td);
+    });
+    tb.appendChild(tr);
+    const msg = S.paramMsg[p.name];
+    if (msg) markParam(p.name, msg.ok, msg.text);
+  }
+}
+
+function markParam(name, ok, text) {
+  S.paramMsg[name] = { ok, text };
+  const tr = document.querySelector('tr[data-param="' + CSS.escape(name) + '"]');
+  if (!tr) return;
+  const td = tr.querySelector('td.msg');
+  td.textContent = text; td.classList.toggle('err', !ok); td.classList.toggle('ok', ok);
+}
+
+function onCmStatus(which, first) {
+  // 'ok running step=rs progress=40% ...' / 'ok pass step=...' / 'ok fail step=... error=...'
+  const w = first.split(/\s+/);
+  const verdict = w[1] || '';
+  const step = (first.match(/step=(\S+)/) || [])[1] || '';
+  if (verdict === 'idle' && S.cm && S.cm.which !== which) return;
+  const prog = +((first.match(/progress=([\d.]+)/) || [])[1] || (verdict === 'pass' ? 100 : 0));
+  S.cm = { which, verdict, step, progress: prog, text: first.replace(/^ok\s+/, '') };
+  $('cm-bar').style.width = Math.min(100, prog) + '%';
+  $('cm-status').textContent = which.split(' ')[0] + ': ' + S.cm.text;
+  $('cm-status').style.color = verdict === 'fail' ? '#b71c1c' : verdict === 'pass' ? '#2e7d32' : '';
+}
+
+function buildResults(lines) {
+  const tb = $('cm-results').tBodies[0];
+  tb.textContent = '';
+  for (const l of lines) {
+    const p = l.trim().split(/\s+/);
+    const tr = document.createElement('tr');
+    for (const c of [p[0], p[1], p[2] === '-' ? '' : p[2]]) {
+      const td = document.createElement('td'); td.textContent = c || ''; tr.appendChild(td);
+    }
+    tb.appendChild(tr);
+  }
+}
+
+function telStart() {
+  const names = [...document.querySelectorAll('#signals input:checked')].map((c) => c.value);
+  const use = names.length ? names : DEFAULT_SIGNALS;
+  command('tel start ' + use.join(' ') + ' every ' + $('every').value.trim());
+}
+
+// ---------------------------------------------------------------- header and readouts
+function render() {
+  const st = S.status;
+  $('target').textContent = S.target || '—';
+  const link = $('link');
+  link.textContent = S.gone ? 'target gone' : S.connected ? 'connected' : 'disconnected';
+  link.className = 'chip ' + (S.gone || !S.connected ? 'bad' : 'ok');
+  $('st-state').textContent = st.state || '—';
+  $('st-ctrl').textContent = st.ctrl || '—';
+  $('st-mode').textContent = st.mode || '—';
+  const fault = st.fault || '';
+  const f = $('st-fault');
+  f.textContent = 'fault ' + (fault || '—');
+  f.className = 'chip ' + (fault && !fault.startsWith('0') ? 'bad' : '');
+  const warns = Object.keys(st).filter((k) => k.startsWith('warn')).map((k) => k + '=' + st[k])
+    .filter((s) => !/=(0|none)$/.test(s));
+  $('st-warn').textContent = warns.join(' ');
+  $('st-warn').className = 'chip warn' + (warns.length ? '' : ' hidden');
+  $('st-speed').textContent = st.speed_rpm || '—';
+  $('st-speedref').textContent = st.speed_ref_rpm || '—';
+  $('st-torque').textContent = st.torque_nm || '—';
+  $('st-torqueref').textContent = st.torque_ref_nm || '—';
+  $('c-frames').textContent = S.counters.frames;
+  $('c-lost').textContent = S.counters.lost;
+  $('c-bad').textContent = S.counters.bad;
+  const role = $('role');
+  role.textContent = S.role === 'control' ? 'controlling' : S.role === 'watch' ? 'watching' : '—';
+  role.className = 'chip ' + (S.role === 'control' ? 'ok' : '');
+  $('take').classList.toggle('hidden', S.role !== 'watch');
+  $('rec-info').textContent = S.recording ? S.recording.rows.length + ' samples' : '';
+}
+
+function frame() {
+  charts.draw();
+  $('c-fps').textContent = charts.fps.toFixed(0);
+  requestAnimationFrame(frame);
+}
+
+// ---------------------------------------------------------------- files
+function download(name, blob) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob); a.download = name;
+  document.body.appendChild(a); a.click(); a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+}
+
+function csvText(rec) {
+  const head = ['time_s'].concat(rec.names.map((n, k) => n + (rec.units[k] ? ' (' + rec.units[k] + ')' : '')));
+  return head.join(',') + '\n' + rec.rows.map((r) => r.map((x) => Number(x.toPrecision(9))).join(',')).join('\n') + '\n';
+}
+
+function plotPng(cb) {
+  const cs = charts.canvases;
+  if (!cs.length) return;
+  const w = cs[0].width, h = cs.reduce((a, c) => a + c.height, 0);
+  const out = document.createElement('canvas');
+  out.width = w; out.height = h;
+  const g = out.getContext('2d');
+  g.fillStyle = '#fff'; g.fillRect(0, 0, w, h);
+  let y = 0;
+  for (const c of cs) { g.drawImage(c, 0, y); y += c.height; }
+  out.toBlob(cb, 'image/png');
+}
+
+// ---------------------------------------------------------------- wiring
+function wire() {
+  $('stop').onclick = () => { send({ type: 'stop' }); log('STOP', 'sent'); };
+  $('take').onclick = () => send({ type: 'take_control' });
+  $('arm').onclick = () => command('arm');
+  $('disarm').onclick = () => command('disarm');
+  $('fault-clear').onclick = () => command('fault clear');
+  $('ctrl-set').onclick = () => command('ctrl select ' + $('ctrl').value);
+  $('ref-set').onclick = () => command('ref ' + $('mode').value + ' ' + $('ref').value.trim());
+  $('tel-start').onclick = telStart;
+  $('tel-stop').onclick = () => command('tel stop');
+  $('win').onchange = () => { const v = +$('win').value; if (v > 0) charts.windowS = v; };
+  $('pause').onclick = () => charts.pause();
+  $('live').onclick = () => charts.goLive();
+  $('params-load').onclick = () => command('param list', { quiet: true });
+  $('rec').onclick = () => {
+    if (S.recording) { S.recording.stopped = true; S.lastRecording = S.recording; S.recording = null; $('rec').textContent = 'record'; } else if (S.meta) {
+      S.recording = { names: S.meta.signals, units: S.meta.units, rows: [] };
+      $('rec').textContent = 'stop recording';
+    }
+    render();
+  };
+  $('csv').onclick = () => {
+    const rec = S.recording || S.lastRecording;
+    if (rec) download('pmsm-telemetry.csv', new Blob([csvText(rec)], { type: 'text/csv' }));
+  };
+  $('png').onclick = () => plotPng((b) => download('pmsm-plot.png', b));
+  for (const b of document.querySelectorAll('[data-cm]')) b.onclick = () => command(b.dataset.cm);
+  $('cm-step-run').onclick = () => command('ident step ' + $('cm-step').value);
+  $('bu-run').onclick = () => command('bringup ' + $('bu-step').value);
+  for (const b of document.querySelectorAll('.tabs button')) {
+    b.onclick = () => {
+      for (const x of document.querySelectorAll('.tabs button')) x.classList.toggle('on', x === b);
+      for (const t of document.querySelectorAll('.tab')) t.classList.toggle('hidden', t.id !== b.dataset.tab);
+    };
+  }
+  const cmd = $('cmd');
+  cmd.addEventListener('keydown', (e) => {
+    if (e.key === 'Enter') {
+      const line = cmd.value.trim();
+      if (line) { S.history.push(line); S.histPos = S.history.length; command(line); }
+      cmd.value = '';
+    } else if (e.key === 'ArrowUp' && S.histPos > 0) {
+      cmd.value = S.history[--S.histPos]; e.preventDefault();
+    } else if (e.key === 'ArrowDown') {
+      S.histPos = Math.min(S.history.length, S.histPos + 1);
+      cmd.value = S.history[S.histPos] || ''; e.preventDefault();
+    }
+  });
+}
+
+wire();
+connect();
+requestAnimationFrame(frame);
