@@ -5,6 +5,7 @@ if(NOT TARGET pmsm_fw_proto)
   add_library(pmsm_fw_proto STATIC
     ${CMAKE_CURRENT_LIST_DIR}/cmd.c
     ${CMAKE_CURRENT_LIST_DIR}/cmd_num.c
+    ${CMAKE_CURRENT_LIST_DIR}/text_fmt.c
     ${CMAKE_CURRENT_LIST_DIR}/telemetry.c
     ${CMAKE_CURRENT_LIST_DIR}/telemetry_frame.c)
   target_include_directories(pmsm_fw_proto PUBLIC ${CMAKE_CURRENT_LIST_DIR})
@@ -14,6 +15,18 @@ if(NOT TARGET pmsm_fw_proto)
   # size on the targets (the board image's flash; -8.7 kB there).
   if(NOT PMSM_TARGET STREQUAL "host")
     set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/cmd.c ${CMAKE_CURRENT_LIST_DIR}/cmd_num.c
+                                ${CMAKE_CURRENT_LIST_DIR}/text_fmt.c
                                 PROPERTIES COMPILE_OPTIONS "-Os")
   endif()
+endif()
+# libc functions replaced by smaller ones of the firmware's (libc_small.c:
+# snprintf and vsnprintf by the formatter above, strcmp) for target images
+# linked with newlib-nano (the B-G431B-ESC1 image): every message of the
+# firmware and the core then prints its numbers. An OBJECT library: in the
+# link whatever the archives' order.
+if(NOT PMSM_TARGET STREQUAL "host" AND NOT TARGET pmsm_libc_small)
+  add_library(pmsm_libc_small OBJECT ${CMAKE_CURRENT_LIST_DIR}/libc_small.c)
+  set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/libc_small.c PROPERTIES COMPILE_OPTIONS "-Os")
+  target_link_libraries(pmsm_libc_small PUBLIC pmsm_fw_proto)
+  pmsm_strict(pmsm_libc_small)
 endif()

@@ -8,3 +8,7 @@ add_test(NAME esc1_flash
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/test_flash.py ${PROJECT_SOURCE_DIR}
                  ${PMSM_ESC1_ELF})
 set_tests_properties(esc1_flash PROPERTIES LABELS "board")
+# Its messages print their numbers: no float conversion newlib-nano would drop.
+add_test(NAME esc1_image_printf
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_printf.py ${PMSM_ESC1_ELF})
+set_tests_properties(esc1_image_printf PROPERTIES LABELS "board")
