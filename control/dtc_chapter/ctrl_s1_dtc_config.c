@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_params.h"
 #include "ctrl_s1_dtc.h"
 #include "ctrl_s1_dtc_config.h"
@@ -168,8 +169,8 @@ int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTION
             a = a < 0.0 ? 0.0 : (a > 60.0 * deg ? 60.0 * deg : a);
             /* SVM dwell times: v = t1 V_k1 + t2 V_k2 (Ts = 1) gives
              * t1 = |v| sin(60 - a) / (|V_k| sin 60) = m sin(60 - a), t2 = m sin(a). */
-            long p1 = lround(HPDTC_POINTS * m * sin(60.0 * deg - a));
-            long p2 = lround(HPDTC_POINTS * m * sin(a));
+            long p1 = lround(HPDTC_POINTS * m * ctrl_cfg_sin(60.0 * deg - a));
+            long p2 = lround(HPDTC_POINTS * m * ctrl_cfg_sin(a));
             while (p1 + p2 > HPDTC_POINTS) { /* rounding only: never beyond the hexagon */
                 if (p1 >= p2) {
                     p1--;

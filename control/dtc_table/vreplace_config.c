@@ -3,6 +3,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_params.h"
 #include "ctrl_units.h"
 #include "vectors.h"
@@ -27,9 +28,9 @@ int ctrl_vreplace_config(ctrl_vreplace_t *c, double sigma_rad)
         sigma_rad = sigma_max;
     }
     const double b = CTRL_PI / 6.0 - sigma_rad;
-    c->cos_b = ctrl_q24_from_double(cos(b));
-    c->sin_b = ctrl_q24_from_double(sin(b));
-    c->enabled = ctrl_q24_from_double(sin(sigma_rad)) > 0 ? 1u : 0u;
+    c->cos_b = ctrl_q24_from_double(ctrl_cfg_cos(b));
+    c->sin_b = ctrl_q24_from_double(ctrl_cfg_sin(b));
+    c->enabled = ctrl_q24_from_double(ctrl_cfg_sin(sigma_rad)) > 0 ? 1u : 0u;
     /* u = d e^{-+j(pi/6 - sigma)}: (dx cb +- dy sb, dy cb -+ dx sb), one
      * rounding each (vreplace.h) */
     for (unsigned x = 1u; x <= 6u; x++) {

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 #include "flux_observer.h"
 #include "flux_observer_config.h"
@@ -76,7 +77,7 @@ int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b
     n.v_fwd = ctrl_q24_from_double(c->v_fwd_v / b->v_v);
     n.inv_band =
         (int32_t)lround(65536.0 / band_pu < 2147483647.0 ? 65536.0 / band_pu : 2147483647.0);
-    n.psi_k = c->psi_tau_s > 0.0 ? ctrl_q24_from_double(1.0 - exp(-ts / c->psi_tau_s)) : 0;
+    n.psi_k = c->psi_tau_s > 0.0 ? ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-ts / c->psi_tau_s)) : 0;
     n.psi_speed_min =
         ctrl_q24_from_double(c->psi_speed_min * (double)p->speed_rated_e / (double)FX_ONE);
     n.primed = 0u;

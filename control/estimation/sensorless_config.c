@@ -3,6 +3,7 @@
 #include <string.h>
 
 #include "ctrl_units.h"
+#include "fx.h"
 #include "sensorless.h"
 #include "sensorless_config.h"
 
@@ -86,8 +87,9 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
         const double f = pos - (double)k;
         const double id = (1.0 - f) * p->mtpa_id[k] + f * p->mtpa_id[k + 1];
         const double iq = (1.0 - f) * p->mtpa_iq[k] + f * p->mtpa_iq[k + 1];
-        const double beta = atan2(-id, iq);
-        n->pol_shift = (fx_angle_t)(uint32_t)(int32_t)llround(beta / CTRL_TWO_PI * 4294967296.0);
+        /* beta = atan2(-i_d, i_q) by the core's own fx_atan2 (|i| < 2^31 in
+         * Q24: the table's values), not libm's: host and target alike */
+        n->pol_shift = fx_atan2((int32_t)llround(-id), (int32_t)llround(iq));
     }
     n->zero_n = (uint32_t)ceil(1e-3 * fs); /* the current back to zero: 1 ms */
     n->pol_min = (fx_angle_t)(uint32_t)llround(c->pol_min_frac * c->pol_deg / 360.0 * 4294967296.0);

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_params.h"
 #include "ctrl_units.h"
 
@@ -74,7 +75,7 @@ int ctrl_params_set_speed_lpf(ctrl_params_t *p, double fc_hz)
         return CTRL_EINVAL;
     }
     /* EMA y += k (x - y): pole exp(-2 pi fc Ts) matched (impulse invariance). */
-    const double k = 1.0 - exp(-CTRL_TWO_PI * fc_hz / (double)p->fs_hz);
+    const double k = 1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * fc_hz / (double)p->fs_hz);
     p->speed_lpf_k = ctrl_q24_from_double(k);
     return p->speed_lpf_k > 0 ? CTRL_OK : CTRL_EINVAL;
 }
@@ -90,7 +91,7 @@ static void mtpa_point(double ld, double lq, double psi_pm, double i, double *id
     *id = dl == 0.0 ? 0.0 : (psi_pm - sqrt(psi_pm * psi_pm + 8.0 * dl * dl * i * i)) / (4.0 * dl);
     *iq = sqrt(fmax(i * i - *id * *id, 0.0));
     *te = *iq * (psi_pm - dl * *id);
-    *psi = hypot(psi_pm + ld * *id, lq * *iq);
+    *psi = ctrl_cfg_hypot(psi_pm + ld * *id, lq * *iq);
 }
 
 /* The MTPA table: psi_s, i_d, i_q at CTRL_MTPA_N + 1 uniform torques up to

@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_m2ptfc_model.h"
 #include "ctrl_m2ptfc_model_config.h"
 
@@ -57,7 +58,7 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
     /* |psi| on |i| = current_max is at most |(psi_pm + Ld i_max, Lq i_max)|. */
     const double i_max = ctrl_q24_to_double(params->current_max);
     const double psi_max =
-        hypot(ctrl_q24_to_double(params->psi_pm) + i_max / inv_ld, i_max / inv_lq);
+        ctrl_cfg_hypot(ctrl_q24_to_double(params->psi_pm) + i_max / inv_ld, i_max / inv_lq);
     /* Limits of the fast k+2 arithmetic (ctrl_m2ptfc_model.h). */
     const double ab_max = ctrl_q24_to_double(CTRL_MPC_AB_MAX);
     if (fabs(a) > ab_max) {

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 
 void ctrl_fieldweak_cfg_default(ctrl_fieldweak_cfg_t *c)
@@ -97,7 +98,7 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     double mq;
     ctrl_fieldweak_mtpa_split(psi, ld, lq, i, &md, &mq);
     const double t_mtpa = psi * mq + (ld - lq) * md * mq;
-    const double psi_mtpa = hypot(ld * md + psi, lq * mq);
+    const double psi_mtpa = ctrl_cfg_hypot(ld * md + psi, lq * mq);
     const double c1 = psi / ld;
     const double c2 = 1.0 / ld - 1.0 / lq;
     const double vf = c->v_frac / sqrt(3.0);
@@ -124,8 +125,8 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     rc = rc ? rc : fw_q24(8.0 * c2 * c2, "8 (1/Ld - 1/Lq)^2", &s->c2_sq8, why, why_len);
     rc = rc ? rc : fw_q24(c->torque_margin, "torque_margin", &s->t_margin, why, why_len);
     rc = rc ? rc
-            : fw_q24(1.0 - exp(-2.0 * CTRL_PI * c->vdc_lpf_hz / fs), "DC-link filter coefficient",
-                     &s->vdc_k, why, why_len);
+            : fw_q24(1.0 - ctrl_cfg_exp(-2.0 * CTRL_PI * c->vdc_lpf_hz / fs),
+                     "DC-link filter coefficient", &s->vdc_k, why, why_len);
     s->id_star = FX_MAX;
     if (lq > ld && rc == CTRL_OK) {
         const double id_star = ld * psi / (lq * lq - ld * ld);

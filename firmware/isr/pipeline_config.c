@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 #include "field_weak_config.h"
 #include "pipeline.h"
@@ -114,8 +115,8 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         return fwrc == CTRL_ERANGE ? FW_ERANGE : FW_EINVAL;
     }
     fw->torque_max = 0;
-    fw->trim_k =
-        ctrl_q24_from_double(1.0 - exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
+    fw->trim_k = ctrl_q24_from_double(
+        1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
     /* PM-flux tracking: the encoder-mode observer, its estimate adopted above

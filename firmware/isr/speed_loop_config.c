@@ -3,6 +3,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 #include "speed_loop.h"
 
@@ -64,7 +65,7 @@ int fw_speed_loop_design(fw_speed_design_t *d, const ctrl_machine_t *m, double l
     }
     /* tan as sin / cos: libm's tan would add 1 KB to the board's image */
     const double phi = (90.0 - pm) * FW_SL_DEG - wc * td;
-    const double wz = wc * sin(phi) / cos(phi);
+    const double wz = wc * ctrl_cfg_sin(phi) / ctrl_cfg_cos(phi);
     const double kp = m->inertia_kgm2 * wc / sqrt(1.0 + (wz / wc) * (wz / wc));
     d->bandwidth_hz = wc / (2.0 * CTRL_PI);
     d->phase_margin_deg = pm;

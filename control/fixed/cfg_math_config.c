@@ -1,0 +1,147 @@
+/* Elementary functions of the configuration code (ctrl_cfg_math.h). */
+#include "ctrl_cfg_math.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/* pi/2 in two parts: the first 33 bits (n CFG_PIO2_HI exact for n < 2^20)
+ * and the rest, as in Cody and Waite's argument reduction. */
+#define CFG_PIO2_HI 1.57079632673412561417e+00
+#define CFG_PIO2_LO 6.07710050650619224932e-11
+#define CFG_2_OVER_PI 6.36619772367581382433e-01
+/* ln 2 in two parts: the first 32 bits (k CFG_LN2_HI exact for |k| < 2^21). */
+#define CFG_LN2_HI 6.93147180369123816490e-01
+#define CFG_LN2_LO 1.90821492927058770002e-10
+#define CFG_1_OVER_LN2 1.44269504088896338700e+00
+
+/* n = round(x) for |x| < 2^62, half away from zero. */
+static int64_t cfg_round(double x)
+{
+    return (int64_t)(x >= 0.0 ? x + 0.5 : x - 0.5);
+}
+
+/* sin r, cos r for |r| <= pi/4: Taylor to r^17 and r^18 (the next terms are
+ * below 1e-19 of the result), by Horner's rule in r^2. */
+static double cfg_sin_kernel(double r)
+{
+    const double z = r * r;
+    const double p =
+        -1.0 / 6.0 +
+        z * (1.0 / 120.0 +
+             z * (-1.0 / 5040.0 +
+                  z * (1.0 / 362880.0 +
+                       z * (-1.0 / 39916800.0 +
+                            z * (1.0 / 6227020800.0 +
+                                 z * (-1.0 / 1307674368000.0 + z * (1.0 / 355687428096000.0)))))));
+    return r + r * z * p;
+}
+
+static double cfg_cos_kernel(double r)
+{
+    const double z = r * r;
+    const double p =
+        -0.5 +
+        z * (1.0 / 24.0 +
+             z * (-1.0 / 720.0 +
+                  z * (1.0 / 40320.0 + z * (-1.0 / 3628800.0 +
+                                            z * (1.0 / 479001600.0 +
+                                                 z * (-1.0 / 87178291200.0 +
+                                                      z * (1.0 / 20922789888000.0 +
+                                                           z * (-1.0 / 6402373705728000.0))))))));
+    return 1.0 + z * p;
+}
+
+void ctrl_cfg_sincos(double x, double *s, double *c)
+{
+    double sv = NAN;
+    double cv = NAN;
+    if (x >= -CTRL_CFG_TRIG_MAX && x <= CTRL_CFG_TRIG_MAX) { /* false for NaN */
+        const int64_t n = cfg_round(x * CFG_2_OVER_PI);
+        const double dn = (double)n;
+        const double r = (x - dn * CFG_PIO2_HI) - dn * CFG_PIO2_LO;
+        const double sr = cfg_sin_kernel(r);
+        const double cr = cfg_cos_kernel(r);
+        switch ((unsigned)((uint64_t)n & 3u)) { /* quadrant of x */
+        case 0u:
+            sv = sr;
+            cv = cr;
+            break;
+        case 1u:
+            sv = cr;
+            cv = -sr;
+            break;
+        case 2u:
+            sv = -sr;
+            cv = -cr;
+            break;
+        default:
+            sv = -cr;
+            cv = sr;
+            break;
+        }
+    }
+    if (s != NULL) {
+        *s = sv;
+    }
+    if (c != NULL) {
+        *c = cv;
+    }
+}
+
+double ctrl_cfg_sin(double x)
+{
+    double s;
+    ctrl_cfg_sincos(x, &s, NULL);
+    return s;
+}
+
+double ctrl_cfg_cos(double x)
+{
+    double c;
+    ctrl_cfg_sincos(x, NULL, &c);
+    return c;
+}
+
+double ctrl_cfg_exp(double x)
+{
+    if (!(x == x)) {
+        return x;
+    }
+    if (x > 709.0) {
+        return INFINITY;
+    }
+    if (x < -708.0) {
+        return 0.0;
+    }
+    /* e^x = 2^k e^r, |r| <= ln2 / 2: Taylor to r^13 (the next term < 5e-18). */
+    const int64_t k = cfg_round(x * CFG_1_OVER_LN2);
+    const double dk = (double)k;
+    const double r = (x - dk * CFG_LN2_HI) - dk * CFG_LN2_LO;
+    const double p =
+        1.0 +
+        r * (1.0 +
+             r * (1.0 / 2.0 +
+                  r * (1.0 / 6.0 +
+                       r * (1.0 / 24.0 +
+                            r * (1.0 / 120.0 +
+                                 r * (1.0 / 720.0 +
+                                      r * (1.0 / 5040.0 +
+                                           r * (1.0 / 40320.0 +
+                                                r * (1.0 / 362880.0 +
+                                                     r * (1.0 / 3628800.0 +
+                                                          r * (1.0 / 39916800.0 +
+                                                               r * (1.0 / 479001600.0 +
+                                                                    r * (1.0 /
+                                                                         6227020800.0)))))))))))));
+    /* 2^k exactly, k in [-1022, 1023]: the biased exponent alone */
+    const uint64_t bits = (uint64_t)(k + 1023) << 52;
+    double scale;
+    memcpy(&scale, &bits, sizeof scale);
+    return p * scale;
+}
+
+double ctrl_cfg_hypot(double x, double y)
+{
+    return sqrt(x * x + y * y);
+}
