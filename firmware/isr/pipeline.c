@@ -177,6 +177,18 @@ static inline fx_angle_t fw_encoder_angle(fw_t *fw, const hal_encoder_raw_t *enc
     return (fx_angle_t)(e & 0xFFFFFFFFu) + fw->enc_offset;
 }
 
+/* The medium task's state anew at its next run, which is this period's, inside
+ * the interrupt (fw_control). */
+static void fw_mid_restart(fw_t *fw)
+{
+    fw->mid_reset = 1u;
+    fw->mid_bump = 0u;
+    fw->mid_fresh = 0u;
+    fw->mid_count = 1u;
+    fw->mid_vdc_sum = 0;
+    fw->mid_n = 0u;
+}
+
 static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
 {
     if (fw->req_clear != 0u) {
@@ -213,12 +225,8 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             fw->ctrl->reset(fw->ctrl_state.bytes);
             ctrl_estimator_reset(&fw->est, &fw->params);
             ctrl_psi_track_reset(&fw->psi_track); /* from the current model at the first period */
-            ctrl_speed_pi_reset(&fw->speed_pi, 0);
-            ctrl_fieldweak_reset(&fw->fwk);
-            fw->torque_max = fw->torque_ref_max;
+            fw_mid_restart(fw);
             fw->trim = 0;
-            fw->speed_tref = 0;
-            fw->speed_cnt = 0u;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
             hal_gate_enable(fw->hal, true);
         }
@@ -324,7 +332,60 @@ static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
     sl->torque_est = fw->estimate.now.torque;
 }
 
-static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
+/* The DC link summed for the medium task; once in mid_div periods (or at
+ * once, mid_count = 1) its inputs into the free slot: true, a run is due. */
+static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req, uint8_t hold)
+{
+    fw->mid_vdc_sum += est->vdc;
+    fw->mid_n++;
+    if (--fw->mid_count != 0u) {
+        return false;
+    }
+    fw->mid_count = fw->mid_div;
+    const uint32_t req = fw->mid_req + 1u;
+    fw_mid_in_t *const in = &fw->mid_in[req & 1u];
+    in->vdc_sum = fw->mid_vdc_sum;
+    in->n = fw->mid_n;
+    in->omega_e = est->omega_e;
+    in->tref = t_req;
+    in->torque_now = fw->torque_ref_now;
+    in->speed_ref = fw->speed_ref;
+    in->bump_torque = fw->mid_bump_t;
+    in->ref_mode = (uint8_t)fw->ref_mode;
+    in->hold = hold;
+    in->reset = fw->mid_reset;
+    in->bump = fw->mid_bump;
+    fw->mid_vdc_sum = 0;
+    fw->mid_n = 0u;
+    fw->mid_reset = 0u;
+    fw->mid_bump = 0u;
+    fw->mid_fresh = 1u;
+    fw->mid_req = req;
+    return true;
+}
+
+/* The first period after a reset (fw_init, arming, a commissioning step's
+ * controller reset): the medium task's first run here, inside the interrupt,
+ * so that this period already has the speed loop's output and the limits of
+ * its own speed and DC link, as every later one has (a drive started at its
+ * limit, the 80 kW IPMSM at its fixed-flux torque limit under m2ptfc, lost the
+ * load angle after a first period at zero torque). Out of line: rare. */
+#if defined(__GNUC__)
+#define FW_NOINLINE __attribute__((noinline))
+#else
+#define FW_NOINLINE
+#endif
+static FW_NOINLINE void fw_mid_first_run(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req,
+                                         uint8_t hold)
+{
+    fw->mid_count = 1u;
+    (void)fw_mid_trigger(fw, est, t_req, hold);
+    fw_medium(fw);
+}
+
+/* The estimate, the torque reference within the medium task's limits, the
+ * controller's step, the compare values; true when the medium task is due. */
+static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
     ctrl_angle_sl_t *const sl =
@@ -345,41 +406,38 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     tm->psi_d = est->now.psi_d;
     tm->psi_q = est->now.psi_q;
     tm->torque = est->now.torque;
-    /* overspeed, or (speed mode) the speed running away at full torque */
+    /* The torque reference without the speed loop: the sensorless start's
+     * (forced angle or the initial angle's pulses: the start-up current along
+     * the forced q axis, the speed loop waiting, sensorless.h), or torque
+     * mode's (torque_ref clamped by fw_set_torque_ref). */
+    const uint8_t hold = sl != NULL && sl->out.mode != CTRL_SL_OBSERVER ? 1u : 0u;
+    q24_t tref = hold != 0u ? sl->out.torque_ref : fw->torque_ref_lim;
+    const bool first = fw->mid_fresh == 0u;
+    if (first) {
+        fw_mid_first_run(fw, est, tref, hold);
+    }
+    /* The medium task's last run. */
+    const fw_mid_out_t *const mo = &fw->mid_out[fw->mid_done & 1u];
+    /* overspeed, or a slow protection of the medium task */
     uint32_t f = fw_protect_overspeed(&fw->prot, est->omega_e);
+    if (f == FW_FAULT_NONE) {
+        f = mo->fault;
+    }
 
-    q24_t tref;
-    if (sl != NULL && sl->out.mode != CTRL_SL_OBSERVER) {
-        /* Forced start (or the initial angle's pulses): the start-up current
-         * along the forced q axis; the speed loop waits (sensorless.h). */
-        tref = sl->out.torque_ref;
-        fw->speed_cnt = 0u;
+    if (hold != 0u) {
+        /* the sensorless start's reference (above) */
     } else if (fw->ref_mode == FW_REF_SPEED) {
         if (sl != NULL && sl->out.handover != 0u) {
-            /* bumpless: the speed loop starts from the torque it takes over */
-            ctrl_speed_pi_reset(&fw->speed_pi, est->now.torque);
-            fw->speed_cnt = 0u;
+            /* bumpless: the speed loop restarts from the torque it takes over,
+             * in a run of the medium task now */
+            tref = est->now.torque;
+            fw->mid_bump = 1u;
+            fw->mid_bump_t = tref;
+            fw->mid_count = 1u;
+        } else {
+            /* the speed loop's output, held between the medium task's runs */
+            tref = mo->speed_tref;
         }
-        /* The speed loop runs at its own, lower rate and holds its output in
-         * between: a piecewise-constant torque reference, as from a drive's
-         * outer loop (a reference that changes every period would also keep
-         * FST's reference-step logic, §4.5.3, permanently in its dynamic mode). */
-        if (fw->speed_cnt == 0u) {
-            /* Anti-windup against the torque limit of the last period (field
-             * weakening) as well as the configured one: the integrator stays
-             * within what the drive can deliver, so leaving the limit does not
-             * overshoot. */
-            fw->speed_pi.out_max = fx_max(fx_min(fw->torque_ref_max, fw->torque_max), 1);
-            fw->speed_tref = ctrl_speed_pi_step(&fw->speed_pi, fw->speed_ref, est->omega_e);
-        }
-        fw->speed_cnt = fw->speed_cnt + 1u >= fw->speed_div ? 0u : fw->speed_cnt + 1u;
-        tref = fx_clamp(fw->speed_tref, fw->torque_ref_min, fw->torque_ref_max);
-        if (f == FW_FAULT_NONE) {
-            f = fw_protect_speed_follow(&fw->prot, fw->speed_ref, est->omega_e, tref,
-                                        fw->speed_pi.out_max);
-        }
-    } else {
-        tref = fw->torque_ref_lim; /* torque_ref clamped by fw_set_torque_ref */
     }
     if (f != FW_FAULT_NONE) {
         /* latched, gates off, no references in the record */
@@ -390,14 +448,14 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         tm->torque_max = 0;
         tm->fw_limit = 0u;
         fw_pwm_off(fw, tm);
-        return;
+        return false;
     }
-    /* Torque limited by the current and voltage limits; flux reference
+    /* Torque limited by the current and voltage limits, flux reference
      * weakened to what the voltage allows (0 = the controller's own below
-     * base speed, so nothing changes there). */
-    ctrl_fieldweak_out_t lim;
-    ctrl_fieldweak_step_lazy(&fw->fwk, &fw->params, est->vdc, est->omega_e, tref, &lim);
-    tref = lim.torque;
+     * base speed, so nothing changes there): the medium task's (field_weak.h). */
+    const q24_t torque_max = mo->torque_max;
+    const q24_t t_req = tref;
+    tref = fx_clamp(t_req, fx_neg(torque_max), torque_max);
     /* Mean-torque trim in field weakening: with the flux at the voltage's
      * limit the torque rises slowly (little voltage beyond the back-EMF) and
      * falls fast, so a hysteresis or duty-ratio controller settles below its
@@ -405,19 +463,18 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * FW_TRIM_HZ, the DRR EMA's of thesis sec. 5.3.2) restores the mean.
      * Outside field weakening it decays with the same time constant (smooth
      * exit); bounded by a quarter of the torque limit. */
-    const uint8_t weak = lim.weakening;
+    const uint8_t weak = mo->weakening;
     if (weak != 0u || fw->trim != 0) { /* else it stays 0 */
-        const q24_t trim_lim = fx_rshift32_round(lim.torque_max, 2u);
+        const q24_t trim_lim = fx_rshift32_round(torque_max, 2u);
         const q24_t trim_in = weak != 0u ? fx_sub(tref, est->now.torque) : fx_neg(fw->trim);
         fw->trim =
             fx_clamp(fx_add(fw->trim, fx_mul(fw->trim_k, trim_in)), fx_neg(trim_lim), trim_lim);
     }
     fw->refs.torque = fx_add(tref, fw->trim);
-    fw->refs.psi = weak != 0u ? lim.psi_ref : 0;
-    fw->torque_max = lim.torque_max;
+    fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
     fw->torque_ref_now = tref;
-    tm->torque_max = lim.torque_max;
-    tm->fw_limit = (uint8_t)(lim.limit + 4u * lim.clipped + 8u * weak);
+    tm->torque_max = torque_max;
+    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != t_req) + 8u * weak);
 
     const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed
@@ -439,10 +496,11 @@ static inline void fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     tm->vec = has_plan ? out.plan.vec[0] : 0u;
     tm->duty = has_plan ? out.plan.dur[0] : 0;
     tm->torque_ref = tref;
+    return !first && fw_mid_trigger(fw, est, t_req, hold);
 }
 
 /* A running period: measurements, protections, control. */
-static inline void fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
+static inline bool fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
                                      const hal_adc_raw_t *raw, const hal_encoder_raw_t *enc)
 {
     /* The measurements go straight into the telemetry record. */
@@ -461,11 +519,11 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
         }
     }
     if (f == FW_FAULT_NONE) {
-        fw_control(fw, hal, tm, m);
-    } else {
-        fw_tm_no_estimate(tm);
-        fw_pwm_off(fw, tm);
+        return fw_control(fw, hal, tm, m);
     }
+    fw_tm_no_estimate(tm);
+    fw_pwm_off(fw, tm);
+    return false;
 }
 
 /* ---- commissioning dispatch (firmware/commission; cm.h) ----
@@ -473,7 +531,7 @@ static inline void fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
  * decides the next period: gates off, leg duties, or the controller with a
  * torque reference. A protection or a failed step ends it with the gates off
  * (the step's reason stays in fw->cm.err, the fault latches). */
-static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const hal_adc_raw_t *raw,
+static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const hal_adc_raw_t *raw,
                                  const hal_encoder_raw_t *enc)
 {
     ctrl_meas_t *const m = &tm->meas;
@@ -492,7 +550,7 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
     fw_tm_no_estimate(tm);
     if (f != FW_FAULT_NONE) {
         fw_pwm_off(fw, tm); /* fw_fault_now ended the step */
-        return;
+        return false;
     }
     cm_in_t in;
     in.i_a = m->i_a;
@@ -512,12 +570,12 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         } else {
             fw_fault_now(fw, FW_FAULT_COMMISSION);
         }
-        return;
+        return false;
     }
     if (out.mode == CM_OUT_OFF) {
         fw->cm_gates = 0u;
         fw_pwm_off(fw, tm);
-        return;
+        return false;
     }
     if (fw->cm_gates == 0u) {
         /* Effective at k+1, together with the compare values written now. */
@@ -529,18 +587,18 @@ static void fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         if (out.ctrl_reset != 0u) {
             fw->ctrl->reset(fw->ctrl_state.bytes);
             ctrl_estimator_reset(&fw->est, &fw->params);
-            ctrl_fieldweak_reset(&fw->fwk);
+            fw_mid_restart(fw);
             fw->trim = 0;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
         }
         fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
         fw->ref_mode = FW_REF_TORQUE;
-        fw_control(fw, hal, tm, m);
-        return;
+        return fw_control(fw, hal, tm, m);
     }
     ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
     fw_pwm_out(fw, hal, tm, &legs);
     fw->applied = legs; /* acting in [k+1, k+2) */
+    return false;
 }
 
 /* Every other state (boot, calibration, ready, fault): gates off. */
@@ -572,18 +630,19 @@ static void fw_period_idle(fw_t *fw, fw_telemetry_t *tm, const hal_adc_raw_t *ra
     fw_pwm_off(fw, tm);
 }
 
-void fw_isr(fw_t *fw)
+bool fw_isr_fast(fw_t *fw)
 {
     if (fw == NULL || fw->hal == NULL || fw->ctrl == NULL) {
-        return;
+        return false;
     }
     /* The handle is fixed from fw_init on: kept in a register. */
     hal_t *const hal = fw->hal;
     const uint32_t t0 = hal_cycles(hal);
-    if (fw->busy) {
-        /* Entered while the previous period's ISR was still running. */
+    if (fw->busy || fw->mid_done != fw->mid_req) {
+        /* Entered while the previous period's ISR, or the medium task it
+         * started, was still running. */
         fw_fault_now(fw, FW_FAULT_DEADLINE);
-        return;
+        return false;
     }
     fw->busy = true;
     fw->period++;
@@ -601,10 +660,11 @@ void fw_isr(fw_t *fw)
     }
     /* Running: one predictable branch to the straight path; boot,
      * calibration, ready and fault take the general one. */
+    bool mid = false;
     if (fw->sm.state == FW_STATE_RUNNING) {
-        fw_period_running(fw, hal, tm, &raw, &enc);
+        mid = fw_period_running(fw, hal, tm, &raw, &enc);
     } else if (fw->sm.state == FW_STATE_COMMISSION) {
-        fw_period_commission(fw, hal, tm, &raw, &enc);
+        mid = fw_period_commission(fw, hal, tm, &raw, &enc);
     } else {
         fw_period_idle(fw, tm, &raw, &enc);
     }
@@ -645,6 +705,14 @@ void fw_isr(fw_t *fw)
         }
     }
     fw->busy = false;
+    return mid;
+}
+
+void fw_isr(fw_t *fw)
+{
+    if (fw_isr_fast(fw)) {
+        fw_medium(fw);
+    }
 }
 
 void fw_cmd_arm(fw_t *fw)
@@ -690,12 +758,8 @@ void fw_set_torque_ref(fw_t *fw, q24_t torque_pu)
 void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu)
 {
     if (fw != NULL) {
-        if (fw->ref_mode != FW_REF_SPEED) {
-            /* Bumpless: the integrator starts at the present torque reference. */
-            ctrl_speed_pi_reset(&fw->speed_pi, fw->torque_ref_now);
-            fw->speed_tref = fw->torque_ref_now;
-            fw->speed_cnt = 0u;
-        }
+        /* Bumpless: until the medium task's next run the speed loop's output
+         * is the present torque reference, from which that run starts it. */
         fw->speed_ref = omega_e_pu;
         fw->ref_mode = FW_REF_SPEED;
     }

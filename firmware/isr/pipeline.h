@@ -1,8 +1,9 @@
 /*
- * The PWM-period interrupt of every target, top to bottom (TI MotorWare
- * style), in fw_isr():
+ * The control loop at two rates (docs/architecture.md, "Two rates").
  *
- *   t0 = hal_cycles(); re-entry check
+ * fw_isr_fast(), the PWM-period interrupt, top to bottom (TI MotorWare style):
+ *
+ *   t0 = hal_cycles(); re-entry check; the medium task's completion check
  *   hal_adc_read, hal_encoder_read          samples of period start k
  *   commands (arm / disarm / clear) requested from the main loop
  *   boot/calib: gates off, average ADC offsets, then ready
@@ -10,13 +11,25 @@
  *   protections                             over-current first: gates off now
  *   ctrl_estimator_update                   estimate at k, predict k+1 with
  *                                           the plan acting in [k, k+1)
- *   speed PI (speed mode) -> torque reference
+ *   torque reference (torque mode, the speed loop's held output, or the
+ *   sensorless start's) clamped to the medium task's limits; mean-torque trim
  *   desc->step                              leg duties (and the plan they
  *                                           realise) for [k+1, k+2)
  *   leg duties -> compare values -> hal_pwm_write (effective at k+1)
  *   deadline check (hal_cycles against the period budget)
  *   telemetry: the period's record is written into the ring as it is
  *   computed, published once in tm_every periods (fw_tm_stream)
+ *   once in mid_div periods: the medium task's inputs (fw_mid_in_t), and
+ *   fw_isr_fast returns true: the caller runs fw_medium() at a lower priority
+ *
+ * fw_medium(), the medium-rate task (medium.c; fs / mid_div, default 1 kHz):
+ * the speed PI, the speed-following protection, the field-weakening and MTPV
+ * torque limit and flux reference (field_weak.h, on the DC link's mean over
+ * the medium period); its outputs (fw_mid_out_t) act from period k+1 on. It
+ * must end before the interrupt of k+1 (else FW_FAULT_DEADLINE). After a reset
+ * (fw_init, arming) the interrupt runs it once itself, before the controller.
+ * fw_isr() is the two in that order: the host engine's and the tests'
+ * scheduler.
  *
  * Fixed-point formats of the conversion (computed at init, pipeline_config.c):
  *   ADC offsets: Q8 counts (average of calib_samples samples, 8 fractional bits)
@@ -114,6 +127,37 @@ typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
  * EMA's, thesis sec. 5.3.2, as FST's f_i. */
 #define FW_TRIM_HZ 50.0
 
+/* The hand-over between the two rates (docs/architecture.md, "Two rates"):
+ * one writer per direction, two slots each. The interrupt fills
+ * mid_in[(mid_req + 1) & 1], then counts mid_req up; fw_medium reads
+ * mid_in[mid_req & 1], fills mid_out[(mid_done + 1) & 1], then counts
+ * mid_done up to mid_req; the interrupt reads mid_out[mid_done & 1]. A slot is
+ * never written while the other side may read it. */
+typedef struct {
+    int64_t vdc_sum;   /* the estimator's DC link summed over n periods, Q24 pu */
+    uint32_t n;        /* periods summed since the last run (>= 1) */
+    q24_t omega_e;     /* electrical speed estimate at k, Q24 pu */
+    q24_t tref;        /* torque reference of k before the limits (torque mode, the
+                          sensorless start), Q24 pu */
+    q24_t torque_now;  /* torque reference of k after the limits (fw_t.torque_ref_now) */
+    q24_t speed_ref;   /* Q24 pu electrical */
+    q24_t bump_torque; /* bump: the torque the speed loop restarts from, Q24 pu */
+    uint8_t ref_mode;  /* fw_ref_mode_t of k */
+    uint8_t hold;      /* 1: the speed loop waits (sensorless start) */
+    uint8_t reset;     /* 1: arm or a commissioning reset: the task's state anew */
+    uint8_t bump;      /* 1: the speed loop restarts from bump_torque (sensorless handover) */
+} fw_mid_in_t;
+
+typedef struct {
+    q24_t speed_tref;  /* speed loop's torque reference, clamped to +-torque_ref_max (in
+                          torque mode the limited torque reference: a bumpless switch), Q24 */
+    q24_t torque_max;  /* |torque| limit (field_weak.h), Q24 pu */
+    q24_t psi_ref;     /* stator-flux reference while weakening, Q24 pu */
+    uint8_t limit;     /* ctrl_fw_limit_t: what bounds torque_max */
+    uint8_t weakening; /* 1: psi_ref is below the controller's own reference */
+    uint8_t fault;     /* a slow protection's fault (FW_FAULT_*), latched by the interrupt */
+} fw_mid_out_t;
+
 /* Start-up configuration (SI, read once by fw_init). */
 typedef struct {
     const ctrl_machine_t *machine; /* machine the controller is configured for */
@@ -134,8 +178,8 @@ typedef struct {
     ctrl_speed_unit_t speed_unit;
     double speed_out_max_nm; /* torque-reference limit (> 0), default
                                 fw_torque_limit_nm (speed_loop.h) */
-    uint32_t speed_loop_hz;  /* speed PI update rate (divides fs), default 1000;
-                                0 = every period */
+    uint32_t speed_loop_hz;  /* the medium-rate task's rate: speed PI, field weakening
+                                (divides fs), default 1000; 0 = every period */
     double overspeed_rpm;    /* overspeed trip level (mechanical); 0 = 1.05 x the machine's
                                 maximum speed (fw_speed_max_rpm, protect.h) */
     /* PM flux from the voltage model where it is reliable (|speed| >= 10 % of
@@ -189,24 +233,36 @@ typedef struct {
     bool psi_engaged;    /* the estimate has left the band: params follow it */
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
     ctrl_refs_t refs;
-    /* Field weakening and the torque limit (regulators/field_weak.h): flux the
-     * voltage of this period allows, torque limit from the current circle,
-     * the voltage ellipse and MTPV; the references every controller sees. */
-    ctrl_fieldweak_t fwk;
     q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */
     q24_t trim;           /* mean-torque trim in field weakening, Q24 pu (pipeline.c) */
     q24_t trim_k;         /* its gain per period, 1 - exp(-2 pi FW_TRIM_HZ / fs), Q24 */
-    ctrl_speed_pi_t speed_pi;
     fw_ref_mode_t ref_mode;
     q24_t torque_ref;     /* Q24 pu (torque mode) */
     q24_t torque_ref_lim; /* torque_ref clamped to +-torque_ref_max (fw_set_torque_ref) */
     q24_t speed_ref;      /* Q24 pu electrical (speed mode) */
     q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
     q24_t torque_ref_min; /* Q24 pu, fx_neg(torque_ref_max) (set with it) */
-    q24_t speed_tref;     /* last speed-PI output, Q24 pu (held between updates) */
-    q24_t torque_max;     /* torque limit of the last period (field weakening), Q24 pu */
-    uint32_t speed_div;   /* periods per speed-PI update (>= 1) */
-    uint32_t speed_cnt;   /* periods since the last update */
+    /* The medium-rate task (medium.c) and the hand-over (fw_mid_in_t). */
+    uint32_t mid_div;    /* PWM periods per run (>= 1) */
+    uint32_t mid_count;  /* interrupt: periods to the next run, 1..mid_div (1: this one) */
+    int64_t mid_vdc_sum; /* interrupt: DC link summed since the last run, Q24 pu */
+    uint32_t mid_n;      /* interrupt: periods in mid_vdc_sum */
+    uint8_t mid_reset;   /* interrupt: the next run starts the task's state anew */
+    uint8_t mid_bump;    /* interrupt: the next run restarts the speed loop at mid_bump_t */
+    uint8_t mid_fresh;   /* interrupt: mid_out holds a run since the last reset (else
+                            the interrupt runs the task itself first) */
+    q24_t mid_bump_t;
+    fw_mid_in_t mid_in[2];      /* written by the interrupt only */
+    fw_mid_out_t mid_out[2];    /* written by fw_medium only */
+    volatile uint32_t mid_req;  /* runs requested (interrupt) */
+    volatile uint32_t mid_done; /* runs completed (fw_medium) */
+    /* The medium task's own state: the speed PI, field weakening and the
+     * torque limit (regulators/field_weak.h: the flux the voltage allows,
+     * torque limit from the current circle, the voltage ellipse and MTPV). */
+    ctrl_speed_pi_t speed_pi;
+    ctrl_fieldweak_t fwk;
+    q24_t torque_max; /* the last run's torque limit, Q24 pu (speed PI's anti-windup) */
+    uint8_t mid_mode; /* the last run's fw_ref_mode_t */
     fw_speed_info_t speed_info;
     fw_state_t sm;
     fw_protect_t prot;
@@ -273,7 +329,14 @@ const char *fw_strerror(int code);
  * as one line (ctrl_diag_format). */
 size_t fw_explain(const fw_t *fw, char *buf, size_t cap);
 
-/* The PWM-period interrupt. */
+/* The PWM-period interrupt; true when it has handed the medium-rate task a
+ * run (the caller then runs fw_medium at a lower priority, to end before the
+ * next period's interrupt). */
+bool fw_isr_fast(fw_t *fw);
+/* The medium-rate task (medium.c): one run on the inputs of the last trigger. */
+void fw_medium(fw_t *fw);
+/* One PWM period with the medium task where due: fw_isr_fast, then fw_medium
+ * (the scheduler of the host engine, the replay images and the tests). */
 void fw_isr(fw_t *fw);
 
 /* Main-loop side (called from the command interface or a test). */

@@ -214,22 +214,34 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
                           in->cycle_clock_hz, fw->speed_info.overspeed_rpm) != CTRL_OK) {
         return FW_EINVAL;
     }
+    /* The medium-rate task's rate: fs / mid_div, mid_div >= 1 rounded to the
+     * nearest; speed following counts its runs (the same 50 ms, rounded up). */
+    const uint32_t loop_hz = cfg->speed_loop_hz == 0u || cfg->speed_loop_hz > in->pwm_freq_hz
+                                 ? in->pwm_freq_hz
+                                 : cfg->speed_loop_hz;
+    fw->mid_div = (in->pwm_freq_hz + loop_hz / 2u) / loop_hz;
+    fw->mid_count = 1u;
+    pc.follow_periods = (pc.follow_periods + fw->mid_div - 1u) / fw->mid_div;
+    /* Field weakening runs in the medium task on the DC link's mean over a
+     * run: its filter's coefficient per run, for the same corner. Its first
+     * run starts its state anew. */
+    fw->fwk.vdc_k =
+        ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * fwc.vdc_lpf_hz *
+                                                (double)fw->mid_div / (double)in->pwm_freq_hz));
+    fw->mid_reset = 1u;
+    fw->mid_fresh = 0u;
     if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
         return FW_ERANGE;
     }
 
-    /* Speed loop rate: fs / speed_div, speed_div >= 1 rounded to the nearest. */
-    const uint32_t loop_hz = cfg->speed_loop_hz == 0u || cfg->speed_loop_hz > in->pwm_freq_hz
-                                 ? in->pwm_freq_hz
-                                 : cfg->speed_loop_hz;
-    fw->speed_div = (in->pwm_freq_hz + loop_hz / 2u) / loop_hz;
+    /* Speed loop: one update per run of the medium task. */
     fw_speed_info_t *si = &fw->speed_info;
     double kp = cfg->speed_kp;
     double ki = cfg->speed_ki;
     ctrl_speed_unit_t unit = cfg->speed_unit;
     if (!(kp > 0.0) && !(ki > 0.0)) {
         fw_speed_design_t d = {cfg->speed_bw_hz, cfg->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
-        const double loop_rate = (double)in->pwm_freq_hz / (double)fw->speed_div;
+        const double loop_rate = (double)in->pwm_freq_hz / (double)fw->mid_div;
         const double lpf_hz = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)in->pwm_freq_hz
                                   ? CTRL_SPEED_LPF_HZ_DEFAULT
                                   : 0.45 * (double)in->pwm_freq_hz;
@@ -251,7 +263,7 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     si->ki_nm_rad = ki * per_rad;
     if (!(cfg->speed_out_max_nm > 0.0) ||
         ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
-                             cfg->speed_out_max_nm, in->pwm_freq_hz / fw->speed_div) != CTRL_OK) {
+                             cfg->speed_out_max_nm, in->pwm_freq_hz / fw->mid_div) != CTRL_OK) {
         return FW_ERANGE;
     }
 

@@ -34,8 +34,15 @@
 #define NVIC_ISER0 REG32(0xE000E100u)
 #define NVIC_ICER0 REG32(0xE000E180u)
 #define NVIC_ICPR0 REG32(0xE000E280u)
+/* System control block: ICSR, SHPR3 (PendSV's priority in bits 23:16) */
+#define SCB_ICSR REG32(0xE000ED04u)
+#define SCB_ICSR_PENDSVSET (1u << 28)
+#define SCB_SHPR3 REG32(0xE000ED20u)
 
 void TIMER0_Handler(void);
+void PendSV_Handler(void);
+
+static pendsv_callback_t pendsv_callback;
 
 static timer0_callback_t timer0_callback;
 static uint32_t timer0_period;
@@ -130,6 +137,24 @@ void TIMER0_Handler(void)
     TIMER_INTCLEAR(TIMER0_BASE) = 1u;
     if (timer0_callback != NULL) {
         timer0_callback();
+    }
+}
+
+void board_pendsv_set(pendsv_callback_t callback)
+{
+    pendsv_callback = callback;
+    SCB_SHPR3 = (SCB_SHPR3 & ~(0xFFu << 16)) | (0xFFu << 16); /* lowest priority */
+}
+
+void board_pendsv_pend(void)
+{
+    SCB_ICSR = SCB_ICSR_PENDSVSET;
+}
+
+void PendSV_Handler(void)
+{
+    if (pendsv_callback != NULL) {
+        pendsv_callback();
     }
 }
 

@@ -55,6 +55,14 @@ uint32_t timer0_period_ticks(void);
  * Differences of two readings (unsigned subtraction) are elapsed ticks. */
 uint32_t timer1_read(void);
 
+/* PendSV, the lowest-priority exception (ARMv7-M ARM B3.2.4 ICSR.PENDSVSET,
+ * B3.2.12 SHPR3): board_pendsv_set gives it the lowest priority and the
+ * callback it runs; board_pendsv_pend pends it (it runs once no handler of
+ * higher priority is active: after the Timer0 interrupt that pended it). */
+typedef void (*pendsv_callback_t)(void);
+void board_pendsv_set(pendsv_callback_t callback);
+void board_pendsv_pend(void);
+
 /* Interrupt masking (PRIMASK). */
 void board_irq_disable(void);
 void board_irq_enable(void);

@@ -69,6 +69,12 @@ void g4_nvic_set_priority(uint32_t irq, uint32_t prio)
     g4_mod(G4_NVIC + G4_NVIC_IPR_WORD(irq), 0xFu << sh, (prio & 0xFu) << sh);
 }
 
+void g4_pendsv_set_priority(uint32_t prio)
+{
+    g4_mod(G4_SCB + G4_SCB_SHPR3, 0xFu << G4_SCB_SHPR3_PENDSV_SHIFT,
+           (prio & 0xFu) << G4_SCB_SHPR3_PENDSV_SHIFT);
+}
+
 void g4_nvic_enable(uint32_t irq)
 {
     g4_wr(G4_NVIC + G4_NVIC_ISER(irq / 32u), 1u << (irq % 32u));

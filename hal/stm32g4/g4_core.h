@@ -45,4 +45,13 @@ void g4_nvic_set_priority(uint32_t irq, uint32_t prio);
 void g4_nvic_enable(uint32_t irq);
 void g4_nvic_disable(uint32_t irq);
 
+/* PendSV, the software-triggered exception (the firmware's medium-rate task):
+ * its priority 0 .. 15 (SHPR3), and pending it (ICSR.PENDSVSET); it runs when
+ * no higher-priority handler is active. */
+void g4_pendsv_set_priority(uint32_t prio);
+static inline void g4_pendsv_pend(void)
+{
+    g4_wr(G4_SCB + G4_SCB_ICSR, G4_SCB_ICSR_PENDSVSET);
+}
+
 #endif /* HAL_STM32G4_G4_CORE_H */

@@ -395,7 +395,11 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_DWT_CTRL 0x00u
 #define G4_DWT_CTRL_CYCCNTENA G4_BIT(0)
 #define G4_DWT_CYCCNT 0x04u
+#define G4_SCB_ICSR 0x04u                /* ICSR (0xE000ED04), ARMv7-M ARM B3.2.4 */
+#define G4_SCB_ICSR_PENDSVSET G4_BIT(28) /* write 1: PendSV pending; 0s: no effect */
 #define G4_SCB_VTOR 0x08u
+#define G4_SCB_SHPR3 0x20u /* SHPR3 (0xE000ED20), B3.2.12: PendSV priority in bits 23:16 */
+#define G4_SCB_SHPR3_PENDSV_SHIFT 20u /* 4 priority bits implemented: 23:20 */
 #define G4_SCB_SHCSR 0x24u
 #define G4_SCB_SHCSR_FAULTS_ENA (G4_BIT(16) | G4_BIT(17) | G4_BIT(18)) /* MEM, BUS, USG */
 #define G4_SCB_CPACR 0x88u

@@ -30,7 +30,7 @@ SPEEDS = (750, 2250)
 TORQUE_NM = 1.8
 SENSORLESS_RPM = 150  # 5 % of the thesis SPMSM's rated 3000 r/min (sensorless_config.h w_on)
 # Section indices of the plugin's end markers (order of the end= arguments).
-SECTIONS = ("empty", "boot", "run", "est", "step")
+SECTIONS = ("empty", "boot", "run", "est", "step", "mid")
 # The Cortex-M4 replay target: QEMU machine and where the recording is loaded.
 CM4_TARGET = {"machine": "mps2-an386", "blob": 0x20200000}
 MARKERS = ["bench_mark_begin"] + ["bench_mark_end_" + s for s in SECTIONS]
@@ -498,6 +498,14 @@ def main():
         r["cm4_est_mean"] = round(statistics.fmean(est), 1) if est else None
         r["cm4_step_mean"] = round(statistics.fmean(stp), 1) if stp else None
         r["cm4_step_max"] = max(stp) if stp else None
+        # the medium-rate task (fw_medium): its runs, and its instructions
+        # spread over the PWM periods (of the whole recording: boot included)
+        mid = [v for s in speeds for v in cm4[(n, s)]["sections"]["mid"]]
+        periods = sum(len(cm4[(n, s)]["sections"][k]) for s in speeds for k in ("run", "boot"))
+        r["cm4_mid_mean"] = round(statistics.fmean(mid), 1) if mid else None
+        r["cm4_mid_max"] = max(mid) if mid else None
+        r["mid_runs"] = len(mid)
+        r["cm4_mid_per_period"] = round(sum(mid) / periods, 1) if periods else None
         r["host_ns_median"] = round(statistics.fmean(host_t[(n, s)]["ns_median"]
                                                       for s in speeds), 1)
         r["host_instr"] = host_instr.get(n)
@@ -518,9 +526,11 @@ def main():
                         "calibration, not counted)" % ("/".join(map(str, speeds)), TORQUE_NM,
                                                         args.periods),
             "cm4": "QEMU mps2-an386 (Cortex-M4F, -O2 -g), recorded inputs replayed through "
-                   "fw_isr; exact instruction counts between marker calls from a TCG plugin "
-                   "(tools/bench_fw/bench_plugin.c), marker overhead subtracted; counts include "
-                   "the call of fw_isr (argument set-up and bl)",
+                   "fw_isr_fast (the PWM-period interrupt) and, where it triggered one, "
+                   "fw_medium (the medium-rate task), counted apart; exact instruction counts "
+                   "between marker calls from a TCG plugin (tools/bench_fw/bench_plugin.c), "
+                   "marker overhead subtracted; counts include the call (argument set-up and "
+                   "bl)",
             "host": "host-release -O2, median over repetitions of the mean wall time per "
                     "running-period ISR (CLOCK_MONOTONIC), averaged over the two speeds",
             "host_instr": "valgrind --tool=callgrind --toggle-collect=bench_isr_running: "
@@ -557,9 +567,9 @@ def main():
 
 def print_table(doc, names, ref, out_path):
     c = doc["controllers"]
-    hdr = ("%-10s %9s %7s %8s %8s %8s %8s %8s %6s %9s %7s %6s %6s %8s %6s" %
-           ("controller", "cm4 mean", "max", "@750", "@2250", "est", "step", "host ns", "/m1",
-            "host ins", "flash", "ram", "state", "m0 mean", "max"))
+    hdr = ("%-10s %9s %7s %8s %8s %8s %8s %7s %7s %6s %8s %6s %9s %7s %6s %6s %8s %6s" %
+           ("controller", "cm4 mean", "max", "@750", "@2250", "est", "step", "mid", "max",
+            "/T", "host ns", "/m1", "host ins", "flash", "ram", "state", "m0 mean", "max"))
     print(hdr)
     print("-" * len(hdr))
     for n in names:
@@ -568,19 +578,24 @@ def print_table(doc, names, ref, out_path):
         m2250 = (r.get("cm4_2250") or {}).get("mean", float("nan"))
         flag = "*" if any(r.get("not_running_periods_%d" % s, 0) for s in SPEEDS) else ""
         hi = r["host_instr"]
-        print("%-10s %9.1f %7d %8.1f %8.1f %8s %8s %8.1f %6.2f %9s %7d %6d %6d %8s %6s" %
+        print("%-10s %9.1f %7d %8.1f %8.1f %8s %8s %7s %7s %6s %8.1f %6.2f %9s %7d %6d %6d %8s %6s" %
               (n + flag, r["cm4_instr_mean"], r["cm4_instr_max"], m750, m2250,
                "%.1f" % r["cm4_est_mean"] if r["cm4_est_mean"] is not None else "-",
                "%.1f" % r["cm4_step_mean"] if r["cm4_step_mean"] is not None else "-",
+               "%.1f" % r["cm4_mid_mean"] if r["cm4_mid_mean"] is not None else "-",
+               r["cm4_mid_max"] if r["cm4_mid_max"] is not None else "-",
+               "%.1f" % r["cm4_mid_per_period"] if r["cm4_mid_per_period"] is not None else "-",
                r["host_ns_median"], r["host_ratio_to_m1"],
                "%.1f" % hi if hi is not None else "-", r["flash_bytes"], r["ram_bytes"],
                r["state_bytes"], "%.1f" % r["cm0_instr_mean"] if "cm0_instr_mean" in r else "-",
                r.get("cm0_instr_max", "-")))
     print()
-    print("cm4: Cortex-M4 instructions per fw_isr call (QEMU, exact, deterministic: %s); "
-          "est/step: estimator / controller step alone (mean); host ns: median wall time per "
-          "call (-O2, this PC); /m1: host ratio to %s; host ins: callgrind instructions per "
-          "call; flash/ram: bytes added to a cm4 image; state: controller state bytes; "
+    print("cm4: Cortex-M4 instructions per fw_isr_fast call, the PWM-period interrupt (QEMU, "
+          "exact, deterministic: %s); est/step: estimator / controller step alone (mean); "
+          "mid/max: the medium-rate task fw_medium per run (mean, max); /T: its instructions "
+          "per PWM period; host ns: median wall time per period, both rates "
+          "(-O2, this PC); /m1: host ratio to %s; host ins: callgrind instructions per "
+          "period; flash/ram: bytes added to a cm4 image; state: controller state bytes; "
           "m0: ARMv6-M instructions per fw_isr call (QEMU microbit, shorter recordings)."
           % (doc["deterministic"], ref))
     if doc.get("cm0_fit"):

@@ -3,16 +3,18 @@
  * bench_cm0 for ARMv6-M (QEMU microbit, BENCH_MICROBIT).
  *
  * QEMU's `-device loader` puts a recording (bench_blob.h) at BENCH_BLOB_ADDR;
- * this image replays it through fw_isr with the replay HAL and brackets every
- * call with marker functions. The counting plugin (bench_plugin.c) watches the
+ * this image replays it through fw_isr_fast and fw_medium (the two rates,
+ * pipeline.h) with the replay HAL and brackets every call with marker
+ * functions. The counting plugin (bench_plugin.c) watches the
  * first instruction of each marker and writes the number of instructions
  * executed between bench_mark_begin and the following bench_mark_end_*:
  *   end_empty  begin/end with nothing in between (call overhead, subtracted)
- *   end_boot   fw_isr not running (boot, calibration, ready, fault)
- *   end_run    fw_isr of a running period (from the arm on, state running
+ *   end_boot   fw_isr_fast not running (boot, calibration, ready, fault)
+ *   end_run    fw_isr_fast of a running period (from the arm on, state running
  *              after the ISR; a period in which the drive faults is "boot")
  *   end_est    ctrl_estimator_update alone, on a copy of the pre-ISR state
  *   end_step   the controller's step alone, on a copy of the pre-ISR state
+ *   end_mid    fw_medium, in the periods whose interrupt triggered it
  * The split (est, step) repeats exactly what fw_isr computed in that period
  * (its leg duties are compared with the ISR's), so its parts add up to the ISR's
  * estimator and controller cost.
@@ -20,6 +22,7 @@
  * UART0 prints one summary line; the exit status is 0 when the replay matched
  * the PC's recording in every period.
  */
+#include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -46,6 +49,7 @@ BENCH_MARK(bench_mark_end_boot)
 BENCH_MARK(bench_mark_end_run)
 BENCH_MARK(bench_mark_end_est)
 BENCH_MARK(bench_mark_end_step)
+BENCH_MARK(bench_mark_end_mid)
 
 static fw_t fw;
 static hal_t hal;
@@ -56,6 +60,16 @@ static union {
     max_align_t align;
     unsigned char bytes[CTRL_STATE_MAX];
 } state_saved;
+
+/* The medium task where the interrupt triggered it, counted apart. */
+static void bench_medium(bool due)
+{
+    if (due) {
+        bench_mark_begin();
+        fw_medium(&fw);
+        bench_mark_end_mid();
+    }
+}
 
 static int legs_equal(const ctrl_legs_t *a, const ctrl_legs_t *b)
 {
@@ -112,8 +126,9 @@ int main(void)
     for (uint32_t k = 0; k < arm; k++) {
         bench_replay_input(&rep, &fw, &hal, k);
         bench_mark_begin();
-        fw_isr(&fw);
+        const bool due = fw_isr_fast(&fw);
         bench_mark_end_boot();
+        bench_medium(due);
         fw_watchdog_kick(&fw);
         differs += (uint32_t)bench_replay_differs(&rep, &fw, &hal, k);
     }
@@ -124,15 +139,17 @@ int main(void)
         memcpy(state_saved.bytes, fw.ctrl_state.bytes, desc->state_size);
         /* Running periods (state after the ISR, as recorded) are counted
          * apart from the others (after a fault the gates are off). */
+        bool due;
         if (rep.rec[k].state_after == (uint8_t)FW_STATE_RUNNING) {
             bench_mark_begin();
-            fw_isr(&fw);
+            due = fw_isr_fast(&fw);
             bench_mark_end_run();
         } else {
             bench_mark_begin();
-            fw_isr(&fw);
+            due = fw_isr_fast(&fw);
             bench_mark_end_boot();
         }
+        bench_medium(due);
         fw_watchdog_kick(&fw);
         differs += (uint32_t)bench_replay_differs(&rep, &fw, &hal, k);
         if (fw_state(&fw) != FW_STATE_RUNNING) {

@@ -2,11 +2,11 @@
  * PC recorder of the interrupt-cost benchmark (tools/bench):
  *
  *   bench_rec record --machine INI --speed RPM --torque NM --periods N --outdir DIR
- *                    [--ctrl NAME] [--sensorless 0|1]
+ *                    [--ctrl NAME] [--sensorless 0|1] [--fs HZ]
  *       For every registered controller (or NAME): a closed loop on the PC
  *       (plant, dynamometer at RPM + hal/sim + firmware) from fw_init through
  *       calibration and arm, then N running periods at the controller's
- *       default fs; writes DIR/<name>_<rpm>.bin (bench_blob.h).
+ *       default fs (or HZ); writes DIR/<name>_<rpm>.bin (bench_blob.h).
  *   bench_rec list
  *       The registered controllers, one per line.
  * (A separate program from bench_host: hal/sim and the replay HAL both define
@@ -45,13 +45,16 @@ static void put_name(char *dst, size_t n, const char *src)
 /* ---- record ------------------------------------------------------------ */
 
 static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double speed_rpm,
-                      double torque_nm, uint32_t periods, bool sensorless, const char *outdir)
+                      double torque_nm, uint32_t periods, bool sensorless, uint32_t fs_hz,
+                      const char *outdir)
 {
     static rec_loop_t loop;
     const uint32_t calib = 256u;
     ctrl_machine_t cm;
     sim_ctrl_machine_from(sm, &cm);
-    const uint32_t fs = d->fs_default_hz != 0u ? d->fs_default_hz : (uint32_t)sm->fs_hz;
+    const uint32_t fs = fs_hz != 0u              ? fs_hz
+                        : d->fs_default_hz != 0u ? d->fs_default_hz
+                                                 : (uint32_t)sm->fs_hz;
     const char *fail = rec_loop_init(&loop, d, sm, fs, speed_rpm, calib, sensorless);
     if (fail != NULL) {
         return die(fail, d->name);
@@ -157,7 +160,7 @@ static int cmd_record(int argc, char **argv)
 {
     const char *machine = NULL, *outdir = NULL, *only = NULL;
     double speed = 750.0, torque = 1.8;
-    unsigned long periods = 2000u;
+    unsigned long periods = 2000u, fs = 0u;
     bool sensorless = false;
     for (int i = 0; i < argc; i += 2) {
         const char *a = argv[i];
@@ -187,6 +190,11 @@ static int cmd_record(int argc, char **argv)
                 return die("--sensorless expects 0 or 1, got ", v);
             }
             sensorless = v[0] == '1';
+        } else if (strcmp(a, "--fs") == 0) {
+            fs = strtoul(v, &end, 10);
+            if (*end != '\0' || fs < 1000u || fs > 200000u) {
+                return die("--fs expects 1000 .. 200000 Hz, got ", v);
+            }
         } else if (strcmp(a, "--periods") == 0) {
             periods = strtoul(v, &end, 10);
             if (*end != '\0' || periods == 0u || periods > 20000u) {
@@ -209,11 +217,12 @@ static int cmd_record(int argc, char **argv)
         if (d == NULL) {
             return die("unknown controller ", only);
         }
-        return record_one(d, &sm, speed, torque, (uint32_t)periods, sensorless, outdir);
+        return record_one(d, &sm, speed, torque, (uint32_t)periods, sensorless, (uint32_t)fs,
+                          outdir);
     }
     for (size_t i = 0; i < ctrl_count(); i++) {
-        if (record_one(ctrl_at(i), &sm, speed, torque, (uint32_t)periods, sensorless, outdir) !=
-            0) {
+        if (record_one(ctrl_at(i), &sm, speed, torque, (uint32_t)periods, sensorless, (uint32_t)fs,
+                       outdir) != 0) {
             return 1;
         }
     }

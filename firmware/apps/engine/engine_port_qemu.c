@@ -8,6 +8,8 @@
 
 #include <string.h>
 
+#include "qemu_mps2.h"
+
 #ifndef ENGINE_QEMU_CPU_HZ
 #define ENGINE_QEMU_CPU_HZ 100000000u
 #endif
@@ -40,4 +42,21 @@ int engine_hal_end(hal_t *h)
 bool engine_hal_gates_on(const hal_t *h)
 {
     return hal_qemu_plant_gates_on(h->plant);
+}
+
+/* The firmware whose medium task PendSV runs (set before the first pend). */
+static fw_t *engine_medium_fw;
+
+static void engine_medium_run(void)
+{
+    fw_medium(engine_medium_fw);
+}
+
+void engine_medium(fw_t *fw)
+{
+    if (engine_medium_fw != fw) {
+        engine_medium_fw = fw;
+        board_pendsv_set(engine_medium_run);
+    }
+    board_pendsv_pend();
 }

@@ -26,3 +26,8 @@ bool engine_hal_gates_on(const hal_t *h)
 {
     return hal_sim_gates_on(h);
 }
+
+void engine_medium(fw_t *fw)
+{
+    fw_medium(fw);
+}

@@ -209,7 +209,9 @@ static int sim_period_raw(sim_run_t *r)
     r->vec_now = on ? tm->vec : 0u;
     r->duty_now = on ? ctrl_q24_to_double(tm->duty) : 0.0;
     engine_hal_begin(&r->hal);
-    fw_isr(&r->fw);
+    if (fw_isr_fast(&r->fw)) {
+        engine_medium(&r->fw);
+    }
     if (r->cfg.plant_machine.filter.type == PLANT_FILTER_ACTIVE) {
         /* the active filter's reference generator follows the drive's torque
          * setting, S1 (50) (0 while the drive is not running) */

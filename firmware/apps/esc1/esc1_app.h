@@ -62,7 +62,8 @@ double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m);
 int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
 
 /* The body of the ADC1_2 interrupt (end of the injected sequence): flags
- * acknowledged, the firmware's period, the telemetry sample. esc1_isr.c, also
+ * acknowledged, the firmware's period (fw_isr_fast; PendSV pended when the
+ * medium-rate task is due), the telemetry sample. esc1_isr.c, also
  * built into the QEMU image that counts its instructions. */
 void esc1_control_isr(esc1_t *s);
 

@@ -11,8 +11,9 @@
  *
  * Interrupts (priority: lower number first):
  *   0 TIM1_BRK_TIM15  break: the hardware has cleared MOE; latch the cause
- *   1 ADC1_2          end of the injected sequence: fw_isr
+ *   1 ADC1_2          end of the injected sequence: fw_isr_fast
  *   2 USART2          byte rings
+ *   3 PendSV          the medium-rate task (fw_medium), pended by fw_isr_fast
  * Main loop: received bytes -> command interpreter, telemetry frames out,
  * firmware watchdog kick, board temperature every 100 ms, independent
  * watchdog refreshed only while the control interrupt keeps running.
@@ -37,6 +38,7 @@ static esc1_t esc1;
 void ADC1_2_IRQHandler(void);
 void TIM1_BRK_TIM15_IRQHandler(void);
 void USART2_IRQHandler(void);
+void PendSV_Handler(void);
 
 void ADC1_2_IRQHandler(void)
 {
@@ -52,6 +54,11 @@ void TIM1_BRK_TIM15_IRQHandler(void)
 void USART2_IRQHandler(void)
 {
     esc1_uart_irq(&esc1.uart);
+}
+
+void PendSV_Handler(void)
+{
+    fw_medium(&esc1.fw);
 }
 
 /* After the gates are off in a fault handler: the PWM pins as outputs at
@@ -135,6 +142,7 @@ int main(void)
     g4_nvic_set_priority(G4_IRQ_TIM1_BRK_TIM15, 0u);
     g4_nvic_set_priority(G4_IRQ_ADC1_2, 1u);
     g4_nvic_set_priority(G4_IRQ_USART2, 2u);
+    g4_pendsv_set_priority(3u);
     g4_nvic_enable(G4_IRQ_TIM1_BRK_TIM15);
     g4_nvic_enable(G4_IRQ_USART2);
     g4_nvic_enable(G4_IRQ_ADC1_2);

@@ -1,0 +1,69 @@
+/* The medium-rate task (pipeline.h; the two rates: docs/architecture.md).
+ * Integer-only; runs once in mid_div PWM periods, after the interrupt that
+ * triggered it and before the next one, on that interrupt's inputs. */
+#include "pipeline.h"
+
+/* The speed loop of one run: the PI on the speed error, its output clamped
+ * to the configured torque limit; the speed-following protection on it. */
+static q24_t fw_mid_speed(fw_t *fw, const fw_mid_in_t *in, uint8_t *fault)
+{
+    if (in->bump != 0u) {
+        /* sensorless handover: from the torque it takes over */
+        ctrl_speed_pi_reset(&fw->speed_pi, in->bump_torque);
+    } else if (fw->mid_mode != (uint8_t)FW_REF_SPEED) {
+        /* from torque mode: from the torque reference in force (bumpless) */
+        ctrl_speed_pi_reset(&fw->speed_pi, in->torque_now);
+    }
+    /* Anti-windup against the torque limit of the last run (field
+     * weakening) as well as the configured one: the integrator stays within
+     * what the drive can deliver, so leaving the limit does not overshoot. */
+    fw->speed_pi.out_max = fx_max(fx_min(fw->torque_ref_max, fw->torque_max), 1);
+    const q24_t t = fx_clamp(ctrl_speed_pi_step(&fw->speed_pi, in->speed_ref, in->omega_e),
+                             fw->torque_ref_min, fw->torque_ref_max);
+    *fault = (uint8_t)fw_protect_speed_follow(&fw->prot, in->speed_ref, in->omega_e, t,
+                                              fw->speed_pi.out_max);
+    return t;
+}
+
+void fw_medium(fw_t *fw)
+{
+    if (fw == NULL || fw->mid_done == fw->mid_req) {
+        return; /* nothing requested */
+    }
+    const uint32_t done = fw->mid_done + 1u;
+    const fw_mid_in_t *const in = &fw->mid_in[done & 1u];
+    fw_mid_out_t *const out = &fw->mid_out[done & 1u];
+    if (in->reset != 0u) {
+        ctrl_speed_pi_reset(&fw->speed_pi, 0);
+        ctrl_fieldweak_reset(&fw->fwk);
+        fw->torque_max = fw->torque_ref_max;
+        fw->mid_mode = in->ref_mode;
+    }
+    out->fault = FW_FAULT_NONE;
+    /* The speed loop runs in speed mode unless the sensorless start holds it;
+     * otherwise its output follows the torque reference (a later switch to
+     * speed mode starts from there). */
+    q24_t t_req = in->tref;
+    if (in->ref_mode == (uint8_t)FW_REF_SPEED && in->hold == 0u) {
+        t_req = fw_mid_speed(fw, in, &out->fault);
+        out->speed_tref = t_req;
+    } else {
+        out->speed_tref = in->torque_now;
+    }
+    fw->mid_mode = in->hold == 0u ? in->ref_mode : (uint8_t)FW_REF_TORQUE;
+    /* Field weakening on the DC link's mean over the run's periods (the
+     * filter's coefficient is per run, pipeline_config.c); 0 <= sum < n 2^31. */
+    const uint32_t n = in->n != 0u ? in->n : 1u;
+    const q24_t vdc = (q24_t)((in->vdc_sum + (int64_t)(n / 2u)) / (int64_t)n);
+    /* ctrl_fieldweak_step_lazy without its inline shortcut (the same outputs,
+     * field_weak.h; flash matters more than time here) */
+    ctrl_fieldweak_out_t lim;
+    ctrl_fieldweak_limits_lazy(&fw->fwk, &fw->params, ctrl_fieldweak_vdc_filter(&fw->fwk, vdc),
+                               in->omega_e, t_req, &lim);
+    fw->torque_max = lim.torque_max;
+    out->torque_max = lim.torque_max;
+    out->psi_ref = lim.psi_ref;
+    out->limit = lim.limit;
+    out->weakening = lim.weakening;
+    fw->mid_done = done;
+}
