@@ -105,10 +105,15 @@ def main():
             if kind == "esc1" and c["summary"].get("differs") != "0":
                 raise SystemExit("bench_esc1: %s: the board path computed other compare values "
                                  "than the recording: %s" % (n, c["summary"]))
-            counts[kind] = c["sections"]["run"]
+            # qemu_count names the sections by position (bench.SECTIONS); an
+            # image without some markers (esc1: no est/step) shifts them
+            names = [m[len("bench_mark_end_"):] for m in markers[1:]]
+            sec = {names[i]: c["sections"].get(bench.SECTIONS[i], [])
+                   for i in range(1, len(names))}
+            counts[kind] = sec["run"]
             if kind == "esc1":
-                mid = c["sections"]["mid"]
-                periods = len(c["sections"]["run"]) + len(c["sections"]["boot"])
+                mid = sec.get("mid", [])
+                periods = len(sec["run"]) + len(sec["boot"])
         v = counts["esc1"]
         if not v:
             raise SystemExit("bench_esc1: %s: no running period" % n)

@@ -127,6 +127,7 @@ int main(void)
 
     fw_config_default(&s.fc, &machine, desc);
     s.fc.calib_samples = h->calib_samples;
+    s.fc.sensorless = h->sensorless != 0u; /* as recorded (tools/bench --esc1 --sensorless) */
     if (fw_init(&s.fw, hal, &s.fc) != FW_OK) {
         uart_puts("bench: fw_init failed\n");
         return 3;
