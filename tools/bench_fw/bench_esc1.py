@@ -11,8 +11,9 @@ the board image's control interrupt, esc1_control_isr (flags acknowledged,
 fw_isr_fast with the G4 back-end of hal.h reading the ADC data registers, the
 encoder counter and writing TIM1_CCRx, PendSV pended when the medium-rate
 task is due), and that task (fw_medium, PendSV's handler), counted apart;
-built by the cm4 preset
-as esc1_isr_bench with the peripheral registers in arrays (the same
+built with the cm4 toolchain
+and link-time optimisation, as the image is (build/cm4-lto), as
+esc1_isr_bench with the peripheral registers in arrays (the same
 instructions as at the chip's addresses). Every period's compare values must
 equal the recording. For comparison the same recording through bench_cm4
 (fw_isr_fast with the replay HAL). --fs records at another PWM frequency
@@ -54,7 +55,7 @@ def main():
     ap.add_argument("--host-build", default=os.environ.get(
         "BENCH_HOST_BUILD", os.path.join(ROOT, "build", "host-release")))
     ap.add_argument("--cm4-build", default=os.environ.get(
-        "BENCH_CM4_BUILD", os.path.join(ROOT, "build", "cm4")))
+        "BENCH_CM4_BUILD", os.path.join(ROOT, "build", "cm4-lto")))
     args = ap.parse_args()
     if args.speed is None:
         args.speed = bench.SENSORLESS_RPM if args.sensorless else 750
@@ -64,8 +65,10 @@ def main():
     bench.configure(host, {"CMAKE_BUILD_TYPE": "Release", "CMAKE_C_FLAGS_RELEASE": "-O2",
                            "CMAKE_CXX_FLAGS_RELEASE": "-O2", "PMSM_TARGET": "host",
                            "PMSM_SANITIZE": "OFF"})
+    # With link-time optimisation, as the board image is built (its preset).
     bench.configure(cm4, {"CMAKE_BUILD_TYPE": "Release", "CMAKE_C_FLAGS_RELEASE": "-O2 -g",
-                          "CMAKE_CXX_FLAGS_RELEASE": "-O2 -g", "PMSM_TARGET": "cm4"},
+                          "CMAKE_CXX_FLAGS_RELEASE": "-O2 -g", "PMSM_TARGET": "cm4",
+                          "CMAKE_INTERPROCEDURAL_OPTIMIZATION": "ON"},
                     toolchain=os.path.join(ROOT, "tools", "cmake", "arm-none-eabi-cm4.cmake"))
     bench.log("building bench_rec (host-release), esc1_isr_bench and bench_cm4 (cm4)")
     bench.run(["cmake", "--build", host, "-j2", "--target", "bench_rec"])
