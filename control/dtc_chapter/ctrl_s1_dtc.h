@@ -1,9 +1,10 @@
 /*
  * DTC controllers of the book chapter (S1): "hdtc" (§3, S1 Table 3 = thesis
  * Table 4.1), "svm_dtc" (§4, S1(17)-(20), Fig. 25) and "hpdtc" (§5, S1
- * Table 4, S1(40), §5.2.3).
+ * Table 4, S1(40), §5.2.3); "hdtc_pred", this project's variant of hdtc.
  *
- * Decisions on the k+1 prediction. Flux reference: ref->psi, else the tunable
+ * hdtc decides on the sampled errors (k), as the chapter does; the others on
+ * the k+1 prediction. Flux reference: ref->psi, else the tunable
  * psi_ref (Wb), else the machine's psi_ref, else psi_pm (S1 §4, §6.1.4). Bands
  * of S1 §3.3 / §6.1.4: 0.01 Wb and 0.01 N*m (half widths, SI).
  *
@@ -88,12 +89,14 @@ static inline int8_t ctrl_s1_flux_phi(ctrl_hyst2_sq_t *h, q24_t *lim_ref, q24_t 
 }
 
 extern const ctrl_desc_t ctrl_desc_hdtc;
+extern const ctrl_desc_t ctrl_desc_hdtc_pred;
 extern const ctrl_desc_t ctrl_desc_svm_dtc;
 extern const ctrl_desc_t ctrl_desc_hpdtc;
 
 /* ---- Internal: per-sample parts, shared with ctrl_s1_dtc_config.c. ---- */
 void ctrl_hdtc_reset(void *state);
 void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
+void ctrl_hdtc_pred_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void ctrl_svm_dtc_reset(void *state);
 void ctrl_svm_dtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out);
 void ctrl_hpdtc_reset(void *state);

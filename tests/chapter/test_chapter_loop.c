@@ -9,12 +9,13 @@
  *    free mechanics with 2 N*m load, speed loop closed at 70 rad/s
  *    (668.45 r/min), started at that speed: torque ripple, peak-to-peak and
  *    std of the plant's true torque on the Ts/10 grid (plant sampling) over
- *    50..150 ms, of hdtc vs hpdtc (foc, svm_dtc, foc_hyst printed too).
- *    S1 reports 3.2 N*m p-p for HDTC and < 0.15 N*m for HP-DTC (a factor
- *    > 20). Our HDTC is delay-compensated (decisions on est->next), so its
- *    ripple is far below S1's; the HP-DTC gain measured here is about 3x.
- *    Asserted: hpdtc p-p and std <= 0.5 x hdtc's (at least halved: margin
- *    of 1.5x to the measured ratio 0.33), hpdtc p-p < 0.3 N*m (2x S1's
+ *    150..300 ms (after the speed loop has recovered from the load applied
+ *    at t = 0), of hdtc vs hpdtc (foc, svm_dtc, foc_hyst, hdtc_pred printed
+ *    too). S1 reports 3.2 N*m p-p for HDTC and < 0.15 N*m for HP-DTC (a
+ *    factor > 20). hdtc decides on the sampled errors as S1 does (measured
+ *    1.15 N*m p-p); hdtc_pred, on the k+1 prediction, ripples about half as
+ *    much. Asserted: hpdtc p-p and std <= 0.5 x hdtc's (at least halved: the
+ *    measured ratios are 0.17 and 0.13), hpdtc p-p < 0.3 N*m (2x S1's
  *    < 0.15 N*m: the 20-point table, 5 levels and the Ts/10 plant grid
  *    including the PWM current ripple, which S1's figure does not resolve),
  *    both holding the speed (mean within 1 %) and the load (mean torque
@@ -121,9 +122,9 @@ static ripple_t chapter_case(const char *name)
     c.load_nm = 2.0;
     c.speed_mode = true;
     c.speed_ref_rpm = W_RPM;
-    c.duration_s = 0.15;
-    c.win_start_s = 0.05;
-    c.win_end_s = 0.15;
+    c.duration_s = 0.3;
+    c.win_start_s = 0.15; /* after the speed loop's recovery from the load at t = 0 */
+    c.win_end_s = 0.3;
     FILE *tr = tmpfile();
     TEST_ASSERT_NOT_NULL(tr);
     c.trace = tr;
@@ -198,6 +199,7 @@ static void test_chapter_others(void)
     chapter_case("foc");
     chapter_case("svm_dtc");
     chapter_case("foc_hyst");
+    chapter_case("hdtc_pred");
 }
 
 int main(void)

@@ -1,7 +1,8 @@
 /*
- * hdtc and svm_dtc (control/ctrl_s1_dtc.h): registry entries and defaults
- * (S1 §3.3 bands +-0.01, S1 §4.1 Kp = 1, Ki = 0.03), the HDTC decisions
- * against S1 Table 3 as printed (every sector, phi, tau, including its fixed
+ * hdtc, hdtc_pred and svm_dtc (control/ctrl_s1_dtc.h): registry entries and
+ * defaults (S1 §3.3 bands +-0.01, S1 §4.1 Kp = 1, Ki = 0.03), the HDTC decisions
+ * against S1 Table 3 as printed, on the sampled state (hdtc) or the k+1
+ * prediction (hdtc_pred), the other instant holding opposite errors (every sector, phi, tau, including its fixed
  * V0/V7 entries reached after the preceding active vector), and the SVM-DTC
  * predictive controller's basic behaviour (hold, advance, PI integration).
  */
@@ -39,17 +40,26 @@ static void rig_init(const char *name)
     TEST_ASSERT_EQUAL_UINT32(10000u, rig.d->fs_default_hz);
 }
 
+/* The machine state m (rig.est.now or rig.est.next) with the flux at angle
+ * lam, amplitude amp (pu) and torque t (pu); rotor at theta 0, so the rotor
+ * and stator frames coincide. */
+static void set_state(ctrl_mstate_t *m, double lam, double amp, double t)
+{
+    memset(m, 0, sizeof *m);
+    m->psi_alpha = ctrl_q24_from_double(amp * cos(lam));
+    m->psi_beta = ctrl_q24_from_double(amp * sin(lam));
+    m->psi_d = m->psi_alpha;
+    m->psi_q = m->psi_beta;
+    m->psi_amp = ctrl_q24_from_double(amp);
+    m->psi_amp_sq = (uint64_t)((int64_t)m->psi_amp * m->psi_amp); /* its root: psi_amp */
+    m->torque = ctrl_q24_from_double(t);
+    m->cos_theta = FX_ONE;
+    m->sector = ctrl_sector(m->psi_alpha, m->psi_beta); /* (4.5), as the estimator */
+}
+
 static void set_next(double lam, double amp, double t)
 {
-    ctrl_mstate_t *nx = &rig.est.next;
-    memset(nx, 0, sizeof *nx);
-    nx->psi_alpha = ctrl_q24_from_double(amp * cos(lam));
-    nx->psi_beta = ctrl_q24_from_double(amp * sin(lam));
-    nx->psi_amp = ctrl_q24_from_double(amp);
-    nx->psi_amp_sq = (uint64_t)((int64_t)nx->psi_amp * nx->psi_amp); /* its root: psi_amp */
-    nx->torque = ctrl_q24_from_double(t);
-    nx->cos_theta = FX_ONE;
-    nx->sector = ctrl_sector(nx->psi_alpha, nx->psi_beta); /* (4.5), as the estimator */
+    set_state(&rig.est.next, lam, amp, t);
 }
 
 /* S1 Table 3 as printed: [phi 1/0][tau 1/0/-1][sector 1..6]. */
@@ -58,9 +68,12 @@ static const uint8_t s1_table3[2][3][6] = {
     {{3, 4, 5, 6, 1, 2}, {0, 7, 0, 7, 0, 7}, {5, 6, 1, 2, 3, 4}},
 };
 
-static void test_hdtc_table3(void)
+/* hdtc decides on the sampled state (k), hdtc_pred on the prediction (k+1):
+ * the other instant holds the opposite errors, so reading it would give
+ * another vector of Table 3. */
+static void hdtc_table3(const char *name, int sampled)
 {
-    rig_init("hdtc");
+    rig_init(name);
     double v;
     TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_tunable_get(rig.d, rig.cfg, "h_T", &v));
     TEST_ASSERT_EQUAL_DOUBLE(0.01, v);
@@ -73,7 +86,10 @@ static void test_hdtc_table3(void)
             const double amp = ph == 0 ? 1.0 - big : 1.0 + big; /* psi_ref = psi_pm = 1 pu */
             /* tau = +1 */
             rig.d->reset(rig.state);
-            set_next(lam, amp, 0.1);
+            const double amp_other = ph == 0 ? 1.0 + big : 1.0 - big;
+            const double lam_other = lam + CTRL_PI; /* three sectors away */
+            set_state(sampled ? &rig.est.now : &rig.est.next, lam, amp, 0.1);
+            set_state(sampled ? &rig.est.next : &rig.est.now, lam_other, amp_other, 0.5);
             rig.ref.torque = ctrl_q24_from_double(0.1 + big);
             ctrl_out_t out;
             chapter_rig_step(&rig, &out);
@@ -93,6 +109,16 @@ static void test_hdtc_table3(void)
     ctrl_out_t out;
     ctrl_step(rig.d, rig.state, NULL, &out); /* no context: a zero vector, no crash */
     TEST_ASSERT_TRUE(out.plan.vec[0] == 0u || out.plan.vec[0] == 7u);
+}
+
+static void test_hdtc_table3(void)
+{
+    hdtc_table3("hdtc", 1);
+}
+
+static void test_hdtc_pred_table3(void)
+{
+    hdtc_table3("hdtc_pred", 0);
 }
 
 static void test_svm_dtc_basics(void)
@@ -150,6 +176,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_hdtc_table3);
+    RUN_TEST(test_hdtc_pred_table3);
     RUN_TEST(test_svm_dtc_basics);
     return UNITY_END();
 }

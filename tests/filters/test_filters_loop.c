@@ -1,6 +1,7 @@
 /*
  * The book chapter's filter cases in closed loop (S1 §6.1.4 passive, §6.2.5
- * active): HDTC on the chapter IPMSM (S1 Table 2), fs 10 kHz, free
+ * active): the chapter's HDTC (hdtc: S1 Table 3 on the sampled errors) on
+ * the chapter IPMSM (S1 Table 2), fs 10 kHz, free
  * mechanics with the 2 N*m load, speed loop at 70 rad/s (668.45 r/min),
  * started at that speed; the same run without a filter, with the passive
  * filter (S1 Table 5) and with the active filter (S1 Table 6), each from the
@@ -22,13 +23,14 @@
  *    ~1 kHz (torque minus its 1 ms moving mean) <= 0.1 x the unfiltered
  *    run's: the AF holds the motor voltage within its hysteresis band plus
  *    one sampling step (a few volts against ~100 V inverter steps); the AF's
- *    storage capacitors stay charged (> 0 V: the model's validity).
+ *    storage capacitors stay charged (> 0 V: the model's validity); the
+ *    torque ripple (peak to peak) <= 0.3 x the unfiltered run's (S1 Table 6:
+ *    +-1.62 -> +-0.1 N*m, 0.06 x; measured 0.14 x).
  * Printed, not asserted (see sim_host/README.md, "Output filters"): the
- * torque-ripple ratios derived from S1 Tables 5 and 6 (passive <= 0.6 x, active <= 0.3 x), which
- * this plant does not reach: the passive filter's lightly damped 0.5 kHz
- * mode enters the HDTC's torque loop, and S1's active filter has no energy
- * source, so its capacitors drain at the motor's power while the HDTC
- * applies zero vectors.
+ * passive filter's torque-ripple ratio (S1 Table 5: 1.4 -> 0.6 N*m, 0.43 x;
+ * target <= 0.6 x) and THD_I ratio (<= 0.8 x), which this plant does not
+ * reach (measured 1.07 x and 0.99 x; tools/filters.py's report shows the
+ * torque spectra with and without the filter).
  */
 #include <math.h>
 #include <stdio.h>
@@ -188,7 +190,7 @@ static void test_passive(void)
 static void test_active(void)
 {
     const case_t a = chapter_case("chapter_ipmsm_active_filter.ini");
-    printf("  active / none: torque p-p %.2f (target: <= 0.3, not reached), std %.2f, "
+    printf("  active / none: torque p-p %.2f (<= 0.3), std %.2f, "
            "1.5-10 kHz %.3f (<= 0.1); THD_V %.2f %% (S1: < 5 %%); AF capacitors >= %.0f V\n",
            a.mp.torque_pp_nm / g_none.mp.torque_pp_nm,
            a.mp.torque_ripple_nm / g_none.mp.torque_ripple_nm, a.hf_rms_nm / g_none.hf_rms_nm,
@@ -196,6 +198,7 @@ static void test_active(void)
     TEST_ASSERT_TRUE(a.mp.thd_v_pct < 5.0);
     TEST_ASSERT_TRUE(a.hf_rms_nm <= 0.1 * g_none.hf_rms_nm);
     TEST_ASSERT_TRUE(a.cf_min_v > 0.0);
+    TEST_ASSERT_TRUE(a.mp.torque_pp_nm <= 0.3 * g_none.mp.torque_pp_nm);
 }
 
 int main(void)
