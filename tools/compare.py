@@ -69,7 +69,7 @@ FAMILIES = (
     ("switching tables (thesis ch. 4)", ("bst", "mbst", "ast", "zst", "fst")),
     ("duty-ratio DTC (thesis ch. 5)", ("drr", "drr_d1", "drr_d2", "drr_pi", "drr_df")),
     ("model-predictive (thesis ch. 6)", ("m2ptfc", "m1", "mptfc", "m3", "m2")),
-    ("book chapter", ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc")),
+    ("book chapter", ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc", "hdtc_pred")),
 )
 FAST_CTRLS = ("bst", "m2ptfc")
 LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)))

@@ -208,7 +208,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
                 ("tables", ("bst", "mbst", "ast", "zst", "fst")),
                 ("drr", ("drr", "drr_d1", "drr_d2", "drr_pi", "drr_df")),
                 ("mpc", ("m2ptfc", "m1", "mptfc", "m3", "m2")),
-                ("chapter", ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc")))]
+                ("chapter", ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc", "hdtc_pred")))]
         for g, members in groups:
             if not members:
                 continue
