@@ -404,7 +404,8 @@ static int active_ok(const plant_filter_active_t *f)
            pos_finite(f->l2_h) && pos_finite(f->r2_ohm) && pos_finite(f->c2_f) &&
            pos_finite(f->lf_h) && pos_finite(f->cf_f) && pos_finite(f->cf_v0_v) &&
            pos_finite(f->sample_hz) && isfinite(f->band_v) && f->band_v >= 0.0 &&
-           pos_finite(f->ref_cutoff_hz);
+           pos_finite(f->ref_cutoff_hz) && isfinite(f->dc_bw_hz) && f->dc_bw_hz >= 0.0 &&
+           f->dc_bw_hz < 0.1 * f->sample_hz && (f->dc_bw_hz == 0.0 || pos_finite(f->dc_re_max_ohm));
 }
 
 int plant_filter_setup(plant_t *p)
@@ -675,6 +676,45 @@ static void af_track_cf(plant_t *p)
     }
 }
 
+/* Storage regulation (plant_filter_active_t.dc_bw_hz): the energy error of
+ * the six capacitors against their pre-charge, E* - E (J), through a PI with
+ * both poles at -2 pi bw (dE/dt = P: Kp = 2 w, Ki = w^2) gives the power P
+ * to draw; the AF draws it as the series resistance r_e = P / (1.5 |i|^2)
+ * (amplitude-invariant space vector: three-phase power 1.5 r_e |i|^2), with
+ * |i|^2 low-passed at 10 bw. r_e is limited; the integrator stops while the
+ * limit holds it (clamping anti-windup). Returns r_e for this sample. */
+static double af_storage_re(plant_t *p, const double iin[2], double h)
+{
+    plant_filter_t *f = &p->flt;
+    const plant_filter_active_t *as = &p->cfg.filter.active;
+    if (as->dc_bw_hz <= 0.0) {
+        return 0.0;
+    }
+    double ab[2], u[3];
+    rot(cos(p->theta_e), sin(p->theta_e), f->x + AS_U, ab);
+    ab_to_abc(ab, u);
+    double e_err = 0.0;
+    const double v0sq = as->cf_v0_v * as->cf_v0_v;
+    for (int k = 0; k < 3; ++k) {
+        const double up = f->sw[k] ? u[k] + f->u0 : f->v_up[k];
+        const double lo = f->sw[k] ? f->v_lo[k] : -(u[k] + f->u0);
+        e_err += 0.5 * as->cf_f * ((v0sq - up * up) + (v0sq - lo * lo));
+    }
+    const double w = 2.0 * PLANT_PI * as->dc_bw_hz;
+    f->dc_i2 += (iin[0] * iin[0] + iin[1] * iin[1] - f->dc_i2) * (1.0 - exp(-h * 10.0 * w));
+    const double i2 = fmax(f->dc_i2, 1e-6);
+    const double p_cmd = 2.0 * w * e_err + f->dc_int;
+    double re = p_cmd / (1.5 * i2);
+    const double lim = as->dc_re_max_ohm;
+    const int held = re > lim || re < -lim;
+    re = fmin(lim, fmax(-lim, re));
+    if (!held || (re > 0.0) != (e_err > 0.0)) {
+        f->dc_int += w * w * e_err * h;
+    }
+    f->dc_re = re;
+    return re;
+}
+
 /* Sampled hysteresis voltage control (S1 §6.2.1, Fig. 57): the AF injects
  * v_sig = v_inv - v* so that the motor sees v*; comparing its output v_AF =
  * v_inv - v_M with v_sig is comparing the motor phase voltage v_M with v*.
@@ -703,19 +743,20 @@ void plant_filter_event(plant_t *p)
     }
     const double w = p->step_on ? p->step_wm * (double)p->cfg.pole_pairs
                                 : p->omega_m * (double)p->cfg.pole_pairs;
-    /* S1 (51), (52) */
-    const double vref_dq[2] = {-w * p->cfg.lq_h * f->isq_f, p->cfg.rs_ohm * f->isq_f +
-                                                                p->cfg.lq_h * disq +
-                                                                w * p->cfg.psi_pm_wb};
+    quant_t q;
+    double z[PLANT_FILTER_NA] = {0.0};
+    memcpy(z, f->x, (size_t)f->n * sizeof(double));
+    quantities(p, z, 0, &q);
+    /* S1 (51), (52); less the storage regulation's drop r_e i_inv */
+    const double re = af_storage_re(p, q.iin, h);
+    const double vref_dq[2] = {-w * p->cfg.lq_h * f->isq_f - re * q.iin[0],
+                               p->cfg.rs_ohm * f->isq_f + p->cfg.lq_h * disq +
+                                   w * p->cfg.psi_pm_wb - re * q.iin[1]};
     /* S1 (53), K = 1 for the amplitude-invariant transform (3.3) */
     const double c = cos(p->theta_e), s = sin(p->theta_e);
     double ab[2], vref[3], vm[3];
     rot(c, s, vref_dq, ab);
     ab_to_abc(ab, vref);
-    quant_t q;
-    double z[PLANT_FILTER_NA] = {0.0};
-    memcpy(z, f->x, (size_t)f->n * sizeof(double));
-    quantities(p, z, 0, &q);
     rot(c, s, q.vm, ab);
     ab_to_abc(ab, vm);
     uint8_t sw[3];

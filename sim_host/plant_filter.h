@@ -72,6 +72,13 @@ typedef struct {
     double sample_hz;          /* hysteresis controller sampling rate */
     double band_v;             /* hysteresis half band on the motor phase voltage, >= 0 */
     double ref_cutoff_hz;      /* low-pass of the torque command before d/dt in S1 (52) */
+    /* Storage regulation (not in S1; 0 = none, S1's AF): a PI on the six
+     * capacitors' energy against their pre-charge's, bandwidth dc_bw_hz, sets
+     * the active power the AF draws from the line; it draws it as a series
+     * resistance r_e (|r_e| <= dc_re_max_ohm) emulated in phase with the line
+     * current, v* - r_e i, the usual DC-link control of series active filters. */
+    double dc_bw_hz;      /* >= 0 */
+    double dc_re_max_ohm; /* > 0 when dc_bw_hz > 0 */
 } plant_filter_active_t;
 
 typedef struct {
@@ -157,6 +164,9 @@ typedef struct {
     double tq_cmd_nm; /* torque command for S1 (50) */
     double isq_f;     /* low-passed i_sq of S1 (50) */
     int af_manual;    /* tests: switches set by plant_filter_set_switches */
+    double dc_int;    /* storage regulation: integral part of the power, W */
+    double dc_i2;     /* its low-passed |i_inv|^2, A^2 */
+    double dc_re;     /* its emulated series resistance, ohm */
     plant_filter_stats_t st;
 } plant_filter_t;
 

@@ -77,6 +77,8 @@ static const key_t_ k_keys[] = {
     {"filter", "af_sample_hz", K_REAL, 0, 1e3, 1e8, 0, 1.0, OFF(filter.active.sample_hz)},
     {"filter", "af_band_v", K_REAL, 0, 0, 1e4, 0, 1.0, OFF(filter.active.band_v)},
     {"filter", "af_ref_cutoff_hz", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(filter.active.ref_cutoff_hz)},
+    {"filter", "af_dc_bw_hz", K_REAL, 0, 0, 1e4, 0, 1.0, OFF(filter.active.dc_bw_hz)},
+    {"filter", "af_dc_re_max_ohm", K_REAL, 0, 0, 1e6, 0, 1.0, OFF(filter.active.dc_re_max_ohm)},
     {"sensors", "encoder_lines", K_INT, 0, 1, 1e7, 0, 1.0, OFF(encoder_lines)},
     {"sensors", "encoder_offset_deg", K_REAL, 0, -360, 360, 0, 1.0, OFF(encoder_offset_deg)},
     {"sensors", "encoder_direction", K_INT, 0, -1, 1, 0, 1.0, OFF(encoder_direction)},
@@ -234,7 +236,9 @@ static int filter_check(sim_machine_t *m, const unsigned char *seen, char *err, 
         char prefix[8];
         snprintf(prefix, sizeof prefix, "%.*s", (int)(us - K->name + 1), K->name);
         const int mine = strstr(want, prefix) != NULL;
-        if (mine && !seen[k]) {
+        /* the active filter's storage regulation is optional (not in S1; 0 = none) */
+        const int optional = strncmp(K->name, "af_dc_", 6) == 0;
+        if (mine && !seen[k] && !optional) {
             snprintf(err, errlen, "missing key %s in [filter] (type = %s)", K->name,
                      m->filter_type);
             return -1;

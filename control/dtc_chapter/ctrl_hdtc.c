@@ -41,8 +41,8 @@ void ctrl_hdtc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const ctrl_mstate_t *now = &ctx->est->now;
     /* |psi(k)|^2 from the rotor frame (rotation-invariant): each square
      * <= 2^62, so their sum as unsigned <= 2^63 cannot wrap. */
-    const uint64_t amp_sq = (uint64_t)((int64_t)now->psi_d * now->psi_d) +
-                            (uint64_t)((int64_t)now->psi_q * now->psi_q);
+    const uint64_t amp_sq =
+        (uint64_t)((int64_t)now->psi_d * now->psi_d) + (uint64_t)((int64_t)now->psi_q * now->psi_q);
     hdtc_decide(state, ctx, now, amp_sq, out);
 }
 

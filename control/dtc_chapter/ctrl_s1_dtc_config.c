@@ -250,8 +250,8 @@ static int hpdtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
 S1_DESC(hdtc, "HDTC, hysteresis DTC, S1 Table 3 on the sampled errors (S1 sec. 3)",
         ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_step,
         CTRL_EST_SECTOR_NOW);
-S1_DESC(hdtc_pred, "HDTC on the k+1 prediction (S1 Table 3, delay-compensated)",
-        ctrl_hdtc_state_t, hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_pred_step,
+S1_DESC(hdtc_pred, "HDTC on the k+1 prediction (S1 Table 3, delay-compensated)", ctrl_hdtc_state_t,
+        hdtc_tunables, hdtc_init, ctrl_hdtc_reset, ctrl_hdtc_pred_step,
         CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 S1_DESC(svm_dtc, "SVM-DTC with the predictive controller (S1 sec. 4, S1(17)-(20))",
         ctrl_svm_dtc_state_t, svm_tunables, svm_dtc_init, ctrl_svm_dtc_reset, ctrl_svm_dtc_step,

@@ -2,8 +2,8 @@
  * hdtc, hdtc_pred and svm_dtc (control/ctrl_s1_dtc.h): registry entries and
  * defaults (S1 §3.3 bands +-0.01, S1 §4.1 Kp = 1, Ki = 0.03), the HDTC decisions
  * against S1 Table 3 as printed, on the sampled state (hdtc) or the k+1
- * prediction (hdtc_pred), the other instant holding opposite errors (every sector, phi, tau, including its fixed
- * V0/V7 entries reached after the preceding active vector), and the SVM-DTC
+ * prediction (hdtc_pred), the other instant holding opposite errors (every sector, phi, tau,
+ * including its fixed V0/V7 entries reached after the preceding active vector), and the SVM-DTC
  * predictive controller's basic behaviour (hold, advance, PI integration).
  */
 #include <math.h>

@@ -13,8 +13,8 @@
  *  - all three: running, no fault, mean speed within 1 % and mean torque
  *    within 2 % of the load (the speed loop holds the chapter's operating
  *    point);
- *  - passive: THD_I <= 0.8 x the unfiltered run's (the chapter's THD_I drop, S1 Table 5: 3 % -> < 1.7 %, relaxed to 0.8 x);
- *    THD_V of the motor phase voltage <= 0.62 x: a two-level inverter at
+ *  - passive: THD_I <= 0.8 x the unfiltered run's (the chapter's THD_I drop, S1 Table 5: 3 % ->
+ * < 1.7 %, relaxed to 0.8 x); THD_V of the motor phase voltage <= 0.62 x: a two-level inverter at
  *    ~2 kHz average switching puts its phase-voltage harmonics above 1 kHz,
  *    where the filter with the machine passes at most 0.62 (|V3/V1| from
  *    S1 (41)-(44), both axes, tests/plant/test_plant_filter.c checks the

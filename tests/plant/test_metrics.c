@@ -99,7 +99,7 @@ static void test_thd_band_limit(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 10.0, thd); /* the 15 kHz component is outside */
 }
 
-/* f_av = transitions / (2 * 3 * window) (REFERENCE section 5). */
+/* f_av = transitions / (2 * 3 * window) (thesis Appendix B, per switch and second). */
 static void test_f_av(void)
 {
     metrics_acc_t m;

@@ -78,7 +78,8 @@ static void test_ini_shipped_machines(void)
     TEST_ASSERT_EQUAL_INT_MESSAGE(
         0, sim_machine_load(PLANT_MACHINES_DIR "/chapter_ipmsm.ini", &m, err, sizeof err), err);
     TEST_ASSERT_EQUAL_INT(2, m.pole_pairs);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 44.8e-3, m.ld_h); /* Ld < Lq (REFERENCE resolution) */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 44.8e-3,
+                              m.ld_h); /* Ld < Lq: S1 prints the two labels crossed */
     TEST_ASSERT_DOUBLE_WITHIN(1e-15, 102.7e-3, m.lq_h);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.533, m.psi_pm_wb);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 10000.0, m.fs_hz);

@@ -15,8 +15,8 @@
  *    two-port admittances, measured with two different loads; Z12 = Z1 in
  *    parallel with R2 + sL2 (S1 Fig. 47);
  *  - S1 (58): the active filter's shunt currents i_CR1 and i_CR2.
- * Bound: 1 % (a modelling tolerance far above exact integration); the measured errors are ~1e-9 (exact integration).
- * Also: energy balance with the filters, configuration checks, probes.
+ * Bound: 1 % (a modelling tolerance far above exact integration); the measured errors are ~1e-9
+ * (exact integration). Also: energy balance with the filters, configuration checks, probes.
  */
 #include <complex.h>
 #include <math.h>
@@ -359,6 +359,17 @@ static void test_config_checks(void)
     TEST_ASSERT_EQUAL_INT(PLANT_EINVAL, plant_init(&p, &c));
     c.filter = table6();
     c.filter.active.sample_hz = 0.0;
+    TEST_ASSERT_EQUAL_INT(PLANT_EINVAL, plant_init(&p, &c));
+    /* storage regulation: a limit on r_e is needed, and a bandwidth far
+     * below the AF controller's sampling rate */
+    c.filter = table6();
+    c.filter.active.dc_bw_hz = 1.0;
+    TEST_ASSERT_EQUAL_INT(PLANT_EINVAL, plant_init(&p, &c));
+    c.filter.active.dc_re_max_ohm = 60.0;
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
+    c.filter.active.dc_bw_hz = 0.1 * c.filter.active.sample_hz;
+    TEST_ASSERT_EQUAL_INT(PLANT_EINVAL, plant_init(&p, &c));
+    c.filter.active.dc_bw_hz = NAN;
     TEST_ASSERT_EQUAL_INT(PLANT_EINVAL, plant_init(&p, &c));
     c.filter = table6();
     c.filter.type = (plant_filter_type_t)7;
