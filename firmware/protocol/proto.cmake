@@ -7,8 +7,11 @@ if(NOT TARGET pmsm_fw_proto)
     ${CMAKE_CURRENT_LIST_DIR}/cmd_num.c
     ${CMAKE_CURRENT_LIST_DIR}/text_fmt.c
     ${CMAKE_CURRENT_LIST_DIR}/telemetry.c
-    ${CMAKE_CURRENT_LIST_DIR}/telemetry_frame.c)
-  target_include_directories(pmsm_fw_proto PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+    ${CMAKE_CURRENT_LIST_DIR}/telemetry_frame.c
+    ${CMAKE_CURRENT_LIST_DIR}/pil_frame.c)
+  # pil_frame.h carries hal.h's sample and compare types.
+  target_include_directories(pmsm_fw_proto PUBLIC ${CMAKE_CURRENT_LIST_DIR}
+                                                  ${PROJECT_SOURCE_DIR}/hal)
   target_link_libraries(pmsm_fw_proto PUBLIC pmsm_control)
   pmsm_strict(pmsm_fw_proto)
   # The interpreter runs in the main loop, never per period: optimised for
