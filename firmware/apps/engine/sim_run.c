@@ -209,8 +209,17 @@ static int sim_period_raw(sim_run_t *r)
     r->vec_now = on ? tm->vec : 0u;
     r->duty_now = on ? ctrl_q24_to_double(tm->duty) : 0.0;
     engine_hal_begin(&r->hal);
+    const sim_link_t *link = r->cfg.link;
+    if (link != NULL && link->send(link->ctx, r) != 0) {
+        r->link_failed = true;
+        return -1;
+    }
     if (fw_isr_fast(&r->fw)) {
         engine_medium(&r->fw);
+    }
+    if (link != NULL && link->receive(link->ctx, r) != 0) {
+        r->link_failed = true;
+        return -1;
     }
     if (r->cfg.plant_machine.filter.type == PLANT_FILTER_ACTIVE) {
         /* the active filter's reference generator follows the drive's torque
@@ -426,8 +435,7 @@ static int sim_ctrl_cfg_build(const sim_run_cfg_t *c, const ctrl_machine_t *m, u
     return 0;
 }
 
-/* The pipeline configuration of the run (controller configuration aside). */
-static void sim_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_config_t *fc)
+void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_config_t *fc)
 {
     fw_config_default(fc, m, c->ctrl);
     fc->calib_samples = c->calib_samples;
@@ -474,7 +482,7 @@ static int sim_fw_trial(const sim_run_cfg_t *c, const ctrl_machine_t *m, uint32_
         return FW_EINVAL;
     }
     fw_config_t fc;
-    sim_fw_config(c, m, &fc);
+    sim_run_fw_config(c, m, &fc);
     fc.ctrl_cfg = c->ctrl_cfg != NULL ? c->ctrl_cfg : buf;
     return fw_init(&fw, &hal, &fc);
 }
@@ -767,7 +775,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         return sim_err(err, errlen, "HAL simulation rejected its configuration");
     }
     fw_config_t fc;
-    sim_fw_config(c, &c->ctrl_machine, &fc);
+    sim_run_fw_config(c, &c->ctrl_machine, &fc);
     if (!(c->speed_kp > 0.0)) {
         /* The speed-loop design named before fw_init (which only says no). */
         fw_speed_design_t sd = {c->speed_bw_hz, c->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
@@ -853,6 +861,10 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         fprintf(c->trace, "t,i_a,i_b,i_c,i_d,i_q,psi_s,torque,speed_rpm,torque_ref,vec,duty,state,"
                           "speed_ref_rpm,load_nm,v_a,v_b,v_c,i_inv_a\n");
     }
+    if (c->link != NULL && c->link->setup(c->link->ctx, r, &fc, err, errlen) != 0) {
+        r->link_failed = true;
+        return -1;
+    }
     if (c->defer_start) {
         return 0; /* the caller runs the periods from boot on (sim_run_period) */
     }
@@ -860,6 +872,11 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     const uint32_t max_boot = c->calib_samples + 16u;
     for (uint32_t k = 0; k < max_boot && !r->armed; k++) {
         if (sim_run_period(r) != 0) {
+            if (r->link_failed) {
+                (void)snprintf(err, errlen, "PIL link during calibration: %s",
+                               c->link->error(c->link->ctx));
+                return -1;
+            }
             return sim_err(err, errlen, "plant failed during calibration");
         }
         if (fw_state(&r->fw) == FW_STATE_FAULT) {
@@ -884,7 +901,12 @@ int sim_run_all(sim_run_t *r, char *err, size_t errlen)
 {
     while (!sim_run_done(r)) {
         if (sim_run_period(r) != 0) {
-            char msg[200];
+            char msg[400];
+            if (r->link_failed) {
+                (void)snprintf(msg, sizeof msg, "PIL link at t = %.6f s: %s", sim_run_time(r),
+                               r->cfg.link->error(r->cfg.link->ctx));
+                return sim_err(err, errlen, msg);
+            }
             (void)snprintf(msg, sizeof msg, "plant integration failed at t = %.6f s (code %d)",
                            sim_run_time(r), r->plant_rc);
             return sim_err(err, errlen, msg);

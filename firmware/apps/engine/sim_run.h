@@ -50,6 +50,26 @@
 #include "sim_scenario.h"
 
 #define SIM_MAX_SETS 32u
+
+typedef struct sim_run sim_run_t;
+
+/*
+ * A target that runs the same firmware period by period (processor in the
+ * loop over a link, host_sim/sim_pil.h). setup: after the host's fw_init,
+ * before the first period (fc: the configuration fw_init got). send: after
+ * the period's samples, before the host's fw_isr (the samples and the main
+ * loop's commands). receive: after the host's fw_isr: the target's outputs
+ * replace the host's at the HAL (they drive the plant), and must equal them.
+ * Each returns 0, or -1 for a link fault (named by error()): gates off, the
+ * run stops.
+ */
+typedef struct {
+    void *ctx;
+    int (*setup)(void *ctx, sim_run_t *r, const fw_config_t *fc, char *err, size_t errlen);
+    int (*send)(void *ctx, sim_run_t *r);
+    int (*receive)(void *ctx, sim_run_t *r);
+    const char *(*error)(void *ctx);
+} sim_link_t;
 #define SIM_SET_NAME_MAX 48u
 
 /* A controller tunable set by name (--set NAME=VALUE). */
@@ -102,9 +122,10 @@ typedef struct {
     int ctrl_enc_dir;
     double theta0_e_rad;      /* initial electrical rotor angle of the plant */
     sim_warnings_t *warnings; /* may be NULL (warnings printed only) */
+    const sim_link_t *link;   /* PIL target, NULL: the host firmware alone */
 } sim_run_cfg_t;
 
-typedef struct {
+struct sim_run {
     sim_run_cfg_t cfg;
     plant_t plant;
     plant_fluxmap_t fluxmap; /* the machine file's [fluxmap], when it names one */
@@ -148,7 +169,11 @@ typedef struct {
     double lim_min_nm, tref_sum_nm;
     uint8_t lim_last; /* fw_telemetry_t.fw_limit of the last clipped period */
     bool lim_warned;
-} sim_run_t;
+    bool link_failed; /* the PIL link reported a fault (cfg.link->error) */
+};
+
+/* The pipeline configuration of a run (the controller's aside). */
+void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_config_t *fc);
 
 /* Convert a machine file into the controller's machine description. */
 void sim_ctrl_machine_from(const sim_machine_t *m, ctrl_machine_t *out);

@@ -20,6 +20,7 @@
 #include "controller.h"
 #include "sim_diag.h"
 #include "sim_ident.h"
+#include "sim_pil.h"
 #include "sim_replay.h"
 #include "sim_run.h"
 
@@ -47,6 +48,8 @@ typedef struct {
     const char *machine, *control_machine, *controller, *scenario, *trace, *metrics, *replay;
     const char *list_tunables, *current_sense;
     const char *identify_out, *identify_steps, *inject;
+    const char *target, *pil_image, *pil_transport;
+    double link_timeout_ms, baud;
     int identify;
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
@@ -152,6 +155,18 @@ static const cli_opt_t k_opts[] = {
      "only these steps: vbus probe encoder rs ldq flux gates sense run"},
     {"--inject", "CASE", K_TEXT, 0, 0, "", M_IDENT, "--identify", NULL, F(inject),
      "bad case: open (motor not connected), short (a-b leads), encoder_stuck, vbus_low"},
+    {"--target", "WHERE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(target),
+     "host (default) | qemu | board:DEVICE: where the firmware runs; the plant stays here "
+     "(processor in the loop, hal/qemu_mps2/README-pil.md)"},
+    {"--pil-image", "FILE.elf", K_TEXT, 0, 0, "", M_LOOP, "--target", NULL, F(pil_image),
+     "--target qemu: the target image (tools/sim builds and passes pil_target.elf)"},
+    {"--pil-transport", "HOW", K_TEXT, 0, 0, "", M_LOOP, "--target", NULL, F(pil_transport),
+     "--target qemu: semihosting (default, faster) | socket (UART0 on a chardev socket)"},
+    {"--link-timeout-ms", "MS", K_UINT, 1, 600000, "ms", M_LOOP, "--target", NULL,
+     F(link_timeout_ms),
+     "PIL: a frame later than this is the link fault 'time-out' (default 2000)"},
+    {"--baud", "N", K_UINT, 9600, 12000000, "baud", M_LOOP, "--target", NULL, F(baud),
+     "--target board:DEVICE: serial rate (default 921600)"},
     {"--help", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(help), "this text"},
 };
 #undef F
@@ -159,9 +174,9 @@ static const cli_opt_t k_opts[] = {
 
 static const char *const k_help_tail =
     "exit status: 0 the run completed without a fault; 1 the run could not complete\n"
-    "  (plant failure, I/O error); 2 invalid input, nothing simulated; 3 the drive\n"
-    "  faulted (the run stops there unless --continue-on-fault; metrics and trace\n"
-    "  are written up to it).\n"
+    "  (plant failure, I/O error, a link fault with --target); 2 invalid input,\n"
+    "  nothing simulated; 3 the drive faulted (the run stops there unless\n"
+    "  --continue-on-fault; metrics and trace are written up to it).\n"
     "Warnings (clamped references, events that never fire, ...) go to stderr and\n"
     "to the \"warnings\" list of the metrics JSON. Undefined indices print n/a\n"
     "(null in JSON).\n";
@@ -801,14 +816,43 @@ int main(int argc, char **argv)
         }
     }
 
+    sim_pil_t *pil = NULL;
+    if (c.target != NULL && strcmp(c.target, "host") != 0) {
+        const sim_pil_opts_t po = {c.target, c.pil_image, c.pil_transport,
+                                   (uint32_t)c.link_timeout_ms, (uint32_t)c.baud};
+        pil = sim_pil_open(&po, err, sizeof err);
+        if (pil == NULL) {
+            if (trace != NULL) {
+                fclose(trace);
+            }
+            if (mf != NULL) {
+                fclose(mf);
+                (void)remove(c.metrics);
+            }
+            fprintf(stderr, "sim: error: %s\n", err);
+            return SIM_EXIT_RUN;
+        }
+        cfg.link = sim_pil_link(pil);
+    }
+
     static sim_run_t run;
     int status = SIM_EXIT_OK;
     if (sim_run_init(&run, &cfg, err, sizeof err) != 0) {
         fprintf(stderr, "sim: error: %s\n", err);
-        status = SIM_EXIT_USAGE;
+        /* A link fault is not the input's: the run could not complete. */
+        status = run.link_failed ? SIM_EXIT_RUN : SIM_EXIT_USAGE;
     } else if (sim_run_all(&run, err, sizeof err) != 0) {
         fprintf(stderr, "sim: error: %s\n", err);
         status = SIM_EXIT_RUN;
+    }
+    if (pil != NULL) {
+        if (status == SIM_EXIT_OK) {
+            sim_pil_report(pil, stderr);
+        }
+        if (sim_pil_close(pil) != 0 && status == SIM_EXIT_OK) {
+            fprintf(stderr, "sim: error: the PIL target did not stop cleanly\n");
+            status = SIM_EXIT_RUN;
+        }
     }
     if (status == SIM_EXIT_OK) {
         metrics_result_t mp, mc;
