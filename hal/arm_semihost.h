@@ -9,7 +9,10 @@
 
 #include <stdint.h>
 
+#define SYS_OPEN 0x01
 #define SYS_WRITE0 0x04
+#define SYS_WRITE 0x05
+#define SYS_READ 0x06
 #define SYS_EXIT 0x18
 #define SYS_EXIT_EXTENDED 0x20
 #define ADP_STOPPED_APPLICATION_EXIT 0x20026u

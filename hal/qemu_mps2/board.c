@@ -163,6 +163,31 @@ uint32_t timer1_read(void)
     return 0xFFFFFFFFu - TIMER_VALUE(TIMER1_BASE);
 }
 
+/* Exactly 1000 instructions (plus the call), for the Timer1 calibration:
+ * under -icount, Timer1 counts virtual time = instructions x 2^shift ns. */
+__attribute__((noinline)) static void board_nops_1000(void)
+{
+    __asm__ volatile(".rept 1000\n\tnop\n\t.endr" ::: "memory");
+}
+
+__attribute__((noinline)) static void board_nops_0(void)
+{
+    __asm__ volatile("" ::: "memory");
+}
+
+uint32_t timer1_ticks_per_kinstr(void)
+{
+    uint32_t t0 = timer1_read();
+    board_nops_0();
+    uint32_t t1 = timer1_read();
+    const uint32_t base = t1 - t0;
+    t0 = timer1_read();
+    board_nops_1000();
+    t1 = timer1_read();
+    const uint32_t d = (t1 - t0) - base;
+    return d == 0u ? 1u : d;
+}
+
 void board_irq_disable(void)
 {
     __asm__ volatile("cpsid i" ::: "memory");

@@ -6,31 +6,6 @@
 
 #include "qemu_mps2.h"
 
-/* Exactly 1000 instructions (plus the call), for the Timer1 calibration:
- * under -icount, Timer1 counts virtual time = instructions x 2^shift ns. */
-__attribute__((noinline)) static void hal_qemu_nops_1000(void)
-{
-    __asm__ volatile(".rept 1000\n\tnop\n\t.endr" ::: "memory");
-}
-
-__attribute__((noinline)) static void hal_qemu_nops_0(void)
-{
-    __asm__ volatile("" ::: "memory");
-}
-
-static uint32_t hal_qemu_calibrate(void)
-{
-    uint32_t t0 = timer1_read();
-    hal_qemu_nops_0();
-    uint32_t t1 = timer1_read();
-    const uint32_t base = t1 - t0;
-    t0 = timer1_read();
-    hal_qemu_nops_1000();
-    t1 = timer1_read();
-    const uint32_t d = (t1 - t0) - base;
-    return d == 0u ? 1u : d;
-}
-
 int hal_qemu_init(hal_t *h, hal_qemu_plant_t *plant, uint32_t cpu_hz)
 {
     if (h == NULL || plant == NULL || cpu_hz == 0u) {
@@ -39,7 +14,7 @@ int hal_qemu_init(hal_t *h, hal_qemu_plant_t *plant, uint32_t cpu_hz)
     memset(h, 0, sizeof *h);
     h->plant = plant;
     hal_qemu_plant_info(plant, &h->info);
-    h->ticks_per_kinstr = hal_qemu_calibrate();
+    h->ticks_per_kinstr = timer1_ticks_per_kinstr();
     /* Budget cpu_hz / fs instructions (1 instruction per cycle) expressed in
      * Timer1 ticks: ticks = instructions * ticks_per_kinstr / 1000. */
     const uint64_t hz = (uint64_t)cpu_hz * h->ticks_per_kinstr / 1000u;
