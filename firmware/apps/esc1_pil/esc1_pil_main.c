@@ -6,9 +6,10 @@
  * docs/bringup.md "PIL on the board").
  *
  * The power stage is never used: TIM1 is not started and the six gate pins
- * are held as GPIO outputs at their inactive level (g4_hal_gate_pins_safe)
- * from the first instruction on; the ADCs, op-amps and comparators stay at
- * reset. The firmware's gate requests go to the PC's plant only.
+ * are held as GPIO outputs at their inactive level from the first
+ * instruction on; the ADCs, op-amps and comparators stay at reset. The
+ * firmware's gate requests go to the PC's plant only. hal/stm32g4's hal.h
+ * back-end (g4_hal.c) is not linked: hal/pil is this image's.
  *
  * Start-up: DWT cycle counter (hal_cycles), clock (HSE 8 MHz -> PLL 170 MHz,
  * on a failure the HSI's 16 MHz, reported in READY as the cycle clock),
@@ -27,7 +28,7 @@
 #include "esc1_uart.h"
 #include "g4_clock.h"
 #include "g4_core.h"
-#include "g4_hal.h"
+#include "g4_periph.h"
 #include "g4_startup.h"
 #include "pil_target.h"
 
@@ -48,11 +49,24 @@ void USART2_IRQHandler(void)
     esc1_uart_irq(&uart);
 }
 
-/* The fault handlers turn the gates off first (g4_startup.c); the pins are
- * already safe here, and stay so. */
+/* The six gate pins as GPIO outputs at their inactive level (both switches
+ * of every leg off): g4_hal_gate_pins_safe's steps, which live in g4_hal.c
+ * beside the hal.h back-end this image does not link. */
+static void esc1_pil_gates_safe(const g4_board_t *b)
+{
+    for (unsigned x = 0; x < 3u; x++) {
+        g4_gpio_write(b->pwm_high[x], b->gate_active_low);
+        g4_gpio_write(b->pwm_low[x], b->gate_active_low);
+        g4_gpio_config(b->pwm_high[x], G4_PIN_OUTPUT, 2u);
+        g4_gpio_config(b->pwm_low[x], G4_PIN_OUTPUT, 2u);
+    }
+}
+
+/* The fault handlers' last step (g4_startup.c): the pins are safe already,
+ * and stay so. */
 void g4_board_fault_hook(void)
 {
-    g4_hal_gate_pins_safe(&g4_board_esc1);
+    esc1_pil_gates_safe(&g4_board_esc1);
 }
 
 static int esc1_pil_read(void *ctx, uint8_t *buf, size_t cap)
@@ -84,7 +98,7 @@ static uint32_t esc1_pil_cycles(void)
 int main(void)
 {
     const g4_board_t *b = &g4_board_esc1;
-    g4_hal_gate_pins_safe(b);
+    esc1_pil_gates_safe(b);
     g4_cycle_counter_init();
     const uint32_t f_cpu =
         g4_clock_init(b->hse_hz, b->sysclk_hz) == G4_OK ? b->sysclk_hz : G4_HSI_HZ;
