@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "../plant/ini_machines.h"
-#include "pil_digest.h"
+#include "pil_shared.h"
 #include "pil_frame.h"
 #include "pil_target.h"
 #include "unity.h"

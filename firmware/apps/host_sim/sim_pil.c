@@ -17,8 +17,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "pil_digest.h"
 #include "pil_frame.h"
+#include "pil_shared.h"
 
 #define SIM_PIL_TIMEOUT_MS_DEFAULT 2000u
 #define SIM_PIL_BAUD_DEFAULT 921600u
@@ -377,20 +377,7 @@ static int sim_pil_setup(void *ctx, sim_run_t *r, const fw_config_t *fc, char *e
         memcpy(s.sets[k].name, c->sets[k].name, strlen(c->sets[k].name) + 1u); /* fits: above */
         s.sets[k].value = c->sets[k].value;
     }
-    s.calib_samples = fc->calib_samples;
-    s.speed_bw_hz = fc->speed_bw_hz;
-    s.speed_pm_deg = fc->speed_pm_deg;
-    s.speed_kp = fc->speed_kp;
-    s.speed_ki = fc->speed_ki;
-    s.speed_unit = (uint8_t)fc->speed_unit;
-    s.overspeed_rpm = fc->overspeed_rpm;
-    s.psi_adapt = fc->psi_adapt;
-    s.sensorless = fc->sensorless;
-    s.dead_time_s = fc->dead_time_s;
-    s.v_fwd_v = fc->v_fwd_v;
-    s.enc_offset = fc->enc_offset;
-    s.enc_direction = fc->enc_direction;
-    s.enc_cpr = fc->enc_cpr;
+    pil_setup_from_fw_config(&s, fc);
     hal_info_get(&r->hal, &s.info);
     static uint8_t pl[PIL_BODY_MAX];
     const size_t n = pil_setup_pack(&s, pl, sizeof pl);
@@ -581,13 +568,13 @@ void sim_pil_report(const sim_pil_t *p, FILE *f)
             "simulated s",
             p->o.target, (unsigned long long)p->periods, sim_s, wall,
             sim_s > 0.0 ? wall / sim_s : 0.0);
-    if (p->run_n > 0u) {
-        fprintf(f, "; fw_isr running: mean %.1f, max %u cycles",
-                (double)p->cyc_sum / (double)p->run_n, (unsigned)p->cyc_max);
-        if (p->cycle_clock_hz > 0u && p->fs_hz > 0u) {
-            fprintf(f, " of a %.0f-cycle budget (%.4g MHz cycle clock)",
-                    (double)p->cycle_clock_hz / (double)p->fs_hz, 1e-6 * (double)p->cycle_clock_hz);
-        }
+    if (p->run_n > 0u && p->cycle_clock_hz > 0u && p->fs_hz > 0u) {
+        /* No cycle clock: no counter either (the host program). */
+        fprintf(f,
+                "; fw_isr running: mean %.1f, max %u cycles of a %.0f-cycle budget (%.4g MHz "
+                "cycle clock)",
+                (double)p->cyc_sum / (double)p->run_n, (unsigned)p->cyc_max,
+                (double)p->cycle_clock_hz / (double)p->fs_hz, 1e-6 * (double)p->cycle_clock_hz);
     }
     fprintf(f, "\n");
 }

@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "controller.h"
-#include "pil_digest.h"
+#include "pil_shared.h"
 
 static void pil_send(pil_target_t *t, uint8_t type, uint16_t seq, const uint8_t *p, size_t n)
 {
@@ -63,20 +63,7 @@ static void pil_on_setup(pil_target_t *t, const pil_frame_t *f)
         fw_config_t fc;
         fw_config_default(&fc, &s->machine, d);
         fc.ctrl_cfg = t->ctrl_cfg;
-        fc.calib_samples = s->calib_samples;
-        fc.speed_bw_hz = s->speed_bw_hz;
-        fc.speed_pm_deg = s->speed_pm_deg;
-        fc.speed_kp = s->speed_kp;
-        fc.speed_ki = s->speed_ki;
-        fc.speed_unit = (ctrl_speed_unit_t)s->speed_unit;
-        fc.overspeed_rpm = s->overspeed_rpm;
-        fc.psi_adapt = s->psi_adapt;
-        fc.sensorless = s->sensorless;
-        fc.dead_time_s = s->dead_time_s;
-        fc.v_fwd_v = s->v_fwd_v;
-        fc.enc_offset = s->enc_offset;
-        fc.enc_direction = s->enc_direction;
-        fc.enc_cpr = s->enc_cpr;
+        pil_setup_to_fw_config(s, &fc);
         hal_pil_init(&t->hal, &s->info, t->port->cycles, t->port->cycle_clock_hz);
         rd.rc = fw_init(&t->fw, &t->hal, &fc);
         if (rd.rc != FW_OK) {
