@@ -1,0 +1,283 @@
+/*
+ * The servo-style throttle decoder (firmware/throttle/throttle.h) fed by a
+ * simulated pulse source: a sender at 50..490 Hz with a set width, jitter
+ * (a fixed-seed generator, the same sequence on the host and in QEMU),
+ * glitches, an unplugged wire and out-of-range pulses. The bounds come from
+ * the rules the decoder implements (the ESC convention and the RC signal's
+ * limits): arming after 1 s at the low end, never with the throttle high at
+ * power-up; no valid pulse for 100 ms -> the reference ramps to zero over
+ * 100 ms, then disarm with the cause.
+ */
+#include <string.h>
+
+#include "throttle.h"
+#include "unity.h"
+
+static thr_t thr;
+static uint32_t t_us;    /* simulated time */
+static uint32_t next_us; /* next rising edge */
+static uint32_t seed;
+static uint32_t n_arm, n_disarm;
+static uint32_t t_arm_ms, t_disarm_ms;
+static thr_out_t last;
+
+typedef struct {
+    uint32_t period_us; /* 0: no pulses (wire unplugged) */
+    uint32_t width_us;
+    uint32_t jitter_us;    /* width +- jitter, uniform */
+    uint32_t glitch_every; /* every n-th period also carries a 0.3 us..300 us glitch (0: none) */
+} sender_t;
+
+static uint32_t rnd(void)
+{
+    seed = seed * 1664525u + 1013904223u;
+    return seed >> 8;
+}
+
+static void reset(uint8_t mode)
+{
+    thr_config_t c;
+    thr_config_default(&c);
+    c.mode = mode;
+    TEST_ASSERT_EQUAL_INT(0, thr_config_check(&c));
+    t_us = 0u;
+    next_us = 3000u;
+    seed = 12345u;
+    n_arm = n_disarm = 0u;
+    thr_init(&thr, &c, 0u);
+}
+
+/* Runs the sender for ms milliseconds: a pulse is reported at its falling
+ * edge with the period since the previous rising edge; thr_update every 1 ms
+ * (the main loop). */
+static void run(const sender_t *s, uint32_t ms)
+{
+    static uint32_t n_period;
+    const uint32_t end = t_us + ms * 1000u;
+    while (t_us < end) {
+        t_us += 1000u;
+        while (s->period_us != 0u && next_us + s->width_us <= t_us) {
+            uint32_t w = s->width_us;
+            if (s->jitter_us != 0u) {
+                w = w - s->jitter_us + rnd() % (2u * s->jitter_us + 1u);
+            }
+            thr_pulse(&thr, w, s->period_us, (next_us + w) / 1000u);
+            n_period++;
+            if (s->glitch_every != 0u && n_period % s->glitch_every == 0u) {
+                /* a spike: a short pulse, and a short "period" before it */
+                thr_pulse(&thr, 1u + rnd() % 300u, 1u + rnd() % 600u, (next_us + w) / 1000u);
+            }
+            next_us += s->period_us;
+        }
+        if (s->period_us == 0u) {
+            next_us = t_us + 3000u;
+        }
+        last = thr_update(&thr, t_us / 1000u);
+        if (last.event == THR_EV_ARM) {
+            n_arm++;
+            t_arm_ms = t_us / 1000u;
+        } else if (last.event == THR_EV_DISARM) {
+            n_disarm++;
+            t_disarm_ms = t_us / 1000u;
+        }
+    }
+}
+
+/* Low end at 50 Hz with +-5 us jitter: armed after 1 s of it, not before.
+ * The first pulse ends at 3.995..4.005 ms: arming 1 s after it, at most one
+ * period plus one main-loop step later. */
+static void test_arms_after_one_second_at_the_low_end(void)
+{
+    reset(THR_MODE_TORQUE);
+    const sender_t low = {20000u, 1000u, 5u, 0u};
+    run(&low, 1000u);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_arm);
+    run(&low, 100u);
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+    TEST_ASSERT_TRUE(t_arm_ms >= 1003u && t_arm_ms <= 1005u + 20u + 1u);
+    TEST_ASSERT_EQUAL_INT32(0, last.ref);
+    TEST_ASSERT_EQUAL_UINT8(THR_ARMED, thr.state);
+}
+
+/* Throttle high at power-up (490 Hz, 1600 us) for 5 s: never armed. Then
+ * at the low end: armed 1 s after the first low pulse, not earlier. */
+static void test_throttle_high_at_power_up_never_arms(void)
+{
+    reset(THR_MODE_TORQUE);
+    const sender_t high = {2040u, 1600u, 3u, 0u};
+    run(&high, 5000u);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_arm);
+    TEST_ASSERT_TRUE(thr.n_valid > 2000u);
+    const uint32_t t_low = t_us / 1000u;
+    const sender_t low = {2040u, 1010u, 3u, 0u};
+    run(&low, 990u);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_arm);
+    run(&low, 30u);
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+    /* the pulse in flight at the switch may end (low) up to 1 ms before it */
+    TEST_ASSERT_TRUE(t_arm_ms + 1u >= t_low + 1000u);
+}
+
+/* A break in the low-end run restarts the second: 600 ms low, 200 ms at
+ * 1400 us, then low: armed 1 s after the return, not 1 s after the start. */
+static void test_arming_needs_an_unbroken_second(void)
+{
+    reset(THR_MODE_SPEED);
+    const sender_t low = {20000u, 1000u, 0u, 0u};
+    const sender_t mid = {20000u, 1400u, 0u, 0u};
+    run(&low, 600u);
+    run(&mid, 200u);
+    const uint32_t t_back = t_us / 1000u;
+    run(&low, 990u);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_arm);
+    run(&low, 50u);
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+    TEST_ASSERT_TRUE(t_arm_ms + 1u >= t_back + 1000u);
+}
+
+static void arm(void)
+{
+    const sender_t low = {4000u, 1000u, 0u, 0u};
+    run(&low, 1100u);
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+}
+
+/* Reference: 0 up to low + dead band (1030 us), linear to 1 at 2000 us,
+ * 1 above: (1515 - 1030) / (2000 - 1030) = 1/2 exactly. With +-4 us jitter
+ * it stays within 4 / 970 of full scale of the value at the nominal width. */
+static void test_reference_follows_the_width(void)
+{
+    reset(THR_MODE_TORQUE);
+    arm();
+    const uint32_t w[5] = {1000u, 1030u, 1515u, 2000u, 2150u};
+    const q24_t want[5] = {0, 0, FX_ONE / 2, FX_ONE, FX_ONE};
+    for (unsigned i = 0; i < 5u; i++) {
+        const sender_t s = {4000u, w[i], 0u, 0u};
+        run(&s, 20u);
+        TEST_ASSERT_EQUAL_INT32(want[i], last.ref);
+    }
+    const sender_t jit = {4000u, 1515u, 4u, 0u};
+    const int32_t bound = (int32_t)(((int64_t)4 << 24) / 970 + 1);
+    for (unsigned k = 0; k < 200u; k++) {
+        run(&jit, 1u);
+        TEST_ASSERT_INT32_WITHIN(bound, FX_ONE / 2, last.ref);
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
+}
+
+/* Glitches (spikes of 1..300 us with short periods) between good pulses:
+ * dropped and counted; the reference and the arming are untouched. */
+static void test_glitches_are_dropped(void)
+{
+    reset(THR_MODE_TORQUE);
+    arm();
+    const sender_t s = {4000u, 1515u, 0u, 3u};
+    run(&s, 2000u);
+    TEST_ASSERT_TRUE(thr.n_invalid > 100u);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, last.ref);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
+    TEST_ASSERT_EQUAL_UINT8(THR_ARMED, thr.state);
+}
+
+/* Wire unplugged at full throttle: the reference holds for the 100 ms
+ * time-out after the last pulse, then falls linearly to zero over 100 ms
+ * (half way at 50 ms), then the drive is disarmed with cause "no pulse".
+ * Pulses coming back high do not re-arm it; 1 s at the low end does. */
+static void test_unplugged_wire_ramps_down_and_disarms(void)
+{
+    reset(THR_MODE_TORQUE);
+    arm();
+    const sender_t full = {4000u, 2000u, 0u, 0u};
+    run(&full, 100u);
+    const uint32_t t_last = thr.t_valid_ms;
+    const sender_t none = {0u, 0u, 0u, 0u};
+    run(&none, t_last + 100u - t_us / 1000u);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, last.ref); /* still within the time-out */
+    run(&none, 51u);
+    TEST_ASSERT_EQUAL_UINT8(THR_RAMP_DOWN, thr.state);
+    TEST_ASSERT_INT32_WITHIN(FX_ONE / 50, FX_ONE / 2, last.ref);
+    TEST_ASSERT_INT32_WITHIN(FX_ONE / 50, FX_ONE / 2, last.ramp);
+    q24_t prev = last.ref;
+    for (unsigned k = 0; k < 60u && n_disarm == 0u; k++) {
+        run(&none, 1u);
+        TEST_ASSERT_TRUE(last.ref <= prev);
+        prev = last.ref;
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, n_disarm);
+    TEST_ASSERT_TRUE(t_disarm_ms >= t_last + 200u && t_disarm_ms <= t_last + 202u);
+    TEST_ASSERT_EQUAL_INT32(0, last.ref);
+    TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_NO_PULSE, thr.cause);
+
+    run(&full, 3000u);
+    TEST_ASSERT_EQUAL_UINT32(1u, n_arm);
+    TEST_ASSERT_EQUAL_INT32(0, last.ref);
+    const sender_t low = {4000u, 1000u, 0u, 0u};
+    run(&low, 1100u);
+    TEST_ASSERT_EQUAL_UINT32(2u, n_arm);
+    TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_NONE, thr.cause);
+}
+
+/* Pulses that keep coming but are out of range (2500 us; or 1500 us at
+ * 600 Hz, a period below 490 Hz's): no valid pulse, so the same loss, with
+ * cause "invalid". Pulses at 800 and 2200 us are still valid. */
+static void test_out_of_range_pulses_are_a_loss(void)
+{
+    const sender_t bad[2] = {{4000u, 2500u, 0u, 0u}, {1667u, 1500u, 0u, 0u}};
+    for (unsigned i = 0; i < 2u; i++) {
+        reset(THR_MODE_TORQUE);
+        arm();
+        run(&bad[i], 250u);
+        TEST_ASSERT_EQUAL_UINT32(1u, n_disarm);
+        TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_INVALID, thr.cause);
+        TEST_ASSERT_EQUAL_UINT8(THR_WAIT_LOW, thr.state);
+    }
+    reset(THR_MODE_TORQUE);
+    arm();
+    const sender_t edge[2] = {{20000u, 800u, 0u, 0u}, {20000u, 2200u, 0u, 0u}};
+    run(&edge[0], 500u);
+    run(&edge[1], 500u);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE, last.ref);
+}
+
+/* Settings outside their ranges are refused, naming which. */
+static void test_config_check(void)
+{
+    thr_config_t c;
+    thr_config_default(&c);
+    TEST_ASSERT_EQUAL_INT(0, thr_config_check(&c));
+    c.mode = 3u;
+    TEST_ASSERT_EQUAL_INT(1, thr_config_check(&c));
+    thr_config_default(&c);
+    c.low_us = 799u;
+    TEST_ASSERT_EQUAL_INT(2, thr_config_check(&c));
+    thr_config_default(&c);
+    c.high_us = 2201u;
+    TEST_ASSERT_EQUAL_INT(3, thr_config_check(&c));
+    thr_config_default(&c);
+    c.deadband_us = 500u;
+    TEST_ASSERT_EQUAL_INT(4, thr_config_check(&c));
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_arms_after_one_second_at_the_low_end);
+    RUN_TEST(test_throttle_high_at_power_up_never_arms);
+    RUN_TEST(test_arming_needs_an_unbroken_second);
+    RUN_TEST(test_reference_follows_the_width);
+    RUN_TEST(test_glitches_are_dropped);
+    RUN_TEST(test_unplugged_wire_ramps_down_and_disarms);
+    RUN_TEST(test_out_of_range_pulses_are_a_loss);
+    RUN_TEST(test_config_check);
+    return UNITY_END();
+}
