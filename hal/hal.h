@@ -57,6 +57,12 @@ typedef struct {
      * told the voltage actually applied (tests/loop/test_loop_duty_cap.c).
      * 0 = no limit (period_counts). */
     uint32_t pwm_cmp_max;
+    /* Phase-current code (as hal_adc_read returns it) expected at zero
+     * current, and the largest deviation the offset calibration accepts,
+     * counts; tolerance 0 = not known to the back-end (mid-scale +- 1/32 of
+     * full scale). */
+    uint16_t adc_current_zero;
+    uint16_t adc_current_zero_tol;
 } hal_info_t;
 
 void hal_info_get(const hal_t *h, hal_info_t *info);

@@ -5,9 +5,6 @@
 #include "plan.h"
 #include "svpwm.h"
 
-/* Plausible ADC offset: within 1/16 of full scale from mid-scale. */
-#define FW_CALIB_OFFSET_TOL_SHIFT 4u
-
 static void fw_fault_now(fw_t *fw, uint32_t code)
 {
     /* Gates off before anything else, then latch the code. */
@@ -66,12 +63,13 @@ static void fw_calibrate(fw_t *fw, const hal_adc_raw_t *raw)
     }
     /* Average in Q8 counts, rounded (sum < 2^16 * 2^16, times 2^8 fits 64 bits). */
     const uint64_t n = fw->calib_n;
-    const int32_t tol = (int32_t)fw->adc_mid * 256 >> FW_CALIB_OFFSET_TOL_SHIFT;
+    /* Plausible offset: within adc_zero_tol of adc_zero (pipeline_config.c). */
+    const int32_t tol = (int32_t)fw->adc_zero_tol * 256;
     bool ok = true;
     for (int x = 0; x < 3; x++) {
         const uint64_t avg = ((uint64_t)fw->calib_sum[x] * 256u + n / 2u) / n;
         fw->off_q8[x] = (int32_t)avg;
-        const int32_t dev = fw->off_q8[x] - (int32_t)fw->adc_mid * 256;
+        const int32_t dev = fw->off_q8[x] - (int32_t)fw->adc_zero * 256;
         if (x < 2 && (dev > tol || dev < -tol)) {
             ok = false;
         }

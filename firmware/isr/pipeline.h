@@ -269,12 +269,13 @@ typedef struct {
     /* calibration */
     uint32_t calib_samples, calib_n;
     uint32_t calib_sum[3];
-    int32_t off_q8[3];    /* Q8 counts */
-    int32_t gain_q30[3];  /* Q30 pu per count */
-    int32_t vdc_gain_q30; /* Q30 pu per count */
-    uint16_t adc_mid;     /* 2^(bits-1) */
-    uint32_t pwm_n8;      /* period_counts * 2^8 if period_counts < 2^24, else 0 */
-    q24_t duty_max;       /* largest leg duty the HAL applies (hal_info_t.pwm_cmp_max), Q24 */
+    int32_t off_q8[3];     /* Q8 counts */
+    int32_t gain_q30[3];   /* Q30 pu per count */
+    int32_t vdc_gain_q30;  /* Q30 pu per count */
+    uint16_t adc_zero;     /* expected offset, counts (hal_info_t.adc_current_zero) */
+    uint16_t adc_zero_tol; /* accepted deviation of the measured offsets, counts */
+    uint32_t pwm_n8;       /* period_counts * 2^8 if period_counts < 2^24, else 0 */
+    q24_t duty_max;        /* largest leg duty the HAL applies (hal_info_t.pwm_cmp_max), Q24 */
     /* encoder */
     uint32_t enc_cpr;
     uint32_t enc_q32; /* floor(p 2^32 / cpr) mod 2^32 (angle per count, integer part) */

@@ -298,7 +298,10 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
         !(in->adc_vdc_v_per_count > 0.0) || in->encoder_counts_per_rev == 0u ||
         cfg->calib_samples == 0u || cfg->calib_samples > 65536u ||
         (cfg->enc_direction != 1 && cfg->enc_direction != -1) ||
-        in->pwm_cmp_max > in->period_counts) {
+        in->pwm_cmp_max > in->period_counts ||
+        (in->adc_current_zero_tol != 0u &&
+         (in->adc_current_zero < in->adc_current_zero_tol ||
+          (uint32_t)in->adc_current_zero + in->adc_current_zero_tol >= (1u << in->adc_bits)))) {
         return FW_EINVAL;
     }
     fw->machine_own = *cfg->machine;
@@ -313,13 +316,18 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     if (rc != FW_OK) {
         return rc;
     }
-    fw->adc_mid = (uint16_t)(1u << (in->adc_bits - 1u));
+    /* Offsets accepted by the calibration: the back-end's expected code and
+     * tolerance (its board data), else mid-scale +- 1/32 of full scale. */
+    const uint16_t mid = (uint16_t)(1u << (in->adc_bits - 1u));
+    const bool known = in->adc_current_zero_tol != 0u;
+    fw->adc_zero = known ? in->adc_current_zero : mid;
+    fw->adc_zero_tol = known ? in->adc_current_zero_tol : (uint16_t)(mid >> 4);
     fw->pwm_n8 = in->period_counts < (1u << 24) ? in->period_counts << 8 : 0u;
     /* floor(cmp_max 2^24 / N): its compare value round(d N / 2^24) <= cmp_max. */
     fw->duty_max = in->pwm_cmp_max == 0u
                        ? FX_ONE
                        : (q24_t)(((uint64_t)in->pwm_cmp_max << 24) / in->period_counts);
-    fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_mid * 256;
+    fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_zero * 256;
     fw->calib_samples = cfg->calib_samples;
     fw->ref_mode = FW_REF_TORQUE;
     memset(&fw->applied, 0, sizeof fw->applied);

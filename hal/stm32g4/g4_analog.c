@@ -1,6 +1,7 @@
 /* Op-amps, comparators, DAC3 (g4_analog.h). */
 #include "g4_analog.h"
 
+#include "g4_adc.h"
 #include "g4_core.h"
 #include "g4_regs.h"
 
@@ -66,4 +67,41 @@ void g4_comp_init(uint32_t x, uint32_t csr, uint32_t f_cpu_hz)
 bool g4_comp_value(uint32_t x)
 {
     return (g4_rd(G4_COMP + G4_COMP_CSR(x)) & G4_COMP_CSR_VALUE) != 0u;
+}
+
+/* VINP's share of VDDA at zero current (g4_board_t: the bias divider). */
+static float g4_bias_ratio(float r_gnd, float r_bias, float r_shunt)
+{
+    const float g_bias = 1.0f / r_bias;
+    return g_bias / (1.0f / r_gnd + g_bias + 1.0f / r_shunt);
+}
+
+/* Single precision: a handful of FPU instructions on the Cortex-M4F (double
+ * is library code there), and 24 bits are plenty for whole counts. */
+void g4_sense_zero(const g4_board_t *b, uint16_t *zero, uint16_t *tol)
+{
+    *zero = 0u;
+    *tol = 0u;
+    const float rg = (float)b->sense_r_gnd, rb = (float)b->sense_r_bias;
+    const float rs = (float)b->sense_r_shunt, e = (float)b->sense_r_tol;
+    if (!(rb > 0.0f) || !(rg > 0.0f) || !(rs > 0.0f)) {
+        return;
+    }
+    const float fs = (float)G4_ADC_FULL_SCALE;
+    const float gain = (float)b->opamp_pga_gain;
+    const float k = gain * fs; /* counts per unit of VINP / VDDA */
+    const float nom = k * g4_bias_ratio(rg, rb, rs);
+    /* The ratio rises with r_gnd and r_shunt and falls with r_bias. */
+    const float top = k * g4_bias_ratio(rg * (1.0f + e), rb * (1.0f - e), rs * (1.0f + e));
+    const float bot = k * g4_bias_ratio(rg * (1.0f - e), rb * (1.0f + e), rs * (1.0f - e));
+    const float r_dev = top - nom > nom - bot ? top - nom : nom - bot;
+    const float spread =
+        r_dev + gain * (float)(b->opamp_vio_v / b->vref) * fs + (float)b->opamp_gain_err * nom;
+    if (!(nom < fs) || !(spread >= 0.0f) || !(spread < fs)) {
+        return;
+    }
+    const float raw = b->sense_gain < 0.0 ? fs - nom : nom; /* as hal_adc_read returns it */
+    *zero = (uint16_t)(raw + 0.5f);
+    const uint16_t t = (uint16_t)spread;
+    *tol = (float)t < spread ? (uint16_t)(t + 1u) : t; /* rounded up */
 }

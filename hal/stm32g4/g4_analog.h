@@ -9,6 +9,8 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "g4_board.h"
+
 #define G4_DAC_STEPS 4096u /* 12-bit DAC: V_out = VREF+ x DOR / 4096 (RM0440) */
 
 /* OPAMPx_CSR without OPAEN: non-inverting input VINPy (vpsel 0..3), PGA mode
@@ -35,5 +37,11 @@ uint32_t g4_comp_csr_dac3(uint32_t hyst);
 void g4_comp_init(uint32_t x, uint32_t csr, uint32_t f_cpu_hz);
 /* Comparator output level (COMPx_CSR.VALUE). */
 bool g4_comp_value(uint32_t x);
+
+/* Expected phase-current code at zero current, as hal_adc_read returns it
+ * (mirrored for a negative sense gain), and its worst-case deviation, counts,
+ * from the board's bias network (g4_board_t); both 0 when the board does not
+ * describe it (hal_info_t.adc_current_zero, adc_current_zero_tol). */
+void g4_sense_zero(const g4_board_t *b, uint16_t *zero, uint16_t *tol);
 
 #endif /* HAL_STM32G4_G4_ANALOG_H */

@@ -55,6 +55,15 @@ typedef struct {
      * current flows from the motor into the inverter leg). */
     double sense_gain;
     uint32_t current_smp_half; /* sampling time of the current channels, half cycles */
+    /* Zero-current level: each op-amp plus input (VINP) sits on a divider of
+     * r_gnd to ground, r_bias to VDDA and r_shunt from the shunt; VINM0 at
+     * ground. At zero current V_out = pga_gain VDDA G_bias / (G_gnd + G_bias +
+     * G_shunt) (G = 1/R), a fixed fraction of VREF+ = VDDA. Its spread: the
+     * resistors at +-r_tol, the op-amp's input offset (up to opamp_vio_v,
+     * times the gain) and the PGA's gain error (opamp_gain_err, relative).
+     * r_bias = 0: not described (g4_hal_current_zero gives no window). */
+    double sense_r_gnd, sense_r_bias, sense_r_shunt, sense_r_tol;
+    double opamp_vio_v, opamp_gain_err;
     /* DC link */
     g4_pin_t vbus_pin;
     uint8_t vbus_adc, vbus_channel, vbus_rank;
@@ -75,6 +84,12 @@ typedef struct {
     /* serial link (USART2) */
     g4_pin_t uart_tx, uart_rx;
     uint32_t baud;
+    /* BOOT0 pin (PB8 on the STM32G431CB) pulled up by the board: the option
+     * bytes must take BOOT0 from nBOOT0 (g4_boot_risk). */
+    bool boot0_pulled_up;
+    /* servo-style throttle input: TIM2_CH1 (g4_tim2_capture_init) */
+    g4_pin_t throttle;
+    uint8_t throttle_filter; /* TIM2_CCMR1.IC1F code */
     /* status LED */
     g4_pin_t led;
     /* USB Type-C dead-battery pull-downs on PB4/PB6 (UCPD1 CC pins) switched

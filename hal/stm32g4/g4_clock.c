@@ -116,9 +116,12 @@ int g4_clock_init(uint32_t hse_hz, uint32_t sysclk_hz)
         return G4_E_PLL;
     }
     /* Wait states before the frequency rises; read back (RM0440: check that
-     * the new latency is taken into account by reading FLASH_ACR). */
-    g4_wr(G4_FLASH + G4_FLASH_ACR,
-          (uint32_t)ws | G4_FLASH_ACR_PRFTEN | G4_FLASH_ACR_ICEN | G4_FLASH_ACR_DCEN);
+     * the new latency is taken into account by reading FLASH_ACR). Only the
+     * latency and cache bits change: the register also holds DBG_SWEN (reset
+     * value 1), and clearing it locks the debugger out. */
+    g4_mod(G4_FLASH + G4_FLASH_ACR,
+           G4_FLASH_ACR_LATENCY_MASK | G4_FLASH_ACR_PRFTEN | G4_FLASH_ACR_ICEN | G4_FLASH_ACR_DCEN,
+           (uint32_t)ws | G4_FLASH_ACR_PRFTEN | G4_FLASH_ACR_ICEN | G4_FLASH_ACR_DCEN);
     if ((g4_rd(G4_FLASH + G4_FLASH_ACR) & G4_FLASH_ACR_LATENCY_MASK) != (uint32_t)ws) {
         return G4_E_FLASH;
     }

@@ -324,6 +324,7 @@ int g4_hal_init(hal_t *h, const g4_board_t *b, const g4_hal_cfg_t *c)
     h->info.has_i_c = true;
     h->info.cycle_clock_hz = b->sysclk_hz;
     h->info.pwm_cmp_max = h->cmp_max;
+    g4_sense_zero(b, &h->info.adc_current_zero, &h->info.adc_current_zero_tol);
 
     /* 10. Counter on; the update event must fall on the counter peak. Flags
      * raised while the comparators settled are cleared (before any MOE). */
@@ -343,22 +344,49 @@ void g4_hal_adc_irq_ack(hal_t *h)
 
 void g4_hal_break_irq(hal_t *h)
 {
+    const uint32_t flags = G4_TIM_SR_BIF | G4_TIM_SR_B2IF | G4_TIM_SR_SBIF;
     const uint32_t sr = g4_rd(G4_TIM1 + G4_TIM_SR);
-    uint32_t t = 0u;
     if ((sr & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF)) != 0u) {
-        t |= G4_TRIP_BREAK;
+        h->break_n++;
     }
     if ((sr & G4_TIM_SR_SBIF) != 0u) {
-        t |= G4_TRIP_SYSTEM;
+        h->system_n++;
     }
-    h->trip |= t;
-    g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF | G4_TIM_SR_SBIF));
+    g4_wr(G4_TIM1 + G4_TIM_SR, ~flags);
+    /* RM0440 TIM1 break: a flag cannot be cleared while its input is still
+     * active, and the interrupt would be taken again at once, for as long as
+     * a comparator stays high. Masked until hal_trip_clear finds the inputs
+     * released (DIER holds BIE only: written whole, no read-modify-write). */
+    if ((g4_rd(G4_TIM1 + G4_TIM_SR) & flags) != 0u) {
+        g4_wr(G4_TIM1 + G4_TIM_DIER, 0u);
+    }
 }
 
-void g4_hal_trip_board(hal_t *h)
+void g4_hal_trip_board(hal_t *h, bool on)
 {
-    g4_tim1_gates_off_now();
-    h->trip |= G4_TRIP_BOARD;
+    /* The latch first: a control interrupt in between no longer enables the
+     * gates. MOE cleared without a software break (EGR.BG would raise BIF and
+     * read as an over-current). */
+    h->board_trip = on;
+    if (on) {
+        g4_tim1_outputs(false);
+    }
+}
+
+uint32_t g4_hal_trip_cause(const hal_t *h)
+{
+    const uint32_t sr = g4_rd(G4_TIM1 + G4_TIM_SR);
+    uint32_t t = 0u;
+    if (h->break_n != h->break_acked || (sr & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF)) != 0u) {
+        t |= G4_TRIP_BREAK;
+    }
+    if (h->system_n != 0u || (sr & G4_TIM_SR_SBIF) != 0u) {
+        t |= G4_TRIP_SYSTEM;
+    }
+    if (h->board_trip) {
+        t |= G4_TRIP_BOARD;
+    }
+    return t;
 }
 
 int32_t g4_hal_temp_counts(hal_t *h)
@@ -419,30 +447,39 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
 
 void hal_gate_enable(hal_t *h, bool enable)
 {
-    if (enable && h->trip == 0u) {
+    if (enable && !hal_trip_active(h)) {
         g4_tim1_outputs(true);
-    } else {
-        g4_tim1_outputs(false);
+        /* A break between the check and the write (its interrupt has
+         * latched it, the hardware had cleared MOE, the write set it again):
+         * off again. A break after this check clears MOE in hardware. */
+        if (!hal_trip_active(h)) {
+            return;
+        }
     }
+    g4_tim1_outputs(false);
 }
 
 bool hal_trip_active(const hal_t *h)
 {
-    return h->trip != 0u ||
-           (g4_rd(G4_TIM1 + G4_TIM_SR) & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF | G4_TIM_SR_SBIF)) != 0u;
+    return g4_hal_trip_cause(h) != 0u;
 }
 
 void hal_trip_clear(hal_t *h)
 {
-    /* Stays latched while a comparator still sees over-current or the board
-     * cause (over-temperature) persists: the board clears that one. */
+    /* Stays latched while a comparator still sees over-current; the board
+     * cause (over-temperature) is the board's to clear (g4_hal_trip_board). */
     for (unsigned x = 0; x < 3u; x++) {
         if (g4_comp_value(h->board->phase[x].comp)) {
             return;
         }
     }
+    /* Flags left from while the interrupt was masked are cleared (the inputs
+     * are released now); a break after this is counted by the interrupt and
+     * stays latched (break_n moves past n). */
     g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF));
-    h->trip &= ~(uint32_t)G4_TRIP_BREAK;
+    const uint32_t n = h->break_n;
+    g4_wr(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE);
+    h->break_acked = n;
 }
 
 uint32_t hal_cycles(const hal_t *h)

@@ -38,7 +38,7 @@ typedef struct {
     double trip_current_a; /* hardware over-current threshold, A (see g4_hal_trip_codes) */
 } g4_hal_cfg_t;
 
-/* Why the trip latch is set (hal_trip_active). */
+/* Why the trip latch is set (g4_hal_trip_cause). */
 #define G4_TRIP_BREAK 0x1u  /* comparator -> TIM1 break (over-current) */
 #define G4_TRIP_SYSTEM 0x2u /* TIM1 system break: clock failure, core lockup */
 #define G4_TRIP_BOARD 0x4u  /* set by the board application (e.g. over-temperature) */
@@ -55,9 +55,15 @@ struct hal {
     g4_enc_ext_t enc;
     bool index_seen;
     uint32_t index_count;
-    volatile uint32_t trip; /* G4_TRIP_* latched */
-    uint16_t vinp_zero[3];  /* comparator plus inputs at zero current, ADC counts */
-    uint32_t dac_code[2];   /* DAC3 channel 1, 2 thresholds */
+    /* Trip latch, one writer per word (no read-modify-write shared between
+     * priorities): break_n, system_n counted by the break interrupt,
+     * break_acked set by hal_trip_clear, board_trip by the main loop. */
+    volatile uint32_t break_n;     /* comparator breaks seen */
+    volatile uint32_t break_acked; /* break_n at the last accepted clear */
+    volatile uint32_t system_n;    /* system breaks seen (not clearable) */
+    volatile bool board_trip;      /* G4_TRIP_BOARD */
+    uint16_t vinp_zero[3];         /* comparator plus inputs at zero current, ADC counts */
+    uint32_t dac_code[2];          /* DAC3 channel 1, 2 thresholds */
     double trip_current_a;
 };
 
@@ -92,8 +98,13 @@ void g4_hal_gate_pins_safe(const g4_board_t *b);
 
 /* From the interrupts (board application). */
 void g4_hal_adc_irq_ack(hal_t *h); /* clears the end-of-sequence flags */
-void g4_hal_break_irq(hal_t *h);   /* latches and clears the break flags */
-void g4_hal_trip_board(hal_t *h);  /* latches G4_TRIP_BOARD */
+/* Counts and clears the break flags; masks the interrupt while a break input
+ * is still active (re-enabled by hal_trip_clear). */
+void g4_hal_break_irq(hal_t *h);
+/* Main loop: sets (gates off at once) or releases G4_TRIP_BOARD. */
+void g4_hal_trip_board(hal_t *h, bool on);
+/* The G4_TRIP_* causes latched now (0: no trip). */
+uint32_t g4_hal_trip_cause(const hal_t *h);
 
 /* Board temperature: one regular conversion (main loop); -1 on time-out. */
 int32_t g4_hal_temp_counts(hal_t *h);

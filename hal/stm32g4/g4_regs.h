@@ -29,6 +29,7 @@
  * Addresses: RM0440 "Memory map" table of peripheral register boundary
  * addresses (= stm32g431xx.h *_BASE); core: ARMv7-M System Control Space. */
 #define G4_PERIPHS(X)                                                                              \
+    X(TIM2, tim2, 0x40000000u, 0x400u)                                                             \
     X(TIM4, tim4, 0x40000800u, 0x400u)                                                             \
     X(IWDG, iwdg, 0x40003000u, 0x400u)                                                             \
     X(USART2, usart2, 0x40004400u, 0x400u)                                                         \
@@ -60,6 +61,7 @@ G4_PERIPHS(G4_DECLARE_ARRAY)
 #define G4_BASE(n, addr) ((uintptr_t)(addr))
 #endif
 
+#define G4_TIM2 G4_BASE(tim2, 0x40000000u)
 #define G4_TIM4 G4_BASE(tim4, 0x40000800u)
 #define G4_IWDG G4_BASE(iwdg, 0x40003000u)
 #define G4_USART2 G4_BASE(usart2, 0x40004400u)
@@ -127,6 +129,15 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_FLASH_ACR_PRFTEN G4_BIT(8)
 #define G4_FLASH_ACR_ICEN G4_BIT(9)
 #define G4_FLASH_ACR_DCEN G4_BIT(10)
+#define G4_FLASH_ACR_DBG_SWEN G4_BIT(18) /* debugger access; reset value 1 */
+#define G4_FLASH_ACR_RESET 0x00040600u   /* DBG_SWEN | DCEN | ICEN */
+/* FLASH_OPTR: loaded from the option bytes at reset (RM0440 FLASH_OPTR,
+ * table "Boot modes"): nSWBOOT0 = 0 takes BOOT0 from nBOOT0, = 1 from the
+ * BOOT0 pin (PB8); BOOT0 = 1 with nBOOT1 = 1 starts the ROM bootloader. */
+#define G4_FLASH_OPTR 0x20u
+#define G4_FLASH_OPTR_nBOOT1 G4_BIT(23)
+#define G4_FLASH_OPTR_nSWBOOT0 G4_BIT(26)
+#define G4_FLASH_OPTR_nBOOT0 G4_BIT(27)
 
 /* ---- PWR (RM0440 PWR chapter) ---- */
 #define G4_PWR_CR1 0x00u
@@ -179,6 +190,7 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_RCC_AHB2ENR_ADC12EN G4_BIT(13)
 #define G4_RCC_AHB2ENR_DAC3EN G4_BIT(18)
 #define G4_RCC_APB1ENR1 0x58u
+#define G4_RCC_APB1ENR1_TIM2EN G4_BIT(0)
 #define G4_RCC_APB1ENR1_TIM4EN G4_BIT(2)
 #define G4_RCC_APB1ENR1_USART2EN G4_BIT(17)
 #define G4_RCC_APB1ENR1_PWREN G4_BIT(28)
@@ -192,7 +204,13 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_RCC_CSR_LSION G4_BIT(0)
 #define G4_RCC_CSR_LSIRDY G4_BIT(1)
 #define G4_RCC_CSR_RMVF G4_BIT(23)
+#define G4_RCC_CSR_OBLRSTF G4_BIT(25)
+#define G4_RCC_CSR_PINRSTF G4_BIT(26)
+#define G4_RCC_CSR_BORRSTF G4_BIT(27)
+#define G4_RCC_CSR_SFTRSTF G4_BIT(28)
 #define G4_RCC_CSR_IWDGRSTF G4_BIT(29)
+#define G4_RCC_CSR_WWDGRSTF G4_BIT(30)
+#define G4_RCC_CSR_LPWRRSTF G4_BIT(31)
 
 /* ---- SYSCFG (RM0440 SYSCFG chapter) ---- */
 #define G4_SYSCFG_CFGR2 0x1Cu
@@ -227,13 +245,19 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_TIM_CR2_MMS2_UPDATE G4_FIELD(2u, 20)
 #define G4_TIM_SMCR 0x08u
 #define G4_TIM_SMCR_SMS_ENCODER3 G4_FIELD(3u, 0) /* x4: count on TI1FP1 and TI2FP2 edges */
+#define G4_TIM_SMCR_SMS_RESET G4_FIELD(4u, 0)    /* trigger edge resets the counter */
+#define G4_TIM_SMCR_TS_TI1FP1 G4_FIELD(5u, 4)    /* TS[2:0] = 101 (TS[4:3] = 00) */
 #define G4_TIM_DIER 0x0Cu
 #define G4_TIM_DIER_BIE G4_BIT(7)
 #define G4_TIM_SR 0x10u
 #define G4_TIM_SR_UIF G4_BIT(0)
+#define G4_TIM_SR_CC1IF G4_BIT(1)
+#define G4_TIM_SR_CC2IF G4_BIT(2)
 #define G4_TIM_SR_CC3IF G4_BIT(3)
 #define G4_TIM_SR_BIF G4_BIT(7)
 #define G4_TIM_SR_B2IF G4_BIT(8)
+#define G4_TIM_SR_CC1OF G4_BIT(9)
+#define G4_TIM_SR_CC2OF G4_BIT(10)
 #define G4_TIM_SR_SBIF G4_BIT(13)
 #define G4_TIM_EGR 0x14u
 #define G4_TIM_EGR_UG G4_BIT(0)
@@ -368,6 +392,7 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_USART_ISR_NE G4_BIT(2)
 #define G4_USART_ISR_ORE G4_BIT(3)
 #define G4_USART_ISR_RXNE G4_BIT(5)
+#define G4_USART_ISR_TC G4_BIT(6)
 #define G4_USART_ISR_TXE G4_BIT(7)
 #define G4_USART_ICR 0x20u
 #define G4_USART_ICR_FECF G4_BIT(1)

@@ -173,6 +173,36 @@ void g4_tim4_encoder_init(uint32_t icf, bool index)
     g4_wr(t + G4_TIM_CR1, G4_TIM_CR1_CEN);
 }
 
+void g4_tim2_capture_init(uint32_t psc, uint32_t icf)
+{
+    const uintptr_t t = G4_TIM2;
+    g4_set(G4_RCC + G4_RCC_APB1ENR1, G4_RCC_APB1ENR1_TIM2EN);
+    g4_wr(t + G4_TIM_CR1, 0u);
+    /* CC1S = 01 (TI1), CC2S = 10 (TI1 as well), both filtered. */
+    g4_wr(t + G4_TIM_CCMR1, G4_TIM_CCMR_IC_DIRECT(0u, icf) | G4_FIELD(2u, 8) | G4_FIELD(icf, 12));
+    /* CC1 on the rising edge, CC2 on the falling edge (CC2P). */
+    g4_wr(t + G4_TIM_CCER, G4_TIM_CCER_CCE(1u) | G4_TIM_CCER_CCE(2u) | G4_TIM_CCER_CCP(2u));
+    g4_wr(t + G4_TIM_SMCR, G4_TIM_SMCR_TS_TI1FP1 | G4_TIM_SMCR_SMS_RESET);
+    g4_wr(t + G4_TIM_PSC, psc);
+    g4_wr(t + G4_TIM_ARR, 0xFFFFFFFFu);
+    g4_wr(t + G4_TIM_EGR, G4_TIM_EGR_UG);
+    g4_wr(t + G4_TIM_SR, 0u);
+    g4_wr(t + G4_TIM_CR1, G4_TIM_CR1_CEN);
+}
+
+bool g4_tim2_capture_read(uint32_t *width, uint32_t *period)
+{
+    if ((g4_rd(G4_TIM2 + G4_TIM_SR) & G4_TIM_SR_CC1IF) == 0u) {
+        return false;
+    }
+    *width = g4_rd(G4_TIM2 + G4_TIM_CCR2);
+    *period = g4_rd(G4_TIM2 + G4_TIM_CCR1);
+    /* Captures overwritten meanwhile (a slow main loop) only lose pulses. */
+    g4_wr(G4_TIM2 + G4_TIM_SR,
+          ~(G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_CC1OF | G4_TIM_SR_CC2OF));
+    return true;
+}
+
 static int32_t g4_s16(uint16_t u)
 {
     return u <= 0x7FFFu ? (int32_t)u : (int32_t)u - 65536;

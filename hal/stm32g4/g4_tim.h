@@ -76,6 +76,15 @@ void g4_tim1_gates_off_now(void);
  * when `index` is set. */
 void g4_tim4_encoder_init(uint32_t icf, bool index);
 
+/* TIM2 measuring a pulse train on CH1 (RM0440 TIM2/3/4/5, "PWM input
+ * mode"): IC1 on TI1 rising edges, IC2 on TI1 falling edges, the rising edge
+ * resets the counter (slave reset mode on TI1FP1): CCR1 = period, CCR2 =
+ * width, in ticks of f_tim / (psc + 1); 32-bit counter; input filter `icf`. */
+void g4_tim2_capture_init(uint32_t psc, uint32_t icf);
+/* A period has ended since the last call (CC1IF): its width (CCR2, read
+ * first) and period (CCR1, whose read clears CC1IF), ticks; false if not. */
+bool g4_tim2_capture_read(uint32_t *width, uint32_t *period);
+
 /* 16-bit hardware counter extended to the 32-bit count of hal.h: the signed
  * 16-bit difference since the last read is added (valid while the encoder
  * moves less than 32768 counts between two reads, i.e. below

@@ -39,14 +39,44 @@ void g4_model_reset(void)
 #undef G4_CLEAR
     memset(&g4_model, 0, sizeof g4_model);
     g4_model.adc_regular = 128u;
-    /* Reset values the HAL relies on: PWR_CR1.VOS = range 1, PWR_CR5.R1MODE = 1
-     * (boost off), ADC_CR.DEEPPWD = 1, ADC_CFGR.JQDIS = 1 (RM0440 reset values). */
-    g4_mem_pwr[G4_PWR_CR1 / 4u] = G4_PWR_CR1_VOS_RANGE1;
-    g4_mem_pwr[G4_PWR_CR5 / 4u] = G4_PWR_CR5_R1MODE;
+    /* Every modelled register starts at its RM0440 reset value, so that a
+     * whole-register write that clobbers a bit shows in the image. */
+    g4_mem_flash[G4_FLASH_ACR / 4u] = G4_FLASH_ACR_RESET; /* 0x0004_0600: DBG_SWEN, DCEN, ICEN */
+    /* FLASH_OPTR holds the option bytes: as ST ships the B-G431B-ESC1
+     * (factory 0xFFEF_F8AA with nSWBOOT0 = 0: BOOT0 from nBOOT0 = 1). */
+    g4_mem_flash[G4_FLASH_OPTR / 4u] = 0xFFEFF8AAu & ~G4_FLASH_OPTR_nSWBOOT0;
+    g4_mem_rcc[G4_RCC_CR / 4u] = 0x00000500u;                              /* HSION, HSIRDY */
+    g4_mem_rcc[G4_RCC_CFGR / 4u] = 0x00000005u;                            /* SW = SWS = HSI16 */
+    g4_mem_rcc[G4_RCC_PLLCFGR / 4u] = 0x00001000u;                         /* PLLN = 16 */
+    g4_mem_rcc[G4_RCC_AHB1ENR / 4u] = 0x00000100u;                         /* FLASHEN */
+    g4_mem_rcc[G4_RCC_APB1ENR1 / 4u] = 0x00000400u;                        /* RTCAPBEN */
+    g4_mem_rcc[G4_RCC_CSR / 4u] = G4_RCC_CSR_PINRSTF | G4_RCC_CSR_BORRSTF; /* power-on */
+    g4_mem_pwr[G4_PWR_CR1 / 4u] = G4_PWR_CR1_VOS_RANGE1;                   /* 0x200 */
+    g4_mem_pwr[G4_PWR_CR3 / 4u] = 0x00008000u;                             /* EIWUL */
+    g4_mem_pwr[G4_PWR_CR5 / 4u] = G4_PWR_CR5_R1MODE;                       /* 0x100: boost off */
+    g4_mem_gpioa[G4_GPIO_MODER / 4u] = 0xABFFFFFFu; /* analog, PA13/14/15 debug AF */
+    g4_mem_gpioa[G4_GPIO_OSPEEDR / 4u] = 0x0C000000u;
+    g4_mem_gpioa[G4_GPIO_PUPDR / 4u] = 0x64000000u;
+    g4_mem_gpiob[G4_GPIO_MODER / 4u] = 0xFFFFFEBFu; /* analog, PB3/PB4 debug AF */
+    g4_mem_gpiob[G4_GPIO_PUPDR / 4u] = 0x00000100u;
+    g4_mem_gpioc[G4_GPIO_MODER / 4u] = 0xFFFFFFFFu;
     g4_mem_adc1[G4_ADC_CR / 4u] = G4_ADC_CR_DEEPPWD;
     g4_mem_adc2[G4_ADC_CR / 4u] = G4_ADC_CR_DEEPPWD;
     g4_mem_adc1[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
     g4_mem_adc2[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
+    g4_mem_tim1[G4_TIM_ARR / 4u] = 0xFFFFu;
+    g4_mem_tim4[G4_TIM_ARR / 4u] = 0xFFFFu;
+    g4_mem_tim2[G4_TIM_ARR / 4u] = 0xFFFFFFFFu;
+    g4_mem_iwdg[G4_IWDG_RLR / 4u] = 0xFFFu;
+    g4_mem_usart2[G4_USART_ISR / 4u] = G4_USART_ISR_TXE | G4_USART_ISR_TC;
+}
+
+/* An interrupt of priority 0 is pending while its enable and its flag are
+ * both set (the NVIC takes it again as soon as the handler returns). */
+bool g4_model_break_pending(void)
+{
+    return (g4_mem_tim1[G4_TIM_DIER / 4u] & G4_TIM_DIER_BIE) != 0u &&
+           (g4_mem_tim1[G4_TIM_SR / 4u] & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF | G4_TIM_SR_SBIF)) != 0u;
 }
 
 const char *g4_model_name(uintptr_t reg)
@@ -139,7 +169,15 @@ uint32_t g4_trace_read(uintptr_t reg)
     if (reg >= G4_COMP && reg < G4_COMP + 0x10u) {
         *c = (*c & ~G4_COMP_CSR_VALUE) | (g4_model.comp_high ? G4_COMP_CSR_VALUE : 0u);
     }
-    return *c;
+    const uint32_t v = *c;
+    if (g4_model.irq_on_read == reg && g4_model.irq != NULL) {
+        /* An interrupt taken right after this load: the caller stores what it
+         * read, modified, after the handler has run. */
+        void (*irq)(void) = g4_model.irq;
+        g4_model.irq = NULL;
+        irq();
+    }
+    return v;
 }
 
 void g4_trace_write(uintptr_t reg, uint32_t value)
@@ -190,10 +228,18 @@ void g4_trace_write(uintptr_t reg, uint32_t value)
         tb = G4_TIM1;
     } else if (reg >= G4_TIM4 && reg < G4_TIM4 + 0x400u) {
         tb = G4_TIM4;
+    } else if (reg >= G4_TIM2 && reg < G4_TIM2 + 0x400u) {
+        tb = G4_TIM2;
     }
     if (tb != 0u) {
         if (reg == tb + G4_TIM_SR) {
             *c &= value; /* rc_w0 */
+            /* RM0440 TIM1 break: BIF cannot be cleared while the break input
+             * (here: a comparator output) is still active. */
+            if (tb == G4_TIM1 && g4_model.comp_high &&
+                (g4_mem_tim1[G4_TIM_BDTR / 4u] & G4_TIM_BDTR_BKE) != 0u) {
+                *c |= G4_TIM_SR_BIF;
+            }
             return;
         }
         if (reg == tb + G4_TIM_EGR) {

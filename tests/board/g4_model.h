@@ -31,7 +31,11 @@ typedef struct {
     bool hse_broken;      /* HSERDY never rises */
     bool uev_at_valley;   /* the TIM1 update falls at the counter valley */
     uint16_t adc_regular; /* result of every regular conversion */
-    bool comp_high;       /* every comparator output high */
+    bool comp_high;       /* every comparator output high (and the break input with it) */
+    /* The next read of irq_on_read runs irq() right after the load (an
+     * interrupt inside a read-modify-write); one shot. */
+    uintptr_t irq_on_read;
+    void (*irq)(void);
     /* state the model keeps */
     bool rcr_before_cen;
     bool rcr_written;
@@ -39,8 +43,10 @@ typedef struct {
 
 extern g4_model_t g4_model;
 
-/* Clears every register array, the log and the switches. */
+/* Every register to its RM0440 reset value; clears the log and the switches. */
 void g4_model_reset(void);
+/* The TIM1 break interrupt would be taken (again): BIE and a break flag set. */
+bool g4_model_break_pending(void);
 /* Name of a register address ("TIM1+0x44") for messages. */
 const char *g4_model_name(uintptr_t reg);
 /* Index in the log of the first write to reg with (value & mask) == want at

@@ -22,6 +22,7 @@
 #include "controller.h"
 #include "ctrl_params.h"
 #include "esc1_app.h"
+#include "esc1_report.h"
 #include "g4_clock.h"
 #include "g4_core.h"
 #include "g4_model.h"
@@ -195,6 +196,44 @@ static void test_link_refusal_names_quantity_value_range(void)
     TEST_ASSERT_EQUAL_STRING("err 4 range [10, 100000]", command("param set m.n_rated_rpm 1"));
 }
 
+/* The offset calibration on the board's code path: with the phase-current
+ * ADCs at 2553 (2.06 V, the bias network's zero-current level) the firmware
+ * calibrates and becomes ready; at 2048 (1.65 V, mid-scale) the offsets are
+ * 505 counts off the board's expected code: fault adc_calibration, with the
+ * measured offsets kept for the report (esc1_offsets_line). */
+static void calibrate_at(uint32_t code)
+{
+    esc1_start();
+    g4_model_put(G4_ADC1 + G4_ADC_JDR1, code);
+    g4_model_put(G4_ADC2 + G4_ADC_JDR1, code);
+    g4_model_put(G4_ADC1 + G4_ADC_JDR2, code);
+    g4_model_put(G4_ADC2 + G4_ADC_JDR2, 1433u); /* 12 V */
+    for (uint32_t k = 0; k < 2u * esc.fc.calib_samples && fw_state(&esc.fw) != FW_STATE_READY &&
+                         fw_state(&esc.fw) != FW_STATE_FAULT;
+         k++) {
+        esc1_control_isr(&esc);
+    }
+}
+
+static void test_calibration_takes_the_board_zero(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_INT32(1542 * 256, esc.fw.off_q8[0]);
+
+    calibrate_at(2048u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_FAULT, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_CALIB, esc.fw.sm.fault_code);
+    char line[96];
+    TEST_ASSERT_TRUE(esc1_offsets_line(line, sizeof line, esc.fw.off_q8, esc.fw.adc_zero,
+                                       esc.fw.adc_zero_tol) > 0);
+    char want[96];
+    snprintf(want, sizeof want,
+             "esc1: current offsets 2047 2047 2047 counts, expected 1542 +- %u\r\n",
+             (unsigned)esc.hal.info.adc_current_zero_tol);
+    TEST_ASSERT_EQUAL_STRING(want, line);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -202,5 +241,6 @@ int main(void)
     RUN_TEST(test_default_machine_within_the_board);
     RUN_TEST(test_core_and_every_controller_take_it);
     RUN_TEST(test_link_refusal_names_quantity_value_range);
+    RUN_TEST(test_calibration_takes_the_board_zero);
     return UNITY_END();
 }

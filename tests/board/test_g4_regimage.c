@@ -6,6 +6,7 @@
  * order RM0440 requires (each order check names the rule). Then the run-time
  * functions of hal.h on the same registers.
  */
+#include <math.h>
 #include <string.h>
 
 #include "board_esc1.h"
@@ -66,7 +67,9 @@ static uint32_t pin_af(uintptr_t gpio, uint32_t pin)
 /* ---- clock ---- */
 
 /* End state: PLLCFGR 0x0100_5513 (HSE, M 2, N 85, R 2, PLLREN: see
- * test_g4_calc), FLASH_ACR = LATENCY 4 | PRFTEN | ICEN | DCEN = 0x704,
+ * test_g4_calc), FLASH_ACR = LATENCY 4 | PRFTEN | ICEN | DCEN = 0x704 on top
+ * of its reset value 0x0004_0600, whose DBG_SWEN (bit 18) must survive: with
+ * it cleared the debugger cannot halt the core after the first boot,
  * RCC_CFGR SW = 11 (PLL), HPRE = 0000 (/1), PPRE1 = PPRE2 = 000 (/1),
  * PWR_CR5.R1MODE = 0 (boost), RCC_CR HSEON, PLLON, CSSON. Order (RM0440 RCC
  * and PWR: frequency increase): boost mode and wait states before the
@@ -76,7 +79,7 @@ static void test_clock_register_image_and_order(void)
 {
     TEST_ASSERT_EQUAL_INT(G4_OK, g4_clock_init(8000000u, 170000000u));
     TEST_ASSERT_EQUAL_HEX32(0x01005513u, reg(G4_RCC + G4_RCC_PLLCFGR));
-    TEST_ASSERT_EQUAL_HEX32(0x704u, reg(G4_FLASH + G4_FLASH_ACR));
+    TEST_ASSERT_EQUAL_HEX32(0x00040704u, reg(G4_FLASH + G4_FLASH_ACR));
     TEST_ASSERT_EQUAL_HEX32(0x3u, reg(G4_RCC + G4_RCC_CFGR) & 0x3FF3u);
     TEST_ASSERT_EQUAL_HEX32(0u, reg(G4_PWR + G4_PWR_CR5) & G4_PWR_CR5_R1MODE);
     const uint32_t cr = reg(G4_RCC + G4_RCC_CR);
@@ -375,6 +378,38 @@ static void test_init_refuses_implausible_zero(void)
         -1, g4_model_find(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE, G4_TIM_BDTR_MOE, 0));
 }
 
+/* Zero-current code from the bias network (board_esc1.c: 2.2 k to ground,
+ * 22 k to VDDA, 1.5 k from the shunt, PGA gain 16, VINM0 at ground):
+ * 16 x 4095 x (1/22k) / (1/2.2k + 1/22k + 1/1.5k) = 2552.7 = 2.06 V, 1542
+ * as hal_adc_read returns it (mirrored: 4095 - 2552.7). The tolerance is
+ * worked out here independently, over all eight resistor corners at 1 %,
+ * plus 16 x 3 mV input offset and a 2 % gain error. The calibration window
+ * leaves mid-scale (2048, what a 1.65 V bias would give) outside. */
+static double bias_code(double rg, double rb, double rs)
+{
+    return 16.0 * 4095.0 * (1.0 / rb) / (1.0 / rg + 1.0 / rb + 1.0 / rs);
+}
+
+static void test_init_current_zero_from_bias_network(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    hal_info_t info;
+    hal_info_get(&hal, &info);
+    const double nom = bias_code(2200.0, 22000.0, 1500.0);
+    TEST_ASSERT_DOUBLE_WITHIN(0.1, 2552.7, nom);
+    double dev = 0.0;
+    for (unsigned c = 0; c < 8u; c++) {
+        const double k[3] = {(c & 1u) ? 1.01 : 0.99, (c & 2u) ? 1.01 : 0.99,
+                             (c & 4u) ? 1.01 : 0.99};
+        const double d = fabs(bias_code(2200.0 * k[0], 22000.0 * k[1], 1500.0 * k[2]) - nom);
+        dev = d > dev ? d : dev;
+    }
+    const double tol = dev + 16.0 * 0.003 / 3.3 * 4095.0 + 0.02 * nom;
+    TEST_ASSERT_EQUAL_UINT16(1542u, info.adc_current_zero);
+    TEST_ASSERT_EQUAL_UINT16((uint16_t)ceil(tol), info.adc_current_zero_tol);
+    TEST_ASSERT_TRUE(2048u > info.adc_current_zero + info.adc_current_zero_tol);
+}
+
 /* ---- run time ---- */
 
 /* Gates: enable sets MOE, disable clears it at once. A break (BIF) latches
@@ -414,6 +449,79 @@ static void test_runtime_gates_and_trip(void)
     TEST_ASSERT_EQUAL_INT(
         (int)n0, g4_model_find(G4_TIM1 + G4_TIM_EGR, G4_TIM_EGR_BG, G4_TIM_EGR_BG, (int)n0));
     TEST_ASSERT_FALSE(reg(bdtr) & G4_TIM_BDTR_MOE);
+}
+
+/* A comparator stuck high (RM0440 TIM1 break: BIF cannot be cleared while
+ * the break input is active): the handler must not leave the interrupt
+ * pending, or it re-enters at priority 0 until the watchdog resets the chip.
+ * The trip stays latched; hal_trip_clear re-arms the interrupt once the
+ * comparators are low. */
+static void test_runtime_break_input_stuck(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    hal_gate_enable(&hal, true);
+    g4_model.comp_high = true;
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF);
+    g4_hal_break_irq(&hal);
+    TEST_ASSERT_TRUE_MESSAGE(reg(G4_TIM1 + G4_TIM_SR) & G4_TIM_SR_BIF, "model: flag stuck");
+    TEST_ASSERT_FALSE_MESSAGE(g4_model_break_pending(), "break interrupt taken again at once");
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_BREAK, g4_hal_trip_cause(&hal));
+    hal_trip_clear(&hal); /* refused: the comparator is still high */
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    TEST_ASSERT_FALSE(g4_model_break_pending());
+    g4_model.comp_high = false;
+    hal_trip_clear(&hal);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
+}
+
+/* The board trip (over-temperature) turns the gates off and reads as cause
+ * G4_TRIP_BOARD (4) alone: no software break, whose BIF would read as an
+ * over-current too (cause 5). The NVIC is emulated: a pending break
+ * interrupt runs its handler. */
+static void test_runtime_board_trip_cause(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    hal_gate_enable(&hal, true);
+    g4_hal_trip_board(&hal, true);
+    if (g4_model_break_pending()) {
+        g4_hal_break_irq(&hal);
+    }
+    TEST_ASSERT_FALSE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_BOARD, g4_hal_trip_cause(&hal));
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_FALSE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
+    hal_trip_clear(&hal); /* the board's cause is the board's to release */
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_BOARD, g4_hal_trip_cause(&hal));
+    g4_hal_trip_board(&hal, false);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
+}
+
+/* A short break taken inside hal_gate_enable's read-modify-write of
+ * TIM1_BDTR: the hardware clears MOE, the interrupt latches the trip, then
+ * the write would set MOE again. The gates must end off, the trip latched. */
+static void break_pulse_irq(void)
+{
+    g4_model_put(G4_TIM1 + G4_TIM_SR, reg(G4_TIM1 + G4_TIM_SR) | G4_TIM_SR_BIF);
+    g4_model_put(G4_TIM1 + G4_TIM_BDTR, reg(G4_TIM1 + G4_TIM_BDTR) & ~G4_TIM_BDTR_MOE);
+    g4_hal_break_irq(&hal);
+}
+
+static void test_runtime_break_during_gate_enable(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    g4_model.irq_on_read = G4_TIM1 + G4_TIM_BDTR;
+    g4_model.irq = break_pulse_irq;
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_NULL_MESSAGE(g4_model.irq, "the break came inside the enable");
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    TEST_ASSERT_FALSE_MESSAGE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE,
+                              "gates on after a latched break");
 }
 
 /* Samples: the ESC1's amplifier inverts (sense gain -64/7), so the HAL
@@ -513,7 +621,11 @@ int main(void)
     RUN_TEST(test_init_order_overcurrent_and_timer);
     RUN_TEST(test_init_refuses_wrong_update_phase);
     RUN_TEST(test_init_refuses_implausible_zero);
+    RUN_TEST(test_init_current_zero_from_bias_network);
     RUN_TEST(test_runtime_gates_and_trip);
+    RUN_TEST(test_runtime_break_input_stuck);
+    RUN_TEST(test_runtime_board_trip_cause);
+    RUN_TEST(test_runtime_break_during_gate_enable);
     RUN_TEST(test_runtime_samples_and_compare);
     RUN_TEST(test_runtime_encoder);
     RUN_TEST(test_iwdg_sequence);

@@ -15,6 +15,7 @@
 #include "fw_link.h"
 #include "g4_hal.h"
 #include "pipeline.h"
+#include "throttle.h"
 
 /* Build-time defaults (compile definitions may override them). */
 #ifndef ESC1_FS_HZ
@@ -38,8 +39,13 @@ typedef struct {
     g4_hal_cfg_t hc;
     esc1_uart_t uart;
     volatile uint32_t isr_count;
-    bool temp_check; /* board over-temperature trip enabled */
-    double temp_c;   /* last board temperature (NaN: sensor open/short) */
+    uint32_t last_isr;  /* isr_count at the last watchdog refresh */
+    uint32_t reset_csr; /* RCC_CSR at start-up (b.reset) */
+    thr_t thr;          /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
+    q24_t thr_tref;     /* speed mode: the torque when the signal was lost, Q24 pu */
+    uint32_t now_ms;    /* main loop's millisecond clock */
+    bool temp_check;    /* board over-temperature trip enabled */
+    double temp_c;      /* last board temperature (NaN: sensor open/short) */
 } esc1_t;
 
 /* The compiled-in machine, generated at build time from a machine file
@@ -66,6 +72,10 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
  * medium-rate task is due), the telemetry sample. esc1_isr.c, also
  * built into the QEMU image that counts its instructions. */
 void esc1_control_isr(esc1_t *s);
+
+/* Main loop: the throttle's pulses (TIM2 capture) to its decoder, and its
+ * decisions to the drive (arm, disarm with the cause, reference). */
+void esc1_throttle_poll(esc1_t *s);
 
 /* The parameter table for fw_link_set_params. */
 void esc1_params_attach(esc1_t *s);

@@ -1,9 +1,11 @@
 /*
  * The firmware on the ST B-G431B-ESC1 (esc1_app.h).
  *
- * Start-up: DWT cycle counter, core lockup -> TIM1 break, clock (HSE 8 MHz ->
- * PLL 170 MHz, boost mode); on a clock failure the board stays on HSI16 with
- * the gates never enabled and says so on USART2 once a second. Then USART2,
+ * Start-up: DWT cycle counter, core lockup -> TIM1 break, reset flags and
+ * option bytes read, clock (HSE 8 MHz -> PLL 170 MHz, boost mode), USART2,
+ * the start-up report by polled output (reset cause, boot option bytes,
+ * clock result: esc1_report.h); on a clock failure the board stays on HSI16
+ * with the gates never enabled and says so on USART2 once a second. Then
  * the board HAL (gates off, op-amps, ADCs calibrated, comparator thresholds,
  * TIM1 with break, encoder, TIM1 started and its phase checked), fw_init with
  * the compiled-in machine, the command link, the interrupts, the independent
@@ -16,7 +18,8 @@
  *   3 PendSV          the medium-rate task (fw_medium), pended by fw_isr_fast
  * Main loop: received bytes -> command interpreter, telemetry frames out,
  * firmware watchdog kick, board temperature every 100 ms, independent
- * watchdog refreshed only while the control interrupt keeps running.
+ * watchdog refreshed only while the control interrupt keeps running (also
+ * while a reply waits for transmit space: esc1_service).
  */
 #include <math.h>
 #include <stdio.h>
@@ -25,11 +28,14 @@
 #include "board_esc1.h"
 #include "controller.h"
 #include "esc1_app.h"
+#include "esc1_report.h"
+#include "g4_boot.h"
 #include "g4_clock.h"
 #include "g4_core.h"
 #include "g4_periph.h"
 #include "g4_regs.h"
 #include "g4_startup.h"
+#include "g4_tim.h"
 
 /* Everything lives in one instance; the interrupt handlers take no argument,
  * so it is reachable at file scope. */
@@ -74,15 +80,30 @@ static void esc1_write(void *ctx, const uint8_t *bytes, size_t len)
 }
 
 /* Start-up failed: gates off for good, the reason on the serial link once a
- * second (no watchdog refresh needed: the watchdog is not started). */
+ * second by polled output (the USART interrupt may not be enabled; it is
+ * masked so that the ring does not interleave). No watchdog refresh needed:
+ * the watchdog is not started. */
 static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_cpu_hz)
 {
     g4_tim1_gates_off_now();
-    char line[96];
-    (void)snprintf(line, sizeof line, "esc1: %s failed: %s; gates off, not armable\r\n", what, why);
+    g4_nvic_disable(G4_IRQ_USART2);
     for (;;) {
-        esc1_uart_puts(&s->uart, line);
+        esc1_report_failure(&s->uart, what, why);
         g4_delay_cycles(f_cpu_hz);
+    }
+}
+
+/* The main loop's liveness: the firmware watchdog's kick, and the
+ * independent watchdog refreshed only while the control interrupt keeps
+ * running. Also called while the serial writer waits for space. */
+static void esc1_service(void *ctx)
+{
+    esc1_t *s = ctx;
+    fw_watchdog_kick(&s->fw);
+    const uint32_t n = s->isr_count;
+    if (n != s->last_isr) {
+        s->last_isr = n;
+        g4_iwdg_refresh();
     }
 }
 
@@ -93,13 +114,13 @@ static void esc1_temperature(esc1_t *s)
     const int32_t counts = g4_hal_temp_counts(&s->hal);
     s->temp_c = g4_hal_temp_c(s->hal.board, counts);
     if (!s->temp_check) {
-        s->hal.trip &= ~(uint32_t)G4_TRIP_BOARD;
+        g4_hal_trip_board(&s->hal, false);
         return;
     }
     if (isnan(s->temp_c) || s->temp_c > s->hal.board->temp_trip_c) {
-        g4_hal_trip_board(&s->hal);
+        g4_hal_trip_board(&s->hal, true);
     } else if (s->temp_c < s->hal.board->temp_trip_c - 10.0) {
-        s->hal.trip &= ~(uint32_t)G4_TRIP_BOARD; /* 10 C hysteresis */
+        g4_hal_trip_board(&s->hal, false); /* 10 C hysteresis */
     }
 }
 
@@ -112,9 +133,13 @@ int main(void)
     g4_set(G4_RCC + G4_RCC_APB2ENR, G4_RCC_APB2ENR_SYSCFGEN);
     g4_set(G4_SYSCFG + G4_SYSCFG_CFGR2, G4_SYSCFG_CFGR2_CLL);
 
+    g4_boot_info_t boot;
+    g4_boot_read(&boot);
+    s->reset_csr = boot.csr;
     const int clk = g4_clock_init(b->hse_hz, b->sysclk_hz);
     const uint32_t f_cpu = clk == G4_OK ? b->sysclk_hz : G4_HSI_HZ;
     (void)esc1_uart_init(&s->uart, f_cpu, b->baud);
+    esc1_report_startup(&s->uart, b, &boot, clk);
     if (clk != G4_OK) {
         esc1_halt(s, "clock", g4_strerror(clk), f_cpu);
     }
@@ -138,6 +163,13 @@ int main(void)
     }
     fw_link_init(&s->link, &s->fw, esc1_write, &s->uart);
     esc1_params_attach(s);
+    /* Throttle: TIM2 counting microseconds; decoding only when its mode is
+     * set ([throttle] settings, throttle.* parameters). An unplugged pad
+     * reads low (pull-down): no edges, no pulses. */
+    thr_config_default(&s->thr.cfg);
+    thr_init(&s->thr, &s->thr.cfg, 0u);
+    g4_gpio_config(b->throttle, G4_PIN_AF, 2u);
+    g4_tim2_capture_init(f_cpu / 1000000u - 1u, b->throttle_filter);
 
     g4_nvic_set_priority(G4_IRQ_TIM1_BRK_TIM15, 0u);
     g4_nvic_set_priority(G4_IRQ_ADC1_2, 1u);
@@ -153,7 +185,12 @@ int main(void)
         esc1_halt(s, "watchdog", "LSI not ready", f_cpu);
     }
 
-    uint32_t last_isr = s->isr_count;
+    bool offsets_told = false;
+    const uint32_t ms_cycles = f_cpu / 1000u;
+    uint32_t t_ms = g4_cycles();
+    s->last_isr = s->isr_count;
+    s->uart.idle = esc1_service;
+    s->uart.idle_ctx = s;
     uint32_t t_temp = g4_cycles();
     const uint32_t temp_period = f_cpu / 10u;
     for (;;) {
@@ -162,7 +199,23 @@ int main(void)
             fw_link_rx(&s->link, (uint8_t)c);
         }
         fw_link_poll(&s->link);
-        fw_watchdog_kick(&s->fw);
+        esc1_service(s);
+        while (g4_cycles() - t_ms >= ms_cycles) {
+            t_ms += ms_cycles;
+            s->now_ms++;
+        }
+        esc1_throttle_poll(s);
+        /* Once the offset calibration has ended (ready, or its fault): the
+         * measured offsets, which the fault alone would not show. */
+        const fw_state_id_t st_now = fw_state(&s->fw);
+        if (!offsets_told && st_now != FW_STATE_BOOT && st_now != FW_STATE_CALIB) {
+            char line[96];
+            offsets_told = true;
+            if (esc1_offsets_line(line, sizeof line, s->fw.off_q8, s->fw.adc_zero,
+                                  s->fw.adc_zero_tol) > 0) {
+                esc1_uart_puts(&s->uart, line);
+            }
+        }
         if (g4_cycles() - t_temp >= temp_period) {
             t_temp += temp_period;
             esc1_temperature(s);
@@ -171,12 +224,6 @@ int main(void)
             static bool blink;
             blink = !blink;
             g4_gpio_write(b->led, st == FW_STATE_RUNNING || (st == FW_STATE_FAULT && blink));
-        }
-        /* The independent watchdog proves that the control interrupt runs. */
-        const uint32_t n = s->isr_count;
-        if (n != last_isr) {
-            last_isr = n;
-            g4_iwdg_refresh();
         }
     }
 }

@@ -167,7 +167,13 @@ static int esc1_get_temp(void *ctx, double *v)
 
 static int esc1_get_trip(void *ctx, double *v)
 {
-    *v = (double)esc1_of(ctx)->hal.trip;
+    *v = (double)g4_hal_trip_cause(&esc1_of(ctx)->hal);
+    return CMD_OK;
+}
+
+static int esc1_get_reset(void *ctx, double *v)
+{
+    *v = (double)(esc1_of(ctx)->reset_csr >> 24);
     return CMD_OK;
 }
 
@@ -184,6 +190,68 @@ static int esc1_set_temp_check(void *ctx, double v)
     }
     esc1_of(ctx)->temp_check = v != 0.0;
     return CMD_OK;
+}
+
+/* [throttle] settings: changed only while the throttle has not armed the
+ * drive; the decoder restarts (disarmed, waiting for the low end). */
+static int esc1_thr_set(esc1_t *s, unsigned i, double v)
+{
+    if (v != floor(v)) {
+        return CMD_E_RANGE;
+    }
+    if (s->thr.state != THR_WAIT_LOW || fw_state(&s->fw) == FW_STATE_RUNNING) {
+        return CMD_E_STATE;
+    }
+    thr_config_t c = s->thr.cfg;
+    uint16_t *f[4] = {NULL, &c.low_us, &c.high_us, &c.deadband_us};
+    if (i == 0u) {
+        c.mode = (uint8_t)v;
+    } else {
+        *f[i] = (uint16_t)v;
+    }
+    if (thr_config_check(&c) != 0) {
+        return CMD_E_RANGE; /* e.g. a dead band over half the span */
+    }
+    thr_init(&s->thr, &c, s->now_ms);
+    return CMD_OK;
+}
+
+static int esc1_thr_get(const esc1_t *s, unsigned i, double *v)
+{
+    const thr_t *t = &s->thr;
+    const uint32_t x[7] = {t->cfg.mode, t->cfg.low_us, t->cfg.high_us, t->cfg.deadband_us,
+                           t->width_us, t->state,      t->cause};
+    *v = (double)x[i];
+    return CMD_OK;
+}
+
+#define ESC1_THR_FNS(F, i)                                                                         \
+    static int esc1_get_##F(void *ctx, double *v)                                                  \
+    {                                                                                              \
+        return esc1_thr_get(esc1_of(ctx), i, v);                                                   \
+    }                                                                                              \
+    static int esc1_set_##F(void *ctx, double v)                                                   \
+    {                                                                                              \
+        return esc1_thr_set(esc1_of(ctx), i, v);                                                   \
+    }
+ESC1_THR_FNS(T_MODE, 0u)
+ESC1_THR_FNS(T_LOW, 1u)
+ESC1_THR_FNS(T_HIGH, 2u)
+ESC1_THR_FNS(T_DB, 3u)
+
+static int esc1_get_t_us(void *ctx, double *v)
+{
+    return esc1_thr_get(esc1_of(ctx), 4u, v);
+}
+
+static int esc1_get_t_state(void *ctx, double *v)
+{
+    return esc1_thr_get(esc1_of(ctx), 5u, v);
+}
+
+static int esc1_get_t_cause(void *ctx, double *v)
+{
+    return esc1_thr_get(esc1_of(ctx), 6u, v);
 }
 
 #define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
@@ -216,9 +284,22 @@ static const fw_link_param_t esc1_params[] = {
     ESC1_RO("b.temp_c", "C", "board temperature (NTC, linear model)", esc1_get_temp),
     ESC1_RO("b.trip", "-", "trip latch: 1 over-current, 2 system break, 4 board (temp)",
             esc1_get_trip),
+    ESC1_RO("b.reset", "-",
+            "RCC_CSR reset flags at start-up >> 24: 2 option bytes, 4 pin, 8 brown-out, "
+            "16 software, 32 watchdog",
+            esc1_get_reset),
     {{"b.temp_check", "-", "1 = board over-temperature trip on", 0.0, 1.0, false},
      esc1_get_temp_check,
      esc1_set_temp_check},
+    ESC1_RW("throttle.mode", "-", 0.0, 2.0, "PWM pad (PA15): 0 off, 1 torque, 2 speed", T_MODE),
+    ESC1_RW("throttle.low_us", "us", 800.0, 1499.0, "pulse at zero (calibrated low end)", T_LOW),
+    ESC1_RW("throttle.high_us", "us", 1501.0, 2200.0, "pulse at full scale", T_HIGH),
+    ESC1_RW("throttle.deadband_us", "us", 0.0, 349.0, "zero up to low_us + this", T_DB),
+    ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_get_t_us),
+    ESC1_RO("throttle.state", "-", "0 disarmed (1 s at the low end arms), 1 armed, 2 lost",
+            esc1_get_t_state),
+    ESC1_RO("throttle.cause", "-", "last loss: 1 no pulse, 2 invalid pulses (100 ms)",
+            esc1_get_t_cause),
 };
 
 void esc1_params_attach(esc1_t *s)

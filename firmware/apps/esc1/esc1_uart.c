@@ -17,6 +17,7 @@ int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud)
     }
     /* A full ring drains in TX_SIZE x 10 bits / baud; wait at most that. */
     u->tx_wait_cycles = (uint32_t)((uint64_t)f_pclk_hz * 10u * ESC1_UART_TX_SIZE / baud);
+    u->byte_cycles = (uint32_t)((uint64_t)f_pclk_hz * 10u / baud);
     g4_gpio_config(g4_board_esc1.uart_tx, G4_PIN_AF, 0u);
     g4_gpio_config(g4_board_esc1.uart_rx, G4_PIN_AF, 1u);
     g4_usart2_init(brr);
@@ -40,6 +41,9 @@ void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len)
         if (u->tx_head - u->tx_tail >= ESC1_UART_TX_SIZE) {
             const uint32_t t0 = g4_cycles();
             while (u->tx_head - u->tx_tail >= ESC1_UART_TX_SIZE) {
+                if (u->idle != NULL) {
+                    u->idle(u->idle_ctx);
+                }
                 if (g4_cycles() - t0 > u->tx_wait_cycles) {
                     u->tx_dropped += (uint32_t)(len - i);
                     return;
@@ -56,6 +60,18 @@ void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len)
 void esc1_uart_puts(esc1_uart_t *u, const char *s)
 {
     esc1_uart_write(u, (const uint8_t *)s, strlen(s));
+}
+
+void esc1_uart_puts_polled(esc1_uart_t *u, const char *s)
+{
+    for (; *s != '\0'; s++) {
+        if (!g4_wait_bits(G4_USART2 + G4_USART_ISR, G4_USART_ISR_TXE, G4_USART_ISR_TXE,
+                          4u * u->byte_cycles)) {
+            u->tx_dropped++;
+            return;
+        }
+        g4_wr(G4_USART2 + G4_USART_TDR, (uint8_t)*s);
+    }
 }
 
 void esc1_uart_irq(esc1_uart_t *u)

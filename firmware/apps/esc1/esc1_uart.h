@@ -21,6 +21,11 @@ typedef struct {
     volatile uint32_t rx_dropped, rx_errors;
     uint32_t tx_dropped;
     uint32_t tx_wait_cycles; /* longest wait for transmit space before dropping */
+    uint32_t byte_cycles;    /* one character on the line, core cycles */
+    /* Called while the writer waits for space (NULL: none): the main loop's
+     * watchdog service, so that a long reply does not starve the watchdog. */
+    void (*idle)(void *ctx);
+    void *idle_ctx;
 } esc1_uart_t;
 
 /* Pins, USART2 8N1 at `baud` from PCLK1 = f_pclk_hz. Returns G4_OK or
@@ -29,9 +34,14 @@ int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud);
 /* Next received byte, or -1. */
 int esc1_uart_getc(esc1_uart_t *u);
 /* Queues bytes; when the ring is full it waits for the interrupt to drain
- * it, up to tx_wait_cycles, then drops the rest (counted). */
+ * it, up to tx_wait_cycles per byte, calling idle meanwhile, then drops the
+ * rest (counted). */
 void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len);
 void esc1_uart_puts(esc1_uart_t *u, const char *s);
+/* Sends a string by polling TXE, bypassing the ring (start-up, before the
+ * interrupt is enabled, and the halt loop). Gives up on a character after
+ * four character times without TXE (counted in tx_dropped). */
+void esc1_uart_puts_polled(esc1_uart_t *u, const char *s);
 /* USART2 interrupt. */
 void esc1_uart_irq(esc1_uart_t *u);
 

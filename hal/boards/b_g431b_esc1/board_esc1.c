@@ -58,6 +58,19 @@ const g4_board_t g4_board_esc1 = {
     .shunt_ohm = 0.003,        /* [UM2516][NuttX] */
     .sense_gain = -64.0 / 7.0, /* [SimpleFOC]; [NuttX] -9.14 */
     .current_smp_half = 13u,   /* 6.5 cycles: the op-amp output is low impedance */
+    /* Bias of VINP (MB1419 schematic as read by the board review): 2.2 kOhm
+     * to ground, 22 kOhm to 3.3 V, 1.5 kOhm to the shunt: VINP = 0.1286 V +
+     * 4/7 V_shunt (4/7 x 16 = 64/7, the sense gain above), zero current at
+     * 16 x 0.1286 V = 2.06 V = ADC code 2553. UNVERIFIED: the resistor
+     * tolerance (1 %), the op-amp input offset (3 mV) and PGA gain error
+     * (2 %) as worst cases; one forum source reports about 1.65 V at zero
+     * current instead. docs/bringup.md step 3 prints the measured levels. */
+    .sense_r_gnd = 2200.0,
+    .sense_r_bias = 22000.0,
+    .sense_r_shunt = 1500.0,
+    .sense_r_tol = 0.01,
+    .opamp_vio_v = 0.003,
+    .opamp_gain_err = 0.02,
 
     /* Vbus PA0 = ADC2_IN1 [DS]; divider 18 k / (18 k + 169 k) [NuttX]. */
     .vbus_pin = {A, 0u, 0u},
@@ -91,12 +104,22 @@ const g4_board_t g4_board_esc1 = {
     .enc_b = {B, 7u, 2u},
     .enc_index = {B, 8u, 2u},
     .enc_has_index = true,
+    /* PB8 is also BOOT0. UNVERIFIED: pulled up on the board (the board
+     * review's reading of the MB1419 schematic); ST ships the board with
+     * nSWBOOT0 = 0, nBOOT0 = 1 (BOOT0 from the option bit, the pin ignored).
+     * docs/bringup.md step 1 reads the option bytes and PB8. */
+    .boot0_pulled_up = true,
     .enc_filter = 6u, /* ICF 0110: f_DTS/4, N = 6: 24 / 170 MHz = 0.14 us */
 
     /* USART2 TX PB3, RX PB4, AF7: the ST-LINK virtual COM port [UM2516][DS]. */
     .uart_tx = {B, 3u, 7u},
     .uart_rx = {B, 4u, 7u},
     .baud = 115200u,
+
+    /* The PWM pad (the flight controller's throttle): PA15 = TIM2_CH1 AF1
+     * [UM2516][DS]. UNVERIFIED: the pad's series resistor / pull network. */
+    .throttle = {A, 15u, 1u},
+    .throttle_filter = 15u, /* ICF 1111: f_DTS/32, N = 8: 256 / 170 MHz = 1.5 us */
 
     .led = {C, 6u, 0u}, /* LD2, active high [UM2516][NuttX] */
     /* PB4 (USART2 RX) and PB6 (encoder A) are the UCPD1 CC2/CC1 pins, pulled

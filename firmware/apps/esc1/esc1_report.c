@@ -1,0 +1,45 @@
+/* Start-up report of the B-G431B-ESC1 (esc1_report.h). */
+#include "esc1_report.h"
+
+#include <stdio.h>
+
+#include "g4_core.h"
+
+static void esc1_report_line(esc1_uart_t *u, const char *a, const char *b, const char *c)
+{
+    esc1_uart_puts_polled(u, "esc1: ");
+    esc1_uart_puts_polled(u, a);
+    esc1_uart_puts_polled(u, b);
+    esc1_uart_puts_polled(u, c);
+    esc1_uart_puts_polled(u, "\r\n");
+}
+
+void esc1_report_startup(esc1_uart_t *u, const g4_board_t *b, const g4_boot_info_t *bi,
+                         int clock_rc)
+{
+    esc1_report_line(u, "reset: ", g4_reset_cause(bi->csr), "");
+    const char *risk = g4_boot_risk(bi->optr, b->boot0_pulled_up);
+    if (risk != NULL) {
+        esc1_report_line(u, "boot: ", risk, "; see docs/bringup.md step 1");
+    }
+    if (clock_rc == G4_OK) {
+        esc1_report_line(u, "clock: ok", "", "");
+    } else {
+        esc1_report_line(u, "clock failed: ", g4_strerror(clock_rc), "; running on HSI16");
+    }
+}
+
+void esc1_report_failure(esc1_uart_t *u, const char *what, const char *why)
+{
+    esc1_report_line(u, what, " failed: ", why);
+    esc1_report_line(u, "gates off, not armable", "", "");
+}
+
+int esc1_offsets_line(char *line, unsigned size, const int32_t off_q8[3], uint16_t zero,
+                      uint16_t tol)
+{
+    /* 0 <= off_q8 < 2^24: rounded to counts without overflow. */
+    return snprintf(line, size, "esc1: current offsets %ld %ld %ld counts, expected %u +- %u\r\n",
+                    (long)((off_q8[0] + 128) >> 8), (long)((off_q8[1] + 128) >> 8),
+                    (long)((off_q8[2] + 128) >> 8), (unsigned)zero, (unsigned)tol);
+}

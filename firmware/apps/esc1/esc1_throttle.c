@@ -1,0 +1,48 @@
+/* The throttle on the B-G431B-ESC1's PWM pad (esc1_app.h): TIM2 captures to
+ * the hardware-free decoder (firmware/throttle), its decisions to the drive. */
+#include "esc1_app.h"
+#include "g4_tim.h"
+
+void esc1_throttle_poll(esc1_t *s)
+{
+    thr_t *t = &s->thr;
+    if (t->cfg.mode == THR_MODE_OFF) {
+        return;
+    }
+    uint32_t width, period;
+    if (g4_tim2_capture_read(&width, &period)) {
+        thr_pulse(t, width, period, s->now_ms); /* 1 MHz ticks: us */
+    }
+    const uint8_t before = t->state;
+    const thr_out_t o = thr_update(t, s->now_ms);
+    fw_t *fw = &s->fw;
+    const bool speed = t->cfg.mode == THR_MODE_SPEED;
+    if (o.event == THR_EV_ARM) {
+        fw_set_torque_ref(fw, 0);
+        fw_cmd_arm(fw);
+    }
+    if (t->state == THR_ARMED) {
+        if (speed) {
+            fw_set_speed_ref_rpm(fw, (double)o.ref / FX_ONE * fw->speed_info.speed_ref_max_rpm);
+            s->thr_tref = fw->speed_tref;
+        } else {
+            fw_set_torque_ref(fw, fx_mul(o.ref, fw->torque_ref_max));
+        }
+    } else if (t->state == THR_RAMP_DOWN) {
+        /* Torque to zero along the ramp: the throttle's torque, or in speed
+         * mode the speed loop's last torque. */
+        fw_set_torque_ref(fw,
+                          speed ? fx_mul(s->thr_tref, o.ramp) : fx_mul(o.ref, fw->torque_ref_max));
+        if (before == THR_ARMED) {
+            esc1_uart_puts(&s->uart, t->cause == THR_CAUSE_NO_PULSE
+                                         ? "esc1: throttle: no pulse for 100 ms; "
+                                           "torque to zero, gates off\r\n"
+                                         : "esc1: throttle: no valid pulse for 100 ms; "
+                                           "torque to zero, gates off\r\n");
+        }
+    }
+    if (o.event == THR_EV_DISARM) {
+        fw_set_torque_ref(fw, 0);
+        fw_cmd_disarm(fw);
+    }
+}
