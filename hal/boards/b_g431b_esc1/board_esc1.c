@@ -58,13 +58,13 @@ const g4_board_t g4_board_esc1 = {
     .shunt_ohm = 0.003,        /* [UM2516][NuttX] */
     .sense_gain = -64.0 / 7.0, /* [SimpleFOC]; [NuttX] -9.14 */
     .current_smp_half = 13u,   /* 6.5 cycles: the op-amp output is low impedance */
-    /* Bias of VINP (MB1419 schematic as read by the board review): 2.2 kOhm
+    /* Bias of VINP (ST schematic MB1419, as an independent review read it): 2.2 kOhm
      * to ground, 22 kOhm to 3.3 V, 1.5 kOhm to the shunt: VINP = 0.1286 V +
      * 4/7 V_shunt (4/7 x 16 = 64/7, the sense gain above), zero current at
      * 16 x 0.1286 V = 2.06 V = ADC code 2553. UNVERIFIED: the resistor
      * tolerance (1 %), the op-amp input offset (3 mV) and PGA gain error
      * (2 %) as worst cases; one forum source reports about 1.65 V at zero
-     * current instead. docs/bringup.md step 3 prints the measured levels. */
+     * current instead. docs/bringup.md step 2 prints the measured levels. */
     .sense_r_gnd = 2200.0,
     .sense_r_bias = 22000.0,
     .sense_r_shunt = 1500.0,
@@ -104,8 +104,8 @@ const g4_board_t g4_board_esc1 = {
     .enc_b = {B, 7u, 2u},
     .enc_index = {B, 8u, 2u},
     .enc_has_index = true,
-    /* PB8 is also BOOT0. UNVERIFIED: pulled up on the board (the board
-     * review's reading of the MB1419 schematic); ST ships the board with
+    /* PB8 is also BOOT0. UNVERIFIED: pulled up on the board (an independent
+     * review's reading of ST's MB1419 schematic); ST ships the board with
      * nSWBOOT0 = 0, nBOOT0 = 1 (BOOT0 from the option bit, the pin ignored).
      * docs/bringup.md step 1 reads the option bytes and PB8. */
     .boot0_pulled_up = true,
