@@ -30,8 +30,9 @@ int thr_config_check(const thr_config_t *c)
 
 void thr_init(thr_t *t, const thr_config_t *c, uint32_t now_ms)
 {
+    const thr_config_t cfg = *c; /* c may be &t->cfg */
     memset(t, 0, sizeof *t);
-    t->cfg = *c;
+    t->cfg = cfg;
     t->state = THR_WAIT_LOW;
     /* No pulse yet: as if the last valid one were a timeout ago. */
     t->t_valid_ms = now_ms - THR_TIMEOUT_MS - 1u;

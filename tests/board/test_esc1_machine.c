@@ -164,6 +164,7 @@ static void esc1_start(void)
     TEST_ASSERT_EQUAL_INT(FW_OK, fw_init(&esc.fw, &esc.hal, &esc.fc));
     fw_link_init(&esc.link, &esc.fw, capture, NULL);
     esc1_params_attach(&esc);
+    esc1_throttle_init(&esc, b->sysclk_hz);
 }
 
 /* Neighbours of the compiled-in gimbal motor the core cannot represent at
@@ -234,6 +235,53 @@ static void test_calibration_takes_the_board_zero(void)
     TEST_ASSERT_EQUAL_STRING(want, line);
 }
 
+/* The throttle on the board's code path: TIM2 captures (register model) to
+ * the decoder, its decisions to the drive. 50 Hz pulses at the low end for
+ * 1 s arm the calibrated drive (state running); with the pulses gone the
+ * drive is disarmed (ready, gates off) 100 ms + 100 ms of ramp later, and
+ * the loss is counted for the main loop's message. */
+static void pulse_at(uint32_t ms, uint32_t width_us)
+{
+    esc.now_ms = ms;
+    if (width_us != 0u && ms % 20u == 0u) {
+        g4_model_put(G4_TIM2 + G4_TIM_CCR2, width_us);
+        g4_model_put(G4_TIM2 + G4_TIM_CCR1, 20000u);
+        g4_model_put(G4_TIM2 + G4_TIM_SR, G4_TIM_SR_CC1IF);
+    }
+    esc1_throttle_poll(&esc);
+    fw_watchdog_kick(&esc.fw);           /* the main loop's service */
+    for (unsigned k = 0; k < 20u; k++) { /* 1 ms of control periods at 20 kHz */
+        esc1_control_isr(&esc);
+    }
+}
+
+static void test_throttle_arms_and_disarms_the_drive(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.mode 1", command("param set throttle.mode 1"));
+    uint32_t ms = 0u;
+    for (; ms < 990u; ms++) {
+        pulse_at(ms, 1000u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw)); /* not yet 1 s */
+    for (; ms < 1100u; ms++) {
+        pulse_at(ms, 1000u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
+    const uint32_t t_last = ms - 20u;
+    for (; ms < t_last + 195u; ms++) {
+        pulse_at(ms, 0u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw)); /* ramping */
+    for (; ms < t_last + 210u; ms++) {
+        pulse_at(ms, 0u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_UINT32(1u, esc.thr_losses);
+    TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_NO_PULSE, esc.thr.cause);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -242,5 +290,6 @@ int main(void)
     RUN_TEST(test_core_and_every_controller_take_it);
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
+    RUN_TEST(test_throttle_arms_and_disarms_the_drive);
     return UNITY_END();
 }

@@ -258,6 +258,12 @@ static void test_config_check(void)
     thr_config_default(&c);
     c.deadband_us = 500u;
     TEST_ASSERT_EQUAL_INT(4, thr_config_check(&c));
+    /* a restart with the settings in force (c pointing into the state) */
+    thr_config_default(&c);
+    c.low_us = 1100u;
+    thr_init(&thr, &c, 0u);
+    thr_init(&thr, &thr.cfg, 5u);
+    TEST_ASSERT_EQUAL_UINT16(1100u, thr.cfg.low_us);
 }
 
 void setUp(void)

@@ -39,13 +39,16 @@ typedef struct {
     g4_hal_cfg_t hc;
     esc1_uart_t uart;
     volatile uint32_t isr_count;
-    uint32_t last_isr;  /* isr_count at the last watchdog refresh */
-    uint32_t reset_csr; /* RCC_CSR at start-up (b.reset) */
-    thr_t thr;          /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
-    q24_t thr_tref;     /* speed mode: the torque when the signal was lost, Q24 pu */
-    uint32_t now_ms;    /* main loop's millisecond clock */
-    bool temp_check;    /* board over-temperature trip enabled */
-    double temp_c;      /* last board temperature (NaN: sensor open/short) */
+    uint32_t last_isr;   /* isr_count at the last watchdog refresh */
+    uint32_t reset_csr;  /* RCC_CSR at start-up (b.reset) */
+    thr_t thr;           /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
+    q24_t thr_tref;      /* speed mode: the torque when the signal was lost, Q24 pu */
+    uint32_t thr_losses; /* signal losses so far (the main loop reports each) */
+    uint32_t now_ms;     /* main loop's millisecond clock */
+    uint32_t ms_cycle;   /* cycle count at its last tick */
+    uint32_t ms_cycles;  /* core cycles per millisecond */
+    bool temp_check;     /* board over-temperature trip enabled */
+    double temp_c;       /* last board temperature (NaN: sensor open/short) */
 } esc1_t;
 
 /* The compiled-in machine, generated at build time from a machine file
@@ -73,8 +76,12 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
  * built into the QEMU image that counts its instructions. */
 void esc1_control_isr(esc1_t *s);
 
+/* The throttle's pin (AF, pull-down) and TIM2 capture; decoder off
+ * (throttle.mode 0) with the default end points. */
+void esc1_throttle_init(esc1_t *s, uint32_t f_cpu_hz);
 /* Main loop: the throttle's pulses (TIM2 capture) to its decoder, and its
- * decisions to the drive (arm, disarm with the cause, reference). */
+ * decisions to the drive (arm, disarm, reference); a loss counts in
+ * thr_losses (the main loop reports it with the cause). */
 void esc1_throttle_poll(esc1_t *s);
 
 /* The parameter table for fw_link_set_params. */

@@ -35,7 +35,6 @@
 #include "g4_periph.h"
 #include "g4_regs.h"
 #include "g4_startup.h"
-#include "g4_tim.h"
 
 /* Everything lives in one instance; the interrupt handlers take no argument,
  * so it is reachable at file scope. */
@@ -93,9 +92,11 @@ static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_c
     }
 }
 
-/* The main loop's liveness: the firmware watchdog's kick, and the
- * independent watchdog refreshed only while the control interrupt keeps
- * running. Also called while the serial writer waits for space. */
+/* The main loop's liveness: the firmware watchdog's kick, the independent
+ * watchdog refreshed only while the control interrupt keeps running, the
+ * millisecond clock and the throttle. Also called while the serial writer
+ * waits for space, so that neither a watchdog nor the throttle's 100 ms
+ * loss time-out sees a long reply as a hang. */
 static void esc1_service(void *ctx)
 {
     esc1_t *s = ctx;
@@ -105,6 +106,11 @@ static void esc1_service(void *ctx)
         s->last_isr = n;
         g4_iwdg_refresh();
     }
+    while (g4_cycles() - s->ms_cycle >= s->ms_cycles) {
+        s->ms_cycle += s->ms_cycles;
+        s->now_ms++;
+    }
+    esc1_throttle_poll(s);
 }
 
 /* Board temperature every 100 ms; over-temperature or a broken sensor latch
@@ -163,13 +169,7 @@ int main(void)
     }
     fw_link_init(&s->link, &s->fw, esc1_write, &s->uart);
     esc1_params_attach(s);
-    /* Throttle: TIM2 counting microseconds; decoding only when its mode is
-     * set ([throttle] settings, throttle.* parameters). An unplugged pad
-     * reads low (pull-down): no edges, no pulses. */
-    thr_config_default(&s->thr.cfg);
-    thr_init(&s->thr, &s->thr.cfg, 0u);
-    g4_gpio_config(b->throttle, G4_PIN_AF, 2u);
-    g4_tim2_capture_init(f_cpu / 1000000u - 1u, b->throttle_filter);
+    esc1_throttle_init(s, f_cpu);
 
     g4_nvic_set_priority(G4_IRQ_TIM1_BRK_TIM15, 0u);
     g4_nvic_set_priority(G4_IRQ_ADC1_2, 1u);
@@ -186,8 +186,9 @@ int main(void)
     }
 
     bool offsets_told = false;
-    const uint32_t ms_cycles = f_cpu / 1000u;
-    uint32_t t_ms = g4_cycles();
+    uint32_t thr_losses_told = 0u;
+    s->ms_cycles = f_cpu / 1000u;
+    s->ms_cycle = g4_cycles();
     s->last_isr = s->isr_count;
     s->uart.idle = esc1_service;
     s->uart.idle_ctx = s;
@@ -200,11 +201,14 @@ int main(void)
         }
         fw_link_poll(&s->link);
         esc1_service(s);
-        while (g4_cycles() - t_ms >= ms_cycles) {
-            t_ms += ms_cycles;
-            s->now_ms++;
+        if (s->thr_losses != thr_losses_told) {
+            thr_losses_told = s->thr_losses;
+            esc1_uart_puts(&s->uart, s->thr.cause == THR_CAUSE_NO_PULSE
+                                         ? "esc1: throttle: no pulse for 100 ms; torque to "
+                                           "zero, gates off\r\n"
+                                         : "esc1: throttle: no valid pulse for 100 ms; torque "
+                                           "to zero, gates off\r\n");
         }
-        esc1_throttle_poll(s);
         /* Once the offset calibration has ended (ready, or its fault): the
          * measured offsets, which the fault alone would not show. */
         const fw_state_id_t st_now = fw_state(&s->fw);

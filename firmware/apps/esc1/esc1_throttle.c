@@ -1,7 +1,19 @@
 /* The throttle on the B-G431B-ESC1's PWM pad (esc1_app.h): TIM2 captures to
  * the hardware-free decoder (firmware/throttle), its decisions to the drive. */
 #include "esc1_app.h"
+#include "g4_periph.h"
 #include "g4_tim.h"
+
+void esc1_throttle_init(esc1_t *s, uint32_t f_cpu_hz)
+{
+    /* TIM2 counting microseconds. An unplugged pad reads low (pull-down): no
+     * edges, no pulses. Decoding starts when throttle.mode is set. */
+    thr_config_t c;
+    thr_config_default(&c);
+    thr_init(&s->thr, &c, s->now_ms);
+    g4_gpio_config(s->hal.board->throttle, G4_PIN_AF, 2u);
+    g4_tim2_capture_init(f_cpu_hz / 1000000u - 1u, s->hal.board->throttle_filter);
+}
 
 void esc1_throttle_poll(esc1_t *s)
 {
@@ -34,11 +46,7 @@ void esc1_throttle_poll(esc1_t *s)
         fw_set_torque_ref(fw,
                           speed ? fx_mul(s->thr_tref, o.ramp) : fx_mul(o.ref, fw->torque_ref_max));
         if (before == THR_ARMED) {
-            esc1_uart_puts(&s->uart, t->cause == THR_CAUSE_NO_PULSE
-                                         ? "esc1: throttle: no pulse for 100 ms; "
-                                           "torque to zero, gates off\r\n"
-                                         : "esc1: throttle: no valid pulse for 100 ms; "
-                                           "torque to zero, gates off\r\n");
+            s->thr_losses++; /* the main loop says so (not from inside a write) */
         }
     }
     if (o.event == THR_EV_DISARM) {
