@@ -113,15 +113,16 @@ static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
 }
 
 /* get/set functions per field (the link's callbacks take only a context). */
-#define ESC1_FIELD_FNS(F)                                                                          \
+#define ESC1_INDEX_FNS(F, get, set)                                                                \
     static int esc1_get_##F(void *ctx, double *v)                                                  \
     {                                                                                              \
-        return esc1_get_field(esc1_of(ctx), F, v);                                                 \
+        return get(esc1_of(ctx), F, v);                                                            \
     }                                                                                              \
     static int esc1_set_##F(void *ctx, double v)                                                   \
     {                                                                                              \
-        return esc1_set_field(esc1_of(ctx), F, v);                                                 \
+        return set(esc1_of(ctx), F, v);                                                            \
     }
+#define ESC1_FIELD_FNS(F) ESC1_INDEX_FNS(F, esc1_get_field, esc1_set_field)
 ESC1_FIELD_FNS(M_P)
 ESC1_FIELD_FNS(M_RS)
 ESC1_FIELD_FNS(M_LD)
@@ -194,7 +195,10 @@ static int esc1_set_temp_check(void *ctx, double v)
 
 /* [throttle] settings: changed only while the throttle has not armed the
  * drive; the decoder restarts (disarmed, waiting for the low end). */
-static int esc1_thr_set(esc1_t *s, unsigned i, double v)
+/* Throttle values reachable by index (esc1_thr_get / esc1_thr_set). */
+typedef enum { T_MODE, T_LOW, T_HIGH, T_DB, T_US, T_STATE, T_CAUSE } esc1_thr_field_t;
+
+static int esc1_thr_set(esc1_t *s, esc1_thr_field_t i, double v)
 {
     if (v != floor(v)) {
         return CMD_E_RANGE;
@@ -204,7 +208,7 @@ static int esc1_thr_set(esc1_t *s, unsigned i, double v)
     }
     thr_config_t c = s->thr.cfg;
     uint16_t *f[4] = {NULL, &c.low_us, &c.high_us, &c.deadband_us};
-    if (i == 0u) {
+    if (i == T_MODE) {
         c.mode = (uint8_t)v;
     } else {
         *f[i] = (uint16_t)v;
@@ -216,7 +220,7 @@ static int esc1_thr_set(esc1_t *s, unsigned i, double v)
     return CMD_OK;
 }
 
-static int esc1_thr_get(const esc1_t *s, unsigned i, double *v)
+static int esc1_thr_get(const esc1_t *s, esc1_thr_field_t i, double *v)
 {
     const thr_t *t = &s->thr;
     const uint32_t x[7] = {t->cfg.mode, t->cfg.low_us, t->cfg.high_us, t->cfg.deadband_us,
@@ -225,33 +229,24 @@ static int esc1_thr_get(const esc1_t *s, unsigned i, double *v)
     return CMD_OK;
 }
 
-#define ESC1_THR_FNS(F, i)                                                                         \
-    static int esc1_get_##F(void *ctx, double *v)                                                  \
-    {                                                                                              \
-        return esc1_thr_get(esc1_of(ctx), i, v);                                                   \
-    }                                                                                              \
-    static int esc1_set_##F(void *ctx, double v)                                                   \
-    {                                                                                              \
-        return esc1_thr_set(esc1_of(ctx), i, v);                                                   \
-    }
-ESC1_THR_FNS(T_MODE, 0u)
-ESC1_THR_FNS(T_LOW, 1u)
-ESC1_THR_FNS(T_HIGH, 2u)
-ESC1_THR_FNS(T_DB, 3u)
+ESC1_INDEX_FNS(T_MODE, esc1_thr_get, esc1_thr_set)
+ESC1_INDEX_FNS(T_LOW, esc1_thr_get, esc1_thr_set)
+ESC1_INDEX_FNS(T_HIGH, esc1_thr_get, esc1_thr_set)
+ESC1_INDEX_FNS(T_DB, esc1_thr_get, esc1_thr_set)
 
 static int esc1_get_t_us(void *ctx, double *v)
 {
-    return esc1_thr_get(esc1_of(ctx), 4u, v);
+    return esc1_thr_get(esc1_of(ctx), T_US, v);
 }
 
 static int esc1_get_t_state(void *ctx, double *v)
 {
-    return esc1_thr_get(esc1_of(ctx), 5u, v);
+    return esc1_thr_get(esc1_of(ctx), T_STATE, v);
 }
 
 static int esc1_get_t_cause(void *ctx, double *v)
 {
-    return esc1_thr_get(esc1_of(ctx), 6u, v);
+    return esc1_thr_get(esc1_of(ctx), T_CAUSE, v);
 }
 
 #define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
