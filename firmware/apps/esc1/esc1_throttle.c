@@ -36,7 +36,9 @@ void esc1_throttle_poll(esc1_t *s)
     if (t->state == THR_ARMED) {
         if (speed) {
             fw_set_speed_ref_rpm(fw, (double)o.ref / FX_ONE * fw->speed_info.speed_ref_max_rpm);
-            s->thr_tref = fw->speed_tref;
+            /* the medium task's last output (its slot is rewritten only two
+             * runs later; one aligned word) */
+            s->thr_tref = fw->mid_out[fw->mid_done & 1u].speed_tref;
         } else {
             fw_set_torque_ref(fw, fx_mul(o.ref, fw->torque_ref_max));
         }
