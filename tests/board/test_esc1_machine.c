@@ -252,6 +252,11 @@ static void pulse_at(uint32_t ms, uint32_t width_us)
     fw_watchdog_kick(&esc.fw);           /* the main loop's service */
     for (unsigned k = 0; k < 20u; k++) { /* 1 ms of control periods at 20 kHz */
         esc1_control_isr(&esc);
+        /* PendSV (lower priority) runs the medium-rate task when pended */
+        if ((g4_model_get(G4_SCB + G4_SCB_ICSR) & G4_SCB_ICSR_PENDSVSET) != 0u) {
+            g4_model_put(G4_SCB + G4_SCB_ICSR, 0u);
+            fw_medium(&esc.fw);
+        }
     }
 }
 
