@@ -807,6 +807,58 @@ static void observe(plant_t *p)
     p->v_int_t0 = p->t;
 }
 
+/*
+ * The observer instants strictly inside the piece [p->t, t_next) with legs l:
+ * a copy of the plant is advanced from the piece's start to each of them and
+ * observed, the plant itself is not touched, so its integration (the pieces
+ * between switching, dead-time and filter instants) is the same with and
+ * without an observer, bit for bit. The motor-voltage integral carries the
+ * part of the piece after the last instant into the plant's (the copy's
+ * integral is the running one: its last part is the piece's remainder).
+ * Returns PLANT_OK or the copy's error.
+ */
+static int observe_inside(plant_t *p, const legs_t *l, const sine_in_t *sine, double t_next,
+                          double eps)
+{
+    if (p->obs == NULL || (double)p->obs_next * p->obs_dt >= t_next - eps) {
+        return PLANT_OK;
+    }
+    plant_t sh;
+    if (p->flt.type == PLANT_FILTER_NONE) {
+        /* Without a filter a piece reads nothing past the filter's type:
+         * the state before it (640 bytes on the host), not the filter's
+         * 16 kB of cached exponentials, once per observed piece. */
+        memcpy(&sh, p, offsetof(plant_t, flt));
+        sh.flt.type = PLANT_FILTER_NONE;
+    } else {
+        sh = *p;
+    }
+    double before[2] = {0.0, 0.0}; /* the piece's share of the integral up to the last instant */
+    while ((double)p->obs_next * p->obs_dt < t_next - eps) {
+        const double t_obs = (double)p->obs_next * p->obs_dt;
+        if (t_obs > sh.t) {
+            const double v0[2] = {sh.v_int[0], sh.v_int[1]};
+            const int rc = advance_piece(&sh, l, sine, t_obs - sh.t);
+            if (rc != PLANT_OK) {
+                return rc;
+            }
+            before[0] += sh.v_int[0] - v0[0];
+            before[1] += sh.v_int[1] - v0[1];
+            sh.t = t_obs;
+        }
+        p->obs(p->obs_ctx, &sh);
+        p->obs_next++;
+        sh.v_int[0] = sh.v_int[1] = 0.0;
+        sh.v_int_t0 = sh.t;
+        p->v_int_t0 = sh.t;
+    }
+    /* The plant's integral restarts at the last instant: the piece's whole
+     * share is added by advance_piece, so the part before it goes out now. */
+    p->v_int[0] = -before[0];
+    p->v_int[1] = -before[1];
+    return PLANT_OK;
+}
+
 static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_in_t *sine)
 {
     /* Commanded transitions: count them, start the dead time. */
@@ -826,40 +878,35 @@ static int advance_common(plant_t *p, double dt, const uint8_t s[3], const sine_
     const double eps_end = PLANT_T_EPS * (1.0 + fabs(t_end));
     int guard = 0;
     while (p->t < t_end - eps_end) {
+        /* The pieces end at the period's end, the active filter's sampling
+         * instants and the dead times' ends: never at an observer instant. */
         double t_next = t_end;
-        int hit_obs = 0;
-        if (p->obs != NULL) {
-            const double t_obs = (double)p->obs_next * p->obs_dt;
-            if (t_obs <= t_next + eps_end) {
-                t_next = (t_obs < t_next) ? t_obs : t_next;
-                hit_obs = 1;
-            }
-        }
         /* the active filter's controller samples on its own grid */
         const double t_flt = plant_filter_next_event(p);
         int hit_flt = 0;
         if (t_flt <= t_next + eps_end) {
-            if (t_flt < t_next - eps_end) {
-                hit_obs = 0;
-            }
             t_next = (t_flt < t_next) ? t_flt : t_next;
             hit_flt = 1;
         }
         for (int x = 0; x < 3; ++x) {
             if (p->dead_end[x] > p->t + PLANT_T_EPS && p->dead_end[x] < t_next) {
                 t_next = p->dead_end[x];
-                hit_obs = 0;
                 hit_flt = 0;
             }
         }
         legs_t l;
         effective_legs(p, &l);
-        const int rc = advance_piece(p, &l, sine, t_next - p->t);
+        int rc = observe_inside(p, &l, sine, t_next, eps_end);
+        if (rc != PLANT_OK) {
+            return rc;
+        }
+        rc = advance_piece(p, &l, sine, t_next - p->t);
         if (rc != PLANT_OK) {
             return rc;
         }
         p->t = t_next; /* avoid drift of repeated sums */
-        if (hit_obs) {
+        /* An observer instant at the piece's end (within rounding): the plant's state. */
+        while (p->obs != NULL && (double)p->obs_next * p->obs_dt <= p->t + eps_end) {
             observe(p);
         }
         if (hit_flt) {

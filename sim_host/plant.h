@@ -23,9 +23,11 @@
  *    prediction omega_k + dt/2 * (Te_k - T_L - B omega_k)/J, then updated
  *    exactly for the interval's mean torque (Simpson on Te at 0, dt/2, dt).
  *
- * Every call splits additionally at the observer grid n * obs_dt (global time)
- * and calls the observer with the plant state at exactly that instant, so
- * metrics see the true continuous signals, not period-start samples.
+ * The observer (plant_set_observer) sees the state at every instant of its
+ * grid n * obs_dt (global time), so metrics see the true continuous signals,
+ * not period-start samples; it does not split the integration: a copy of the
+ * plant is advanced from the piece's start to each instant, the plant itself
+ * takes the same pieces with and without an observer (bit-identical results).
  */
 #ifndef SIM_HOST_PLANT_H
 #define SIM_HOST_PLANT_H
