@@ -198,8 +198,9 @@ static bool cmd_number(cmd_t *c, cmd_tok_t t, double *v)
     return true;
 }
 
-/* "err 4 range [min, max]" */
-static void cmd_err_range(cmd_t *c, double lo, double hi)
+/* "err 4 range [min, max]", with ", whole numbers" when set (the value was
+ * inside the range and refused for its fraction). */
+static void cmd_err_range_of(cmd_t *c, double lo, double hi, bool whole)
 {
     cmd_out_reset(c);
     cmd_out_str(c, "err ");
@@ -209,7 +210,15 @@ static void cmd_err_range(cmd_t *c, double lo, double hi)
     cmd_out_str(c, ", ");
     cmd_out_num(c, hi);
     cmd_out_char(c, ']');
+    if (whole) {
+        cmd_out_str(c, ", whole numbers");
+    }
     cmd_out_flush(c);
+}
+
+static void cmd_err_range(cmd_t *c, double lo, double hi)
+{
+    cmd_err_range_of(c, lo, hi, false);
 }
 
 /* Find a parameter by name through the iterator. */
@@ -541,7 +550,15 @@ static void cmd_param(cmd_t *c, const cmd_tok_t *tok, size_t n)
             cmd_err_range(c, info.min, info.max);
             return;
         }
-        if (cmd_op_ok(c, c->ops->param_set(c->ctx, info.name, v))) {
+        const int rc = c->ops->param_set(c->ctx, info.name, v);
+        if (rc == CMD_E_RANGE) {
+            /* Inside [min, max] and still refused (a switch given 0.5, a
+             * count given a fraction): the range again, and what else the
+             * value lacks where the parser can tell. */
+            cmd_err_range_of(c, info.min, info.max, v != (double)(int64_t)v); /* |v| <= 1e15 */
+            return;
+        }
+        if (cmd_op_ok(c, rc)) {
             cmd_ok_begin(c);
             cmd_out_char(c, ' ');
             cmd_out_str(c, info.name);

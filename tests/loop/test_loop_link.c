@@ -107,6 +107,15 @@ static void test_commands_reach_the_pipeline(void)
         "err 10 failed current PI Kp / (r_base) = 2429 pu outside [0, 2047]\r\n", out);
     TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_get(&run.fw, "Kp_q", &v));
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, v); /* the default (0 = Lq wc) */
+    /* A value inside the listed range the parameter still refuses (a switch
+     * given a fraction): the answer gives the range and why (the fuzzer's
+     * first finding: a bare "err 4 range"), the value in force stays. */
+    send("ctrl select m2ptfc");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    send("param set centre 0.5");
+    TEST_ASSERT_EQUAL_STRING("err 4 range [0, 1], whole numbers\r\n", out);
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_get(&run.fw, "centre", &v));
+    TEST_ASSERT_TRUE(v == 0.0 || v == 1.0);
     send("ctrl select bst");
     TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
 
