@@ -988,7 +988,7 @@ static void sim_write_filter_json(FILE *f, const sim_run_t *r)
     for (int k = 0; k < b->n_branches; ++k) {
         const double rms = sqrt(fmax(0.5 * (b->i2_int[k] - a->i2_int[k]) / w, 0.0));
         fprintf(f, "%s\n      \"%s\": {\"i_rms_a\": %.6g, \"i_peak_a\": %.6g}", k ? "," : "",
-                plant_filter_branch_name(b->type, k), rms, b->i_peak[k]);
+                plant_filter_branch_name((int)b->type, k), rms, b->i_peak[k]);
     }
     fprintf(f, "\n    }");
     if (b->type == PLANT_FILTER_ACTIVE) {
