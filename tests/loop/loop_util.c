@@ -45,17 +45,22 @@ void loop_start(sim_run_t *r, const sim_run_cfg_t *c)
     }
 }
 
+void loop_scenario(sim_scenario_t *s, const char *text, const char *name)
+{
+    FILE *f = tmpfile();
+    TEST_ASSERT_NOT_NULL(f);
+    fputs(text, f);
+    rewind(f);
+    char err[256];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(s, f, name, err, sizeof err), err);
+    fclose(f);
+}
+
 loop_reversal_t loop_reversal(sim_run_t *run, const sim_run_cfg_t *base, const char *scenario,
                               double fall_nm, double back_s, const char *label)
 {
     static sim_scenario_t scn;
-    FILE *f = tmpfile();
-    TEST_ASSERT_NOT_NULL(f);
-    fputs(scenario, f);
-    rewind(f);
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "reversal", err, sizeof err), err);
-    fclose(f);
+    loop_scenario(&scn, scenario, "reversal");
     sim_run_cfg_t c = *base;
     c.free_mech = true;
     c.load_nm = 0.0;

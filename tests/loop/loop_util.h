@@ -15,6 +15,9 @@ const sim_machine_t *loop_spmsm(void);
 void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torque_nm,
               double duration_s, double win_start_s);
 
+/* Parse a scenario given as text (sim_scenario.h format); fails the test on error. */
+void loop_scenario(sim_scenario_t *s, const char *text, const char *name);
+
 /* Initialise the run; fails the test with the message on error. */
 void loop_start(sim_run_t *r, const sim_run_cfg_t *c);
 

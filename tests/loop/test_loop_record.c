@@ -146,14 +146,7 @@ static void rec_check(const sim_run_cfg_t *c)
 
 static void rec_scenario(sim_run_cfg_t *c)
 {
-    static const char text[] = "at 0 speed_ref=0\nat 0.005 speed_ref=400\nat 0.03 load=2\n";
-    FILE *f = tmpfile();
-    TEST_ASSERT_NOT_NULL(f);
-    fputs(text, f);
-    rewind(f);
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_scenario_parse(&scn, f, "record", err, sizeof err), err);
-    fclose(f);
+    loop_scenario(&scn, "at 0 speed_ref=0\nat 0.005 speed_ref=400\nat 0.03 load=2\n", "record");
     c->scenario = &scn;
     c->free_mech = true;
     c->speed_mode = true;
