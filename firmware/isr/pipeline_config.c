@@ -205,7 +205,17 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
      * FW_OVERSPEED_REL. */
     const double n_max = fw_speed_max_rpm(fw->machine);
     if (!(n_max > 0.0)) {
-        return FW_EINVAL; /* a declared maximum speed below the rated one */
+        /* a declared maximum speed below the rated one: named, as every
+         * refusal (the link's fuzzer found it answered with no reason) */
+        const ctrl_diag_t d = {CTRL_EINVAL,
+                               "maximum speed",
+                               "r/min",
+                               fw->machine->speed_max_rpm,
+                               fw->machine->speed_rated_rpm,
+                               HUGE_VAL,
+                               "speed_max_rpm, speed_rated_rpm"};
+        fw->why = d;
+        return FW_EINVAL;
     }
     fw->speed_info.overspeed_rpm =
         cfg->overspeed_rpm > 0.0 ? cfg->overspeed_rpm : FW_OVERSPEED_REL * n_max;

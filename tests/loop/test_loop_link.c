@@ -227,6 +227,29 @@ static void test_application_parameters(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, app_value);
 }
 
+/* A machine whose declared maximum speed is below its rated speed (thesis
+ * SPMSM, 3750 r/min, rated set to 10000): the refusal names the quantity, its
+ * value and the range, as "err 10 failed" passes it on (it came without a
+ * reason: found by the link's fuzzer). */
+static void test_max_speed_refusal_is_named(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    ctrl_machine_t m = run.fw.machine_own;
+    TEST_ASSERT_TRUE(m.speed_max_rpm > 0.0);
+    m.speed_rated_rpm = 10000.0;
+    fw_config_t fc = run.fw.cfg;
+    fc.machine = &m;
+    fc.ctrl = run.fw.ctrl;
+    fc.ctrl_cfg = NULL;
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&run.fw, &run.hal, &fc));
+    TEST_ASSERT_EQUAL_STRING("maximum speed", run.fw.why.quantity);
+    TEST_ASSERT_EQUAL_DOUBLE(3750.0, run.fw.why.value);
+    TEST_ASSERT_EQUAL_DOUBLE(10000.0, run.fw.why.min);
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -234,5 +257,6 @@ int main(void)
     RUN_TEST(test_application_parameters);
     RUN_TEST(test_telemetry_frames);
     RUN_TEST(test_fault_over_link);
+    RUN_TEST(test_max_speed_refusal_is_named);
     return UNITY_END();
 }
