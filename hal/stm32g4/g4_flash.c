@@ -1,0 +1,231 @@
+/*
+ * STM32G431 flash: the settings pages (g4_flash.h). Sequences of RM0440
+ * sec. 3.3.5 (unlock), 3.3.7 (page erase) and 3.3.8 (standard programming).
+ */
+#include "g4_flash.h"
+
+#include <string.h>
+
+/* BSY polls before giving up: each poll is a bus read of a few cycles, so at
+ * 170 MHz this is well over the 40 ms maximum of a page erase. */
+#define G4_FLASH_BSY_POLLS 20000000u
+
+/* Set by the NMI when a read of the settings pages met ECCD. */
+static volatile uint32_t g4_flash_eccd;
+
+static const char *const g4_flash_sr_names[16] = {
+    "EOP",
+    "OPERR (operation error)",
+    "?",
+    "PROGERR (double word not erased)",
+    "WRPERR (page write-protected)",
+    "PGAERR (programming alignment)",
+    "SIZERR (not a double word)",
+    "PGSERR (programming sequence)",
+    "MISERR (fast programming data miss)",
+    "FASTERR (fast programming)",
+    "?",
+    "?",
+    "?",
+    "?",
+    "RDERR (PCROP read)",
+    "OPTVERR (option validity)",
+};
+
+const char *g4_flash_strerror(int rc)
+{
+    if (rc == 0) {
+        return "ok";
+    }
+    if (rc <= -G4_FLASH_E_SR && rc > -G4_FLASH_E_SR - 16) {
+        return g4_flash_sr_names[-rc - G4_FLASH_E_SR];
+    }
+    switch (rc) {
+    case G4_FLASH_E_BUSY:
+        return "BSY did not clear";
+    case G4_FLASH_E_LOCKED:
+        return "LOCK still set after the KEYR sequence";
+    case G4_FLASH_E_ECC:
+        return "ECCD (uncorrectable ECC error)";
+    case G4_FLASH_E_ADDR:
+        return "address outside the settings pages";
+    default:
+        return "flash error";
+    }
+}
+
+static bool g4_flash_wait_idle(void)
+{
+    for (uint32_t i = 0; i < G4_FLASH_BSY_POLLS; i++) {
+        if ((g4_rd(G4_FLASH + G4_FLASH_SR) & G4_FLASH_SR_BSY) == 0u) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The first error flag of FLASH_SR as a return code, 0 if none. */
+static int g4_flash_sr_error(uint32_t sr)
+{
+    const uint32_t e = sr & G4_FLASH_SR_ERRORS;
+    if (e == 0u) {
+        return 0;
+    }
+    int bit = 0;
+    while ((e & G4_BIT(bit)) == 0u) {
+        bit++;
+    }
+    return -(G4_FLASH_E_SR + bit);
+}
+
+/* No operation running, error flags of an earlier one cleared (rc_w1), the
+ * control register unlocked: steps 1-2 of RM0440's erase and programming
+ * sequences, then sec. 3.3.5 (KEY1 then KEY2; a wrong sequence would lock
+ * FLASH_CR until reset, so the keys are written only while LOCK is set). */
+static int g4_flash_begin(void)
+{
+    if (!g4_flash_wait_idle()) {
+        return G4_FLASH_E_BUSY;
+    }
+    g4_wr(G4_FLASH + G4_FLASH_SR, G4_FLASH_SR_ERRORS | G4_FLASH_SR_EOP);
+    if ((g4_rd(G4_FLASH + G4_FLASH_CR) & G4_FLASH_CR_LOCK) != 0u) {
+        g4_wr(G4_FLASH + G4_FLASH_KEYR, G4_FLASH_KEY1);
+        g4_wr(G4_FLASH + G4_FLASH_KEYR, G4_FLASH_KEY2);
+        if ((g4_rd(G4_FLASH + G4_FLASH_CR) & G4_FLASH_CR_LOCK) != 0u) {
+            return G4_FLASH_E_LOCKED;
+        }
+    }
+    return 0;
+}
+
+/* Wait for the end, clear the operation bits, lock; the operation's result. */
+static int g4_flash_end(uint32_t op_bits)
+{
+    const bool idle = g4_flash_wait_idle();
+    const uint32_t sr = g4_rd(G4_FLASH + G4_FLASH_SR);
+    g4_wr(G4_FLASH + G4_FLASH_SR, (sr & G4_FLASH_SR_ERRORS) | G4_FLASH_SR_EOP);
+    g4_mod(G4_FLASH + G4_FLASH_CR, op_bits, 0u);
+    g4_mod(G4_FLASH + G4_FLASH_CR, G4_FLASH_CR_LOCK, G4_FLASH_CR_LOCK);
+    if (!idle) {
+        return G4_FLASH_E_BUSY;
+    }
+    return g4_flash_sr_error(sr);
+}
+
+/* The data cache may hold words of the page from before the operation: off,
+ * reset (DCRST is writable only while DCEN = 0), on again, as ST's
+ * FLASH_FlushCaches. */
+static void g4_flash_dcache_flush(uint32_t acr)
+{
+    if ((acr & G4_FLASH_ACR_DCEN) != 0u) {
+        g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCEN, 0u);
+        g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCRST, G4_FLASH_ACR_DCRST);
+        g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCRST, 0u);
+        g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCEN, G4_FLASH_ACR_DCEN);
+    }
+}
+
+int g4_flash_erase(unsigned p)
+{
+    if (p > 1u) {
+        return G4_FLASH_E_ADDR;
+    }
+    int rc = g4_flash_begin();
+    if (rc != 0) {
+        return rc;
+    }
+    /* ST's driver turns the data cache off for an erase and resets it after */
+    const uint32_t acr = g4_rd(G4_FLASH + G4_FLASH_ACR);
+    g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCEN, 0u);
+    const uint32_t page = G4_FLASH_SETTINGS_PAGE + p;
+    g4_mod(G4_FLASH + G4_FLASH_CR, G4_FLASH_CR_PNB_MASK | G4_FLASH_CR_PER,
+           G4_FIELD(page, G4_FLASH_CR_PNB_POS) | G4_FLASH_CR_PER);
+    g4_mod(G4_FLASH + G4_FLASH_CR, G4_FLASH_CR_STRT, G4_FLASH_CR_STRT);
+    rc = g4_flash_end(G4_FLASH_CR_PER | G4_FLASH_CR_PNB_MASK);
+    if ((acr & G4_FLASH_ACR_DCEN) != 0u) {
+        g4_mod(G4_FLASH + G4_FLASH_ACR, G4_FLASH_ACR_DCEN, G4_FLASH_ACR_DCEN);
+    }
+    g4_flash_dcache_flush(acr);
+    return rc;
+}
+
+int g4_flash_program(unsigned p, uint32_t off, uint32_t lo, uint32_t hi)
+{
+    if (p > 1u || (off & 7u) != 0u || off >= G4_FLASH_PAGE_SIZE) {
+        return G4_FLASH_E_ADDR;
+    }
+    int rc = g4_flash_begin();
+    if (rc != 0) {
+        return rc;
+    }
+    const uintptr_t at = G4_FLASH_SETTINGS_BASE + p * G4_FLASH_PAGE_SIZE + off;
+    g4_mod(G4_FLASH + G4_FLASH_CR, G4_FLASH_CR_PG, G4_FLASH_CR_PG);
+    /* the low word first, then the high one: the second write starts the
+     * programming of the double word (sec. 3.3.8); volatile stores keep their
+     * order, and the Cortex-M4 does not reorder stores */
+    g4_wr(at, lo);
+    g4_wr(at + 4u, hi);
+    rc = g4_flash_end(G4_FLASH_CR_PG);
+    g4_flash_dcache_flush(g4_rd(G4_FLASH + G4_FLASH_ACR));
+    return rc;
+}
+
+/* ECCD is rc_w1; ECCIE kept, ECCC (a corrected error) left alone. */
+static void g4_flash_eccd_clear(void)
+{
+    const uint32_t eccr = g4_rd(G4_FLASH + G4_FLASH_ECCR);
+    g4_wr(G4_FLASH + G4_FLASH_ECCR, (eccr & G4_FLASH_ECCR_ECCIE) | G4_FLASH_ECCR_ECCD);
+}
+
+int g4_flash_read(unsigned p, uint32_t off, uint8_t *buf, size_t n)
+{
+    if (p > 1u || off > G4_FLASH_PAGE_SIZE || n > G4_FLASH_PAGE_SIZE - off || (off & 3u) != 0u) {
+        return G4_FLASH_E_ADDR;
+    }
+    const uintptr_t base = G4_FLASH_SETTINGS_BASE + p * G4_FLASH_PAGE_SIZE;
+    g4_flash_eccd = 0u;
+    for (size_t i = 0; i < n; i += 4u) {
+        const uint32_t w = g4_rd(base + off + i);
+        /* the NMI handler cleared ECCD and noted it; where no NMI runs (the
+         * register model) ECCD itself says it */
+        if (g4_flash_eccd != 0u || (g4_rd(G4_FLASH + G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD) != 0u) {
+            g4_flash_eccd_clear();
+            g4_flash_eccd = 0u;
+            return G4_FLASH_E_ECC;
+        }
+        const size_t k = n - i < 4u ? n - i : 4u;
+        for (size_t b = 0; b < k; b++) {
+            buf[i + b] = (uint8_t)(w >> (8u * b));
+        }
+    }
+    return 0;
+}
+
+bool g4_flash_nmi_ecc(void)
+{
+    const uint32_t eccr = g4_rd(G4_FLASH + G4_FLASH_ECCR);
+    const uint32_t at = eccr & G4_FLASH_ECCR_ADDR_MASK;
+    const uint32_t lo = G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE;
+    if ((eccr & G4_FLASH_ECCR_ECCD) == 0u || (eccr & G4_FLASH_ECCR_SYSF_ECC) != 0u || at < lo ||
+        at >= lo + 2u * G4_FLASH_PAGE_SIZE) {
+        return false;
+    }
+    g4_flash_eccd_clear();
+    g4_flash_eccd = 1u;
+    return true;
+}
+
+#if !defined(G4_MEM_ARRAYS)
+/* Replaces g4_startup.c's weak NMI_Handler when the flash driver is linked.
+ * An ECC error in the settings pages is a read result, not a fault: it is
+ * cleared and the read reports it (a few register reads before the fault
+ * path); any other NMI goes to the fault path, which turns the gates off. */
+void g4_fault_handler(void);
+void NMI_Handler(void);
+void NMI_Handler(void)
+{
+    if (!g4_flash_nmi_ecc()) {
+        g4_fault_handler();
+    }
+}
+#endif
