@@ -56,6 +56,21 @@ class ConsoleQemuTest(unittest.TestCase):
             # quantisation and the loop's ripple: a few r/min).
             self.assertLess(max(abs(s - 500.0) for s in tail), 25.0, tail)
 
+    def test_settings_commands(self):
+        # The settings record in the image's RAM model of the flash pages:
+        # saved, listed, the compiled-in defaults back, erased.
+        r = console("--qemu", ELF, "--timeout", "30", "--cmd", "ctrl select foc",
+                    "--cmd", "config save", "--cmd", "config show", "--cmd", "config default",
+                    "--cmd", "status", "--cmd", "config erase")
+        print(r.stdout[-1500:], r.stderr[-800:])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("> config save\nok saved record 1", r.stdout)
+        self.assertIn("  record=1\n", r.stdout)
+        self.assertIn("  ctrl=foc\n", r.stdout)
+        self.assertIn("ok compiled-in defaults applied (flash unchanged)", r.stdout)
+        self.assertIn("  ctrl=fst\n", r.stdout)  # the image's compiled-in controller
+        self.assertIn("ok erased: compiled-in defaults from the next start", r.stdout)
+
     def test_reports_the_target_exit(self):
         # The test image calibrates on a turning rotor (RK4 with the gates
         # off, millions of instructions a period): a patient response timeout.

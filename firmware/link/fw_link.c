@@ -434,6 +434,24 @@ static int op_stop(void *ctx)
     return CMD_OK;
 }
 
+/* "config ..." (cmd.h): fw_settings.c's, when the application attached a
+ * store (fw_link_set_settings); the settings code is not linked otherwise. */
+static int op_config(void *ctx, const char *what, const char **detail)
+{
+    fw_link_t *l = fw_link_of(ctx);
+    if (l->settings == NULL || l->settings_cmd == NULL) {
+        return CMD_E_UNSUPPORTED;
+    }
+    return l->settings_cmd(l->settings, l->fw, what, detail);
+}
+
+static bool op_config_item_at(void *ctx, size_t index, cmd_config_item_t *it)
+{
+    const fw_link_t *l = fw_link_of(ctx);
+    return l->settings != NULL && l->settings_item != NULL &&
+           l->settings_item(l->settings, index, it);
+}
+
 static const cmd_ops_t fw_link_ops = {
     op_write,
     op_get_status,
@@ -457,6 +475,8 @@ static const cmd_ops_t fw_link_ops = {
     op_cm_apply,
     op_stop,
     op_failed_detail,
+    op_config,
+    op_config_item_at,
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx)

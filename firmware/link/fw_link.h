@@ -18,6 +18,7 @@
 #include <stdint.h>
 
 #include "cmd.h"
+#include "fw_settings.h"
 #include "pipeline.h"
 #include "telemetry.h"
 
@@ -48,11 +49,19 @@ typedef struct {
     const fw_link_param_t *params; /* application parameters (fw_link_set_params) */
     size_t n_params;
     void *params_ctx;
+    /* "config" commands (fw_link_set_settings in fw_settings.c), NULL: unsupported */
+    fw_settings_t *settings;
+    int (*settings_cmd)(fw_settings_t *st, fw_t *fw, const char *what, const char **detail);
+    bool (*settings_item)(const fw_settings_t *st, size_t index, cmd_config_item_t *it);
 } fw_link_t;
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
 /* Application parameters (after fw_link_init; the table must outlive the link). */
 void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, void *ctx);
+/* The settings store behind "config save|show|erase|default" (after
+ * fw_link_init; it must outlive the link; NULL detaches it). In
+ * fw_settings.c, so that an image without settings does not link them. */
+void fw_link_set_settings(fw_link_t *l, fw_settings_t *st);
 /* For an application parameter's set (main loop) that fails because the core
  * refused the configuration: the reason (fw_t.why before the application
  * restores its previous data), sent as the detail of "err 10 failed". */

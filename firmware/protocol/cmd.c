@@ -251,6 +251,7 @@ static const char *const cmd_help_lines[] = {
     "ident run | resume | step NAME motor identification (ident status)",
     "ident status | result | ini | apply  progress, values, machine file",
     "bringup NAME | bringup status  bench checks: vbus gates sense encoder run",
+    "config save | show | erase | default  settings kept in flash",
 };
 
 static void cmd_help(cmd_t *c)
@@ -908,6 +909,69 @@ static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
     cmd_cm_start(c, "bringup", name);
 }
 
+/* "config save|show|erase|default": the settings record in flash. The op
+ * refuses save, erase and default with the gates on (a flash page erase
+ * stalls the CPU for tens of ms), saying why. */
+static void cmd_config(cmd_t *c, const cmd_tok_t *tok, size_t n)
+{
+    static const char usage[] = "config save|show|erase|default";
+    if (c->ops->config == NULL || c->ops->config_item_at == NULL) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    if (n != 2) {
+        cmd_err(c, CMD_E_ARGS, usage);
+        return;
+    }
+    const char *what = NULL;
+    if (cmd_tok_is(tok[1], "save")) {
+        what = "save";
+    } else if (cmd_tok_is(tok[1], "erase")) {
+        what = "erase";
+    } else if (cmd_tok_is(tok[1], "default")) {
+        what = "default";
+    } else if (cmd_tok_is(tok[1], "show")) {
+        what = "read";
+    } else {
+        cmd_err(c, CMD_E_ARGS, usage);
+        return;
+    }
+    const char *detail = NULL;
+    const int rc = c->ops->config(c->ctx, what, &detail);
+    if (rc != CMD_OK) {
+        cmd_err(c, rc, detail);
+        return;
+    }
+    if (what[0] != 'r') {
+        cmd_ok_begin(c);
+        if (detail != NULL) {
+            cmd_out_char(c, ' ');
+            cmd_out_str(c, detail);
+        }
+        cmd_out_flush(c);
+        return;
+    }
+    cmd_config_item_t it;
+    uint32_t count = 0;
+    while (count < 256u && c->ops->config_item_at(c->ctx, count, &it)) {
+        count++;
+    }
+    cmd_ok_list(c, count);
+    for (uint32_t i = 0; i < count; i++) {
+        memset(&it, 0, sizeof it);
+        (void)c->ops->config_item_at(c->ctx, i, &it);
+        cmd_item_begin(c);
+        cmd_out_str(c, it.key);
+        cmd_out_char(c, '=');
+        if (it.text != NULL) {
+            cmd_out_str(c, it.text);
+        } else {
+            cmd_out_num(c, it.num);
+        }
+        cmd_out_flush(c);
+    }
+}
+
 static void cmd_stop(cmd_t *c, size_t n)
 {
     cmd_run_op(c, n, "stop", c->ops->stop, " stopped");
@@ -1008,6 +1072,8 @@ void cmd_execute(cmd_t *c, const char *line, size_t len)
         cmd_bringup(c, tok, n);
     } else if (cmd_tok_is(tok[0], "stop")) {
         cmd_stop(c, n);
+    } else if (cmd_tok_is(tok[0], "config")) {
+        cmd_config(c, tok, n);
     } else {
         cmd_err(c, CMD_E_UNKNOWN, "try help");
     }

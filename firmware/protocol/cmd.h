@@ -98,6 +98,13 @@ typedef struct {
     bool integer;
 } cmd_cm_item_t;
 
+/* One line of "config show": key and value (text, or a number when text is NULL). */
+typedef struct {
+    const char *key;
+    const char *text;
+    double num;
+} cmd_config_item_t;
+
 /*
  * The firmware behind the interpreter. Every function receives the context
  * pointer given to cmd_init. State-changing ops return CMD_OK or a cmd_err_t
@@ -148,6 +155,13 @@ typedef struct {
      * quantity the control core refused, its value and its range), or NULL;
      * appended to "err 10 failed" (cut at the line's end). Appended. */
     const char *(*failed_detail)(void *ctx);
+    /* settings in flash (PROTOCOL.md "Settings"); appended. what: "save",
+     * "erase", "default" (state-changing) or "read" (the stored record, for
+     * config_item_at). *detail: what was done, or why not (valid until the
+     * next op call). */
+    int (*config)(void *ctx, const char *what, const char **detail);
+    /* read-only: the record last read, line by line; false past the end */
+    bool (*config_item_at)(void *ctx, size_t index, cmd_config_item_t *it);
 } cmd_ops_t;
 
 typedef struct {

@@ -10,6 +10,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "controller.h"
 #include "ctrl_params.h"
 #include "esc1_uart.h"
 #include "fw_link.h"
@@ -49,6 +50,13 @@ typedef struct {
     uint32_t ms_cycles;  /* core cycles per millisecond */
     bool temp_check;     /* board over-temperature trip enabled */
     double temp_c;       /* last board temperature (NaN: sensor open/short) */
+#if defined(ESC1_SETTINGS)
+    fw_settings_t settings; /* the record in flash (esc1_settings.c) */
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } ctrl_cfg; /* the controller's configuration a record gives (fw_settings_config) */
+#endif
 } esc1_t;
 
 /* The compiled-in machine, generated at build time from a machine file
@@ -69,6 +77,17 @@ double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m);
  * previous data are restored. Returns CMD_OK, CMD_E_STATE (running),
  * CMD_E_RANGE (encoder counts) or CMD_E_FAILED (the core refused them). */
 int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr);
+/* The same with a whole configuration (NULL: fw_config_default for m and the
+ * controller in use); cfg->machine is replaced by the kept copy of m. */
+int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
+                         const fw_config_t *cfg);
+
+#if defined(ESC1_SETTINGS)
+/* Start-up (interrupts running, drive not armed): the newest settings record
+ * applied, or the compiled-in defaults, with a line on the serial link saying
+ * which; the "config" commands attached (esc1_settings.c). */
+void esc1_settings_start(esc1_t *s);
+#endif
 
 /* The body of the ADC1_2 interrupt (end of the injected sequence): flags
  * acknowledged, the firmware's period (fw_isr_fast; PendSV pended when the

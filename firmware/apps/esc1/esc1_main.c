@@ -178,6 +178,10 @@ int main(void)
     g4_nvic_enable(G4_IRQ_TIM1_BRK_TIM15);
     g4_nvic_enable(G4_IRQ_USART2);
     g4_nvic_enable(G4_IRQ_ADC1_2);
+#if defined(ESC1_SETTINGS)
+    /* the saved settings (or the defaults), said on the link */
+    esc1_settings_start(s);
+#endif
 
     uint32_t pr, rlr;
     if (g4_iwdg_config(ESC1_IWDG_MS, 32000u, &pr, &rlr) != G4_OK ||

@@ -304,6 +304,12 @@ void esc1_params_attach(esc1_t *s)
 
 int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
 {
+    return esc1_reconfigure_cfg(s, m, encoder_cpr, NULL);
+}
+
+int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
+                         const fw_config_t *cfg)
+{
     if (fw_state(&s->fw) == FW_STATE_RUNNING) {
         return CMD_E_STATE;
     }
@@ -320,7 +326,12 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
     s->machine = *m;
     s->encoder_cpr = encoder_cpr;
     s->hal.info.encoder_counts_per_rev = encoder_cpr;
-    fw_config_default(&s->fc, &s->machine, ctrl);
+    if (cfg != NULL) {
+        s->fc = *cfg;
+        s->fc.machine = &s->machine;
+    } else {
+        fw_config_default(&s->fc, &s->machine, ctrl);
+    }
     int rc = fw_init(&s->fw, &s->hal, &s->fc);
     if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
         rc = FW_ERANGE;

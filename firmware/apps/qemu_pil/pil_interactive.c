@@ -12,6 +12,9 @@
  * PIL_APP_CTRL at its default fs; "ctrl select" changes it while disarmed.
  * Wall time: a running period costs 50-110 k emulated instructions, so plant
  * time runs at about 1/20 of real time (-icount shift=3).
+ * Settings ("config save|show|erase|default"): the record of fw_settings.h in
+ * a RAM model of the G4 flash's two pages (settings_flash_model.h), empty at
+ * each start of QEMU.
  */
 #include <stdio.h>
 #include <string.h>
@@ -22,6 +25,7 @@
 #include "pil_common.h"
 #include "pipeline.h"
 #include "qemu_mps2.h"
+#include "settings_flash_model.h"
 #include "sim_run.h"
 
 #ifndef PIL_APP_CTRL
@@ -36,7 +40,35 @@ static struct {
     fw_link_t link;
     pil_timer_t timer;
     volatile int plant_failed;
+    sfm_t flash;
+    fw_settings_t settings;
+    ctrl_machine_t machine; /* the compiled-in machine (config default) */
 } app;
+
+/* A record's configuration on the running engine (commands run with the
+ * period interrupt masked: pil_poll_uart). */
+static int app_settings_apply(void *ctx, const settings_t *s, char *why, size_t cap)
+{
+    (void)ctx;
+    ctrl_machine_t m;
+    fw_config_t c;
+    if (fw_settings_config(s, &m, &c, app.run.ctrl_cfg_buf, why, cap) != FW_OK) {
+        return CMD_E_FAILED;
+    }
+    if (fw_init(&app.run.fw, &app.run.hal, &c) != FW_OK) {
+        (void)fw_explain(&app.run.fw, why, cap);
+        return CMD_E_FAILED;
+    }
+    return CMD_OK;
+}
+
+static int app_settings_default(void *ctx)
+{
+    (void)ctx;
+    fw_config_t c;
+    fw_config_default(&c, &app.machine, ctrl_find(PIL_APP_CTRL));
+    return fw_init(&app.run.fw, &app.run.hal, &c) == FW_OK ? CMD_OK : CMD_E_FAILED;
+}
 
 /* The PWM-period interrupt (Timer0). */
 static void app_isr(void)
@@ -79,11 +111,19 @@ int main(void)
         return 2;
     }
     plant_set_load_passive(&app.run.plant, PIL_APP_LOAD_NM);
+    app.machine = app.run.fw.machine_own;
+    sfm_init(&app.flash, 1u);
+    sfm_flash(&app.flash, &app.settings.flash);
+    app.settings.apply = app_settings_apply;
+    app.settings.apply_default = app_settings_default;
+    (void)fw_settings_boot(&app.settings);
     fw_link_init(&app.link, &app.run.fw, pil_uart_write, NULL);
+    fw_link_set_settings(&app.link, &app.settings);
     hal_qemu_uart_rx_enable();
     printf("pmsm-dtc on QEMU mps2-an386: %s, free rotor, passive load %.2f N*m; controller %s "
            "at %u Hz; calibrating (256 periods), then 'arm' (PROTOCOL.md, 'help')\n",
            pil_machine.name, PIL_APP_LOAD_NM, desc->name, (unsigned)c.fs_hz);
+    printf("%s (flash: RAM model)\n", app.settings.msg);
     pil_timer_start(&app.timer, app_isr);
     for (;;) {
         pil_poll_uart(&app.link);

@@ -1,0 +1,257 @@
+/*
+ * Settings record <-> firmware configuration (fw_settings.h).
+ */
+#include "fw_settings.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cm.h"
+#include "cmd.h"
+#include "cmd_num.h"
+#include "controller.h"
+#include "fw_link.h"
+
+static void fw_settings_name(char *dst, const char *src)
+{
+    memset(dst, 0, SETTINGS_NAME_MAX);
+    if (src != NULL) {
+        strncpy(dst, src, SETTINGS_NAME_MAX - 1u);
+    }
+}
+
+/* A measured value, 0 where none was measured (NaN never goes into a record). */
+static double fw_settings_finite(double v)
+{
+    return isfinite(v) ? v : 0.0;
+}
+
+void fw_settings_capture(const fw_t *fw, settings_t *s)
+{
+    memset(s, 0, sizeof *s);
+    const ctrl_machine_t *m = &fw->machine_own;
+    s->pole_pairs = m->pole_pairs;
+    s->rs_ohm = m->rs_ohm;
+    s->ld_h = m->ld_h;
+    s->lq_h = m->lq_h;
+    s->psi_pm_wb = m->psi_pm_wb;
+    s->vdc_v = m->vdc_v;
+    s->inertia_kgm2 = m->inertia_kgm2;
+    s->torque_rated_nm = m->torque_rated_nm;
+    s->speed_rated_rpm = m->speed_rated_rpm;
+    s->current_rated_a = m->current_rated_a;
+    s->current_max_a = m->current_max_a;
+    s->psi_ref_wb = m->psi_ref_wb;
+    s->speed_max_rpm = m->speed_max_rpm;
+    /* the encoder as the firmware uses it now (identified offset and direction
+     * included once "ident apply" adopted them) */
+    s->enc_cpr = fw->enc_cpr;
+    s->enc_direction = fw->enc_neg != 0u ? -1 : 1;
+    s->enc_offset = fw->enc_offset;
+    const fw_config_t *c = &fw->cfg;
+    s->sensorless = c->sensorless ? 1u : 0u;
+    s->dead_time_s = c->dead_time_s;
+    s->v_fwd_v = c->v_fwd_v;
+    s->psi_adapt = c->psi_adapt ? 1u : 0u;
+    if (fw->ctrl != NULL) {
+        fw_settings_name(s->ctrl, fw->ctrl->name);
+        const size_t n = fw->ctrl->n_tunables;
+        for (size_t k = 0; k < n && k < SETTINGS_TUNABLES_MAX; k++) {
+            const char *name = fw->ctrl->tunables[k].name;
+            double v = 0.0;
+            if (fw_tunable_get(fw, name, &v) == FW_OK) {
+                fw_settings_name(s->tunable_name[s->n_tunables], name);
+                s->tunable_value[s->n_tunables] = v;
+                s->n_tunables++;
+            }
+        }
+    }
+    s->speed_bw_hz = c->speed_bw_hz;
+    s->speed_pm_deg = c->speed_pm_deg;
+    s->speed_kp = c->speed_kp;
+    s->speed_ki = c->speed_ki;
+    s->speed_unit = (uint8_t)c->speed_unit;
+    s->speed_out_max_nm = c->speed_out_max_nm;
+    s->speed_loop_hz = c->speed_loop_hz;
+    s->overspeed_rpm = c->overspeed_rpm;
+    s->thr_mode = SETTINGS_THR_OFF;
+    cm_si_t r;
+    fw_commission_results(fw, &r);
+    s->id_have = r.have;
+    s->id_rs_ohm = fw_settings_finite(r.rs_ohm);
+    s->id_ld_h = fw_settings_finite(r.ld_h);
+    s->id_lq_h = fw_settings_finite(r.lq_h);
+    s->id_psi_wb = fw_settings_finite(r.psi_wb);
+    s->id_inertia_kgm2 = fw_settings_finite(r.inertia_kgm2);
+    s->id_enc_offset_deg = fw_settings_finite(r.enc_offset_deg);
+    s->id_enc_dir = (int8_t)(r.enc_dir > 0 ? 1 : (r.enc_dir < 0 ? -1 : 0));
+    s->id_enc_cpr = r.enc_cpr;
+}
+
+int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, void *cfg_buf,
+                       char *why, size_t cap)
+{
+    const ctrl_desc_t *d = ctrl_find(s->ctrl);
+    if (d == NULL) {
+        (void)snprintf(why, cap, "controller %s is not in this image", s->ctrl);
+        return FW_ENOENT;
+    }
+    memset(m, 0, sizeof *m);
+    m->name = "settings";
+    m->pole_pairs = (int)s->pole_pairs;
+    m->rs_ohm = s->rs_ohm;
+    m->ld_h = s->ld_h;
+    m->lq_h = s->lq_h;
+    m->psi_pm_wb = s->psi_pm_wb;
+    m->vdc_v = s->vdc_v;
+    m->inertia_kgm2 = s->inertia_kgm2;
+    m->torque_rated_nm = s->torque_rated_nm;
+    m->speed_rated_rpm = s->speed_rated_rpm;
+    m->current_rated_a = s->current_rated_a;
+    m->current_max_a = s->current_max_a;
+    m->psi_ref_wb = s->psi_ref_wb;
+    m->speed_max_rpm = s->speed_max_rpm;
+    fw_config_default(c, m, d);
+    c->enc_cpr = s->enc_cpr;
+    c->enc_direction = s->enc_direction;
+    c->enc_offset = s->enc_offset;
+    c->sensorless = s->sensorless != 0u;
+    c->dead_time_s = s->dead_time_s;
+    c->v_fwd_v = s->v_fwd_v;
+    c->psi_adapt = s->psi_adapt != 0u;
+    c->speed_bw_hz = s->speed_bw_hz;
+    c->speed_pm_deg = s->speed_pm_deg;
+    c->speed_kp = s->speed_kp;
+    c->speed_ki = s->speed_ki;
+    c->speed_unit = (ctrl_speed_unit_t)s->speed_unit;
+    c->speed_out_max_nm = s->speed_out_max_nm;
+    c->speed_loop_hz = s->speed_loop_hz;
+    c->overspeed_rpm = s->overspeed_rpm;
+    memset(cfg_buf, 0, CTRL_CFG_MAX);
+    if (ctrl_cfg_default(d, cfg_buf, m) != CTRL_OK) {
+        (void)snprintf(why, cap, "controller %s: no default configuration", d->name);
+        return FW_EINVAL;
+    }
+    for (unsigned k = 0; k < s->n_tunables && k < SETTINGS_TUNABLES_MAX; k++) {
+        if (ctrl_tunable_set(d, cfg_buf, s->tunable_name[k], s->tunable_value[k]) != CTRL_OK) {
+            char v[24]; /* no float conversion in printf: the target's libc may lack it */
+            if (cmd_num_format(v, sizeof v, s->tunable_value[k], 7u) == 0u) {
+                strcpy(v, "?");
+            }
+            (void)snprintf(why, cap, "%s tunable %s = %s refused", d->name, s->tunable_name[k], v);
+            return FW_EINVAL;
+        }
+    }
+    c->ctrl_cfg = cfg_buf;
+    return FW_OK;
+}
+
+bool fw_settings_boot(fw_settings_t *st)
+{
+    const settings_status_t rc =
+        settings_store_load(&st->flash, st->buf, sizeof st->buf, &st->rec, &st->scan);
+    if (rc != SETTINGS_OK) {
+        (void)settings_load_message(&st->scan, st->msg, sizeof st->msg);
+        return false;
+    }
+    char why[FW_SETTINGS_MSG_MAX - 48u];
+    why[0] = '\0';
+    if (st->apply(st->ctx, &st->rec, why, sizeof why) == CMD_OK) {
+        (void)settings_load_message(&st->scan, st->msg, sizeof st->msg);
+        return true;
+    }
+    (void)st->apply_default(st->ctx);
+    /* cut at the message's end when the reason is long */
+    const int n =
+        snprintf(st->msg, sizeof st->msg, "settings: record %lu refused: %s; compiled-in defaults",
+                 (unsigned long)st->scan.seq[st->scan.page], why);
+    if (n < 0) {
+        st->msg[0] = '\0';
+    }
+    return false;
+}
+
+/* "config save|erase|default|read" (cmd.h ops.config). */
+static int fw_settings_command(fw_settings_t *st, fw_t *fw, const char *what, const char **detail)
+{
+    *detail = st->msg;
+    st->msg[0] = '\0';
+    if (strcmp(what, "read") == 0) {
+        if (settings_store_load(&st->flash, st->buf, sizeof st->buf, &st->rec, &st->scan) !=
+            SETTINGS_OK) {
+            (void)settings_load_message(&st->scan, st->msg, sizeof st->msg);
+            return CMD_E_STATE;
+        }
+        return CMD_OK;
+    }
+    /* an erase stalls the CPU (and the control interrupt) for tens of ms */
+    const fw_state_id_t state = fw_state(fw);
+    if (state == FW_STATE_RUNNING || state == FW_STATE_COMMISSION) {
+        (void)snprintf(st->msg, sizeof st->msg,
+                       "gates on (%s): disarm first (a flash erase stalls the CPU ~20-40 ms)",
+                       fw_state_name(state));
+        return CMD_E_STATE;
+    }
+    if (strcmp(what, "default") == 0) {
+        const int rc = st->apply_default(st->ctx);
+        (void)snprintf(st->msg, sizeof st->msg, "%s",
+                       rc == CMD_OK ? "compiled-in defaults applied (flash unchanged)"
+                                    : "compiled-in defaults refused");
+        return rc;
+    }
+    int rc;
+    if (strcmp(what, "save") == 0) {
+        settings_t s;
+        fw_settings_capture(fw, &s);
+        if (st->capture != NULL) {
+            st->capture(st->ctx, &s);
+        }
+        uint32_t seq = 0;
+        rc = settings_store_save(&st->flash, st->buf, sizeof st->buf, &s, &seq);
+        if (rc == SETTINGS_STORE_OK) {
+            (void)snprintf(st->msg, sizeof st->msg, "saved record %lu", (unsigned long)seq);
+            return CMD_OK;
+        }
+    } else {
+        rc = settings_store_erase(&st->flash, st->buf, sizeof st->buf);
+        if (rc == SETTINGS_STORE_OK) {
+            (void)snprintf(st->msg, sizeof st->msg, "%s",
+                           "erased: compiled-in defaults from the next start");
+            return CMD_OK;
+        }
+    }
+    (void)snprintf(st->msg, sizeof st->msg, "flash: %s", settings_store_strerror(&st->flash, rc));
+    return CMD_E_FAILED;
+}
+
+/* "config show": the record last read, after its sequence number and page. */
+static bool fw_settings_item(const fw_settings_t *st, size_t index, cmd_config_item_t *it)
+{
+    if (st->scan.page < 0) {
+        return false;
+    }
+    it->text = NULL;
+    if (index < 2u) {
+        it->key = index == 0u ? "record" : "page";
+        it->num = index == 0u ? (double)st->scan.seq[st->scan.page] : (double)st->scan.page;
+        return true;
+    }
+    settings_item_t si;
+    if (!settings_item_at(&st->rec, index - 2u, &si)) {
+        return false;
+    }
+    it->key = si.key;
+    it->text = si.text;
+    it->num = si.num;
+    return true;
+}
+
+void fw_link_set_settings(fw_link_t *l, fw_settings_t *st)
+{
+    if (l != NULL) {
+        l->settings = st;
+        l->settings_cmd = st != NULL ? fw_settings_command : NULL;
+        l->settings_item = st != NULL ? fw_settings_item : NULL;
+    }
+}

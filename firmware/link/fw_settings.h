@@ -1,0 +1,60 @@
+/*
+ * The settings record (settings.h) on the firmware: what a save captures
+ * from the running firmware, the configuration a record gives back, and the
+ * "config" commands' side of the link (PROTOCOL.md "Settings").
+ *
+ * An application that keeps settings owns one fw_settings_t: the flash
+ * device (settings_store.h), a work area, and how to reconfigure itself from
+ * a record (its HAL may need more than fw_init: the ESC1's over-current
+ * threshold, for instance). fw_link_set_settings (fw_link.h) attaches it to
+ * the command link; fw_settings_boot applies the newest record at start-up.
+ */
+#ifndef FIRMWARE_FW_SETTINGS_H
+#define FIRMWARE_FW_SETTINGS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "pipeline.h"
+#include "settings.h"
+#include "settings_store.h"
+
+#define FW_SETTINGS_MSG_MAX 112u
+
+typedef struct {
+    settings_flash_t flash;
+    uint8_t buf[SETTINGS_REC_MAX]; /* work area of the store */
+    settings_t rec;                /* the record last read ("config show") */
+    settings_scan_t scan;          /* what the last read found */
+    /* Reconfigure the drive from s (not running): CMD_OK, or a cmd_err_t code
+     * with the reason in why (the previous configuration then stays). */
+    int (*apply)(void *ctx, const settings_t *s, char *why, size_t cap);
+    /* The compiled-in defaults (not running): CMD_OK or a cmd_err_t code. */
+    int (*apply_default)(void *ctx);
+    /* Optional: the application's own fields of the record (throttle). */
+    void (*capture)(void *ctx, settings_t *s);
+    void *ctx;
+    char msg[FW_SETTINGS_MSG_MAX]; /* the last operation's message */
+} fw_settings_t;
+
+/* The firmware's configuration as a record: machine, encoder, inverter,
+ * controller and its tunables, speed loop and limits, identification
+ * results (throttle: off, the application's capture fills it). */
+void fw_settings_capture(const fw_t *fw, settings_t *s);
+
+/* The machine and configuration a record gives: *m from s, *c =
+ * fw_config_default(m, the controller of s) with s's values, the controller's
+ * SI configuration in cfg_buf (CTRL_CFG_MAX bytes, max_align_t aligned; its
+ * defaults for m with s's tunables) and c->ctrl_cfg = cfg_buf. Returns FW_OK,
+ * or FW_ENOENT (controller not in this build) / FW_EINVAL (a tunable refused)
+ * with the reason in why. */
+int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, void *cfg_buf,
+                       char *why, size_t cap);
+
+/* Start-up: the newest valid record applied through st->apply, else the
+ * defaults (st->apply_default when a record was refused). st->msg says which
+ * ("settings: record 3 (page 1) applied", "settings: no record in flash,
+ * compiled-in defaults", ...). Returns true when a record was applied. */
+bool fw_settings_boot(fw_settings_t *st);
+
+#endif /* FIRMWARE_FW_SETTINGS_H */
