@@ -189,7 +189,7 @@ static int fw_settings_command(fw_settings_t *st, fw_t *fw, const char *what, co
     const fw_state_id_t state = fw_state(fw);
     if (state == FW_STATE_RUNNING || state == FW_STATE_COMMISSION) {
         (void)snprintf(st->msg, sizeof st->msg,
-                       "gates on (%s): disarm first (a flash erase stalls the CPU ~20-40 ms)",
+                       "gates on (%s): disarm first (a page erase stalls the CPU ~22 ms)",
                        fw_state_name(state));
         return CMD_E_STATE;
     }

@@ -7,7 +7,7 @@
 #include <string.h>
 
 /* BSY polls before giving up: each poll is a bus read of a few cycles, so at
- * 170 MHz this is well over the 40 ms maximum of a page erase. */
+ * 170 MHz this is over 0.5 s, some twenty times the page erase time. */
 #define G4_FLASH_BSY_POLLS 20000000u
 
 /* Set by the NMI when a read of the settings pages met ECCD. */

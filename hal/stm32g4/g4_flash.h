@@ -10,10 +10,10 @@
  * pages 62 and 63 at 0x0801_F000, hold the settings (the linker script
  * stm32g431cb.ld keeps the image out of them). While an erase or a program
  * runs, a fetch from flash stalls the CPU (one bank: no read-while-write);
- * a 2 KB page erase takes 22 ms typical, 40 ms maximum (STM32G431 data sheet,
- * tERASE), a double word 82 us typical: the interrupts of the control loop
- * are held that long, which is why the firmware refuses to save with the
- * gates on.
+ * a 2 KB page erase takes about 22 ms, a double word about 82 us (ST's
+ * STM32G431 data sheet, flash characteristics, typical values; not measured
+ * here): the interrupts of the control loop are held that long, which is why
+ * the firmware refuses to save with the gates on.
  *
  * Register access through g4_rd/g4_wr (g4_regs.h). With G4_MEM_ARRAYS the two
  * pages are the array g4_mem_flash_settings[] (the test's flash model).
