@@ -16,6 +16,14 @@
 #include "settings_store.h"
 #include "unity.h"
 
+/* Records per starting state: 8 on the host, 1 in QEMU (the same cuts of
+ * every operation, fewer torn contents). */
+#if defined(__arm__)
+#define N_RECORDS 1u
+#else
+#define N_RECORDS 8u
+#endif
+
 void setUp(void)
 {
 }
@@ -198,7 +206,7 @@ static void test_power_cut_every_operation_of_a_save(void)
         int applied_old = 0;
         int applied_new = 0;
         uint32_t ops_max = 0;
-        for (uint32_t seed = 1; seed <= 8u; seed++) {
+        for (uint32_t seed = 1; seed <= N_RECORDS; seed++) {
             uint32_t x = seed * 40503u + 7u;
             settings_t w;
             sgen_settings(&x, &w);
@@ -217,13 +225,13 @@ static void test_power_cut_every_operation_of_a_save(void)
                applied_old, applied_new, cuts - applied_old - applied_new);
         /* every operation of the save was cut: one erase and every double word */
         TEST_ASSERT_EQUAL_UINT32(1u + settings_record_size() / 8u, ops_max);
-        TEST_ASSERT_EQUAL_INT(8 * 2 * (int)ops_max, cuts);
+        TEST_ASSERT_EQUAL_INT((int)N_RECORDS * 2 * (int)ops_max, cuts);
     }
 }
 
 static void test_power_cut_during_erase(void)
 {
-    for (uint32_t seed = 1; seed <= 16u; seed++) {
+    for (uint32_t seed = 1; seed <= 2u * N_RECORDS; seed++) {
         for (int mode = 0; mode < 2; mode++) {
             for (uint32_t k = 1; k <= 2u; k++) {
                 settings_t old;
