@@ -192,7 +192,8 @@ def main():
         base, _, token = url.partition("/?token=")
         print("server:", base)
         # Access control.
-        for bad in (base + "/", base + "/?token=0" + token[1:], base + "/?token=",
+        wrong = ("1" if token[0] == "0" else "0") + token[1:]  # one digit off
+        for bad in (base + "/", base + "/?token=" + wrong, base + "/?token=",
                     base + "/static/console.js", base + "/ws?token=x"):
             code = http_status(bad)
             if code != 403:
