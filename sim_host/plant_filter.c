@@ -661,18 +661,19 @@ static void af_switch(plant_t *p, const uint8_t sw_new[3])
     f->x[AS_U + 1] = -ab[0] * s + ab[1] * c;
 }
 
-/* Capacitor voltages for the statistics (the ones in the line from u_abc). */
-static void af_track_cf(plant_t *p)
+/* The six storage capacitors' voltages, upper and lower per phase (the ones
+ * in the line from u_abc), into the statistics and up[], lo[]. */
+static void af_track_cf(plant_t *p, double up[3], double lo[3])
 {
     plant_filter_t *f = &p->flt;
     double ab[2], u[3];
     rot(cos(p->theta_e), sin(p->theta_e), f->x + AS_U, ab);
     ab_to_abc(ab, u);
     for (int k = 0; k < 3; ++k) {
-        const double up = f->sw[k] ? u[k] + f->u0 : f->v_up[k];
-        const double lo = f->sw[k] ? f->v_lo[k] : -(u[k] + f->u0);
-        f->st.cf_min_v = fmin(f->st.cf_min_v, fmin(up, lo));
-        f->st.cf_max_v = fmax(f->st.cf_max_v, fmax(up, lo));
+        up[k] = f->sw[k] ? u[k] + f->u0 : f->v_up[k];
+        lo[k] = f->sw[k] ? f->v_lo[k] : -(u[k] + f->u0);
+        f->st.cf_min_v = fmin(f->st.cf_min_v, fmin(up[k], lo[k]));
+        f->st.cf_max_v = fmax(f->st.cf_max_v, fmax(up[k], lo[k]));
     }
 }
 
@@ -683,22 +684,18 @@ static void af_track_cf(plant_t *p)
  * (amplitude-invariant space vector: three-phase power 1.5 r_e |i|^2), with
  * |i|^2 low-passed at 10 bw. r_e is limited; the integrator stops while the
  * limit holds it (clamping anti-windup). Returns r_e for this sample. */
-static double af_storage_re(plant_t *p, const double iin[2], double h)
+static double af_storage_re(plant_t *p, const double up[3], const double lo[3], const double iin[2],
+                            double h)
 {
     plant_filter_t *f = &p->flt;
     const plant_filter_active_t *as = &p->cfg.filter.active;
     if (as->dc_bw_hz <= 0.0) {
         return 0.0;
     }
-    double ab[2], u[3];
-    rot(cos(p->theta_e), sin(p->theta_e), f->x + AS_U, ab);
-    ab_to_abc(ab, u);
     double e_err = 0.0;
     const double v0sq = as->cf_v0_v * as->cf_v0_v;
     for (int k = 0; k < 3; ++k) {
-        const double up = f->sw[k] ? u[k] + f->u0 : f->v_up[k];
-        const double lo = f->sw[k] ? f->v_lo[k] : -(u[k] + f->u0);
-        e_err += 0.5 * as->cf_f * ((v0sq - up * up) + (v0sq - lo * lo));
+        e_err += 0.5 * as->cf_f * ((v0sq - up[k] * up[k]) + (v0sq - lo[k] * lo[k]));
     }
     const double w = 2.0 * PLANT_PI * as->dc_bw_hz;
     f->dc_i2 += (iin[0] * iin[0] + iin[1] * iin[1] - f->dc_i2) * (1.0 - exp(-h * 10.0 * w));
@@ -736,7 +733,8 @@ void plant_filter_event(plant_t *p)
     const double i_cmd = f->tq_cmd_nm / (1.5 * (double)p->cfg.pole_pairs * p->cfg.psi_pm_wb);
     f->isq_f += (i_cmd - f->isq_f) * (1.0 - exp(-h / tau));
     const double disq = (i_cmd - f->isq_f) / tau;
-    af_track_cf(p);
+    double cf_up[3], cf_lo[3];
+    af_track_cf(p, cf_up, cf_lo);
     if (f->af_manual || (p->s_valid && p->s[0] == PLANT_LEG_OFF && p->s[1] == PLANT_LEG_OFF &&
                          p->s[2] == PLANT_LEG_OFF)) {
         return; /* tests hold the switches; gates off: the AF idles too */
@@ -748,7 +746,7 @@ void plant_filter_event(plant_t *p)
     memcpy(z, f->x, (size_t)f->n * sizeof(double));
     quantities(p, z, 0, &q);
     /* S1 (51), (52); less the storage regulation's drop r_e i_inv */
-    const double re = af_storage_re(p, q.iin, h);
+    const double re = af_storage_re(p, cf_up, cf_lo, q.iin, h);
     const double vref_dq[2] = {-w * p->cfg.lq_h * f->isq_f - re * q.iin[0],
                                p->cfg.rs_ohm * f->isq_f + p->cfg.lq_h * disq +
                                    w * p->cfg.psi_pm_wb - re * q.iin[1]};
@@ -805,7 +803,8 @@ int plant_filter_reset_peaks(plant_t *p)
     if (p->flt.type == PLANT_FILTER_ACTIVE) {
         p->flt.st.cf_min_v = INFINITY;
         p->flt.st.cf_max_v = -INFINITY;
-        af_track_cf(p);
+        double up[3], lo[3];
+        af_track_cf(p, up, lo);
     }
     return PLANT_OK;
 }
