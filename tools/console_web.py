@@ -64,28 +64,6 @@ def parse_status(lines):
     return st
 
 
-def parse_param_line(ln):
-    """'  name value unit [min, max][ ro] help' -> dict (best effort: lines may be cut)."""
-    s = ln.strip()
-    w = s.split(None, 3)
-    if len(w) < 3:
-        return None
-    p = {"name": w[0], "value": w[1], "unit": "" if w[2] == "-" else w[2], "min": "", "max": "",
-         "ro": False, "help": ""}
-    rest = w[3] if len(w) > 3 else ""
-    if rest.startswith("["):
-        end = rest.find("]")
-        if end > 0:
-            lo, _, hi = rest[1:end].partition(",")
-            p["min"], p["max"] = lo.strip(), hi.strip()
-            rest = rest[end + 1:].strip()
-    if rest == "ro" or rest.startswith("ro "):
-        p["ro"] = True
-        rest = rest[2:].strip()
-    p["help"] = rest
-    return p
-
-
 class LinkWorker(threading.Thread):
     """Owns the transport; see the module's description."""
 
@@ -232,7 +210,6 @@ class WebConsole:
         self.link = LinkWorker(tr, args.timeout, self._emit_threadsafe)
         self.last_status = {}
         self.meta = None
-        self.stopped_for_page_loss = 0
 
     # ---- events from the link thread
     def _emit_threadsafe(self, ev):
@@ -240,13 +217,12 @@ class WebConsole:
             self.loop.call_soon_threadsafe(self._on_link_event, ev)
 
     def _on_link_event(self, ev):
+        # Every event, replies included, goes to every page: watchers see what
+        # the controlling page does.
         if ev["type"] == "status":
             self.last_status = ev["status"]
         elif ev["type"] == "meta":
             self.meta = ev
-        if ev["type"] == "reply" and ev["origin"] not in ("poll",):
-            # Replies go to every page (the watchers see what the controller does).
-            pass
         asyncio.ensure_future(self._broadcast(ev))
 
     async def _broadcast(self, ev):
@@ -296,7 +272,6 @@ class WebConsole:
         self.controller = None
         if self.link.gone is None:
             self.link.submit("stop", "page-loss")
-            self.stopped_for_page_loss += 1
         text = "console: the controlling page was lost (%s): drive stopped (gates off)" % why
         print(text, file=sys.stderr, flush=True)
         await self._broadcast({"type": "text", "line": text})

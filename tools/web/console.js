@@ -14,7 +14,7 @@ const S = {
   ws: null, connected: false, role: null, page: null, gone: null, target: '',
   status: {}, counters: { frames: 0, bad: 0, lost: 0 }, meta: null, signals: [],
   params: [], ctrls: [], cm: null, replies: [], autostarted: false,
-  recording: null, history: [], histPos: 0, pending: {}, paramMsg: {},
+  recording: null, history: [], histPos: 0, paramMsg: {},
 };
 window.consoleState = S;
 
@@ -141,11 +141,7 @@ function onReply(m) {
   if (S.replies.length > 200) S.replies.shift();
   const w = m.line.split(/\s+/);
   if (w[0] === 'param' && w[1] === 'set') markParam(w[2], m.ok, first);
-  if (!m.ok) {
-    const pending = S.pending[m.line];
-    if (pending) { pending(m); delete S.pending[m.line]; }
-    return;
-  }
+  if (!m.ok) return;
   if (m.line === 'tel list') {
     S.signals = listLines(m).map((l) => {
       const p = l.trim().split(/\s+/);
@@ -167,8 +163,6 @@ function onReply(m) {
   } else if (m.line === 'ident result') {
     buildResults(listLines(m));
   }
-  const pending = S.pending[m.line];
-  if (pending) { pending(m); delete S.pending[m.line]; }
 }
 
 function parseParam(l) {
