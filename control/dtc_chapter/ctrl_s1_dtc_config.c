@@ -21,35 +21,38 @@
 #define S1_TILT_DEFAULT (CTRL_PI / 30.0) /* 6 deg: half a section */
 
 static const ctrl_tunable_t hdtc_tunables[] = {
-    {"h_T", "N*m", "torque hysteresis half band (S1 sec. 3.3: +-0.01)",
+    {"h_T", "N*m", HELP_TEXT("torque hysteresis half band (S1 sec. 3.3: +-0.01)"),
      offsetof(ctrl_s1_cfg_t, h_t), 0.0, 1000.0},
-    {"h_psi", "Wb", "flux hysteresis half band (S1 sec. 3.3: +-0.01)",
+    {"h_psi", "Wb", HELP_TEXT("flux hysteresis half band (S1 sec. 3.3: +-0.01)"),
      offsetof(ctrl_s1_cfg_t, h_psi), 0.0, 10.0},
-    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 sec. 4, sec. 6.1.4)",
+    {"psi_ref", "Wb", HELP_TEXT("flux reference; 0 = psi_pm (S1 sec. 4, sec. 6.1.4)"),
      offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
 };
 
 static const ctrl_tunable_t svm_tunables[] = {
-    {"Kp", "rad/pu", "predictive-controller PI, Delta delta per pu torque error (S1 sec. 4.1: 1)",
+    {"Kp", "rad/pu",
+     HELP_TEXT("predictive-controller PI, Delta delta per pu torque error (S1 sec. 4.1: 1)"),
      offsetof(ctrl_s1_cfg_t, kp), 0.0, 100.0},
-    {"Ki", "rad/(pu*sample)", "integral gain per sample (S1 sec. 4.1: 0.03)",
+    {"Ki", "rad/(pu*sample)", HELP_TEXT("integral gain per sample (S1 sec. 4.1: 0.03)"),
      offsetof(ctrl_s1_cfg_t, ki), 0.0, 10.0},
-    {"omega_ff", "-", "1: add the rotor advance omega_e Ts to Delta delta",
+    {"omega_ff", "-", HELP_TEXT("1: add the rotor advance omega_e Ts to Delta delta"),
      offsetof(ctrl_s1_cfg_t, omega_ff), 0.0, 1.0},
-    {"psi_ref", "Wb", "flux reference; 0 = psi_pm (S1 sec. 4)", offsetof(ctrl_s1_cfg_t, psi_ref),
-     0.0, 100.0},
+    {"psi_ref", "Wb", HELP_TEXT("flux reference; 0 = psi_pm (S1 sec. 4)"),
+     offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
 };
 
 static const ctrl_tunable_t hpdtc_tunables[] = {
-    {"h_T", "N*m", "torque two-level hysteresis half band (tau of S1 Table 4)",
+    {"h_T", "N*m", HELP_TEXT("torque two-level hysteresis half band (tau of S1 Table 4)"),
      offsetof(ctrl_s1_cfg_t, h_t), 0.0, 1000.0},
-    {"h_psi", "Wb", "flux two-level hysteresis half band (phi of S1 Table 4)",
+    {"h_psi", "Wb", HELP_TEXT("flux two-level hysteresis half band (phi of S1 Table 4)"),
      offsetof(ctrl_s1_cfg_t, h_psi), 0.0, 10.0},
-    {"psi_ref", "Wb", "flux reference; 0 = psi_pm", offsetof(ctrl_s1_cfg_t, psi_ref), 0.0, 100.0},
+    {"psi_ref", "Wb", HELP_TEXT("flux reference; 0 = psi_pm"), offsetof(ctrl_s1_cfg_t, psi_ref),
+     0.0, 100.0},
     {"e_fs", "N*m",
-     "|T_err| of the full voltage level (5 levels of e_fs/5); 0 = Ts Lq-based, see ctrl_s1_dtc.h",
+     HELP_TEXT("|T_err| of the full voltage level (5 levels of e_fs/5); 0 = Ts Lq-based, see "
+               "ctrl_s1_dtc.h"),
      offsetof(ctrl_s1_cfg_t, e_fs), 0.0, 1000.0},
-    {"tilt", "rad", "timing-table reference tilted from the flux tangent towards V_k1",
+    {"tilt", "rad", HELP_TEXT("timing-table reference tilted from the flux tangent towards V_k1"),
      offsetof(ctrl_s1_cfg_t, tilt), 0.0, CTRL_PI / 6.0},
 };
 

@@ -29,54 +29,58 @@
 #define DRR_PI_FI_HZ 50.0 /* D_PI integral corner (our choice, = the EMA cut-off) */
 
 static const ctrl_tunable_t drr_tunables[] = {
-    {"A", "N*m", "(5.9) AVV torque deviation at zero speed; 0 = p Vdc psi_pm Ts / Ls",
+    {"A", "N*m", HELP_TEXT("(5.9) AVV torque deviation at zero speed; 0 = p Vdc psi_pm Ts / Ls"),
      offsetof(ctrl_drr_cfg_t, a_nm), 0.0, 1e5},
-    {"B", "N*m", "(5.10) ZVV torque deviation at rated speed; 0 = 3 p w_rn psi_pm^2 Ts / (2 Ls)",
+    {"B", "N*m",
+     HELP_TEXT("(5.10) ZVV torque deviation at rated speed; 0 = 3 p w_rn psi_pm^2 Ts / (2 Ls)"),
      offsetof(ctrl_drr_cfg_t, b_nm), 0.0, 1e5},
-    {"C", "-", "(5.12)-(5.13) Delta T[0] / gamma (< 0); 0 = speed-dependent (5.13)",
+    {"C", "-", HELP_TEXT("(5.12)-(5.13) Delta T[0] / gamma (< 0); 0 = speed-dependent (5.13)"),
      offsetof(ctrl_drr_cfg_t, c), -(double)CTRL_DRR_C_MAX, 0.0},
-    {"lambda", "-", "EMA smoothing factor (5.4); 0.03 = 48.5 Hz at 10 kHz by (5.5)",
+    {"lambda", "-", HELP_TEXT("EMA smoothing factor (5.4); 0.03 = 48.5 Hz at 10 kHz by (5.5)"),
      offsetof(ctrl_drr_cfg_t, lambda), 1e-6, 0.999999},
-    {"sigma", "rad", "subsector width (4.19) of the voltage replacement (5.3.5); 0 = off",
+    {"sigma", "rad",
+     HELP_TEXT("subsector width (4.19) of the voltage replacement (5.3.5); 0 = off"),
      offsetof(ctrl_drr_cfg_t, sigma), 0.0, DRR_SIGMA_MAX},
     {"dpsi_max", "Wb",
-     "Delta psi_max of 5.3.5 (replace while |psi_err| < half); 0 = sqrt(3) Vdc Ts/3",
+     HELP_TEXT("Delta psi_max of 5.3.5 (replace while |psi_err| < half); 0 = sqrt(3) Vdc Ts/3"),
      offsetof(ctrl_drr_cfg_t, dpsi_max_wb), 0.0, 10.0},
-    {"pred_516", "-", "torque prediction: 0 = estimator model (4.6)/(5.15), 1 = (5.16)",
+    {"pred_516", "-", HELP_TEXT("torque prediction: 0 = estimator model (4.6)/(5.15), 1 = (5.16)"),
      offsetof(ctrl_drr_cfg_t, pred_516), 0.0, 1.0},
-    {"gamma_max", "N*m", "limit of |gamma| (5.4); 0 = none (thesis)",
+    {"gamma_max", "N*m", HELP_TEXT("limit of |gamma| (5.4); 0 = none (thesis)"),
      offsetof(ctrl_drr_cfg_t, gamma_max_nm), 0.0, 1e5},
     {"centre", "-",
-     "1 = centre-aligned PWM: T_e at the active-vector start (Fig. 5.4); 0 = AVV first",
+     HELP_TEXT("1 = centre-aligned PWM: T_e at the active-vector start (Fig. 5.4); 0 = AVV first"),
      offsetof(ctrl_drr_cfg_t, centre), 0.0, 1.0},
     {"rs_dt", "-",
-     "1 = zero-vector deviation with the resistive term -(Rs Ts/Ls) T_e of (4.10); 0 = thesis "
-     "(5.6)/(5.7); default 1 when Rs i_rated >= 10 % of the rated back-EMF",
+     HELP_TEXT(
+         "1 = zero-vector deviation with the resistive term -(Rs Ts/Ls) T_e of (4.10); 0 = thesis "
+         "(5.6)/(5.7); default 1 when Rs i_rated >= 10 % of the rated back-EMF"),
      offsetof(ctrl_drr_cfg_t, rs_dt), 0.0, 1.0},
 };
 
 static const ctrl_tunable_t d1_tunables[] = {
-    {"C_T", "N*m", "D1 (5.19) torque constant C_T (Table 5.1: 1.2 N*m)",
+    {"C_T", "N*m", HELP_TEXT("D1 (5.19) torque constant C_T (Table 5.1: 1.2 N*m)"),
      offsetof(ctrl_drr_base_cfg_t, c_t_nm), 1e-6, 1e5},
-    {"C_psi", "Wb", "D1 (5.19) flux constant C_psi (Table 5.1: 0.09427 Wb)",
+    {"C_psi", "Wb", HELP_TEXT("D1 (5.19) flux constant C_psi (Table 5.1: 0.09427 Wb)"),
      offsetof(ctrl_drr_base_cfg_t, c_psi_wb), 1e-6, 1e3},
 };
 
 static const ctrl_tunable_t d2_tunables[] = {
-    {"K_a", "N*m", "D2 (5.21) K_a (Table 5.1: 2 N*m)", offsetof(ctrl_drr_base_cfg_t, k_a_nm), 1e-6,
-     1e5},
-    {"K_b", "N*m/(r/min)", "D2 (5.21) K_b (Table 5.1: 6e-4 N*m/(r/min))",
+    {"K_a", "N*m", HELP_TEXT("D2 (5.21) K_a (Table 5.1: 2 N*m)"),
+     offsetof(ctrl_drr_base_cfg_t, k_a_nm), 1e-6, 1e5},
+    {"K_b", "N*m/(r/min)", HELP_TEXT("D2 (5.21) K_b (Table 5.1: 6e-4 N*m/(r/min))"),
      offsetof(ctrl_drr_base_cfg_t, k_b_nm_rpm), 0.0, 1e3},
 };
 
 static const ctrl_tunable_t pi_tunables[] = {
-    {"K_P", "1/(N*m)", "D_PI (5.20) proportional gain", offsetof(ctrl_drr_base_cfg_t, kp), 0.0,
-     1e3},
-    {"K_I", "1/(N*m*s)", "D_PI (5.20) integral gain", offsetof(ctrl_drr_base_cfg_t, ki), 0.0, 1e6},
+    {"K_P", "1/(N*m)", HELP_TEXT("D_PI (5.20) proportional gain"),
+     offsetof(ctrl_drr_base_cfg_t, kp), 0.0, 1e3},
+    {"K_I", "1/(N*m*s)", HELP_TEXT("D_PI (5.20) integral gain"), offsetof(ctrl_drr_base_cfg_t, ki),
+     0.0, 1e6},
 };
 
 static const ctrl_tunable_t df_tunables[] = {
-    {"rms", "-", "0 = D_f (5.18) final-error duty, 1 = D_RMS (5.17)",
+    {"rms", "-", HELP_TEXT("0 = D_f (5.18) final-error duty, 1 = D_RMS (5.17)"),
      offsetof(ctrl_drr_base_cfg_t, rms), 0.0, 1.0},
 };
 

@@ -24,21 +24,25 @@
 #define ST_FI_A_REL 0.5
 
 static const ctrl_tunable_t hyst_tunables[] = {
-    {"h_T", "N*m", "torque hysteresis half band h_T (Fig. 4.2, Table 4.7: 2 % of T_rated)",
+    {"h_T", "N*m",
+     HELP_TEXT("torque hysteresis half band h_T (Fig. 4.2, Table 4.7: 2 % of T_rated)"),
      offsetof(st_hyst_cfg_t, h_t), 0.0, 1000.0},
-    {"h_psi", "Wb", "flux hysteresis half band h_psi (Fig. 4.2, Table 4.7: 2 % of psi_pm)",
+    {"h_psi", "Wb",
+     HELP_TEXT("flux hysteresis half band h_psi (Fig. 4.2, Table 4.7: 2 % of psi_pm)"),
      offsetof(st_hyst_cfg_t, h_psi), 0.0, 10.0},
 };
 
 static const ctrl_tunable_t fst_tunables[] = {
-    {"sigma", "rad", "subsector width of the voltage replacement (4.19), 0 = off",
+    {"sigma", "rad", HELP_TEXT("subsector width of the voltage replacement (4.19), 0 = off"),
      offsetof(st_fst_cfg_t, sigma), 0.0, ST_SIGMA_MAX},
     {"dT_step", "N*m",
-     "reference-step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)",
+     HELP_TEXT(
+         "reference-step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)"),
      offsetof(st_fst_cfg_t, dt_step), 0.0, 1000.0},
     {"f_i", "Hz",
-     "corner of the mean-torque-error integrator; 0 = off (thesis); default 50 Hz where one "
-     "20 kHz period moves the torque by >= T_rated / 2, else 0",
+     HELP_TEXT(
+         "corner of the mean-torque-error integrator; 0 = off (thesis); default 50 Hz where one "
+         "20 kHz period moves the torque by >= T_rated / 2, else 0"),
      offsetof(st_fst_cfg_t, f_i), 0.0, 1000.0},
 };
 

@@ -20,24 +20,25 @@
 #define FOC_KI_TS_MAX 16383.0 /* Ki Ts < 2^31 / 2^17 in Q17 */
 
 static const ctrl_tunable_t foc_tunables[] = {
-    {"wc", "rad/s", "current-loop bandwidth for Kp = L wc, Ki = R wc; 0 = 2 pi fs/20",
+    {"wc", "rad/s", HELP_TEXT("current-loop bandwidth for Kp = L wc, Ki = R wc; 0 = 2 pi fs/20"),
      offsetof(ctrl_foc_cfg_t, wc), 0.0, 1.0e6},
-    {"Kp_d", "V/A", "d-current PI proportional gain; 0 = Ld wc", offsetof(ctrl_foc_cfg_t, kp_d),
-     0.0, 1.0e5},
-    {"Ki_d", "V/(A*s)", "d-current PI integral gain; 0 = Rs wc", offsetof(ctrl_foc_cfg_t, ki_d),
-     0.0, 1.0e8},
-    {"Kp_q", "V/A", "q-current PI proportional gain; 0 = Lq wc", offsetof(ctrl_foc_cfg_t, kp_q),
-     0.0, 1.0e5},
-    {"Ki_q", "V/(A*s)", "q-current PI integral gain; 0 = Rs wc", offsetof(ctrl_foc_cfg_t, ki_q),
-     0.0, 1.0e8},
-    {"mtpa", "-", "1: i_d from the MTPA locus (IPMSM); 0: i_d = 0 (S1 Algorithm 1)",
+    {"Kp_d", "V/A", HELP_TEXT("d-current PI proportional gain; 0 = Ld wc"),
+     offsetof(ctrl_foc_cfg_t, kp_d), 0.0, 1.0e5},
+    {"Ki_d", "V/(A*s)", HELP_TEXT("d-current PI integral gain; 0 = Rs wc"),
+     offsetof(ctrl_foc_cfg_t, ki_d), 0.0, 1.0e8},
+    {"Kp_q", "V/A", HELP_TEXT("q-current PI proportional gain; 0 = Lq wc"),
+     offsetof(ctrl_foc_cfg_t, kp_q), 0.0, 1.0e5},
+    {"Ki_q", "V/(A*s)", HELP_TEXT("q-current PI integral gain; 0 = Rs wc"),
+     offsetof(ctrl_foc_cfg_t, ki_q), 0.0, 1.0e8},
+    {"mtpa", "-", HELP_TEXT("1: i_d from the MTPA locus (IPMSM); 0: i_d = 0 (S1 Algorithm 1)"),
      offsetof(ctrl_foc_cfg_t, mtpa), 0.0, 1.0},
 };
 
 static const ctrl_tunable_t foc_hyst_tunables[] = {
-    {"h_i", "A", "phase-current hysteresis half band (S1 sec. 2 current-controlled inverter)",
+    {"h_i", "A",
+     HELP_TEXT("phase-current hysteresis half band (S1 sec. 2 current-controlled inverter)"),
      offsetof(ctrl_foc_cfg_t, h_i), 0.0, 1.0e4},
-    {"mtpa", "-", "1: i_d from the MTPA locus (IPMSM); 0: i_d = 0 (S1 Algorithm 1)",
+    {"mtpa", "-", HELP_TEXT("1: i_d from the MTPA locus (IPMSM); 0: i_d = 0 (S1 Algorithm 1)"),
      offsetof(ctrl_foc_cfg_t, mtpa), 0.0, 1.0},
 };
 

@@ -20,6 +20,7 @@
 
 #include "ctrl_params.h"
 #include "ctrl_types.h"
+#include "help_text.h"
 
 /* Everything a controller sees at sample k. */
 typedef struct {
@@ -46,7 +47,7 @@ typedef struct {
 typedef struct {
     const char *name; /* e.g. "h_T" */
     const char *unit; /* e.g. "N*m"; "0/1" marks a switch (only 0 and 1 accepted) */
-    const char *help; /* one line, cites the source */
+    const char *help; /* one line, cites the source; NULL without PMSM_HELP_TEXT */
     size_t offset;    /* offsetof(cfg struct, field), field is a double */
     double min, max;  /* accepted range (inclusive) */
 } ctrl_tunable_t;

@@ -46,20 +46,20 @@ int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_setup_t *setup);
 #define CTRL_MPC_LPSI_MODEL_MAX 10.0 /* H or Wb, upper bound of "ld/lq/psi_pm_model" */
 /* clang-format off */
 #define CTRL_MPC_MODEL_TUNABLES(T)                                                  \
-    {"rs_model", "ohm", "Rs of the k+2 prediction (6.10); 0 = machine",            \
+    {"rs_model", "ohm", HELP_TEXT("Rs of the k+2 prediction (6.10); 0 = machine"),            \
      offsetof(T, model.rs_ohm), 0.0, CTRL_MPC_RS_MODEL_MAX},                       \
-    {"ld_model", "H", "Ld of the k+2 prediction (6.12); 0 = machine",              \
+    {"ld_model", "H", HELP_TEXT("Ld of the k+2 prediction (6.12); 0 = machine"),              \
      offsetof(T, model.ld_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
-    {"lq_model", "H", "Lq of the k+2 prediction (6.12); 0 = machine",              \
+    {"lq_model", "H", HELP_TEXT("Lq of the k+2 prediction (6.12); 0 = machine"),              \
      offsetof(T, model.lq_h), 0.0, CTRL_MPC_LPSI_MODEL_MAX},                       \
-    {"psi_pm_model", "Wb", "psi_pm of the k+2 prediction (6.12); 0 = machine",     \
+    {"psi_pm_model", "Wb", HELP_TEXT("psi_pm of the k+2 prediction (6.12); 0 = machine"),     \
      offsetof(T, model.psi_pm_wb), 0.0, CTRL_MPC_LPSI_MODEL_MAX}
 /* The weighting factor zeta of (6.13) of M1, M3 and FS-MPTFC (field zeta of
  * T), with what this controller's help adds. */
 #define CTRL_MPC_ZETA_TUNABLE(T, more)                                              \
     {"zeta", "N*m/Wb",                                                             \
-     "weighting factor of (6.13); 0 = T_rated/psi_pm (default, equal importance, " \
-     "6.5); " more, offsetof(T, zeta), 0.0, 1e5}
+     HELP_TEXT("weighting factor of (6.13); 0 = T_rated/psi_pm (default, equal importance, " \
+               "6.5); " more), offsetof(T, zeta), 0.0, 1e5}
 /* clang-format on */
 
 /* Model constants for the setup (with the overrides of c). CTRL_OK,

@@ -615,7 +615,7 @@ static void cmd_tel(cmd_t *c, const cmd_tok_t *tok, size_t n)
             cmd_out_char(c, ' ');
             cmd_out_str(c, s->unit[0] == '\0' ? "-" : s->unit);
             cmd_out_char(c, ' ');
-            cmd_out_str(c, s->help);
+            cmd_out_str(c, s->help == NULL ? "" : s->help);
             cmd_out_flush(c);
         }
         return;

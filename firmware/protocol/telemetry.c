@@ -6,10 +6,11 @@
 #include <string.h>
 
 #include "ctrl_units.h"
+#include "help_text.h"
 
 #define TEL_SIG(name, unit, help, kind, field)                                                     \
     {                                                                                              \
-        name, unit, help, kind, offsetof(tel_sample_t, field)                                      \
+        name, unit, HELP_TEXT(help), kind, offsetof(tel_sample_t, field)                           \
     }
 
 static const tel_signal_t tel_signals[TEL_SIG_COUNT] = {
