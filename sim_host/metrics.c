@@ -1,5 +1,6 @@
 /*
- * Performance indices of the thesis, Appendix B (definitions made precise in metrics.h). See metrics.h.
+ * Performance indices of the thesis, Appendix B (definitions made precise in metrics.h). See
+ * metrics.h.
  */
 #include "metrics.h"
 #include "plant.h"
@@ -178,6 +179,59 @@ static double thd_window_close(thd_window_t *win, int *n_harm, double *window_s,
     return 100.0 * sqrt(sum) / a1; /* (B.3) */
 }
 
+/* Points c e^{-j k w1 tau} added to the window's sums of harmonics k = 1..N,
+ * THD_BATCH at a time: each point's phasor of harmonic k by repeated
+ * multiplication with its fundamental's (N products: rounding ~N * 1e-16),
+ * the chains of the batch's points side by side so that their products
+ * overlap in the pipeline instead of waiting on each other. */
+#define THD_BATCH 8 /* the pairwise sum below is written for 8 */
+typedef struct {
+    double br[THD_BATCH], bi[THD_BATCH], c[THD_BATCH];
+    int n;
+} thd_batch_t;
+
+static void thd_batch_flush(thd_window_t *win, thd_batch_t *b)
+{
+    for (int p = b->n; p < THD_BATCH; ++p) {
+        b->br[p] = 1.0;
+        b->bi[p] = 0.0;
+        b->c[p] = 0.0;
+    }
+    double zr[THD_BATCH], zi[THD_BATCH];
+    for (int p = 0; p < THD_BATCH; ++p) {
+        zr[p] = 1.0;
+        zi[p] = 0.0;
+    }
+    for (int k = 1; k <= win->n_harm; ++k) {
+        double tr[THD_BATCH], ti[THD_BATCH];
+        for (int p = 0; p < THD_BATCH; ++p) {
+            const double nr = zr[p] * b->br[p] - zi[p] * b->bi[p];
+            zi[p] = zr[p] * b->bi[p] + zi[p] * b->br[p];
+            zr[p] = nr;
+            tr[p] = b->c[p] * zr[p];
+            ti[p] = b->c[p] * zi[p];
+        }
+        /* pairwise: three additions deep, not eight */
+        win->re[k] += ((tr[0] + tr[1]) + (tr[2] + tr[3])) + ((tr[4] + tr[5]) + (tr[6] + tr[7]));
+        win->im[k] += ((ti[0] + ti[1]) + (ti[2] + ti[3])) + ((ti[4] + ti[5]) + (ti[6] + ti[7]));
+    }
+    b->n = 0;
+}
+
+static void thd_batch_add(thd_window_t *win, thd_batch_t *b, double tau, double c)
+{
+    if (c == 0.0) {
+        return; /* adds nothing (a staircase's step of zero) */
+    }
+    const double ph = win->w1 * tau;
+    b->br[b->n] = cos(ph);
+    b->bi[b->n] = -sin(ph);
+    b->c[b->n] = c;
+    if (++b->n == THD_BATCH) {
+        thd_batch_flush(win, b);
+    }
+}
+
 double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz, double fmax_hz,
                        int *n_harm, double *window_s, double *i1_amp)
 {
@@ -186,45 +240,32 @@ double metrics_thd_pct(const double *t, const double *x, size_t n, double f1_hz,
         return NAN;
     }
     const double t_end = win.t_end;
-    const int N = win.n_harm;
+    thd_batch_t batch = {.n = 0};
     /* Trapezoid as a weighted sum of points: every sample in the window gets
      * half of each adjacent segment; the last segment is cut at t_end, whose
-     * value is interpolated. Harmonic k's phasor by repeated multiplication
-     * with the fundamental's (N products: rounding ~N * 1e-16). */
+     * value is interpolated. */
     for (size_t j = 0; j < n && t[j] < t_end; ++j) {
         double wgt = 0.0;
         if (j > 0) {
             wgt += 0.5 * (t[j] - t[j - 1]);
         }
-        double x_end = 0.0, h_end = 0.0;
-        int cut = 0;
         if (j + 1 < n) {
             const double tb = t[j + 1] < t_end ? t[j + 1] : t_end;
-            h_end = tb - t[j];
+            const double h_end = tb - t[j];
             wgt += 0.5 * h_end;
-            if (t[j + 1] >= t_end && h_end > 0.0) { /* last, cut segment */
+            if (t[j + 1] >= t_end && h_end > 0.0) {
+                /* the last, cut segment's interpolated end point, weight
+                 * h_end / 2, phase w1 K T1 = 2 pi K for every harmonic */
                 const double u = (t_end - t[j]) / (t[j + 1] - t[j]);
-                x_end = x[j] + u * (x[j + 1] - x[j]);
-                cut = 1;
+                const double x_end = x[j] + u * (x[j + 1] - x[j]);
+                for (int k = 1; k <= win.n_harm; ++k) {
+                    win.re[k] += 0.5 * h_end * x_end;
+                }
             }
         }
-        const double ph = win.w1 * (t[j] - t[0]);
-        const double br = cos(ph), bi = -sin(ph);
-        double zr = 1.0, zi = 0.0;
-        for (int k = 1; k <= N; ++k) {
-            const double nr = zr * br - zi * bi;
-            zi = zr * bi + zi * br;
-            zr = nr;
-            win.re[k] += wgt * x[j] * zr;
-            win.im[k] += wgt * x[j] * zi;
-        }
-        if (cut) {
-            /* the interpolated end point, weight h_end / 2, phase w1 K T1 = 2 pi K */
-            for (int k = 1; k <= N; ++k) {
-                win.re[k] += 0.5 * h_end * x_end;
-            }
-        }
+        thd_batch_add(&win, &batch, t[j] - t[0], wgt * x[j]);
     }
+    thd_batch_flush(&win, &batch);
     return thd_window_close(&win, n_harm, window_s, i1_amp);
 }
 
@@ -236,29 +277,25 @@ double metrics_thd_zoh_pct(const double *t, const double *v, size_t n, double f1
         return NAN;
     }
     const double t_end = win.t_end;
-    const double w1 = win.w1;
-    /* Interval j = [t[j-1], t[j]] holds the constant v[j]: integral of
-     * e^{-j k w1 (t - t0)} over it is (e^{-j k w1 (b - t0)} - e^{-j k w1 (a - t0)})
-     * / (-j k w1); the phasors of the ends by repeated multiplication. */
+    /* Interval j = [t[j-1], t[j]] holds the constant v[j]; the integral of
+     * e^{-j k w1 (t - t0)} over it is (z_k(b) - z_k(a)) / (-j k w1) with
+     * z_k(tau) = e^{-j k w1 tau}. Summed by parts over the intervals, each
+     * boundary tau_j = t[j] - t0 carries v[j] - v[j+1] (the last, cut at
+     * t_end, v[J]; the first, tau = 0, -v[1]): one phasor chain per
+     * boundary, and S_k / (-j k w1) = j S_k / (k w1) at the end. */
+    thd_batch_t batch = {.n = 0};
+    thd_batch_add(&win, &batch, 0.0, -v[1]); /* t[0] < t_end: K >= 1 */
     for (size_t j = 1; j < n && t[j - 1] < t_end; ++j) {
-        const double a = t[j - 1] - t[0];
+        const int last = !(j + 1 < n && t[j] < t_end);
         const double b = (t[j] < t_end ? t[j] : t_end) - t[0];
-        const double ar = cos(w1 * a), ai = -sin(w1 * a);
-        const double br = cos(w1 * b), bi = -sin(w1 * b);
-        double zar = 1.0, zai = 0.0, zbr = 1.0, zbi = 0.0;
-        for (int k = 1; k <= win.n_harm; ++k) {
-            double tmp = zar * ar - zai * ai;
-            zai = zar * ai + zai * ar;
-            zar = tmp;
-            tmp = zbr * br - zbi * bi;
-            zbi = zbr * bi + zbi * br;
-            zbr = tmp;
-            /* (zb - za) / (-j k w1) = j (zb - za) / (k w1) */
-            const double dr = zbr - zar, di = zbi - zai;
-            const double kw = (double)k * w1;
-            win.re[k] += v[j] * (-di / kw);
-            win.im[k] += v[j] * (dr / kw);
-        }
+        thd_batch_add(&win, &batch, b, last ? v[j] : v[j] - v[j + 1]);
+    }
+    thd_batch_flush(&win, &batch);
+    for (int k = 1; k <= win.n_harm; ++k) {
+        const double kw = (double)k * win.w1;
+        const double sr = win.re[k], si = win.im[k];
+        win.re[k] = -si / kw;
+        win.im[k] = sr / kw;
     }
     return thd_window_close(&win, n_harm, window_s, v1_amp);
 }
