@@ -39,6 +39,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import analyses  # noqa: E402  (the open findings' mechanisms, checked by runs)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MACHINE = os.path.join(ROOT, "sim_host", "machines", "thesis_spmsm.ini")
 CHAPTER_MACHINE = os.path.join(ROOT, "sim_host", "machines", "chapter_ipmsm.ini")
@@ -566,7 +569,10 @@ def findings(S, dyn, chap, bench, sweep_ok):
         rows.append(("HP-DTC vs HDTC: torque ripple (p-p)", "book chapter §5",
                      pct(0.15 / 3.2 - 1.0) + " (3.2 → < 0.15 N·m)",
                      f"{pct(meas)} ({fmt(h, '{:.2f}')} → {fmt(p, '{:.2f}')} N·m)", v,
-                     why + REASON.get(("hpdtc", "ratio"), "")))
+                     why + f". This HDTC is the chapter's (S1 Table 3 on the sampled errors) "
+                     f"and ripples {3.2 / h:.1f} × less than the chapter's 3.2 N·m in the same "
+                     "case, which shrinks HP-DTC's relative gain; that gap is outside these "
+                     "analyses (HP-DTC's own: previous row)"))
     return rows
 
 
@@ -579,20 +585,16 @@ _SIM_VS_RIG = (". The thesis measured on its rig; this plant has no dead time, d
 REASON = {
     ("fst", "flux_ripple_wb"): _SIM_VS_RIG,
     ("fst", "thd_i_pct"): _SIM_VS_RIG,
-    ("drr", "flux"): (". DRR runs at 10 kHz against BST's 20 kHz; its flux ripple is lower at "
-                      "750 r/min and higher at 2250 r/min (per-speed values); not analysed "
-                      "further"),
     ("m2ptfc", "m1", 2250): (". M2PTFC runs at 11 kHz, M1 at 10 kHz here (thesis Table 6.2), "
                              "which alone lowers M2PTFC's ripple by roughly 10 % (ripple "
                              "∝ Ts for these methods, see the sweep); at equal f_av see the "
                              "Pareto section"),
+    # ("drr", "flux"), ("m2ptfc", "thd_i_pct"), ("hpdtc", "pp"), ("hpdtc", "ratio") and the
+    # end of ("m2ptfc", "flux_ripple_wb"): from the runs of tools/analyses.py (main)
     ("m2ptfc", "flux_ripple_wb"): (". M1 runs with ζ = T_rated/ψpm = 25.5 N·m/Wb instead of "
                                    "Table 6.2's 250/640, which exceed its stability limit of "
                                    "149.5 N·m/Wb and trip (docs/algorithms.md, M1): its flux "
-                                   "weighting is not the thesis'; the effect on this comparison "
-                                   "is not analysed"),
-    ("m2ptfc", "thd_i_pct"): (". M1's ζ differs from the thesis' (previous row); not analysed "
-                              "further"),
+                                   "weighting is not the thesis'"),
     ("m2ptfc", "m3"): (". M3 applies a whole-period zero vector whenever Te(k+1) > T_ref (38 % "
                        "of the periods at 750 r/min), a dip that (5.18) repairs only at the next "
                        "sample (thesis §6.6.2; docs/algorithms.md, M3): more ripple than in the "
@@ -600,12 +602,9 @@ REASON = {
     ("hpdtc", "pp"): (". The chapter gives its timing table only as a figure that is not in "
                       "its text: the table here is derived from space-vector geometry and the "
                       "level comes from a quantised proportional controller on the torque error "
-                      "with a loop gain of 1 per period (docs/algorithms.md, HP-DTC), so its "
-                      "ripple is not the chapter's"),
-    ("hpdtc", "ratio"): (". Our HDTC decides on the one-step prediction, which the chapter's "
-                         "does not, so its ripple is about 5 × lower than the chapter's 3.2 N·m "
-                         "and the relative gain of HP-DTC smaller (docs/algorithms.md)"),
+                      "with a loop gain of 1 per period (docs/algorithms.md, HP-DTC)"),
 }
+REASON_STATIC = dict(REASON)  # the texts apply_analyses extends
 _HYST = ("hysteresis DTC holds each vector for a whole period; as the speed rises the back-EMF "
          "makes the torque fall faster under the zero vector than it rises under the active "
          "one, so the ripple lies below the band centre and the mean below T_ref — the thesis "
@@ -650,6 +649,27 @@ CAUSE = {
                        "--set e_fs=0.55 the error halves (0.35 N·m at 2250 r/min), with 2.2 it "
                        "doubles"),
 }
+
+
+def apply_analyses(an):
+    """The reasons of the analysed rows from the runs of tools/analyses.py (None:
+    not run) and the report's section of them."""
+    L = ["## Analyses of three findings\n"]
+    if an is None:
+        L.append("Not run in this configuration (--fast): `tools/analyses.py` runs them "
+                 "alone; the test report_analyses checks their mechanisms.\n")
+        return L
+    REASON[("drr", "flux")] = ". " + an["drr"]["short"]
+    REASON[("m2ptfc", "flux_ripple_wb")] = (REASON_STATIC[("m2ptfc", "flux_ripple_wb")] + "; "
+                                            + an["zeta"]["short_flux"])
+    REASON[("m2ptfc", "thd_i_pct")] = ". " + an["zeta"]["short_thd"]
+    REASON[("hpdtc", "pp")] = REASON_STATIC[("hpdtc", "pp")] + "; " + an["hpdtc"]["short"]
+    L.append("Mechanisms behind three findings above, each checked by runs that change it "
+             "(`tools/analyses.py`, which also writes them alone to analyses.md; its "
+             "--partitions adds HP-DTC with finer timing tables, S1 §5.3.2).\n")
+    for k in ("drr", "zeta", "hpdtc"):
+        L.extend(an[k]["lines"])
+    return L
 
 
 def fst_offset_text(rpm, fs=20000.0):
@@ -749,7 +769,7 @@ def main():
     a = ap.parse_args()
     SPEEDS_USED, SWEEP_FS_USED = SPEEDS, SWEEP_FS
     dyn_duration, sweep_dur, sweep_settle = DYN_DURATION, SWEEP_DURATION, SWEEP_SETTLE
-    chap_dur, chap_settle = 0.15, 0.05
+    chap_dur, chap_settle = analyses.CHAPTER_WINDOW[1], analyses.CHAPTER_WINDOW[0]
     if a.fast:
         a.duration, a.settle = 0.06, 0.03
         SPEEDS_USED, SWEEP_FS_USED = (750,), (4000, 10000, 16000)
@@ -844,6 +864,11 @@ def main():
             if k % 50 == 0 or k == len(jobs):
                 print(f"  {k}/{len(jobs)} done", flush=True)
     sim_wall = time.time() - t_sim
+    # The analyses (about 120 runs) are left out of --fast: report_analyses checks them.
+    t_an = time.time()
+    an = None if a.fast else analyses.run_analyses(sim, a.jobs, a.seed)
+    an_wall = time.time() - t_an
+    an_lines = apply_analyses(an)
 
     RESULTS.update(results)
     S = {(n, r): results.get(("steady", n, r), {}).get("m") for n in names for r in SPEEDS_USED}
@@ -889,7 +914,10 @@ def main():
     w = L.append
     w("# Controller comparison, thesis SPMSM\n")
     w(f"Generated by `tools/compare.py` (seed {a.seed}{', --fast' if a.fast else ''}): "
-      f"{len(jobs)} simulations in {sim_wall:.0f} s on {a.jobs} processes. Thesis SPMSM "
+      f"{len(jobs)} simulations in {sim_wall:.0f} s on {a.jobs} processes"
+      + (f", and {an['_runs']} for the [analyses](#analyses-of-three-findings) in "
+         f"{an_wall:.0f} s. " if an else ". ") +
+      "Thesis SPMSM "
       f"(`sim_host/machines/thesis_spmsm.ini`), Vdc 220 V, no dead time, ideal switches, "
       "ADC noise 0.5 count, 2500-line encoder. Indices (thesis Appendix B): T_rip = standard "
       "deviation of the torque, ψ_rip of |ψs|, T_sse = mean(T_ref − T), f_av = mean per-leg "
@@ -1041,6 +1069,8 @@ def main():
         for n in CHAPTER_CTRLS:
             w(f"| {n} | {fmt(chap.get(n), '{:.3f}')} |")
         w("")
+    # ---- analyses ----
+    L.extend(an_lines)
     # ---- waveforms ----
     w("## Steady-state waveforms\n")
     w("The last electrical period (at least 5 ms) of each steady-state run: torque with its "

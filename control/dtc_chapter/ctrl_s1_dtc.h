@@ -26,8 +26,20 @@
 #include "fx.h"
 #include "hysteresis.h"
 
-#define HPDTC_POINTS 20  /* points per period (S1 §5.2.3) */
-#define HPDTC_LEVELS 5   /* voltage levels */
+/* The timing table's partition (S1 §5.2.3: 20 points, 5 levels, 5 sections).
+ * POINTS and LEVELS may be overridden at build time (-DHPDTC_POINTS=...) for
+ * the finer partitions S1 §5.3.2 mentions (tools/analyses.py --partitions; up
+ * to about 10 levels fit the controller state); the sections are fixed by
+ * ctrl_hpdtc_section's boundaries. */
+#ifndef HPDTC_POINTS
+#define HPDTC_POINTS 20 /* points per period */
+#endif
+#ifndef HPDTC_LEVELS
+#define HPDTC_LEVELS 5 /* voltage levels */
+#endif
+#if HPDTC_POINTS < 1 || HPDTC_POINTS > 255 || HPDTC_LEVELS < 2
+#error "HPDTC_POINTS must be 1..255 (uint8_t table), HPDTC_LEVELS at least 2"
+#endif
 #define HPDTC_SECTIONS 5 /* reflected-position sections of 12 deg */
 
 typedef struct {
