@@ -70,15 +70,21 @@ extern uint32_t g4_mem_flash_settings[2u * G4_FLASH_PAGE_SIZE / 4u];
 #define G4_FLASH_CR_PNB_MASK G4_FIELD(0x3Fu, 3) /* [8:3] on the G431 (64 pages) */
 #define G4_FLASH_CR_STRT G4_BIT(16)
 #define G4_FLASH_CR_LOCK G4_BIT(31)
-#define G4_FLASH_ECCR_ADDR_MASK 0x3FFFFu /* [17:0] byte offset in the bank */
+/* FLASH_ECCR.ADDR_ECC (RM0440 sec. 3.7, FLASH_ECCR; sec. 3.3.9 ECC): the
+ * address of the failing double word as a byte offset from the start of the
+ * bank. Bits 17:0 on the G431/G441 as stm32g431xx.h has it
+ * (FLASH_ECCR_ADDR_ECC_Msk = 0x3FFFF; the G47x/G49x headers have 0x7FFFF);
+ * ST's EEPROM-emulation NMI handler adds the field to FLASH_BASE unscaled,
+ * as g4_flash_nmi_ecc does. */
+#define G4_FLASH_ECCR_ADDR_MASK 0x3FFFFu
 #define G4_FLASH_ECCR_SYSF_ECC G4_BIT(22)
 #define G4_FLASH_ECCR_ECCIE G4_BIT(24)
 #define G4_FLASH_ECCR_ECCC G4_BIT(30)
 #define G4_FLASH_ECCR_ECCD G4_BIT(31)
 
-/* Reset values (RM0440 sec. 3.7): the register-image test starts from them. */
-#define G4_FLASH_ACR_RESET 0x00040600u /* DBG_SWEN, DCEN, ICEN */
-#define G4_FLASH_CR_RESET 0xC0000000u  /* LOCK, OPTLOCK */
+/* Reset value (RM0440 sec. 3.7, FLASH_CR): the register-image test starts from it
+ * (FLASH_ACR's, G4_FLASH_ACR_RESET, is in g4_regs.h). */
+#define G4_FLASH_CR_RESET 0xC0000000u /* LOCK, OPTLOCK */
 
 /* Return codes: 0, or -(G4_FLASH_E_SR + bit) for the FLASH_SR error bit the
  * operation ended with (lowest first), or one of the codes after it. */

@@ -80,8 +80,12 @@ static void esc1_write(void *ctx, const uint8_t *bytes, size_t len)
 
 /* Start-up failed: gates off for good, the reason on the serial link once a
  * second by polled output (the USART interrupt may not be enabled; it is
- * masked so that the ring does not interleave). No watchdog refresh needed:
- * the watchdog is not started. */
+ * masked so that the ring does not interleave). The watchdog is never
+ * refreshed here: after a clock, board or fw_init failure it has not been
+ * started (unless the IWDG_SW option byte starts it in hardware), and after
+ * a failed watchdog start it runs (g4_iwdg_start writes the start key
+ * first), so the chip resets within its time-out and says it again at every
+ * start; a halted board is not kept looking alive. */
 static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_cpu_hz)
 {
     g4_tim1_gates_off_now();
