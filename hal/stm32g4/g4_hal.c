@@ -344,6 +344,11 @@ void g4_hal_adc_irq_ack(hal_t *h)
 
 void g4_hal_break_irq(hal_t *h)
 {
+    /* Gates off first (the hardware has cleared MOE; this makes sure), by
+     * clearing MOE, not by a software break: EGR.BG would set BIF before SR
+     * is read below, and every break, a system break too, would count as an
+     * over-current. */
+    g4_tim1_outputs(false);
     const uint32_t flags = G4_TIM_SR_BIF | G4_TIM_SR_B2IF | G4_TIM_SR_SBIF;
     const uint32_t sr = g4_rd(G4_TIM1 + G4_TIM_SR);
     if ((sr & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF)) != 0u) {
@@ -355,11 +360,41 @@ void g4_hal_break_irq(hal_t *h)
     g4_wr(G4_TIM1 + G4_TIM_SR, ~flags);
     /* RM0440 TIM1 break: a flag cannot be cleared while its input is still
      * active, and the interrupt would be taken again at once, for as long as
-     * a comparator stays high. Masked until hal_trip_clear finds the inputs
-     * released (DIER holds BIE only: written whole, no read-modify-write). */
+     * a comparator stays high. Masked until g4_hal_break_rearm finds the
+     * inputs released (DIER holds BIE only: written whole, no
+     * read-modify-write). The break just counted stays latched meanwhile. */
     if ((g4_rd(G4_TIM1 + G4_TIM_SR) & flags) != 0u) {
         g4_wr(G4_TIM1 + G4_TIM_DIER, 0u);
     }
+}
+
+/* Any comparator output high (a break input still active). */
+static bool g4_hal_comp_high(const hal_t *h)
+{
+    for (unsigned x = 0; x < 3u; x++) {
+        if (g4_comp_value(h->board->phase[x].comp)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+bool g4_hal_break_rearm(hal_t *h)
+{
+    if ((g4_rd(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE) != 0u) {
+        return true;
+    }
+    if (g4_hal_comp_high(h)) {
+        return false;
+    }
+    /* Masked only by the interrupt, right after it counted a break that no
+     * clear has acknowledged yet: the flags cleared here belong to that
+     * latched break, and so does any short break merged into them (one flag
+     * cannot tell two apart). From the enable on, a break is taken and
+     * counted. */
+    g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF));
+    g4_wr(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE);
+    return false;
 }
 
 void g4_hal_trip_board(hal_t *h, bool on)
@@ -469,19 +504,21 @@ bool hal_trip_active(const hal_t *h)
 
 void hal_trip_clear(hal_t *h)
 {
-    /* Stays latched while a comparator still sees over-current; the board
-     * cause (over-temperature) is the board's to clear (g4_hal_trip_board). */
-    for (unsigned x = 0; x < 3u; x++) {
-        if (g4_comp_value(h->board->phase[x].comp)) {
-            return;
-        }
-    }
-    /* Flags left from while the interrupt was masked are cleared (the inputs
-     * are released now); a break after this is counted by the interrupt and
-     * stays latched (break_n moves past n). */
-    g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF));
+    /* The breaks counted before the inputs are seen released are the ones
+     * acknowledged: n is read first, so a break after it (even one that has
+     * ended by the check below) leaves break_n past n, latched. */
     const uint32_t n = h->break_n;
-    g4_wr(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE);
+    /* Stays latched while a comparator still sees over-current, and while
+     * the interrupt is masked: then this call only re-arms it
+     * (g4_hal_break_rearm, which the main loop also calls), because the
+     * flags it clears could hold a short break no interrupt saw; the next
+     * clear acknowledges. A flag the interrupt has not taken yet stays too.
+     * The board cause (over-temperature) is the board's to clear
+     * (g4_hal_trip_board). */
+    if (g4_hal_comp_high(h) || !g4_hal_break_rearm(h) ||
+        (g4_rd(G4_TIM1 + G4_TIM_SR) & (G4_TIM_SR_BIF | G4_TIM_SR_B2IF)) != 0u) {
+        return;
+    }
     h->break_acked = n;
 }
 

@@ -57,7 +57,9 @@ struct hal {
     uint32_t index_count;
     /* Trip latch, one writer per word (no read-modify-write shared between
      * priorities): break_n, system_n counted by the break interrupt,
-     * break_acked set by hal_trip_clear, board_trip by the main loop. */
+     * break_acked set by hal_trip_clear, board_trip by the main loop. A
+     * break counted and not yet acknowledged is latched (break_n !=
+     * break_acked); the interrupt is masked only while one is. */
     volatile uint32_t break_n;     /* comparator breaks seen */
     volatile uint32_t break_acked; /* break_n at the last accepted clear */
     volatile uint32_t system_n;    /* system breaks seen (not clearable) */
@@ -98,9 +100,14 @@ void g4_hal_gate_pins_safe(const g4_board_t *b);
 
 /* From the interrupts (board application). */
 void g4_hal_adc_irq_ack(hal_t *h); /* clears the end-of-sequence flags */
-/* Counts and clears the break flags; masks the interrupt while a break input
- * is still active (re-enabled by hal_trip_clear). */
+/* The TIM1 break interrupt's handler: gates off (MOE cleared, no software
+ * break), counts and clears the break flags; masks the interrupt while a
+ * break input is still active. */
 void g4_hal_break_irq(hal_t *h);
+/* Main loop (and hal_trip_clear): once the break inputs are released,
+ * clears the flags the masked interrupt left and enables it again. True when
+ * the interrupt was enabled already (nothing to do). */
+bool g4_hal_break_rearm(hal_t *h);
 /* Main loop: sets (gates off at once) or releases G4_TRIP_BOARD. */
 void g4_hal_trip_board(hal_t *h, bool on);
 /* The G4_TRIP_* causes latched now (0: no trip). */

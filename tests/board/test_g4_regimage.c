@@ -454,8 +454,8 @@ static void test_runtime_gates_and_trip(void)
 /* A comparator stuck high (RM0440 TIM1 break: BIF cannot be cleared while
  * the break input is active): the handler must not leave the interrupt
  * pending, or it re-enters at priority 0 until the watchdog resets the chip.
- * The trip stays latched; hal_trip_clear re-arms the interrupt once the
- * comparators are low. */
+ * The trip stays latched; the main loop re-arms the interrupt once the
+ * comparators are low (g4_hal_break_rearm), then a clear releases it. */
 static void test_runtime_break_input_stuck(void)
 {
     TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
@@ -471,9 +471,11 @@ static void test_runtime_break_input_stuck(void)
     TEST_ASSERT_TRUE(hal_trip_active(&hal));
     TEST_ASSERT_FALSE(g4_model_break_pending());
     g4_model.comp_high = false;
+    (void)g4_hal_break_rearm(&hal); /* the main loop, once the comparators are low */
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    TEST_ASSERT_FALSE(g4_model_break_pending());
     hal_trip_clear(&hal);
     TEST_ASSERT_FALSE(hal_trip_active(&hal));
-    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
     hal_gate_enable(&hal, true);
     TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
 }
@@ -522,6 +524,108 @@ static void test_runtime_break_during_gate_enable(void)
     TEST_ASSERT_TRUE(hal_trip_active(&hal));
     TEST_ASSERT_FALSE_MESSAGE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE,
                               "gates on after a latched break");
+}
+
+/* A system break (SYSCFG_CFGR2.CLL: a core lockup; SBIF) through the TIM1
+ * break interrupt's handler as the vector runs it (g4_hal_break_irq, whole):
+ * the gates go off without a software break, whose BIF would have been read
+ * as an over-current too (cause 3). A comparator break reads as 1 alone. */
+static void test_runtime_system_break_cause(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    const uintptr_t bdtr = G4_TIM1 + G4_TIM_BDTR;
+    hal_gate_enable(&hal, true);
+    /* SBIF; MOE left set: the handler does not rely on the hardware's clear */
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_SBIF);
+    const uint32_t n0 = g4_model.n_log;
+    g4_hal_break_irq(&hal);
+    while (g4_model_break_pending()) { /* the NVIC takes it again while pending */
+        g4_hal_break_irq(&hal);
+    }
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_SYSTEM, g4_hal_trip_cause(&hal));
+    TEST_ASSERT_FALSE_MESSAGE(reg(bdtr) & G4_TIM_BDTR_MOE, "gates on after the handler");
+    const int moe_off = g4_model_find(bdtr, G4_TIM_BDTR_MOE, 0u, (int)n0);
+    TEST_ASSERT_TRUE_MESSAGE(moe_off >= 0, "the handler clears MOE");
+    TEST_ASSERT_EQUAL_INT_MESSAGE((int)n0, moe_off, "gates off is the handler's first write");
+
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF);
+    g4_hal_break_irq(&hal);
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_BREAK, g4_hal_trip_cause(&hal));
+}
+
+/* A short break (BIF set, MOE cleared by the hardware) taken right after the
+ * load it is hooked on; the NVIC runs the handler when BIE is set. */
+static void short_break_irq(void)
+{
+    g4_model_put(G4_TIM1 + G4_TIM_SR, reg(G4_TIM1 + G4_TIM_SR) | G4_TIM_SR_BIF);
+    g4_model_put(G4_TIM1 + G4_TIM_BDTR, reg(G4_TIM1 + G4_TIM_BDTR) & ~G4_TIM_BDTR_MOE);
+    if (g4_model_break_pending()) {
+        g4_hal_break_irq(&hal);
+    }
+}
+
+static void hook_short_break_on_comp_read(void)
+{
+    g4_model.irq_on_read = G4_COMP + G4_COMP_CSR(g4_board_esc1.phase[2].comp);
+    g4_model.irq = short_break_irq;
+}
+
+/* A break after the comparators were seen low is never acknowledged by the
+ * clear that saw them: (1) while the interrupt is masked by a long break,
+ * its flag merges with the one left set, so the clear that clears that flag
+ * only re-arms the interrupt and the next clear acknowledges; (2) with the
+ * interrupt on, the break is counted at once and stays latched. */
+static void test_runtime_break_during_clear_kept(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    hal_gate_enable(&hal, true);
+    g4_model.comp_high = true; /* a long break: the interrupt masks itself */
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF);
+    g4_hal_break_irq(&hal);
+    TEST_ASSERT_FALSE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    g4_model.comp_high = false; /* released; BIF stays set */
+
+    hook_short_break_on_comp_read();
+    hal_trip_clear(&hal);
+    TEST_ASSERT_NULL_MESSAGE(g4_model.irq, "the break came inside the clear");
+    TEST_ASSERT_TRUE_MESSAGE(hal_trip_active(&hal), "(1) a break while masked was acknowledged");
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE); /* re-armed */
+    hal_trip_clear(&hal);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
+
+    short_break_irq(); /* a short break, latched; then a clear with another one inside */
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    hook_short_break_on_comp_read();
+    hal_trip_clear(&hal);
+    TEST_ASSERT_NULL(g4_model.irq);
+    TEST_ASSERT_TRUE_MESSAGE(hal_trip_active(&hal),
+                             "(2) a break inside the clear was acknowledged");
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_FALSE(reg(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_MOE);
+    hal_trip_clear(&hal);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
+    TEST_ASSERT_EQUAL_HEX32(0u, g4_hal_trip_cause(&hal));
+}
+
+/* The main loop re-arms the masked interrupt once the comparators are low,
+ * and not before; the break stays latched until a clear. */
+static void test_runtime_break_rearm(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    g4_model.comp_high = true;
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF);
+    g4_hal_break_irq(&hal);
+    TEST_ASSERT_FALSE(g4_hal_break_rearm(&hal));
+    TEST_ASSERT_FALSE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    g4_model.comp_high = false;
+    TEST_ASSERT_FALSE(g4_hal_break_rearm(&hal));
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    TEST_ASSERT_FALSE(g4_model_break_pending());
+    TEST_ASSERT_TRUE(g4_hal_break_rearm(&hal));
+    TEST_ASSERT_EQUAL_HEX32(G4_TRIP_BREAK, g4_hal_trip_cause(&hal));
+    hal_trip_clear(&hal);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
 }
 
 /* Samples: the ESC1's amplifier inverts (sense gain -64/7), so the HAL
@@ -626,6 +730,9 @@ int main(void)
     RUN_TEST(test_runtime_break_input_stuck);
     RUN_TEST(test_runtime_board_trip_cause);
     RUN_TEST(test_runtime_break_during_gate_enable);
+    RUN_TEST(test_runtime_system_break_cause);
+    RUN_TEST(test_runtime_break_during_clear_kept);
+    RUN_TEST(test_runtime_break_rearm);
     RUN_TEST(test_runtime_samples_and_compare);
     RUN_TEST(test_runtime_encoder);
     RUN_TEST(test_iwdg_sequence);

@@ -17,9 +17,9 @@
  *   2 USART2          byte rings
  *   3 PendSV          the medium-rate task (fw_medium), pended by fw_isr_fast
  * Main loop: received bytes -> command interpreter, telemetry frames out,
- * firmware watchdog kick, board temperature every 100 ms, independent
- * watchdog refreshed only while the control interrupt keeps running (also
- * while a reply waits for transmit space: esc1_service).
+ * firmware watchdog kick, the break interrupt re-armed after a long break, board temperature every
+ * 100 ms, independent watchdog refreshed only while the control interrupt keeps running (also while
+ * a reply waits for transmit space: esc1_service).
  */
 #include <math.h>
 #include <stdio.h>
@@ -52,8 +52,7 @@ void ADC1_2_IRQHandler(void)
 
 void TIM1_BRK_TIM15_IRQHandler(void)
 {
-    g4_tim1_gates_off_now();
-    g4_hal_break_irq(&esc1.hal);
+    g4_hal_break_irq(&esc1.hal); /* gates off first, then the cause */
 }
 
 void USART2_IRQHandler(void)
@@ -209,6 +208,9 @@ int main(void)
         }
         fw_link_poll(&s->link);
         esc1_service(s);
+        /* The break interrupt, masked by a long break, back on once the
+         * comparators are low (the trip stays latched until a clear). */
+        (void)g4_hal_break_rearm(&s->hal);
         if (s->thr_losses != thr_losses_told) {
             thr_losses_told = s->thr_losses;
             esc1_uart_puts(&s->uart, s->thr.cause == THR_CAUSE_NO_PULSE
