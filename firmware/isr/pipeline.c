@@ -1,6 +1,8 @@
 /* The PWM-period interrupt (order and Q formats in pipeline.h). Integer-only. */
 #include "pipeline.h"
 
+#include <stdatomic.h>
+
 #include "fw_pwm.h"
 #include "plan.h"
 #include "svpwm.h"
@@ -766,6 +768,21 @@ void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu)
 fw_state_id_t fw_state(const fw_t *fw)
 {
     return fw != NULL ? fw->sm.state : FW_STATE_FAULT;
+}
+
+const char *fw_gates_request_pending(const fw_t *fw, fw_state_id_t *state)
+{
+    const char *req = fw->req_arm != 0u ? "arm" : fw->req_cm != 0u ? "commissioning start" : NULL;
+    atomic_signal_fence(memory_order_seq_cst); /* no load of the state before those */
+    *state = fw->sm.state;
+    return req;
+}
+
+bool fw_gates_on_or_pending(const fw_t *fw)
+{
+    fw_state_id_t s;
+    return fw_gates_request_pending(fw, &s) != NULL || s == FW_STATE_RUNNING ||
+           s == FW_STATE_COMMISSION;
 }
 
 uint32_t fw_fault(const fw_t *fw)

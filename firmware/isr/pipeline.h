@@ -352,6 +352,14 @@ void fw_set_torque_ref_nm(fw_t *fw, double nm);
 void fw_set_speed_ref_rpm(fw_t *fw, double rpm);
 
 fw_state_id_t fw_state(const fw_t *fw);
+/* Main loop: the request the interrupt has not taken yet that turns the
+ * gates on at its next period ("arm", "commissioning start"), or NULL; then
+ * *state (read after the requests: an interrupt that takes one in between has
+ * set the state by the time it is read). */
+const char *fw_gates_request_pending(const fw_t *fw, fw_state_id_t *state);
+/* Main loop: the gates are on (running, commissioning) or go on at the next
+ * period (a request pending): no reconfiguration, no flash access. */
+bool fw_gates_on_or_pending(const fw_t *fw);
 uint32_t fw_fault(const fw_t *fw);
 /* The record of the last period (zeroes before the first; NULL for NULL). */
 const fw_telemetry_t *fw_telemetry(const fw_t *fw);

@@ -177,6 +177,19 @@ static int fw_settings_command(fw_settings_t *st, fw_t *fw, const char *what, co
 {
     *detail = st->msg;
     st->msg[0] = '\0';
+    /* Gates off, and no request pending that turns them on at the next
+     * period: an erase stalls the CPU (and the control interrupt) for tens
+     * of ms, and a read that meets an ECC error takes the NMI, which turns
+     * the gates off (g4_flash.c) */
+    fw_state_id_t state;
+    const char *pending = fw_gates_request_pending(fw, &state);
+    if (pending != NULL || state == FW_STATE_RUNNING || state == FW_STATE_COMMISSION) {
+        (void)snprintf(st->msg, sizeof st->msg,
+                       "%s%s (%s): disarm first (a page erase stalls the CPU ~22 ms)",
+                       pending != NULL ? pending : "gates on", pending != NULL ? " pending" : "",
+                       fw_state_name(state));
+        return CMD_E_STATE;
+    }
     if (strcmp(what, "read") == 0) {
         if (settings_store_load(&st->flash, st->buf, sizeof st->buf, &st->rec, &st->scan) !=
             SETTINGS_OK) {
@@ -184,14 +197,6 @@ static int fw_settings_command(fw_settings_t *st, fw_t *fw, const char *what, co
             return CMD_E_STATE;
         }
         return CMD_OK;
-    }
-    /* an erase stalls the CPU (and the control interrupt) for tens of ms */
-    const fw_state_id_t state = fw_state(fw);
-    if (state == FW_STATE_RUNNING || state == FW_STATE_COMMISSION) {
-        (void)snprintf(st->msg, sizeof st->msg,
-                       "gates on (%s): disarm first (a page erase stalls the CPU ~22 ms)",
-                       fw_state_name(state));
-        return CMD_E_STATE;
     }
     if (strcmp(what, "default") == 0) {
         const int rc = st->apply_default(st->ctx);

@@ -6,12 +6,16 @@
 
 #include <string.h>
 
-/* BSY polls before giving up: each poll is a bus read of a few cycles, so at
- * 170 MHz this is over 0.5 s, some twenty times the page erase time (the
- * register-model test sets fewer). */
-#ifndef G4_FLASH_BSY_POLLS
-#define G4_FLASH_BSY_POLLS 20000000u
-#endif
+#include "g4_core.h"
+
+#define G4_FLASH_STR2(x) #x
+#define G4_FLASH_STR(x) G4_FLASH_STR2(x)
+
+/* The fault path of g4_startup.c: gates off, waits for the watchdog. */
+void g4_fault_handler(void);
+
+/* Core cycles a BSY wait may take (g4_flash_set_clock; 0: not given). */
+static uint32_t g4_flash_bsy_cycles;
 
 /* Set by the NMI when a read of the settings pages met ECCD. */
 static volatile uint32_t g4_flash_eccd;
@@ -45,7 +49,9 @@ const char *g4_flash_strerror(int rc)
     }
     switch (rc) {
     case G4_FLASH_E_BUSY:
-        return "BSY did not clear";
+        return "BSY did not clear in " G4_FLASH_STR(G4_FLASH_BSY_MS) " ms";
+    case G4_FLASH_E_CLOCK:
+        return "no core clock for the BSY time-out (g4_flash_set_clock)";
     case G4_FLASH_E_LOCKED:
         return "LOCK still set after the KEYR sequence";
     case G4_FLASH_E_ECC:
@@ -57,14 +63,16 @@ const char *g4_flash_strerror(int rc)
     }
 }
 
+void g4_flash_set_clock(uint32_t hclk_hz)
+{
+    g4_flash_bsy_cycles = hclk_hz / 1000u * (uint32_t)G4_FLASH_BSY_MS;
+}
+
+/* Timed by the cycle counter, which also counts the cycles the core spends
+ * stalled on a fetch from the bank being erased. */
 static bool g4_flash_wait_idle(void)
 {
-    for (uint32_t i = 0; i < G4_FLASH_BSY_POLLS; i++) {
-        if ((g4_rd(G4_FLASH + G4_FLASH_SR) & G4_FLASH_SR_BSY) == 0u) {
-            return true;
-        }
-    }
-    return false;
+    return g4_wait_bits(G4_FLASH + G4_FLASH_SR, G4_FLASH_SR_BSY, 0u, g4_flash_bsy_cycles);
 }
 
 /* The first error flag of FLASH_SR as a return code, 0 if none. */
@@ -87,6 +95,9 @@ static int g4_flash_sr_error(uint32_t sr)
  * FLASH_CR until reset, so the keys are written only while LOCK is set). */
 static int g4_flash_begin(void)
 {
+    if (g4_flash_bsy_cycles == 0u) {
+        return G4_FLASH_E_CLOCK;
+    }
     if (!g4_flash_wait_idle()) {
         return G4_FLASH_E_BUSY;
     }
@@ -218,17 +229,26 @@ bool g4_flash_nmi_ecc(void)
     return true;
 }
 
-#if !defined(G4_MEM_ARRAYS)
-/* Replaces g4_startup.c's weak NMI_Handler when the flash driver is linked.
- * An ECC error in the settings pages is a read result, not a fault: it is
- * cleared and the read reports it (a few register reads before the fault
- * path); any other NMI goes to the fault path, which turns the gates off. */
-void g4_fault_handler(void);
-void NMI_Handler(void);
-void NMI_Handler(void)
+void g4_flash_nmi(void)
 {
+    /* Gates off first, as in every fault handler: MOE cleared (RM0440 TIM1
+     * BDTR), not a software break, whose BIF the break interrupt would count
+     * as an over-current when this NMI is a settings read's ECC error. Reads
+     * of the settings pages are made with the gates off (fw_settings.c). */
+    g4_clr(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
+    /* An ECC error in the settings pages is a read result, not a fault: it is
+     * cleared and the read reports it; any other NMI (clock security, an ECC
+     * error in the code, SRAM parity) goes to the fault path. */
     if (!g4_flash_nmi_ecc()) {
         g4_fault_handler();
     }
+}
+
+#if !defined(G4_MEM_ARRAYS)
+/* Replaces g4_startup.c's weak NMI_Handler when the flash driver is linked. */
+void NMI_Handler(void);
+void NMI_Handler(void)
+{
+    g4_flash_nmi();
 }
 #endif

@@ -93,9 +93,23 @@ extern uint32_t g4_mem_flash_settings[2u * G4_FLASH_PAGE_SIZE / 4u];
 #define G4_FLASH_E_LOCKED (-61) /* KEYR sequence did not clear LOCK */
 #define G4_FLASH_E_ECC (-62)    /* uncorrectable ECC error (ECCD) in the data read */
 #define G4_FLASH_E_ADDR (-63)   /* outside the settings pages, or not double-word aligned */
+#define G4_FLASH_E_CLOCK (-64)  /* g4_flash_set_clock not called */
+
+/* BSY time-out of every erase and program, ms: above the longest operation,
+ * a 2 KB page erase (t_ERASE max 24.47 ms: STM32G431 data sheet, "Flash
+ * memory characteristics", as Zephyr's STM32 flash driver quotes it for the
+ * G4), and below the independent watchdog (100 ms), which nothing refreshes
+ * while a save runs: a save (1 erase + 72 double words of about 82 us,
+ * some 31 ms) plus one time-out stays under it, so a flash that never clears
+ * BSY is reported as such (G4_FLASH_E_BUSY), not by a watchdog reset. */
+#define G4_FLASH_BSY_MS 40
 
 /* Name of a return code: "PROGERR (double word not erased)", ... */
 const char *g4_flash_strerror(int rc);
+
+/* The core clock (HCLK), for the BSY time-out: before the first erase or
+ * program (which return G4_FLASH_E_CLOCK until then). */
+void g4_flash_set_clock(uint32_t hclk_hz);
 
 /* Settings page p (0, 1): erase (PER, PNB, STRT; BSY; the data cache reset
  * after, as ST's driver does), program one double word (PG, two word writes,
@@ -108,7 +122,10 @@ int g4_flash_read(unsigned p, uint32_t off, uint8_t *buf, size_t n);
 /* The NMI's ECC case: an uncorrectable ECC error (FLASH_ECCR.ECCD) while
  * reading the settings pages raises the NMI (RM0440 sec. 3.3.9); this clears
  * ECCD, notes it for g4_flash_read and returns true. False for any other
- * NMI (the caller's fault path then turns the gates off). */
+ * NMI (the caller then takes the fault path). */
 bool g4_flash_nmi_ecc(void);
+/* The NMI (NMI_Handler on the target): gates off, then g4_flash_nmi_ecc, or
+ * the fault path (g4_fault_handler of g4_startup.c) for any other cause. */
+void g4_flash_nmi(void);
 
 #endif /* HAL_STM32G4_G4_FLASH_H */

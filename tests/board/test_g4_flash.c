@@ -23,6 +23,16 @@
 
 uint32_t g4_mem_flash[0x400u / 4u];
 uint32_t g4_mem_flash_settings[2u * G4_FLASH_PAGE_SIZE / 4u];
+/* the other registers the driver touches: the cycle counter (g4_core.c's
+ * time-outs), TIM1 (the NMI's gates off); NVIC and SCB for g4_core.c */
+uint32_t g4_mem_dwt[0x10u / 4u];
+uint32_t g4_mem_tim1[0x400u / 4u];
+uint32_t g4_mem_nvic[0x400u / 4u];
+uint32_t g4_mem_scb[0x100u / 4u];
+
+/* Core clock of the model: DWT_CYCCNT counts its cycles. */
+#define MODEL_HZ 170000000u
+#define MS_CYCLES(ms) ((uint32_t)((double)(ms) * (MODEL_HZ / 1000u)))
 
 #define LOG_MAX 256u
 static struct {
@@ -34,17 +44,26 @@ static struct {
     bool pg_pending;    /* first word of a double word written */
     uintptr_t pg_addr;
     uint32_t pg_lo;
-    unsigned busy_polls;    /* BSY stays set for this many SR reads */
-    unsigned busy_after_op; /* ... after each operation */
+    uint32_t busy_until;   /* BSY set until DWT_CYCCNT reaches this */
+    uint32_t erase_cycles; /* how long an erase keeps BSY set */
+    uint32_t prog_cycles;  /* ... a double word's programming */
+    uint32_t poll_cycles;  /* the core cycles one read of FLASH_SR takes */
     bool busy_stuck;
-    bool wrp; /* both settings pages write-protected */
+    unsigned stuck_at_program; /* BSY sticks from this double word on (0: never) */
+    bool wrp;                  /* both settings pages write-protected */
     uint8_t ecc_bad[2u * G4_FLASH_PAGE_SIZE / 8u];
     unsigned erases, programs;
     unsigned foreign_erase;  /* erases of a page that is not a settings page */
     unsigned dcrst_while_on; /* DCRST written with DCEN set */
     unsigned stray_writes;   /* flash memory written without PG */
     unsigned polls;          /* SR reads */
+    unsigned seq;            /* accesses (reads and writes) so far */
+    unsigned moe_off_seq;    /* seq of the first write clearing TIM1_BDTR.MOE, 0: none */
+    unsigned flash_reg_seq;  /* seq of the first flash register access, 0: none */
+    unsigned faults;         /* calls of the fault path (g4_fault_handler) */
 } fm;
+
+#define NOW g4_mem_dwt[G4_DWT_CYCCNT / 4u]
 
 #define REG(off) g4_mem_flash[(off) / 4u]
 
@@ -55,7 +74,20 @@ static void model_reset(void)
     REG(G4_FLASH_ACR) = G4_FLASH_ACR_RESET;
     REG(G4_FLASH_CR) = G4_FLASH_CR_RESET;
     memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
-    fm.busy_after_op = 3u;
+    memset(g4_mem_dwt, 0, sizeof g4_mem_dwt);
+    memset(g4_mem_tim1, 0, sizeof g4_mem_tim1);
+    /* BSY for three polls after each operation (the timing test sets the
+     * data sheet's times) */
+    fm.poll_cycles = 8u;
+    fm.erase_cycles = fm.prog_cycles = 3u * fm.poll_cycles;
+    g4_flash_set_clock(MODEL_HZ);
+}
+
+/* The fault path of g4_startup.c, counted. */
+void g4_fault_handler(void);
+void g4_fault_handler(void)
+{
+    fm.faults++;
 }
 
 static bool in_settings(uintptr_t a)
@@ -69,9 +101,9 @@ static void sr_set(uint32_t bits)
     REG(G4_FLASH_SR) |= bits;
 }
 
-static void op_done(void)
+static void op_done(uint32_t cycles)
 {
-    fm.busy_polls = fm.busy_after_op;
+    fm.busy_until = NOW + cycles;
     if ((REG(G4_FLASH_CR) & G4_BIT(24)) != 0u) { /* EOPIE */
         sr_set(G4_FLASH_SR_EOP);
     }
@@ -112,7 +144,8 @@ static void model_program(uintptr_t a, uint32_t v)
     mem[0] &= fm.pg_lo;
     mem[1] &= v;
     fm.programs++;
-    op_done();
+    op_done(fm.prog_cycles);
+    fm.busy_stuck = fm.busy_stuck || fm.programs == fm.stuck_at_program;
 }
 
 static void model_cr(uint32_t v)
@@ -143,14 +176,51 @@ static void model_cr(uint32_t v)
     memset(&g4_mem_flash_settings[p * G4_FLASH_PAGE_SIZE / 4u], 0xFF, G4_FLASH_PAGE_SIZE);
     memset(&fm.ecc_bad[p * G4_FLASH_PAGE_SIZE / 8u], 0, G4_FLASH_PAGE_SIZE / 8u);
     fm.erases++;
-    op_done();
+    op_done(fm.erase_cycles);
 }
 
 void g4_trace_write(uintptr_t reg, uint32_t value);
 uint32_t g4_trace_read(uintptr_t reg);
 
+/* A register of the model's other arrays, or NULL. */
+static uint32_t *other_cell(uintptr_t reg)
+{
+    static const struct {
+        uint32_t *a;
+        size_t bytes;
+    } arr[] = {{g4_mem_dwt, sizeof g4_mem_dwt},
+               {g4_mem_tim1, sizeof g4_mem_tim1},
+               {g4_mem_nvic, sizeof g4_mem_nvic},
+               {g4_mem_scb, sizeof g4_mem_scb}};
+    for (size_t i = 0; i < sizeof arr / sizeof arr[0]; i++) {
+        if (reg >= (uintptr_t)arr[i].a && reg < (uintptr_t)arr[i].a + arr[i].bytes) {
+            return (uint32_t *)reg;
+        }
+    }
+    return NULL;
+}
+
+static void note_flash_reg(uintptr_t reg)
+{
+    fm.seq++;
+    if (fm.flash_reg_seq == 0u && reg >= (uintptr_t)g4_mem_flash &&
+        reg < (uintptr_t)g4_mem_flash + sizeof g4_mem_flash) {
+        fm.flash_reg_seq = fm.seq;
+    }
+}
+
 void g4_trace_write(uintptr_t reg, uint32_t value)
 {
+    note_flash_reg(reg);
+    uint32_t *o = other_cell(reg);
+    if (o != NULL) {
+        if (reg == G4_TIM1 + G4_TIM_BDTR && (*o & G4_TIM_BDTR_MOE) != 0u &&
+            (value & G4_TIM_BDTR_MOE) == 0u && fm.moe_off_seq == 0u) {
+            fm.moe_off_seq = fm.seq;
+        }
+        *o = value;
+        return;
+    }
     if (fm.n < LOG_MAX) {
         fm.reg[fm.n] = reg;
         fm.val[fm.n] = value;
@@ -201,6 +271,11 @@ void g4_trace_write(uintptr_t reg, uint32_t value)
 
 uint32_t g4_trace_read(uintptr_t reg)
 {
+    note_flash_reg(reg);
+    const uint32_t *o = other_cell(reg);
+    if (o != NULL) {
+        return *o;
+    }
     if (in_settings(reg)) {
         const size_t w = (reg - (uintptr_t)g4_mem_flash_settings) / 4u;
         if (fm.ecc_bad[w / 2u] != 0u) {
@@ -214,10 +289,8 @@ uint32_t g4_trace_read(uintptr_t reg)
     const uintptr_t off = reg - (uintptr_t)g4_mem_flash;
     if (off == G4_FLASH_SR) {
         fm.polls++;
-        if (fm.busy_stuck || fm.busy_polls > 0u) {
-            if (fm.busy_polls > 0u) {
-                fm.busy_polls--;
-            }
+        NOW += fm.poll_cycles;
+        if (fm.busy_stuck || (int32_t)(fm.busy_until - NOW) > 0) {
             return REG(G4_FLASH_SR) | G4_FLASH_SR_BSY;
         }
     }
@@ -286,7 +359,7 @@ static void test_erase_sequence(void)
     const int dc_off = find(G4_FLASH_ACR, G4_FLASH_ACR_DCEN, 0u, 0);
     TEST_ASSERT_TRUE(dc_off >= 0 && dc_off < strt);
     /* the driver waited for BSY (the model holds it for 3 reads) */
-    TEST_ASSERT_EQUAL_UINT(0u, fm.busy_polls);
+    TEST_ASSERT_TRUE((int32_t)(NOW - fm.busy_until) >= 0);
     assert_idle_locked();
 }
 
@@ -303,7 +376,7 @@ static void test_program_sequence(void)
     TEST_ASSERT_EQUAL_HEX32(0x03020100u, fm.val[w0]); /* low word first */
     const int pg_off = find(G4_FLASH_CR, G4_FLASH_CR_PG, 0u, w1);
     TEST_ASSERT_TRUE(pg_off > w1);
-    TEST_ASSERT_EQUAL_UINT(0u, fm.busy_polls);
+    TEST_ASSERT_TRUE((int32_t)(NOW - fm.busy_until) >= 0);
     assert_idle_locked();
     uint8_t b[8];
     TEST_ASSERT_EQUAL_INT(0, g4_flash_read(0u, 16u, b, sizeof b));
@@ -403,17 +476,56 @@ static void test_ecc_read_and_nmi(void)
     TEST_ASSERT_EQUAL_INT(0, g4_flash_read(0u, 0u, b, sizeof b));
 }
 
+/* BSY never clears: the driver gives up after G4_FLASH_BSY_MS of core
+ * cycles and says so, locked again. The bound is above the data sheet's
+ * longest operation (t_ERASE max 24.47 ms) and below the independent
+ * watchdog (100 ms at LSI 32 kHz; 94 ms at its 34 kHz maximum). */
 static void test_busy_timeout(void)
 {
-    /* BSY never clears: the driver gives up after G4_FLASH_BSY_POLLS reads
-     * (1000 in this test's build) and says so, locked again */
     fm.busy_stuck = true;
-    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_BUSY, g4_flash_erase(0u));
+    const uint32_t t0 = NOW;
+    const int rc = g4_flash_erase(0u);
+    const double ms = (double)(NOW - t0) / (MODEL_HZ / 1000u);
+    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_BUSY, rc);
+    TEST_ASSERT_NOT_NULL(strstr(g4_flash_strerror(rc), "BSY"));
     TEST_ASSERT_EQUAL_UINT(0u, fm.erases);
-    TEST_ASSERT_TRUE(fm.polls >= 1000u && fm.polls <= 1010u);
+    TEST_ASSERT_TRUE_MESSAGE(ms > 24.47 && ms < 94.0, "time-out outside (t_ERASE max, watchdog)");
+    TEST_ASSERT_DOUBLE_WITHIN(0.01, (double)G4_FLASH_BSY_MS, ms);
+    assert_idle_locked();
     fm.busy_stuck = false;
-    fm.busy_polls = 0u;
     TEST_ASSERT_EQUAL_INT(0, g4_flash_erase(0u)); /* BSY cleared: the next one goes */
+}
+
+/* Without the core clock the driver cannot time BSY: it refuses, by name,
+ * before touching the flash. */
+static void test_no_clock_refused(void)
+{
+    g4_flash_set_clock(0u);
+    const int rc = g4_flash_erase(0u);
+    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_CLOCK, rc);
+    TEST_ASSERT_NOT_NULL(strstr(g4_flash_strerror(rc), "clock"));
+    TEST_ASSERT_EQUAL_UINT(0u, fm.n);
+}
+
+/* The NMI turns the gates off (TIM1_BDTR.MOE cleared) before it reads any
+ * flash register; a settings-page ECC error returns, any other NMI takes the
+ * fault path. */
+static void test_nmi_gates_off_first(void)
+{
+    g4_mem_tim1[G4_TIM_BDTR / 4u] = G4_TIM_BDTR_MOE | G4_TIM_BDTR_BKE;
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | (G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + 8u);
+    g4_flash_nmi();
+    TEST_ASSERT_TRUE_MESSAGE(fm.moe_off_seq != 0u, "MOE not cleared");
+    TEST_ASSERT_TRUE_MESSAGE(fm.moe_off_seq < fm.flash_reg_seq, "flash read before gates off");
+    TEST_ASSERT_EQUAL_HEX32(G4_TIM_BDTR_BKE, g4_mem_tim1[G4_TIM_BDTR / 4u]);
+    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD);
+    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
+    g4_mem_tim1[G4_TIM_BDTR / 4u] = G4_TIM_BDTR_MOE;
+    fm.moe_off_seq = fm.flash_reg_seq = 0u;
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | 0x1000u; /* in the code: a fault */
+    g4_flash_nmi();
+    TEST_ASSERT_TRUE(fm.moe_off_seq != 0u && fm.moe_off_seq < fm.flash_reg_seq);
+    TEST_ASSERT_EQUAL_UINT(1u, fm.faults);
 }
 
 /* ---- the settings store through the driver ---- */
@@ -469,6 +581,40 @@ static void test_store_through_driver(void)
     assert_idle_locked();
 }
 
+/* A save with the page erase at the data sheet's maximum (t_ERASE 24.47 ms)
+ * and each double word at 100 us (its typical 82 us with margin; the
+ * maximum is not checked here) takes about 32 ms with nothing refreshing
+ * the independent watchdog; with BSY stuck on the last double word it ends
+ * with the flash's error, still inside the watchdog's 94 ms (100 ms nominal
+ * at LSI 32 kHz, 34 kHz at most). */
+static void test_save_time_under_watchdog(void)
+{
+    const settings_flash_t f = {NULL,      G4_FLASH_PAGE_SIZE, dev_read,
+                                dev_erase, dev_program,        g4_flash_strerror};
+    static uint8_t buf[SETTINGS_REC_MAX];
+    settings_t st;
+    memset(&st, 0, sizeof st);
+    st.pole_pairs = 7;
+    st.rs_ohm = 0.25;
+    st.enc_direction = 1;
+    strcpy(st.ctrl, "foc");
+    fm.erase_cycles = MS_CYCLES(24.47);
+    fm.prog_cycles = MS_CYCLES(0.1);
+    const unsigned dw = settings_record_size() / 8u;
+    uint32_t seq = 0;
+    uint32_t t0 = NOW;
+    TEST_ASSERT_EQUAL_INT(0, settings_store_save(&f, buf, sizeof buf, &st, &seq));
+    const double ms_ok = (double)(NOW - t0) / (MODEL_HZ / 1000u);
+    TEST_ASSERT_DOUBLE_WITHIN(0.5, 24.47 + dw * 0.1, ms_ok);
+    fm.stuck_at_program = fm.programs + dw;
+    t0 = NOW;
+    const int rc = settings_store_save(&f, buf, sizeof buf, &st, &seq);
+    const double ms_stuck = (double)(NOW - t0) / (MODEL_HZ / 1000u);
+    TEST_ASSERT_NOT_EQUAL(0, rc);
+    TEST_ASSERT_NOT_NULL(strstr(settings_store_strerror(&f, rc), "BSY"));
+    TEST_ASSERT_TRUE_MESSAGE(ms_stuck < 94.0, "a stuck BSY outlasts the watchdog");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -483,6 +629,9 @@ int main(void)
     RUN_TEST(test_bad_addresses);
     RUN_TEST(test_ecc_read_and_nmi);
     RUN_TEST(test_busy_timeout);
+    RUN_TEST(test_no_clock_refused);
+    RUN_TEST(test_nmi_gates_off_first);
+    RUN_TEST(test_save_time_under_watchdog);
     RUN_TEST(test_store_through_driver);
     return UNITY_END();
 }

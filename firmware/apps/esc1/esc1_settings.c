@@ -68,6 +68,7 @@ void esc1_settings_start(esc1_t *s)
     st->apply = esc1_settings_apply;
     st->apply_default = esc1_settings_default;
     st->ctx = s;
+    g4_flash_set_clock(s->hal.board->sysclk_hz); /* started only when the clock is up */
     (void)fw_settings_boot(st);
     fw_link_set_settings(&s->link, st);
     esc1_uart_puts(&s->uart, st->msg);
