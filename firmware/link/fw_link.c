@@ -371,6 +371,14 @@ static bool op_cm_ini_at(void *ctx, size_t index, cmd_cm_item_t *item)
     return true;
 }
 
+int fw_link_offsets_text(const fw_t *fw, char *buf, size_t cap)
+{
+    const int32_t *o = fw->off_q8; /* 0 <= off_q8 < 2^24: rounded without overflow */
+    return snprintf(buf, cap, "current offsets %ld %ld %ld counts, expected %u +- %u",
+                    (long)((o[0] + 128) >> 8), (long)((o[1] + 128) >> 8), (long)((o[2] + 128) >> 8),
+                    (unsigned)fw->adc_zero, (unsigned)fw->adc_zero_tol);
+}
+
 static int op_cm_start(void *ctx, const char *what, const char **detail)
 {
     fw_link_t *l = fw_link_of(ctx);
@@ -401,6 +409,12 @@ static int op_cm_start(void *ctx, const char *what, const char **detail)
     uint8_t missing = CM_STEP_NONE;
     switch (fw_commission_start(fw, steps, n, &missing)) {
     case FW_OK:
+        if (steps[0] == CM_STEP_SENSE) {
+            /* the offsets the step's currents are measured from, said
+             * before the step judges what it measures */
+            (void)fw_link_offsets_text(fw, l->cm_note, sizeof l->cm_note);
+            *detail = l->cm_note;
+        }
         return CMD_OK;
     case FW_ENOENT:
         (void)snprintf(l->cm_detail, sizeof l->cm_detail, "needs %s", cm_step_name(missing));
@@ -452,6 +466,22 @@ static bool op_config_item_at(void *ctx, size_t index, cmd_config_item_t *it)
            l->settings_item(l->settings, index, it);
 }
 
+/* The state an op was refused in: "in <state>", or the request pending that
+ * turns the gates on at the next period: "arm pending (ready)". */
+static const char *op_state_detail(void *ctx)
+{
+    fw_link_t *l = fw_link_of(ctx);
+    fw_state_id_t s;
+    const char *req = fw_gates_request_pending(l->fw, &s);
+    if (req != NULL) {
+        (void)snprintf(l->state_text, sizeof l->state_text, "%s pending (%s)", req,
+                       fw_state_name(s));
+    } else {
+        (void)snprintf(l->state_text, sizeof l->state_text, "in %s", fw_state_name(s));
+    }
+    return l->state_text;
+}
+
 static const cmd_ops_t fw_link_ops = {
     op_write,
     op_get_status,
@@ -477,6 +507,7 @@ static const cmd_ops_t fw_link_ops = {
     op_failed_detail,
     op_config,
     op_config_item_at,
+    op_state_detail,
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx)

@@ -42,6 +42,8 @@ typedef struct {
     uint8_t send_meta;
     double speed_max_rpm;       /* |speed reference| limit (fw_speed_info_t: the rated speed) */
     char cm_detail[48];         /* detail of the last refused commissioning start */
+    char state_text[48];        /* detail of the last "err 8 state" (op_state_detail) */
+    char cm_note[80];           /* what "bringup sense" says when it starts (the offsets) */
     ctrl_diag_t why;            /* why the core refused the last configuration op (CTRL_OK: none) */
     char why_text[CMD_OUT_MAX]; /* its "err 10 failed" detail */
     fw_link_write_fn write;
@@ -66,6 +68,10 @@ void fw_link_set_settings(fw_link_t *l, fw_settings_t *st);
  * refused the configuration: the reason (fw_t.why before the application
  * restores its previous data), sent as the detail of "err 10 failed". */
 void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why);
+/* "current offsets a b c counts, expected zero +- tol": the phase-current
+ * offsets the calibration measured (Q8 counts, rounded to counts) and the
+ * window it judges them by (hal_info_t). snprintf's result. */
+int fw_link_offsets_text(const fw_t *fw, char *buf, size_t cap);
 /* Main loop: one received byte. */
 void fw_link_rx(fw_link_t *l, uint8_t byte);
 /* Main loop: META frame after "tel start", then a sample frame for each

@@ -176,6 +176,8 @@ static bool cmd_op_ok(cmd_t *c, int rc)
     const char *detail = NULL;
     if (code == CMD_E_FAILED && c->ops->failed_detail != NULL) {
         detail = c->ops->failed_detail(c->ctx);
+    } else if (code == CMD_E_STATE && c->ops->state_detail != NULL) {
+        detail = c->ops->state_detail(c->ctx);
     }
     cmd_err(c, code, detail);
     return false;
@@ -774,6 +776,10 @@ static void cmd_cm_start(cmd_t *c, const char *word, const char *what)
     cmd_out_str(c, word);
     cmd_out_char(c, ' ');
     cmd_out_str(c, what);
+    if (detail != NULL) {
+        cmd_out_char(c, ' ');
+        cmd_out_str(c, detail);
+    }
     cmd_out_flush(c);
 }
 
@@ -910,8 +916,9 @@ static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
 }
 
 /* "config save|show|erase|default": the settings record in flash. The op
- * refuses save, erase and default with the gates on (a flash page erase
- * stalls the CPU for tens of ms), saying why. */
+ * refuses each with the gates on or about to go on (a flash page erase
+ * stalls the CPU for tens of ms; an ECC error in a read takes the NMI, which
+ * turns the gates off), saying why. */
 static void cmd_config(cmd_t *c, const cmd_tok_t *tok, size_t n)
 {
     static const char usage[] = "config save|show|erase|default";

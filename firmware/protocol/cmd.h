@@ -145,8 +145,9 @@ typedef struct {
     bool (*cm_ini_at)(void *ctx, size_t index, cmd_cm_item_t *item);
     /* state-changing: what = "run" (the whole identification), "resume" (its
      * first step without a result onward) or a step name. On CMD_E_STATE the
-     * op may set *detail (e.g. "needs encoder"); it stays valid until the
-     * next op call. */
+     * op may set *detail (e.g. "needs encoder"); on CMD_OK too (a note
+     * appended to "ok bringup NAME"); it stays valid until the next op
+     * call. */
     int (*cm_start)(void *ctx, const char *what, const char **detail);
     int (*cm_apply)(void *ctx);
     /* gates off now: ends commissioning or running */
@@ -162,6 +163,10 @@ typedef struct {
     int (*config)(void *ctx, const char *what, const char **detail);
     /* read-only: the record last read, line by line; false past the end */
     bool (*config_item_at)(void *ctx, size_t index, cmd_config_item_t *it);
+    /* optional: the state an op that just returned CMD_E_STATE was refused
+     * in ("in commission", "arm pending (ready)"), appended to "err 8 state".
+     * Appended. */
+    const char *(*state_detail)(void *ctx);
 } cmd_ops_t;
 
 typedef struct {

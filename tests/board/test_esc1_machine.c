@@ -201,7 +201,7 @@ static void test_link_refusal_names_quantity_value_range(void)
  * ADCs at 2553 (2.06 V, the bias network's zero-current level) the firmware
  * calibrates and becomes ready; at 2048 (1.65 V, mid-scale) the offsets are
  * 505 counts off the board's expected code: fault adc_calibration, with the
- * measured offsets kept for the report (esc1_offsets_line). */
+ * measured offsets kept for the report (fw_link_offsets_text). */
 static void calibrate_at(uint32_t code)
 {
     esc1_start();
@@ -226,13 +226,67 @@ static void test_calibration_takes_the_board_zero(void)
     TEST_ASSERT_EQUAL_INT(FW_STATE_FAULT, fw_state(&esc.fw));
     TEST_ASSERT_EQUAL_UINT32(FW_FAULT_CALIB, esc.fw.sm.fault_code);
     char line[96];
-    TEST_ASSERT_TRUE(esc1_offsets_line(line, sizeof line, esc.fw.off_q8, esc.fw.adc_zero,
-                                       esc.fw.adc_zero_tol) > 0);
+    TEST_ASSERT_TRUE(fw_link_offsets_text(&esc.fw, line, sizeof line) > 0);
     char want[96];
-    snprintf(want, sizeof want,
-             "esc1: current offsets 2047 2047 2047 counts, expected 1542 +- %u\r\n",
+    snprintf(want, sizeof want, "current offsets 2047 2047 2047 counts, expected 1542 +- %u",
              (unsigned)esc.hal.info.adc_current_zero_tol);
     TEST_ASSERT_EQUAL_STRING(want, line);
+    /* Q8 counts rounded to counts */
+    esc.fw.off_q8[0] = 1542 * 256 + 127;
+    esc.fw.off_q8[1] = 1542 * 256 + 128;
+    esc.fw.off_q8[2] = 0;
+    TEST_ASSERT_TRUE(fw_link_offsets_text(&esc.fw, line, sizeof line) > 0);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp("current offsets 1542 1543 0 counts", line, 34), line);
+}
+
+static void expect_prefix(const char *want, const char *got)
+{
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(want, got, strlen(want)), got);
+}
+
+/* Machine data change only with the gates off: while an identification or
+ * bring-up step runs (state commission), while running, and while an arm
+ * waits for the next period, "param set m.*" is refused naming the state,
+ * and nothing changes. */
+static void test_link_reconfig_refused_while_gates_on(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    const double rs = esc.machine.rs_ohm;
+    expect_prefix("ok bringup vbus", command("bringup vbus"));
+    esc1_control_isr(&esc);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_COMMISSION, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("err 8 state in commission", command("param set m.rs_ohm 5"));
+    TEST_ASSERT_EQUAL_STRING("err 8 state in commission", command("param set enc.cpr 2048"));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_COMMISSION, fw_state(&esc.fw));
+    TEST_ASSERT_TRUE(esc.machine.rs_ohm == rs);
+    expect_prefix("ok", command("stop"));
+    esc1_control_isr(&esc);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+
+    expect_prefix("ok", command("arm"));
+    TEST_ASSERT_EQUAL_STRING("err 8 state arm pending (ready)", command("param set m.rs_ohm 5"));
+    esc1_control_isr(&esc);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("err 8 state in running", command("param set m.rs_ohm 5"));
+    TEST_ASSERT_TRUE(esc.machine.rs_ohm == rs);
+    expect_prefix("ok", command("disarm"));
+    esc1_control_isr(&esc);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("ok m.rs_ohm 5", command("param set m.rs_ohm 5"));
+}
+
+/* "bringup sense" says the offsets its currents are measured from when it
+ * starts, before it judges anything. */
+static void test_bringup_sense_says_the_offsets(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    char want[160];
+    snprintf(want, sizeof want,
+             "ok bringup sense current offsets 1542 1542 1542 counts, expected 1542 +- %u",
+             (unsigned)esc.hal.info.adc_current_zero_tol);
+    TEST_ASSERT_EQUAL_STRING(want, command("bringup sense"));
 }
 
 /* The throttle on the board's code path: TIM2 captures (register model) to
@@ -296,5 +350,7 @@ int main(void)
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
     RUN_TEST(test_throttle_arms_and_disarms_the_drive);
+    RUN_TEST(test_link_reconfig_refused_while_gates_on);
+    RUN_TEST(test_bringup_sense_says_the_offsets);
     return UNITY_END();
 }

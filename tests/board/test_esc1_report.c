@@ -153,16 +153,6 @@ static void test_full_ring_wait_serves_the_watchdog(void)
     TEST_ASSERT_TRUE(idle_calls >= uart.tx_wait_cycles / 64u);
 }
 
-/* The calibration's offsets, Q8 counts rounded to counts, and its window. */
-static void test_offsets_line(void)
-{
-    const int32_t off[3] = {1542 * 256 + 127, 1542 * 256 + 128, 0};
-    char line[96];
-    TEST_ASSERT_TRUE(esc1_offsets_line(line, sizeof line, off, 1542u, 165u) > 0);
-    TEST_ASSERT_EQUAL_STRING("esc1: current offsets 1542 1543 0 counts, expected 1542 +- 165\r\n",
-                             line);
-}
-
 int main(void)
 {
     UNITY_BEGIN();
@@ -172,6 +162,5 @@ int main(void)
     RUN_TEST(test_boot_option_bytes);
     RUN_TEST(test_boot_read);
     RUN_TEST(test_full_ring_wait_serves_the_watchdog);
-    RUN_TEST(test_offsets_line);
     return UNITY_END();
 }

@@ -223,11 +223,12 @@ int main(void)
          * measured offsets, which the fault alone would not show. */
         const fw_state_id_t st_now = fw_state(&s->fw);
         if (!offsets_told && st_now != FW_STATE_BOOT && st_now != FW_STATE_CALIB) {
-            char line[96];
+            char line[80];
             offsets_told = true;
-            if (esc1_offsets_line(line, sizeof line, s->fw.off_q8, s->fw.adc_zero,
-                                  s->fw.adc_zero_tol) > 0) {
+            if (fw_link_offsets_text(&s->fw, line, sizeof line) > 0) {
+                esc1_uart_puts(&s->uart, "esc1: ");
                 esc1_uart_puts(&s->uart, line);
+                esc1_uart_puts(&s->uart, "\r\n");
             }
         }
         if (g4_cycles() - t_temp >= temp_period) {

@@ -1,7 +1,8 @@
 /*
  * Machine data and board values of the B-G431B-ESC1 image on the command
  * interface (PROTOCOL.md "param list / get / set", the firmware's own
- * parameters). Machine data change only while the drive is not running;
+ * parameters). Machine data change only while the gates are off (not
+ * running, not commissioning, no arm pending: "err 8 state in <state>");
  * every change re-initialises the firmware (state boot -> calibration ->
  * ready, controller tunables back to their defaults) and moves the hardware
  * over-current threshold with m.i_max_a. Nothing is stored across a reset:
@@ -91,9 +92,6 @@ static int esc1_get_field(esc1_t *s, esc1_field_t f, double *v)
 
 static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
 {
-    if (fw_state(&s->fw) == FW_STATE_RUNNING) {
-        return CMD_E_STATE;
-    }
     ctrl_machine_t m = s->machine;
     uint32_t cpr = s->encoder_cpr;
     if (f == M_P || f == M_CPR) {
@@ -113,11 +111,13 @@ static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
 }
 
 /* get/set functions per field (the link's callbacks take only a context). */
-#define ESC1_INDEX_FNS(F, get, set)                                                                \
+#define ESC1_INDEX_GET(F, get)                                                                     \
     static int esc1_get_##F(void *ctx, double *v)                                                  \
     {                                                                                              \
         return get(esc1_of(ctx), F, v);                                                            \
-    }                                                                                              \
+    }
+#define ESC1_INDEX_FNS(F, get, set)                                                                \
+    ESC1_INDEX_GET(F, get)                                                                         \
     static int esc1_set_##F(void *ctx, double v)                                                   \
     {                                                                                              \
         return set(esc1_of(ctx), F, v);                                                            \
@@ -234,20 +234,9 @@ ESC1_INDEX_FNS(T_LOW, esc1_thr_get, esc1_thr_set)
 ESC1_INDEX_FNS(T_HIGH, esc1_thr_get, esc1_thr_set)
 ESC1_INDEX_FNS(T_DB, esc1_thr_get, esc1_thr_set)
 
-static int esc1_get_t_us(void *ctx, double *v)
-{
-    return esc1_thr_get(esc1_of(ctx), T_US, v);
-}
-
-static int esc1_get_t_state(void *ctx, double *v)
-{
-    return esc1_thr_get(esc1_of(ctx), T_STATE, v);
-}
-
-static int esc1_get_t_cause(void *ctx, double *v)
-{
-    return esc1_thr_get(esc1_of(ctx), T_CAUSE, v);
-}
+ESC1_INDEX_GET(T_US, esc1_thr_get)
+ESC1_INDEX_GET(T_STATE, esc1_thr_get)
+ESC1_INDEX_GET(T_CAUSE, esc1_thr_get)
 
 #define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
     {                                                                                              \
@@ -290,11 +279,11 @@ static const fw_link_param_t esc1_params[] = {
     ESC1_RW("throttle.low_us", "us", 800.0, 1499.0, "pulse at zero (calibrated low end)", T_LOW),
     ESC1_RW("throttle.high_us", "us", 1501.0, 2200.0, "pulse at full scale", T_HIGH),
     ESC1_RW("throttle.deadband_us", "us", 0.0, 349.0, "zero up to low_us + this", T_DB),
-    ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_get_t_us),
+    ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_get_T_US),
     ESC1_RO("throttle.state", "-", "0 disarmed (1 s at the low end arms), 1 armed, 2 lost",
-            esc1_get_t_state),
+            esc1_get_T_STATE),
     ESC1_RO("throttle.cause", "-", "last loss: 1 no pulse, 2 invalid pulses (100 ms)",
-            esc1_get_t_cause),
+            esc1_get_T_CAUSE),
 };
 
 void esc1_params_attach(esc1_t *s)
@@ -310,7 +299,9 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
 int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
                          const fw_config_t *cfg)
 {
-    if (fw_state(&s->fw) == FW_STATE_RUNNING) {
+    /* fw_init below starts the firmware anew: not while the gates are on
+     * (running, or an identification driving the legs) or about to go on */
+    if (fw_gates_on_or_pending(&s->fw)) {
         return CMD_E_STATE;
     }
     const double trip = esc1_hw_trip_a(s->hal.board, m);

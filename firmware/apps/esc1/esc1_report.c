@@ -34,12 +34,3 @@ void esc1_report_failure(esc1_uart_t *u, const char *what, const char *why)
     esc1_report_line(u, what, " failed: ", why);
     esc1_report_line(u, "gates off, not armable", "", "");
 }
-
-int esc1_offsets_line(char *line, unsigned size, const int32_t off_q8[3], uint16_t zero,
-                      uint16_t tol)
-{
-    /* 0 <= off_q8 < 2^24: rounded to counts without overflow. */
-    return snprintf(line, size, "esc1: current offsets %ld %ld %ld counts, expected %u +- %u\r\n",
-                    (long)((off_q8[0] + 128) >> 8), (long)((off_q8[1] + 128) >> 8),
-                    (long)((off_q8[2] + 128) >> 8), (unsigned)zero, (unsigned)tol);
-}

@@ -15,11 +15,6 @@
  * or "esc1: clock failed: <why>; running on HSI16". */
 void esc1_report_startup(esc1_uart_t *u, const g4_board_t *b, const g4_boot_info_t *bi,
                          int clock_rc);
-/* The phase-current offsets the calibration measured (Q8 counts, rounded to
- * counts) and the window it judges them by: "esc1: current offsets a b c
- * counts, expected zero +- tol". Returns the length written into line. */
-int esc1_offsets_line(char *line, unsigned size, const int32_t off_q8[3], uint16_t zero,
-                      uint16_t tol);
 /* "esc1: <what> failed: <why>", "esc1: gates off, not armable". */
 void esc1_report_failure(esc1_uart_t *u, const char *what, const char *why);
 
