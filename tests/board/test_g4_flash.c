@@ -550,17 +550,25 @@ static int dev_program(void *ctx, unsigned page, uint32_t off, const uint8_t dw[
     return g4_flash_program(page, off, lo, hi);
 }
 
+static const settings_flash_t store_dev = {NULL,      G4_FLASH_PAGE_SIZE, dev_read,
+                                           dev_erase, dev_program,        g4_flash_strerror};
+
+/* A record with a few fields set. */
+static void record_fill(settings_t *s)
+{
+    memset(s, 0, sizeof *s);
+    s->pole_pairs = 7;
+    s->rs_ohm = 0.25;
+    s->enc_direction = 1;
+    strcpy(s->ctrl, "foc");
+}
+
 static void test_store_through_driver(void)
 {
-    const settings_flash_t f = {NULL,      G4_FLASH_PAGE_SIZE, dev_read,
-                                dev_erase, dev_program,        g4_flash_strerror};
+    const settings_flash_t f = store_dev;
     static uint8_t buf[SETTINGS_REC_MAX];
     settings_t s;
-    memset(&s, 0, sizeof s);
-    s.pole_pairs = 7;
-    s.rs_ohm = 0.25;
-    s.enc_direction = 1;
-    strcpy(s.ctrl, "foc");
+    record_fill(&s);
     uint32_t seq = 0;
     TEST_ASSERT_EQUAL_INT(0, settings_store_save(&f, buf, sizeof buf, &s, &seq));
     TEST_ASSERT_EQUAL_INT(0, settings_store_save(&f, buf, sizeof buf, &s, &seq));
@@ -589,15 +597,10 @@ static void test_store_through_driver(void)
  * at LSI 32 kHz, 34 kHz at most). */
 static void test_save_time_under_watchdog(void)
 {
-    const settings_flash_t f = {NULL,      G4_FLASH_PAGE_SIZE, dev_read,
-                                dev_erase, dev_program,        g4_flash_strerror};
+    const settings_flash_t f = store_dev;
     static uint8_t buf[SETTINGS_REC_MAX];
     settings_t st;
-    memset(&st, 0, sizeof st);
-    st.pole_pairs = 7;
-    st.rs_ohm = 0.25;
-    st.enc_direction = 1;
-    strcpy(st.ctrl, "foc");
+    record_fill(&st);
     fm.erase_cycles = MS_CYCLES(24.47);
     fm.prog_cycles = MS_CYCLES(0.1);
     const unsigned dw = settings_record_size() / 8u;
