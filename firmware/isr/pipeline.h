@@ -372,7 +372,9 @@ const fw_telemetry_t *fw_tm_peek(const fw_t *fw);
 void fw_tm_release(fw_t *fw);
 /*
  * Main-loop side, configuration time (double allowed; pipeline_config.c).
- * Refused with FW_EBUSY while running (the ISR uses the controller state).
+ * Refused with FW_EBUSY while the gates are on or an arm or commissioning
+ * start is pending (fw_gates_on_or_pending: the ISR steps, or is about to
+ * step, the controller state these replace).
  * fw_select_controller: cfg NULL = desc->cfg_default(machine); on failure the
  * previous controller stays selected. fw_tunable_set re-initialises the
  * controller with the changed value (FW_ENOENT unknown name, FW_EINVAL range).

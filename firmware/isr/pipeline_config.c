@@ -460,8 +460,8 @@ int fw_select_controller(fw_t *fw, const ctrl_desc_t *d, const void *cfg)
         fw->machine == NULL) {
         return FW_EINVAL;
     }
-    if (fw->sm.state == FW_STATE_RUNNING) {
-        return FW_EBUSY;
+    if (fw_gates_on_or_pending(fw)) {
+        return FW_EBUSY; /* the interrupt may be stepping the state replaced here */
     }
     if (d->state_size > CTRL_STATE_MAX || d->cfg_size > CTRL_CFG_MAX) {
         return FW_ECTRL;
@@ -484,8 +484,8 @@ int fw_tunable_set(fw_t *fw, const char *name, double value)
     if (fw == NULL || fw->ctrl == NULL || name == NULL) {
         return FW_EINVAL;
     }
-    if (fw->sm.state == FW_STATE_RUNNING) {
-        return FW_EBUSY;
+    if (fw_gates_on_or_pending(fw)) {
+        return FW_EBUSY; /* as fw_select_controller */
     }
     union {
         max_align_t align;

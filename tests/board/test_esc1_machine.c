@@ -244,10 +244,18 @@ static void expect_prefix(const char *want, const char *got)
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(want, got, strlen(want)), got);
 }
 
-/* Machine data change only with the gates off: while an identification or
- * bring-up step runs (state commission), while running, and while an arm
- * waits for the next period, "param set m.*" is refused naming the state,
- * and nothing changes. */
+/* Machine data, the controller, its tunables and the throttle settings
+ * change only with the gates off: while an identification or bring-up step
+ * runs (state commission), while running, and while an arm waits for the next
+ * period, each is refused naming the state, and nothing changes. */
+static void expect_config_refused(const char *want, const char *want_select)
+{
+    TEST_ASSERT_EQUAL_STRING(want, command("param set m.rs_ohm 5"));
+    TEST_ASSERT_EQUAL_STRING(want_select, command("ctrl select " ESC1_CTRL));
+    TEST_ASSERT_EQUAL_STRING(want, command("param set wc 1000"));
+    TEST_ASSERT_EQUAL_STRING(want, command("param set throttle.low_us 1000"));
+}
+
 static void test_link_reconfig_refused_while_gates_on(void)
 {
     calibrate_at(2553u);
@@ -256,7 +264,7 @@ static void test_link_reconfig_refused_while_gates_on(void)
     expect_prefix("ok bringup vbus", command("bringup vbus"));
     esc1_control_isr(&esc);
     TEST_ASSERT_EQUAL_INT(FW_STATE_COMMISSION, fw_state(&esc.fw));
-    TEST_ASSERT_EQUAL_STRING("err 8 state in commission", command("param set m.rs_ohm 5"));
+    expect_config_refused("err 8 state in commission", "err 8 state in commission");
     TEST_ASSERT_EQUAL_STRING("err 8 state in commission", command("param set enc.cpr 2048"));
     TEST_ASSERT_EQUAL_INT(FW_STATE_COMMISSION, fw_state(&esc.fw));
     TEST_ASSERT_TRUE(esc.machine.rs_ohm == rs);
@@ -265,10 +273,11 @@ static void test_link_reconfig_refused_while_gates_on(void)
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
 
     expect_prefix("ok", command("arm"));
-    TEST_ASSERT_EQUAL_STRING("err 8 state arm pending (ready)", command("param set m.rs_ohm 5"));
+    expect_config_refused("err 8 state arm pending (ready)", "err 8 state arm pending (ready)");
     esc1_control_isr(&esc);
     TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
-    TEST_ASSERT_EQUAL_STRING("err 8 state in running", command("param set m.rs_ohm 5"));
+    /* armed: the command layer refuses "ctrl select" itself (PROTOCOL.md) */
+    expect_config_refused("err 8 state in running", "err 8 state disarm first");
     TEST_ASSERT_TRUE(esc.machine.rs_ohm == rs);
     expect_prefix("ok", command("disarm"));
     esc1_control_isr(&esc);

@@ -203,7 +203,7 @@ static int esc1_thr_set(esc1_t *s, esc1_thr_field_t i, double v)
     if (v != floor(v)) {
         return CMD_E_RANGE;
     }
-    if (s->thr.state != THR_WAIT_LOW || fw_state(&s->fw) == FW_STATE_RUNNING) {
+    if (s->thr.state != THR_WAIT_LOW || fw_gates_on_or_pending(&s->fw)) {
         return CMD_E_STATE;
     }
     thr_config_t c = s->thr.cfg;
