@@ -377,8 +377,8 @@ int fw_commission_apply(fw_t *fw)
     if (fw == NULL) {
         return FW_EINVAL;
     }
-    if (fw->sm.state != FW_STATE_READY) {
-        return FW_EBUSY;
+    if (fw->sm.state != FW_STATE_READY || fw_gates_on_or_pending(fw)) {
+        return FW_EBUSY; /* an arm taken next period would gate half-set data */
     }
     cm_si_t r;
     fw_commission_results(fw, &r);

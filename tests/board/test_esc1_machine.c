@@ -350,6 +350,38 @@ static void test_throttle_arms_and_disarms_the_drive(void)
     TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_NO_PULSE, esc.thr.cause);
 }
 
+/* A drive that leaves running without the throttle (here a link "disarm"
+ * with the stick held high) needs the stick at its low end for 1 s again:
+ * neither the held stick nor a later link "arm" lets it drive the torque. */
+static void test_throttle_rearms_only_from_its_low_end(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_STRING("ok throttle.mode 1", command("param set throttle.mode 1"));
+    uint32_t ms = 0u;
+    for (; ms < 1100u; ms++) {
+        pulse_at(ms, 1000u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
+    for (; ms < 1200u; ms++) {
+        pulse_at(ms, 1800u);
+    }
+    TEST_ASSERT_TRUE(esc.fw.torque_ref > 0);
+    expect_prefix("ok", command("disarm"));
+    for (; ms < 2500u; ms++) {
+        pulse_at(ms, 1800u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_UINT8(THR_WAIT_LOW, esc.thr.state);
+    expect_prefix("ok", command("ref torque 0"));
+    expect_prefix("ok", command("arm"));
+    for (; ms < 2600u; ms++) {
+        pulse_at(ms, 1800u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_INT32(0, esc.fw.torque_ref); /* the link's, not the stick's */
+    TEST_ASSERT_EQUAL_UINT8(THR_WAIT_LOW, esc.thr.state);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -359,6 +391,7 @@ int main(void)
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
     RUN_TEST(test_throttle_arms_and_disarms_the_drive);
+    RUN_TEST(test_throttle_rearms_only_from_its_low_end);
     RUN_TEST(test_link_reconfig_refused_while_gates_on);
     RUN_TEST(test_bringup_sense_says_the_offsets);
     return UNITY_END();

@@ -25,9 +25,15 @@ void esc1_throttle_poll(esc1_t *s)
     if (g4_tim2_capture_read(&width, &period)) {
         thr_pulse(t, width, period, s->now_ms); /* 1 MHz ticks: us */
     }
+    fw_t *fw = &s->fw;
+    if (t->state == THR_ARMED && !fw_gates_on_or_pending(fw)) {
+        /* The drive left running without the throttle (a fault, a link
+         * disarm or stop, a refused arm): the stick must come back to its low
+         * end for 1 s before it drives again, as at power-up. */
+        thr_init(t, &t->cfg, s->now_ms);
+    }
     const uint8_t before = t->state;
     const thr_out_t o = thr_update(t, s->now_ms);
-    fw_t *fw = &s->fw;
     const bool speed = t->cfg.mode == THR_MODE_SPEED;
     if (o.event == THR_EV_ARM) {
         fw_set_torque_ref(fw, 0);
