@@ -54,4 +54,27 @@ static inline void g4_pendsv_pend(void)
     g4_wr(G4_SCB + G4_SCB_ICSR, G4_SCB_ICSR_PENDSVSET);
 }
 
+/* Every configurable-priority exception held off (PRIMASK, CPSID i: ARMv7-M
+ * ARM B1.4.3) for a few instructions that one interrupt may also run; the
+ * previous PRIMASK back on unlock. The host register model runs one context:
+ * no-ops there. */
+static inline uint32_t g4_irq_lock(void)
+{
+#if defined(G4_MEM_ARRAYS)
+    return 0u;
+#else
+    uint32_t primask;
+    __asm__ volatile("mrs %0, primask\n\tcpsid i" : "=r"(primask)::"memory");
+    return primask;
+#endif
+}
+static inline void g4_irq_unlock(uint32_t primask)
+{
+#if defined(G4_MEM_ARRAYS)
+    (void)primask;
+#else
+    __asm__ volatile("msr primask, %0" ::"r"(primask) : "memory");
+#endif
+}
+
 #endif /* HAL_STM32G4_G4_CORE_H */

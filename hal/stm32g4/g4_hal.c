@@ -381,20 +381,23 @@ static bool g4_hal_comp_high(const hal_t *h)
 
 bool g4_hal_break_rearm(hal_t *h)
 {
-    if ((g4_rd(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE) != 0u) {
-        return true;
+    /* The main loop and the control interrupt (hal_trip_clear) both call
+     * this: check, clear and enable as one step, or a main loop preempted
+     * after its check could clear a flag the other caller's enable had let
+     * pend, uncounted. */
+    const uint32_t primask = g4_irq_lock();
+    bool enabled = (g4_rd(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE) != 0u;
+    if (!enabled && !g4_hal_comp_high(h)) {
+        /* Masked only by the interrupt, right after it counted a break that
+         * no clear has acknowledged yet: the flags cleared here belong to
+         * that latched break, and so does any short break merged into them
+         * (one flag cannot tell two apart). From the enable on, a break is
+         * taken and counted. */
+        g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF));
+        g4_wr(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE);
     }
-    if (g4_hal_comp_high(h)) {
-        return false;
-    }
-    /* Masked only by the interrupt, right after it counted a break that no
-     * clear has acknowledged yet: the flags cleared here belong to that
-     * latched break, and so does any short break merged into them (one flag
-     * cannot tell two apart). From the enable on, a break is taken and
-     * counted. */
-    g4_wr(G4_TIM1 + G4_TIM_SR, ~(G4_TIM_SR_BIF | G4_TIM_SR_B2IF));
-    g4_wr(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE);
-    return false;
+    g4_irq_unlock(primask);
+    return enabled;
 }
 
 void g4_hal_trip_board(hal_t *h, bool on)

@@ -1,6 +1,8 @@
 /* Register-level STM32G4 model for the HAL tests (g4_model.h). */
 #include "g4_model.h"
 
+#include "g4_flash.h"
+
 #include <stdio.h>
 #include <string.h>
 
@@ -64,7 +66,9 @@ void g4_model_reset(void)
     g4_mem_adc2[G4_ADC_CR / 4u] = G4_ADC_CR_DEEPPWD;
     g4_mem_adc1[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
     g4_mem_adc2[G4_ADC_CFGR / 4u] = G4_ADC_CFGR_JQDIS;
+    g4_mem_flash[G4_FLASH_CR / 4u] = 0xC0000000u; /* LOCK, OPTLOCK */
     g4_mem_tim1[G4_TIM_ARR / 4u] = 0xFFFFu;
+    g4_mem_tim1[G4_TIM_AF1 / 4u] = G4_TIM_AF1_BKINE; /* 0x0000_0001: the BKIN pin enabled */
     g4_mem_tim4[G4_TIM_ARR / 4u] = 0xFFFFu;
     g4_mem_tim2[G4_TIM_ARR / 4u] = 0xFFFFFFFFu;
     g4_mem_iwdg[G4_IWDG_RLR / 4u] = 0xFFFu;
