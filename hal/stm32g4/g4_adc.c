@@ -83,7 +83,10 @@ void g4_adc_injected_start(uintptr_t adc, uint32_t jsqr)
 {
     g4_wr(adc + G4_ADC_JSQR, jsqr);
     g4_wr(adc + G4_ADC_ISR, G4_ADC_ISR_JEOC | G4_ADC_ISR_JEOS | G4_ADC_ISR_JQOVF);
-    g4_wr(adc + G4_ADC_CR, G4_ADC_CR_ADVREGEN | G4_ADC_CR_ADEN | G4_ADC_CR_JADSTART);
+    /* JADSTART alone among the rs bits (written 0: no effect), ADVREGEN kept:
+     * ADEN may be written 1 only with every other ADC_CR bit 0 (RM0440
+     * ADC_CR; ST's LL_ADC_INJ_StartConversion writes the rs bits likewise). */
+    g4_wr(adc + G4_ADC_CR, G4_ADC_CR_ADVREGEN | G4_ADC_CR_JADSTART);
 }
 
 int32_t g4_adc_convert(uintptr_t adc, uint32_t channel, uint32_t timeout_cycles)
@@ -91,9 +94,10 @@ int32_t g4_adc_convert(uintptr_t adc, uint32_t channel, uint32_t timeout_cycles)
     /* SQR1: L = 0 (one conversion), SQ1 = channel. */
     g4_wr(adc + G4_ADC_SQR1, G4_FIELD(channel & 0x1Fu, 6u));
     g4_wr(adc + G4_ADC_ISR, G4_ADC_ISR_EOC | G4_ADC_ISR_EOS | G4_ADC_ISR_OVR);
-    /* ADSTART alone: the other rs bits written 0 have no effect; ADEN and
-     * ADVREGEN stay set (written 1 again: no action for them while set). */
-    g4_wr(adc + G4_ADC_CR, G4_ADC_CR_ADVREGEN | G4_ADC_CR_ADEN | G4_ADC_CR_ADSTART);
+    /* ADSTART alone among the rs bits (written 0: no effect; ADEN stays set
+     * and is not written 1 again while JADSTART is set), ADVREGEN kept: as
+     * ST's LL_ADC_REG_StartConversion. */
+    g4_wr(adc + G4_ADC_CR, G4_ADC_CR_ADVREGEN | G4_ADC_CR_ADSTART);
     if (!g4_wait_bits(adc + G4_ADC_ISR, G4_ADC_ISR_EOC, G4_ADC_ISR_EOC, timeout_cycles)) {
         return -1;
     }

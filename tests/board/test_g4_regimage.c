@@ -318,6 +318,8 @@ static void test_init_order_adcs(void)
         assert_before(cal, en, "calibration before enable (ADCAL needs ADEN = 0)");
         TEST_ASSERT_EQUAL_INT(-1, g4_model_find(cr, G4_ADC_CR_ADCAL | G4_ADC_CR_ADEN,
                                                 G4_ADC_CR_ADCAL | G4_ADC_CR_ADEN, 0));
+        /* ADEN written 1 once: RM0440 allows it only with every other bit 0 */
+        TEST_ASSERT_EQUAL_INT(-1, g4_model_find(cr, G4_ADC_CR_ADEN, G4_ADC_CR_ADEN, en + 1));
         assert_before(en, jsqr, "injected sequence once the ADC is enabled");
         assert_before(jsqr, jstart, "sequence before JADSTART");
         assert_before(jstart, cen, "ADC waiting for the trigger before TIM1 runs");
