@@ -133,6 +133,13 @@ int g4_clock_init(uint32_t hse_hz, uint32_t sysclk_hz)
     g4_mod(G4_RCC + G4_RCC_CFGR, G4_RCC_CFGR_SW_MASK, G4_RCC_CFGR_SW_PLL);
     if (!g4_wait_bits(G4_RCC + G4_RCC_CFGR, G4_RCC_CFGR_SWS_MASK, G4_RCC_CFGR_SWS_PLL,
                       G4_TIMEOUT_SHORT)) {
+        /* Back to HSI16 at AHB / 1, the clock the caller falls back to (its
+         * serial port's baud rate): a switch that completed late would
+         * otherwise leave the core on the PLL at half speed. */
+        g4_mod(G4_RCC + G4_RCC_CFGR, G4_RCC_CFGR_SW_MASK, G4_RCC_CFGR_SW_HSI);
+        (void)g4_wait_bits(G4_RCC + G4_RCC_CFGR, G4_RCC_CFGR_SWS_MASK, G4_RCC_CFGR_SWS_HSI,
+                           G4_TIMEOUT_SHORT);
+        g4_mod(G4_RCC + G4_RCC_CFGR, G4_RCC_CFGR_HPRE_MASK, G4_RCC_CFGR_HPRE_DIV1);
         return G4_E_SWITCH;
     }
     g4_delay_cycles(G4_AHB_STEP_CYCLES);

@@ -152,7 +152,7 @@ uint32_t g4_trace_read(uintptr_t reg)
         }
         *c = v;
     }
-    if (reg == G4_RCC + G4_RCC_CFGR) {
+    if (reg == G4_RCC + G4_RCC_CFGR && !g4_model.sws_stuck) {
         *c = (*c & ~G4_RCC_CFGR_SWS_MASK) | ((*c & G4_RCC_CFGR_SW_MASK) << 2);
     }
     if (reg == G4_DAC3 + G4_DAC_SR) {

@@ -29,6 +29,7 @@ typedef struct {
     bool log_overflow;
     /* behaviour switches */
     bool hse_broken;      /* HSERDY never rises */
+    bool sws_stuck;       /* RCC_CFGR.SWS keeps its value (a switch never completes) */
     bool uev_at_valley;   /* the TIM1 update falls at the counter valley */
     uint16_t adc_regular; /* result of every regular conversion */
     bool comp_high;       /* every comparator output high (and the break input with it) */

@@ -115,6 +115,18 @@ static void test_clock_hse_failure(void)
     TEST_ASSERT_EQUAL_HEX32(0u, reg(G4_RCC + G4_RCC_CR) & G4_RCC_CR_HSEON);
 }
 
+/* The switch to the PLL never completes (SWS stays HSI16): the clock init
+ * gives up (G4_E_SWITCH) and leaves SYSCLK selected as HSI16 at AHB / 1, the
+ * clock its caller sets the serial port's baud rate for. */
+static void test_clock_switch_failure_back_to_hsi(void)
+{
+    g4_model.sws_stuck = true;
+    TEST_ASSERT_EQUAL_INT(G4_E_SWITCH, g4_clock_init(8000000u, 170000000u));
+    const uint32_t cfgr = reg(G4_RCC + G4_RCC_CFGR);
+    TEST_ASSERT_EQUAL_HEX32(G4_RCC_CFGR_SW_HSI, cfgr & G4_RCC_CFGR_SW_MASK);
+    TEST_ASSERT_EQUAL_HEX32(G4_RCC_CFGR_HPRE_DIV1, cfgr & G4_RCC_CFGR_HPRE_MASK);
+}
+
 /* ---- board init: end values ---- */
 
 /* TIM1 (RM0440 chapter 29): CR1 = CMS 01 (0x20) | ARPE (0x80) | CEN = 0xA1;
@@ -718,6 +730,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_clock_register_image_and_order);
     RUN_TEST(test_clock_hse_failure);
+    RUN_TEST(test_clock_switch_failure_back_to_hsi);
     RUN_TEST(test_init_tim1_image);
     RUN_TEST(test_init_analog_image);
     RUN_TEST(test_init_pins_and_info);
