@@ -24,6 +24,7 @@ static void fw_pwm_off(fw_t *fw, fw_telemetry_t *tm)
     hal_gate_enable(fw->hal, false);
     hal_pwm_write(fw->hal, &off);
     fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
+    fw->deadtime.high_prev = 0u;
     tm->legs[0] = tm->legs[1] = tm->legs[2] = 0;
 }
 
@@ -270,24 +271,35 @@ static inline void fw_measure_rest(fw_t *fw, const hal_adc_raw_t *raw, const hal
  * limited to the HAL's largest duty (fw_legs_limit: a board keeps a zero
  * vector around the current sampling instant, hal_info_t.pwm_cmp_max), so
  * that what the estimator is told was applied is what the inverter applies
- * -> telemetry, compare values -> hal_pwm_write (effective at k+1). */
-static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_legs_t *legs)
+ * -> telemetry -> with est (the controller's periods) the dead-time
+ * compensation (deadtime.h), limited again -> compare values ->
+ * hal_pwm_write (effective at k+1). */
+static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_legs_t *legs,
+                              const ctrl_estimate_t *est)
 {
     fw_legs_limit(legs->duty, fw->duty_max);
     tm->legs[0] = legs->duty[0];
     tm->legs[1] = legs->duty[1];
     tm->legs[2] = legs->duty[2];
+    ctrl_legs_t w = *legs;
+    if (fw->deadtime.dd != 0) {
+        if (est != NULL) {
+            ctrl_deadtime_apply(&fw->deadtime, est, &w);
+            fw_legs_limit(w.duty, fw->duty_max);
+        }
+        ctrl_deadtime_written(&fw->deadtime, &w);
+    }
     hal_pwm_t pwm;
     const uint32_t n8 = fw->pwm_n8;
     if (n8 != 0u) {
-        pwm.cmp[0] = fw_pwm_compare8((uint32_t)legs->duty[0], n8);
-        pwm.cmp[1] = fw_pwm_compare8((uint32_t)legs->duty[1], n8);
-        pwm.cmp[2] = fw_pwm_compare8((uint32_t)legs->duty[2], n8);
+        pwm.cmp[0] = fw_pwm_compare8((uint32_t)w.duty[0], n8);
+        pwm.cmp[1] = fw_pwm_compare8((uint32_t)w.duty[1], n8);
+        pwm.cmp[2] = fw_pwm_compare8((uint32_t)w.duty[2], n8);
     } else {
         const uint32_t n = fw->info.period_counts;
-        pwm.cmp[0] = fw_pwm_compare((uint32_t)legs->duty[0], n);
-        pwm.cmp[1] = fw_pwm_compare((uint32_t)legs->duty[1], n);
-        pwm.cmp[2] = fw_pwm_compare((uint32_t)legs->duty[2], n);
+        pwm.cmp[0] = fw_pwm_compare((uint32_t)w.duty[0], n);
+        pwm.cmp[1] = fw_pwm_compare((uint32_t)w.duty[1], n);
+        pwm.cmp[2] = fw_pwm_compare((uint32_t)w.duty[2], n);
     }
     hal_pwm_write(hal, &pwm);
 }
@@ -488,9 +500,9 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
         ctrl_svpwm_duties(sl->out.v_alpha, sl->out.v_beta, m->vdc, &out.legs);
         out.plan.n_seg = 0u;
     }
-    fw_pwm_out(fw, hal, tm, &out.legs);
+    fw_pwm_out(fw, hal, tm, &out.legs, est);
     /* The duties written now act during [k+1, k+2): they are "applied" for
-     * the estimator's prediction at k+1. */
+     * the estimator's prediction at k+1 (the compensation makes them true). */
     fw->applied = out.legs;
     const int has_plan = out.plan.n_seg > 0u;
     tm->vec = has_plan ? out.plan.vec[0] : 0u;
@@ -596,7 +608,8 @@ static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         return fw_control(fw, hal, tm, m);
     }
     ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
-    fw_pwm_out(fw, hal, tm, &legs);
+    /* uncompensated: the steps measure the inverter's error themselves */
+    fw_pwm_out(fw, hal, tm, &legs, NULL);
     fw->applied = legs; /* acting in [k+1, k+2) */
     return false;
 }

@@ -64,6 +64,7 @@
 #include "controller.h"
 #include "ctrl_params.h"
 #include "ctrl_types.h"
+#include "deadtime.h"
 #include "estimator.h"
 #include "field_weak.h"
 #include "flux_observer.h"
@@ -192,6 +193,14 @@ typedef struct {
      * observer's voltage reconstruction removes. */
     bool psi_adapt;
     double dead_time_s, v_fwd_v;
+    /* Dead-time and device-drop compensation of the written duties
+     * (control/modulation/deadtime.h) from dead_time_s and v_fwd_v, the
+     * sign's transition over dead_comp_band_a (0 = the PWM ripple's
+     * default). Default on; with it the estimator and the observers take
+     * the uncompensated duties as the applied voltage, without it the
+     * observers remove the error themselves. */
+    bool dead_comp;
+    double dead_comp_band_a;
     /* No position sensor (control/estimation/sensorless.h): the angle and
      * speed from the stator-flux observer, started on a forced angle
      * (current-frequency ramp to 5 % of rated speed, then the handover); the
@@ -228,10 +237,12 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
-    q24_t psi_pm_cfg;    /* the configured psi_pm, Q24 pu */
-    q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
-    bool psi_engaged;    /* the estimate has left the band: params follow it */
-    ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0) */
+    q24_t psi_pm_cfg;         /* the configured psi_pm, Q24 pu */
+    q24_t psi_band;           /* |estimate - configured| that engages the tracking, Q24 pu */
+    bool psi_engaged;         /* the estimate has left the band: params follow it */
+    ctrl_legs_t applied;      /* leg duties acting in [k, k+1): chosen at k-1 (or 0), before
+                               * the dead-time compensation */
+    ctrl_deadtime_t deadtime; /* compensation of the written duties (dd 0: off) */
     ctrl_refs_t refs;
     q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */
     q24_t trim;           /* mean-torque trim in field weakening, Q24 pu (pipeline.c) */

@@ -45,6 +45,8 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->psi_adapt = true;
     c->dead_time_s = 0.0;
     c->v_fwd_v = 0.0;
+    c->dead_comp = true;
+    c->dead_comp_band_a = 0.0;
     c->sensorless = false;
 }
 
@@ -117,6 +119,22 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     fw->torque_max = 0;
     fw->trim_k = ctrl_q24_from_double(
         1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
+    /* Dead-time and device-drop compensation of the written duties; the
+     * observers then take the duties before it as the applied voltage. */
+    {
+        const double dt = cfg->dead_comp ? cfg->dead_time_s : 0.0;
+        const double vf = cfg->dead_comp ? cfg->v_fwd_v : 0.0;
+        const ctrl_deadtime_config_t dc = {
+            dt, vf,
+            cfg->dead_comp_band_a > 0.0
+                ? cfg->dead_comp_band_a
+                : ctrl_deadtime_band_default(fw->machine, (double)in->pwm_freq_hz)};
+        if (ctrl_deadtime_init(&fw->deadtime, &dc, &fw->params, &fw->bases, &fw->why) != CTRL_OK) {
+            return FW_EINVAL;
+        }
+    }
+    const double obs_dead_time_s = cfg->dead_comp ? 0.0 : cfg->dead_time_s;
+    const double obs_v_fwd_v = cfg->dead_comp ? 0.0 : cfg->v_fwd_v;
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
     /* PM-flux tracking: the encoder-mode observer, its estimate adopted above
@@ -131,8 +149,8 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         oc.psi_speed_min = 0.1;
         /* its PLL does not run (psi_track.h); within the discrete loop's range */
         oc.pll_hz = fmin(oc.pll_hz, 0.4 * (double)in->pwm_freq_hz / (4.0 * CTRL_PI));
-        oc.dead_time_s = cfg->dead_time_s;
-        oc.v_fwd_v = cfg->v_fwd_v;
+        oc.dead_time_s = obs_dead_time_s;
+        oc.v_fwd_v = obs_v_fwd_v;
         if (ctrl_fobs_init(&fw->psi_track.obs, &fw->params, &fw->bases, &oc, &fw->why) != CTRL_OK ||
             ctrl_psi_track_setup(&fw->psi_track, &fw->params) != CTRL_OK) {
             return FW_EINVAL;
@@ -166,8 +184,8 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
             sc.kappa_start = fmin(sc.kappa_start, k_max);
             sc.obs.kappa = fmin(sc.obs.kappa, k_max);
         }
-        sc.obs.dead_time_s = cfg->dead_time_s;
-        sc.obs.v_fwd_v = cfg->v_fwd_v;
+        sc.obs.dead_time_s = obs_dead_time_s;
+        sc.obs.v_fwd_v = obs_v_fwd_v;
         ctrl_angle_sl_t *const sl = ctrl_estimator_angle_state(&fw->est);
         if (ctrl_sl_init(&sl->sl, &fw->params, &fw->bases, &sc, &fw->why) != CTRL_OK) {
             return FW_EINVAL;

@@ -62,6 +62,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->calib_samples = 256u;
     c->stop_on_fault = false;
     c->psi_adapt = true;
+    c->dead_comp = true;
     c->sensorless = false;
     c->speed_bw_hz = m->speed_bw_hz;
     c->speed_pm_deg = m->speed_pm_deg;
@@ -453,6 +454,7 @@ void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_confi
     fc->sensorless = c->sensorless;
     fc->dead_time_s = c->plant_machine.dead_time_s;
     fc->v_fwd_v = c->plant_machine.v_fwd_v;
+    fc->dead_comp = c->dead_comp;
     /* The firmware's encoder configuration (the control machine's [sensors]). */
     double off = fmod(c->ctrl_enc_offset_deg, 360.0);
     off = off < 0.0 ? off + 360.0 : off;

@@ -107,6 +107,7 @@ typedef struct {
     double overspeed_rpm;             /* 0 = 1.05 x rated speed */
     bool stop_on_fault;               /* end the run at a fault (default false) */
     bool psi_adapt;                   /* fw_config_t.psi_adapt (default true) */
+    bool dead_comp;                   /* fw_config_t.dead_comp (default true) */
     bool sensorless;                  /* fw_config_t.sensorless (default false) */
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */

@@ -55,7 +55,8 @@ typedef struct {
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
     cli_span_t window, trace_window;
-    int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, sensorless;
+    int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, no_dead_comp,
+        sensorless;
     sim_set_t sets[SIM_MAX_SETS];
     size_t n_sets;
 } cli_t;
@@ -129,6 +130,9 @@ static const cli_opt_t k_opts[] = {
     {"--no-psi-adapt", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(no_psi_adapt),
      "keep the configured psi_pm: no PM flux from the voltage model above 10 % of rated speed "
      "(docs/algorithms.md)"},
+    {"--no-dead-comp", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(no_dead_comp),
+     "no dead-time and device-drop compensation of the duties (the machine file's [inverter] "
+     "dead_time_ns, v_fwd_v; docs/algorithms.md)"},
     {"--sensorless", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(sensorless),
      "no encoder: angle and speed from the stator-flux observer, forced-angle start-up "
      "(docs/algorithms.md, \"Sensorless start-up\")"},
@@ -762,6 +766,7 @@ int main(int argc, char **argv)
     cfg.n_sets = c.n_sets;
     cfg.stop_on_fault = !c.continue_on_fault;
     cfg.psi_adapt = !c.no_psi_adapt;
+    cfg.dead_comp = c.no_dead_comp == 0;
     cfg.sensorless = c.sensorless != 0;
     if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
         /* The command line's sizing replaces the machine file's speed loop. */
