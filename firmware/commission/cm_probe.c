@@ -6,8 +6,9 @@
  * until the current is measurable, and ODrive's alternating-voltage
  * inductance measurement): along alpha, a volt-second-balanced pulse pattern
  * +V for m periods, -V for 2m, +V for m, then rest; V starts at v_probe0 and
- * doubles (then m doubles once V reaches the standstill voltage limit) until
- * the first segment's current change reaches i_probe. The inductance comes
+ * doubles - grows by half once the response is a quarter of the target - (then
+ * m doubles once V reaches the standstill voltage limit) until the first
+ * segment's current change reaches i_probe. The inductance comes
  * from the middle segment, where the current swings from +dI to -dI:
  *     L = Ts sum(v_alpha applied) / (i_end - i_start)
  * Its symmetric swing through zero makes the dead-time error change sign
@@ -103,7 +104,13 @@ int cm_probe_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
         /* Not enough current yet: raise V, then m; at the largest pattern,
          * no current is an open phase and a little current a large L. */
         bool more = true;
-        if (v <= cm->par.v_lim / 2) {
+        if (d1 >= cm->par.i_probe / 4 && v <= (cm->par.v_lim / 3) * 2) {
+            /* A measurable response: half as much again, not twice (with a
+             * small L and the inverter's error eating the small pulses, the
+             * response grows faster than V: doubling can overshoot the
+             * target by more than the 4x that reads as a short). */
+            x->a[0] = v + v / 2;
+        } else if (v <= cm->par.v_lim / 2) {
             x->a[0] = 2 * v;
         } else if (v < cm->par.v_lim) {
             x->a[0] = cm->par.v_lim;
