@@ -1,6 +1,8 @@
 /* Dead-time and device-drop compensation (deadtime.h). Integer-only. */
 #include "deadtime.h"
 
+#if CTRL_DEAD_COMP
+
 /* s(i) = i / band within [-1, 1], Q24: |i| < 2^31, inv_band < 2^31, the
  * product below 2^62. */
 static inline q24_t dt_sign(const ctrl_deadtime_t *d, q24_t i)
@@ -77,3 +79,4 @@ void ctrl_deadtime_written(ctrl_deadtime_t *d, const ctrl_legs_t *written)
     d->high_prev = (written->duty[0] >= FX_ONE ? 1u : 0u) | (written->duty[1] >= FX_ONE ? 2u : 0u) |
                    (written->duty[2] >= FX_ONE ? 4u : 0u);
 }
+#endif /* CTRL_DEAD_COMP */

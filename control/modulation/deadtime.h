@@ -44,6 +44,12 @@
 #ifndef CONTROL_DEADTIME_H
 #define CONTROL_DEADTIME_H
 
+/* 0: built without it (CMake option PMSM_DEAD_COMP, flash-tight images):
+ * ctrl_deadtime_init leaves it off (dd = 0). */
+#ifndef CTRL_DEAD_COMP
+#define CTRL_DEAD_COMP 1
+#endif
+
 #include <stdint.h>
 
 #include "ctrl_params.h"

@@ -7,6 +7,7 @@
  * the phase sees (2/3) Vdc for d Ts and the current ripple is
  * (2/3) Vdc d (1 - d) / (L fs) peak to peak, largest at d = 1/2:
  * Vdc / (6 L fs); the smaller inductance is the one the ripple follows. */
+#if CTRL_DEAD_COMP
 double ctrl_deadtime_band_default(const ctrl_machine_t *m, double fs_hz)
 {
     const double l = fmin(m->ld_h, m->lq_h);
@@ -37,3 +38,28 @@ int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, cons
     *d = n;
     return CTRL_OK;
 }
+#else
+double ctrl_deadtime_band_default(const ctrl_machine_t *m, double fs_hz)
+{
+    (void)m;
+    (void)fs_hz;
+    return 0.0;
+}
+
+int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, const ctrl_params_t *p,
+                       const ctrl_bases_t *b, ctrl_diag_t *why)
+{
+    (void)c;
+    (void)p;
+    (void)b;
+    (void)why;
+    if (d == NULL) {
+        return CTRL_EINVAL;
+    }
+    d->dd = 0;
+    d->dt = 0;
+    d->inv_band = 0;
+    d->high_prev = 0u;
+    return CTRL_OK;
+}
+#endif /* CTRL_DEAD_COMP */

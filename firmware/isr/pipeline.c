@@ -282,6 +282,7 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
     tm->legs[1] = legs->duty[1];
     tm->legs[2] = legs->duty[2];
     ctrl_legs_t w = *legs;
+#if CTRL_DEAD_COMP
     if (fw->deadtime.dd != 0) {
         if (est != NULL) {
             ctrl_deadtime_apply(&fw->deadtime, est, &w);
@@ -289,6 +290,9 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
         }
         ctrl_deadtime_written(&fw->deadtime, &w);
     }
+#else
+    (void)est;
+#endif
     hal_pwm_t pwm;
     const uint32_t n8 = fw->pwm_n8;
     if (n8 != 0u) {

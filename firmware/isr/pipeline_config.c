@@ -120,10 +120,13 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     fw->trim_k = ctrl_q24_from_double(
         1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
     /* Dead-time and device-drop compensation of the written duties; the
-     * observers then take the duties before it as the applied voltage. */
+     * observers then take the duties before it as the applied voltage
+     * (without it, CTRL_DEAD_COMP 0 or dead_comp off, they remove the
+     * inverter's error themselves). */
+    const bool comp = cfg->dead_comp && CTRL_DEAD_COMP != 0;
     {
-        const double dt = cfg->dead_comp ? cfg->dead_time_s : 0.0;
-        const double vf = cfg->dead_comp ? cfg->v_fwd_v : 0.0;
+        const double dt = comp ? cfg->dead_time_s : 0.0;
+        const double vf = comp ? cfg->v_fwd_v : 0.0;
         const ctrl_deadtime_config_t dc = {
             dt, vf,
             cfg->dead_comp_band_a > 0.0
@@ -133,8 +136,8 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
             return FW_EINVAL;
         }
     }
-    const double obs_dead_time_s = cfg->dead_comp ? 0.0 : cfg->dead_time_s;
-    const double obs_v_fwd_v = cfg->dead_comp ? 0.0 : cfg->v_fwd_v;
+    const double obs_dead_time_s = comp ? 0.0 : cfg->dead_time_s;
+    const double obs_v_fwd_v = comp ? 0.0 : cfg->v_fwd_v;
     /* Before the controller: installing it narrows the estimator's outputs. */
     ctrl_estimator_init(&fw->est, &fw->params);
     /* PM-flux tracking: the encoder-mode observer, its estimate adopted above

@@ -341,6 +341,10 @@ def main():
                     help="running periods per ARMv6-M recording (its flash holds about 1700)")
     ap.add_argument("--no-cm0", dest="cm0", action="store_false",
                     help="no ARMv6-M (QEMU microbit) counts")
+    ap.add_argument("--machine", default=os.path.join(ROOT, "sim_host", "machines",
+                                                       "thesis_spmsm.ini"),
+                    help="machine file of the recordings (default: the thesis SPMSM; one with "
+                         "[inverter] dead_time_ns counts the dead-time compensation too)")
     ap.add_argument("--hotspots", default="m2ptfc,m1",
                     help="controllers with a per-source-line profile (empty: none)")
     args = ap.parse_args()
@@ -348,7 +352,7 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     t_start = time.time()
     tools = build(args)
-    machine = os.path.join(ROOT, "sim_host", "machines", "thesis_spmsm.ini")
+    machine = os.path.abspath(args.machine)
     names = run([tools["rec"], "list"]).split()
     if args.ctrl:
         want = args.ctrl.split(",")
