@@ -85,6 +85,7 @@ typedef enum {
     CM_E_RUN_NO_ACCEL,   /* first run did not accelerate */
     CM_E_RUN_CURRENT,    /* first run drew far more current than the torque needs */
     CM_E_NEEDS,          /* a result this step needs is missing (detail: step) */
+    CM_E_SUPPLY,         /* the supply cannot drive the smallest test current */
     CM_E_COUNT
 } cm_err_t;
 
@@ -122,6 +123,11 @@ typedef struct {
 #define CM_HAVE_MECH 0x040u
 #define CM_HAVE_BALANCE 0x080u
 
+/* Share of a step's voltage limit its test current may take (the rest is
+ * the current regulator's headroom and the inverter's error). */
+#define CM_V_USE 0.8
+#define CM_V_USE_Q24 13421773 /* 0.8 in Q24 */
+
 /* What the steps found (pu of `bases`). */
 typedef struct {
     uint32_t have;          /* CM_HAVE_* */
@@ -155,29 +161,31 @@ typedef struct {
 
 /* Limits and timings in pu and periods (cm_config.c fills them). */
 typedef struct {
-    uint32_t pwm_n;           /* compare value for 100 % duty */
-    uint32_t inv_n_q32;       /* floor(2^32 / pwm_n) */
-    uint32_t enc_cpr;         /* configured counts per revolution */
-    q24_t ts;                 /* control period, pu time */
-    int32_t dangle_to_omega;  /* Q28, ctrl_params_t */
-    q24_t i_lsb;              /* one ADC count of current, pu */
-    q24_t i_rated;            /* rated current, pu */
-    q24_t i_guard;            /* abort above this phase current, pu */
-    q24_t i_hold;             /* alignment / scan / bias current, pu */
-    q24_t i_rs1, i_rs2;       /* the two DC levels, pu */
-    q24_t i_probe;            /* probe target peak, pu */
-    q24_t i_open;             /* below this at the largest probe: open phase, pu */
-    q24_t i_acc;              /* q current to accelerate (flux step), pu */
-    q24_t i_fd;               /* +-d current while coasting (flux step), pu */
-    q24_t i_sense;            /* sense pulse target peak, pu */
-    q24_t i_gate_max;         /* gate test: current above this = load connected, pu */
-    q24_t v_lim;              /* standstill voltage limit per axis, pu */
-    q24_t v_lim_run;          /* spinning voltage limit per axis, pu */
-    q24_t v_probe0;           /* first probe amplitude, pu */
-    q24_t vbus_min, vbus_max; /* test window, pu */
-    q24_t l_min;              /* below: shorted phase, pu */
-    q24_t l_max;              /* above: implausible, pu */
-    q24_t loop_g;             /* current-loop crossover x Ts (rad), Q24 */
+    uint32_t pwm_n;                        /* compare value for 100 % duty */
+    uint32_t inv_n_q32;                    /* floor(2^32 / pwm_n) */
+    uint32_t enc_cpr;                      /* configured counts per revolution */
+    q24_t ts;                              /* control period, pu time */
+    int32_t dangle_to_omega;               /* Q28, ctrl_params_t */
+    q24_t i_lsb;                           /* one ADC count of current, pu */
+    q24_t i_rated;                         /* rated current, pu */
+    q24_t i_guard;                         /* abort above this phase current, pu */
+    q24_t i_min;                           /* smallest test current a step accepts, pu */
+    q24_t i_hold;                          /* alignment / scan / bias current, pu */
+    q24_t i_hold_nom, i_acc_nom, i_fd_nom; /* configured levels before the voltage caps, pu */
+    q24_t i_rs1, i_rs2;                    /* the two DC levels, pu */
+    q24_t i_probe;                         /* probe target peak, pu */
+    q24_t i_open;                          /* below this at the largest probe: open phase, pu */
+    q24_t i_acc;                           /* q current to accelerate (flux step), pu */
+    q24_t i_fd;                            /* +-d current while coasting (flux step), pu */
+    q24_t i_sense;                         /* sense pulse target peak, pu */
+    q24_t i_gate_max;                      /* gate test: current above this = load connected, pu */
+    q24_t v_lim;                           /* standstill voltage limit per axis, pu */
+    q24_t v_lim_run;                       /* spinning voltage limit per axis, pu */
+    q24_t v_probe0;                        /* first probe amplitude, pu */
+    q24_t vbus_min, vbus_max;              /* test window, pu */
+    q24_t l_min;                           /* below: shorted phase, pu */
+    q24_t l_max;                           /* above: implausible, pu */
+    q24_t loop_g;                          /* current-loop crossover x Ts (rad), Q24 */
     int32_t damp_k;           /* rotor damping w_base / Omega, Q16 (i_q = -i slip_pu damp_k) */
     q24_t w_rated;            /* rated electrical speed, pu */
     q24_t w_flux;             /* flux-step target speed, pu */

@@ -3,6 +3,7 @@
  * results back in SI (configuration and reporting time only).
  */
 #include "cm_config.h"
+#include "cm_internal.h"
 #include "ctrl_units.h"
 
 #include <math.h>
@@ -25,6 +26,7 @@ void cm_config_default(cm_config_t *c)
     c->i_sense = 0.2;
     c->i_guard = 1.0;
     c->i_gate_max = 0.05;
+    c->i_min = 0.1;
     c->v_lim = 0.25;
     c->v_lim_run = 0.4;
     c->v_probe0 = 0.02;
@@ -140,6 +142,7 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
         {"i_fd", CM_C(i_fd), S_I, CM_P(i_fd)},
         {"i_sense", CM_C(i_sense), S_I, CM_P(i_sense)},
         {"i_gate_max", CM_C(i_gate_max), S_I, CM_P(i_gate_max)},
+        {"i_min", CM_C(i_min), S_I, CM_P(i_min)},
         {"v_lim", CM_C(v_lim), S_V, CM_P(v_lim)},
         {"v_lim_run", CM_C(v_lim_run), S_V, CM_P(v_lim_run)},
         {"v_probe0", CM_C(v_probe0), S_V, CM_P(v_probe0)},
@@ -207,6 +210,27 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
     q->n_run = cm_periods(c->t_run, fs);
     q->n_gate = cm_periods(c->t_gate, fs);
     q->n_rest = cm_periods(0.005, fs);
+    /* Test currents within the voltage: at most what CM_V_USE of the step's
+     * voltage limit drives through the configured Rs (standstill: alignment,
+     * the rs levels; spinning at w_flux: the flux step's currents, less the
+     * back-EMF, with w L in series; after "rs" again with the measured Rs and
+     * inverter error, cm_refit_currents); the rs levels keep their ratio.
+     * The smallest accepted current: i_min, at least 64 ADC counts (the rs
+     * step's slope from 32 counts of difference). A step whose current falls
+     * below it ends with CM_E_SUPPLY. */
+    q->i_min = fx_max(q->i_min, 64 * q->i_lsb);
+    q->i_hold_nom = q->i_hold;
+    q->i_acc_nom = q->i_acc;
+    q->i_fd_nom = q->i_fd;
+    {
+        const double rs = m->rs_ohm / b->r_ohm;
+        const double cap = CM_V_USE * c->v_lim * vn / rs;
+        if (cap < (double)q->i_rs2 / 16777216.0) { /* the levels keep their ratio */
+            (void)cm_q24(c->i_rs1 * ir * cap / (c->i_rs2 * ir), &q->i_rs1);
+            (void)cm_q24(cap, &q->i_rs2);
+        }
+        cm_refit_currents(cm);
+    }
     /* Open phase: at least 8 ADC counts (noise is a fraction of one). */
     q->i_open = fx_max(q->i_open, 8 * q->i_lsb);
     /* Probe: at least two compare steps of voltage. */
@@ -378,6 +402,7 @@ static const cm_detail_t cm_err_detail[CM_E_COUNT] = {
     [CM_E_RUN_NO_ACCEL] = {{"speed_gain", "periods", "torque"}, {K_RAD_S, K_INT, K_NM}},
     [CM_E_RUN_CURRENT] = {{"current", "needed", "torque"}, {K_A, K_A, K_NM}},
     [CM_E_NEEDS] = {{"step", NULL, NULL}, {K_INT, K_NONE, K_NONE}},
+    [CM_E_SUPPLY] = {{"current_min", "v_needed", "v_lim"}, {K_A, K_V, K_V}},
 };
 
 static const char *const cm_units[] = {"",      "A", "V", "H",   "Ohm", "Wb",

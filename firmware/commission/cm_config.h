@@ -13,7 +13,10 @@
 #include "ctrl_params.h"
 #include "hal.h"
 
-/* Test levels as fractions of the machine's ratings, times in seconds. */
+/* Test levels as fractions of the machine's ratings, times in seconds.
+ * Each step's current is the smaller of its level here and what the voltage
+ * it may use drives through the configured machine (cm_configure; the steps
+ * after "rs" with the measured Rs and inverter error), down to i_min. */
 typedef struct {
     double i_hold;             /* alignment, scan and bias current / rated (0.3) */
     double i_rs1, i_rs2;       /* the two DC levels / rated (0.25, 0.5) */
@@ -24,6 +27,7 @@ typedef struct {
     double i_sense;            /* sense pulse target / rated (0.2) */
     double i_guard;            /* abort above this phase current / rated (1.0) */
     double i_gate_max;         /* gate test: current meaning "load connected" / rated (0.05) */
+    double i_min;              /* smallest test current / rated (0.1); at least 64 ADC counts */
     double v_lim;              /* standstill voltage limit per axis / Vdc (0.25) */
     double v_lim_run;          /* spinning voltage limit per axis / Vdc (0.4) */
     double v_probe0;           /* first probe amplitude / Vdc (0.02) */

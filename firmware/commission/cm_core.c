@@ -62,7 +62,7 @@ static const char *const cm_err_names[CM_E_COUNT] = {
     "voltage_limit",  "current_limit", "rs_range",    "l_range",       "enc_no_motion",
     "enc_cpr",        "enc_unsteady",  "speed_low",   "overspeed",     "flux_range",
     "sense_polarity", "sense_gain",    "sense_sum",   "gates_current", "gates_vbus",
-    "run_direction",  "run_no_accel",  "run_current", "needs",
+    "run_direction",  "run_no_accel",  "run_current", "needs",         "supply",
 };
 
 const char *cm_err_name(uint8_t err)
@@ -427,6 +427,47 @@ q24_t cm_pi_step(cm_pi_t *c, q24_t err)
     }
     c->integ = in;
     return u;
+}
+
+q24_t cm_rs_best(const cm_t *cm)
+{
+    return (cm->res.have & CM_HAVE_RS) != 0u ? cm->res.rs : cm->par.rs_cfg;
+}
+
+q24_t cm_i_within(const cm_t *cm, q24_t v, q24_t e, q24_t r)
+{
+    const q24_t v_inv = (cm->res.have & CM_HAVE_RS) != 0u ? fx_abs(cm->res.v_inv) : 0;
+    const q24_t num = fx_sub(fx_sub(fx_mul(CM_V_USE_Q24, v), v_inv), e);
+    q24_t i = 0;
+    if (num <= 0 || r <= 0 || !cm_ratio(num, r, &i)) {
+        return num > 0 && r > 0 ? FX_MAX : 0;
+    }
+    return i;
+}
+
+int cm_fail_supply(cm_t *cm, q24_t r, q24_t v_lim)
+{
+    const q24_t v_inv = (cm->res.have & CM_HAVE_RS) != 0u ? fx_abs(cm->res.v_inv) : 0;
+    const q24_t need = fx_add(fx_mul(cm->par.i_min, r), v_inv);
+    return cm_fail(cm, CM_E_SUPPLY, cm->par.i_min, need, v_lim);
+}
+
+void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_run)
+{
+    q->i_hold = fx_min(q->i_hold_nom, cap_st);
+    q->i_acc = fx_min(q->i_acc_nom, cap_run);
+    q->i_fd = fx_min(q->i_fd_nom, cap_run);
+}
+
+void cm_refit_currents(cm_t *cm)
+{
+    const cm_par_t *p = &cm->par;
+    const q24_t r = cm_rs_best(cm);
+    /* spinning at w_flux: back-EMF w psi (configured), w L in series */
+    const q24_t e = fx_mul(p->w_flux, p->psi_cfg);
+    const q24_t r_run = fx_add(r, fx_mul(p->w_flux, fx_max(p->l_cfg_d, p->l_cfg_q)));
+    cm_fit_currents(&cm->par, cm_i_within(cm, p->v_lim, 0, r),
+                    cm_i_within(cm, p->v_lim_run, e, r_run));
 }
 
 q24_t cm_l_best(const cm_t *cm)

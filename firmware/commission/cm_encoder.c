@@ -126,6 +126,9 @@ int cm_encoder_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
 
     switch (cm->phase) {
     case P_RAMP:
+        if (p->i_hold < p->i_min) {
+            return cm_fail_supply(cm, cm_rs_best(cm), p->v_lim);
+        }
         /* A slow ramp: the rotor, wherever it rests, is pulled in gently (the
          * swing it keeps is smaller the slower the field grows). */
         cm_hold(cm, x->ang[0], 0,

@@ -98,6 +98,9 @@ int cm_flux_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     cm->progress = (uint16_t)(cm->phase * 166u);
     switch (cm->phase) {
     case P_ENTER:
+        if (p->i_acc < p->i_min) {
+            return cm_fail_supply(cm, cm_rs_best(cm), p->v_lim_run);
+        }
         x->a[1] = cm->hold_valid ? cm->hold_i : 0;
         cm_rotor_regulate(cm, x->a[1], 0, out);
         if (cm->t >= p->n_ramp) {

@@ -69,6 +69,20 @@ void cm_pi_tune_dq(cm_t *cm, q24_t ld, q24_t lq, q24_t lim);
 /* The best inductance known: Ld/Lq mean, else the probe's, else configured. */
 q24_t cm_l_best(const cm_t *cm);
 
+/* Test currents within the voltage (cm_config.c, "rs"): i_hold at most
+ * cap_st (standstill), i_acc and i_fd at most cap_run (at w_flux), each
+ * from its configured level. */
+void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_run);
+/* The same with the measured Rs and inverter error (after "rs"). */
+void cm_refit_currents(cm_t *cm);
+/* Largest current (pu) a share CM_V_USE of v drives through r after the
+ * inverter's error |v_inv| (measured, else 0) and e (a back-EMF); 0 if none. */
+q24_t cm_i_within(const cm_t *cm, q24_t v, q24_t e, q24_t r);
+/* End the step with CM_E_SUPPLY: i_min needs more than v_lim through r. */
+int cm_fail_supply(cm_t *cm, q24_t r, q24_t v_lim);
+/* The resistance known best: measured, else configured. */
+q24_t cm_rs_best(const cm_t *cm);
+
 /* f_dq = f_ab e^{-j ang} and back. */
 void cm_to_frame(q24_t al, q24_t be, fx_angle_t ang, q24_t *d, q24_t *q);
 void cm_from_frame(q24_t d, q24_t q, fx_angle_t ang, q24_t *al, q24_t *be);

@@ -29,8 +29,8 @@
 
 enum { P_ALIGN, P_D, P_Q };
 
-/* Scratch: a[0] align start current, a[1] V_h, k[0] settled periods,
- * s[0]/s[1] sums (v, di) of the running axis, a[2] = Ld. */
+/* Scratch: a[0] align start current, a[1] V_h, a[3] bias, k[0] settled
+ * periods, s[0]/s[1] sums (v, di) of the running axis, a[2] = Ld. */
 
 void cm_ldq_begin(cm_t *cm)
 {
@@ -47,9 +47,20 @@ void cm_ldq_begin(cm_t *cm)
     cm->hold_angle = (fx_angle_t)(k * third + (k == 2u ? 1u : 0u));
     const q24_t l = cm_l_best(cm);
     cm_pi_tune_dq(cm, l, l, cm->par.v_lim);
-    /* V_h = dI L / Ts with dI = i_hold / 8, at most 3/4 of the voltage limit. */
+    /* The bias within the voltage with its injection: Rs i + V_h, V_h =
+     * (i / 8) L / Ts, within 80 % of v_lim (cm_i_within, through
+     * Rs + L / (8 Ts)); at least 32 ADC counts (a zig-zag of 4 counts,
+     * demodulated over n_hf periods), else supply. */
+    q24_t l8 = 0;
+    if (!cm_muldiv(l, FX_ONE, 8 * (int64_t)cm->par.ts, &l8)) {
+        l8 = FX_MAX / 2;
+    }
+    const q24_t r = fx_add(cm_rs_best(cm), fx_min(l8, FX_MAX / 2));
+    const q24_t bias = fx_min(cm->par.i_hold, cm_i_within(cm, cm->par.v_lim, 0, r));
+    cm->x.a[3] = bias;
+    /* V_h = dI L / Ts with dI = bias / 8, at most 3/4 of the voltage limit. */
     q24_t vh = 0;
-    if (!cm_muldiv(cm->par.i_hold / 8, l, cm->par.ts, &vh)) {
+    if (!cm_muldiv(bias / 8, l, cm->par.ts, &vh)) {
         vh = FX_MAX;
     }
     cm->x.a[1] = fx_min(vh, cm->par.v_lim - cm->par.v_lim / 4);
@@ -80,7 +91,11 @@ int cm_ldq_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     const fx_angle_t h = cm->hold_angle;
     if (cm->phase == P_ALIGN) {
         cm->progress = 0u;
-        const q24_t i = fx_add(x->a[0], cm_ramp(fx_sub(p->i_hold, x->a[0]), cm->t, p->n_ramp));
+        if (x->a[3] < 32 * p->i_lsb) {
+            /* the zig-zag (bias / 8) below 4 ADC counts */
+            return cm_fail_supply(cm, cm_rs_best(cm), p->v_lim);
+        }
+        const q24_t i = fx_add(x->a[0], cm_ramp(fx_sub(x->a[3], x->a[0]), cm->t, p->n_ramp));
         cm_hold(cm, h, 0, i, 0, 0, out);
         x->k[0] = cm_slip(cm) < p->w_settle ? x->k[0] + 1 : 0;
         if (cm->t >= p->n_ramp && x->k[0] >= (int32_t)(p->n_settle / 2u)) {
@@ -108,7 +123,7 @@ int cm_ldq_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     if (last) {
         ed = eq = 0;
     }
-    cm_hold(cm, h, 0, p->i_hold, ed, eq, out);
+    cm_hold(cm, h, 0, x->a[3], ed, eq, out);
     if (!last) {
         return CM_RUN;
     }

@@ -21,9 +21,12 @@
  * the differences of the phase resistances; unbalance = (max - min) / Rs
  * above unbalance_max: unbalanced (one phase's resistance off by about
  * twice that fraction).
+ * Test levels: i_rs1, i_rs2 within the voltage (cm_configure: what 80 % of
+ * v_lim drives through the configured Rs, the ratio kept); below i_min:
+ * supply (the motor cannot be identified on this supply).
  * Verdicts: a slope <= 0: rs_range; the regulator at its voltage limit in a
- * window: voltage_limit (resistance too high for the test current, or an
- * open phase); the rotor not settling: enc_unsteady.
+ * window: voltage_limit (resistance above the configured one, or an open
+ * phase); the rotor not settling: enc_unsteady.
  * The rotor ends aligned to phase c's axis (hold_angle).
  */
 #include "cm_internal.h"
@@ -91,6 +94,9 @@ int cm_rs_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     cm->progress = (uint16_t)((uint32_t)x->k[1] * 333u + cm->phase * 66u);
     switch (cm->phase) {
     case P_ALIGN: {
+        if (p->i_rs2 < p->i_min) {
+            return cm_fail_supply(cm, p->rs_cfg, p->v_lim);
+        }
         const q24_t i = fx_add(x->a[0], cm_ramp(fx_sub(p->i_rs1, x->a[0]), cm->t, p->n_ramp));
         cm_hold(cm, h, 0, i, 0, 0, out);
         x->k[0] = cm_slip(cm) < p->w_settle ? x->k[0] + 1 : 0;
@@ -161,5 +167,9 @@ int cm_rs_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     if (u > p->unbalance_max) {
         return cm_fail(cm, CM_E_UNBALANCED, u, p->unbalance_max, 0);
     }
+    /* the later steps' currents from the measured Rs and inverter error
+     * (the step table marks Rs as had on CM_DONE; the same now) */
+    cm->res.have |= CM_HAVE_RS;
+    cm_refit_currents(cm);
     return CM_DONE;
 }
