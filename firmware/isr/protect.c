@@ -41,6 +41,7 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_last_delta = 0;
     p->enc_still = 0u;
     p->enc_move_delta = 0;
+    p->enc_move_dist = 0u;
     p->enc_move_still = 0u;
     p->enc_primed = 0u;
     p->wdg_count = 0u;
@@ -62,6 +63,7 @@ uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
         p->enc_last = count;
         p->enc_primed = p->cfg.enc_jump_max >= 0 ? 2u : 3u;
         p->enc_move_delta = 0;
+        p->enc_move_dist = 0u;
         p->enc_move_still = 0u;
         return FW_FAULT_NONE;
     }

@@ -14,7 +14,10 @@
  *    on one sample (the link capacitor makes a one-sample excursion of 25 %
  *    implausible as noise: ADC noise is a few counts).
  *  - encoder stuck: the counter has not moved for enc_stuck_periods periods
- *    although the last measured rate was >= enc_rate_min. enc_rate_min is the
+ *    although the rate its last move proves was >= enc_rate_min. That rate is
+ *    a lower bound of the rotor's speed, not the move over the time it took: a
+ *    rotor resting on a count edge toggles the count back and forth while it
+ *    hardly moves (fw_protect_encoder_check). enc_rate_min is the
  *    rate from which the rotor, decelerated by the largest torque the drive and
  *    load can produce (a_max = (T(i_max) + T_rated) / J), still travels at
  *    least two counts before it can stop: r^2 / (2 a_max) >= 2 counts. Below it
@@ -107,9 +110,11 @@ typedef struct {
     uint32_t enc_last;      /* counter at the previous period */
     int32_t enc_last_delta; /* counts moved in the previous period */
     uint32_t enc_still;     /* periods since the counter last moved */
-    /* Rate at the last move, kept as the move and the periods it took - 1:
-     * rate (Q16.16) = floor(|move_delta| 2^16 / (move_still + 1)). */
+    /* The last move: its counts (the sign is its direction), the counts the
+     * rotor surely travelled and the periods without a move before it. Rate
+     * (Q16.16) = floor(move_dist 2^16 / (move_still + 2)). */
     int32_t enc_move_delta;
+    uint32_t enc_move_dist;
     uint32_t enc_move_still;
     /* 0: nothing, 1: enc_last valid, 2: enc_last_delta valid (fast form),
      * 3: the same with a negative enc_jump_max (every move is a jump). */
@@ -203,18 +208,17 @@ static inline bool fw_protect_sub_overflow(int32_t a, int32_t b, int32_t *d)
 #endif
 }
 
-/* Whether the rate at the last move, floor(mag 2^16 / (still + 1)) (the
+/* Whether the rate at the last move, floor(dist 2^16 / (still + 2)) (the
  * Q16.16 counts per period), is >= rate_min: for integers, floor(a / b) >= r
- * <=> a >= r b (b >= 1), so no division; a <= 2^47, r b < 2^63. */
+ * <=> a >= r b (b >= 1), so no division; a <= 2^48, r b < 2^63. */
 static inline bool fw_protect_rate_armed(const fw_protect_t *p)
 {
     const int32_t r = p->cfg.enc_rate_min_q16;
     if (r <= 0) {
         return true;
     }
-    const int32_t d = p->enc_move_delta;
-    const uint64_t a = (uint64_t)(d < 0 ? 0u - (uint32_t)d : (uint32_t)d) << 16;
-    return a >= (uint64_t)(uint32_t)r * ((uint64_t)p->enc_move_still + 1u);
+    const uint64_t a = (uint64_t)p->enc_move_dist << 16;
+    return a >= (uint64_t)(uint32_t)r * ((uint64_t)p->enc_move_still + 2u);
 }
 
 /*
@@ -234,6 +238,17 @@ static inline uint32_t fw_protect_encoder_check(fw_protect_t *p, uint32_t count)
         if (p->enc_primed != 2u || ovf || (uint32_t)dd + p->j_off > p->j_span) {
             fault = FW_FAULT_ENC_JUMP;
         }
+        /* What the move proves (counts seen in its direction). The previous
+         * move took the count to c; at the sample before it the rotor was
+         * short of edge c. If this move goes the same way, the rotor is past
+         * edge c + |delta| now: more than |delta| counts in the still + 2
+         * periods since. Reversed (or no move before), the first edge it
+         * passed may be the one it passed the other way just before: more
+         * than |delta| - 1 counts in the last period, so over the still + 2
+         * too. A count toggling at one edge (a rotor resting on it) proves 0. */
+        const uint32_t mag = delta < 0 ? 0u - (uint32_t)delta : (uint32_t)delta;
+        const bool same = delta > 0 ? p->enc_move_delta > 0 : p->enc_move_delta < 0;
+        p->enc_move_dist = same ? mag : mag - 1u;
         p->enc_move_delta = delta;
         p->enc_move_still = p->enc_still;
         p->enc_still = 0u;

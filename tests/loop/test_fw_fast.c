@@ -229,6 +229,7 @@ typedef struct {
     int32_t last_delta;
     uint32_t still;
     int32_t rate_q16;
+    int32_t move; /* the last move's counts (0: none since priming) */
     uint8_t primed;
 } ref_enc_t;
 
@@ -254,8 +255,12 @@ static uint32_t ref_encoder(ref_enc_t *p, const fw_protect_cfg_t *cfg, uint32_t 
         if (dd > cfg->enc_jump_max || dd < -(int64_t)cfg->enc_jump_max) {
             fault = FW_FAULT_ENC_JUMP;
         }
+        /* The counts surely travelled: |delta| after a move the same way,
+         * |delta| - 1 after a reversal or none; over still + 2 periods. */
         const int64_t mag = delta < 0 ? -(int64_t)delta : (int64_t)delta;
-        const int64_t rate = mag * 65536 / (int64_t)(p->still + 1u);
+        const bool same = (delta > 0 && p->move > 0) || (delta < 0 && p->move < 0);
+        const int64_t rate = (same ? mag : mag - 1) * 65536 / ((int64_t)p->still + 2);
+        p->move = delta;
         p->rate_q16 = rate > INT32_MAX ? INT32_MAX : (int32_t)rate;
         p->still = 0u;
     } else {

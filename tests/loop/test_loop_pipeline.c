@@ -236,6 +236,29 @@ static void test_protect_checks(void)
             c++;
         }
     }
+    /* A rotor resting on a count edge: the count toggles +1, -1 a period
+     * apart (as fast as 1 count/period), then rests. The toggles prove no
+     * speed: no fault however long it rests. */
+    fw_protect_reset(&p);
+    for (int k = 0; k < 6; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c + (uint32_t)(k & 1)));
+    }
+    for (int k = 0; k < 100; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+    }
+    /* A reversal by 3 counts in one period (after +1) proves more than 2
+     * counts: rate 2 / 2 >= 1 count/period, armed; 8 periods without motion
+     * are stuck. */
+    fw_protect_reset(&p);
+    (void)fw_protect_encoder(&p, c);
+    (void)fw_protect_encoder(&p, c + 1u);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c + 2u));
+    c -= 1u;
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+    for (int k = 1; k < 8; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_encoder(&p, c));
+    }
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_ENC_STUCK, fw_protect_encoder(&p, c));
     TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_deadline(&p, 1000u));
     TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DEADLINE, fw_protect_deadline(&p, 1001u));
     for (int k = 0; k < 10; k++) {
