@@ -69,8 +69,10 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
         1.5 * (double)m->pole_pairs * (m->psi_pm_wb + dl * m->current_max_a) * m->current_max_a;
     const double a_mech = (t_imax + m->torque_rated_nm) / m->inertia_kgm2; /* rad/s^2 */
     const double a_cpp2 = a_mech * (double)enc_counts_per_rev / CTRL_TWO_PI / (fs * fs);
-    /* Quantisation moves each difference by +-1 count, the second difference by +-2. */
-    cfg->enc_jump_max = (int32_t)(4.0 + ceil(a_cpp2));
+    /* Quantisation moves each difference by +-1 count, the second difference
+     * by +-2. A limit beyond int32_t (a tiny inertia) admits every second
+     * difference the check can form, as the physics does: saturated there. */
+    cfg->enc_jump_max = (int32_t)fmin(4.0 + ceil(a_cpp2), (double)INT32_MAX);
     const double rate_min = sqrt(4.0 * a_cpp2); /* r^2 / (2 a) >= 2 counts */
     cfg->enc_rate_min_q16 = (int32_t)fmin(ceil(rate_min * 65536.0), (double)INT32_MAX);
     const double n_stuck = fmax(FW_ENC_STUCK_MIN_PERIODS, ceil(2.0 / sqrt(a_cpp2)));

@@ -250,6 +250,27 @@ static void test_max_speed_refusal_is_named(void)
     TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
 }
 
+/* A machine with an inertia of 1e-15 kg*m^2 (link fuzzer: param set m.j_kgm2
+ * 1e-15): the encoder's plausible second difference, a_max Ts^2, is beyond
+ * int32_t; the jump limit saturates instead of converting an out-of-range
+ * double (undefined), and every other limit stays as the physics gives it. */
+static void test_tiny_inertia_encoder_limits(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    ctrl_machine_t m = run.fw.machine_own;
+    m.inertia_kgm2 = 1e-15;
+    fw_config_t fc = run.fw.cfg;
+    fc.machine = &m;
+    fc.ctrl = run.fw.ctrl;
+    fc.ctrl_cfg = NULL;
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_init(&run.fw, &run.hal, &fc));
+    TEST_ASSERT_EQUAL_INT32(INT32_MAX, run.fw.prot.cfg.enc_jump_max);
+    TEST_ASSERT_EQUAL_INT32(INT32_MAX, run.fw.prot.cfg.enc_rate_min_q16);
+    TEST_ASSERT_EQUAL_UINT32(8u, run.fw.prot.cfg.enc_stuck_periods);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -258,5 +279,6 @@ int main(void)
     RUN_TEST(test_telemetry_frames);
     RUN_TEST(test_fault_over_link);
     RUN_TEST(test_max_speed_refusal_is_named);
+    RUN_TEST(test_tiny_inertia_encoder_limits);
     return UNITY_END();
 }
