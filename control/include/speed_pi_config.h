@@ -25,5 +25,10 @@ typedef enum {
  * CTRL_EINVAL (NULL, non-finite, negative) or CTRL_ERANGE (does not fit). */
 int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs, double kp,
                          double ki, ctrl_speed_unit_t unit, double out_limit_nm, uint32_t loop_hz);
+/* The same; a CTRL_ERANGE names the per-unit quantity, its value and the
+ * range in *why (may be NULL). */
+int ctrl_speed_pi_config_diag(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs,
+                              double kp, double ki, ctrl_speed_unit_t unit, double out_limit_nm,
+                              uint32_t loop_hz, ctrl_diag_t *why);
 
 #endif /* CONTROL_SPEED_PI_CONFIG_H */

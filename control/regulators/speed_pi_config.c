@@ -46,8 +46,27 @@ static int gain_q(double g, unsigned max_shift, int32_t *mant, uint8_t *shift)
     return CTRL_OK;
 }
 
+/* Names a per-unit quantity the fixed point cannot take (why may be NULL). */
+static int speed_pi_refuse(ctrl_diag_t *why, const char *quantity, double value, double min,
+                           double max, const char *depends)
+{
+    if (why != NULL) {
+        const ctrl_diag_t d = {CTRL_ERANGE, quantity, "pu", value, min, max, depends};
+        *why = d;
+    }
+    return CTRL_ERANGE;
+}
+
 int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs, double kp,
                          double ki, ctrl_speed_unit_t unit, double out_limit_nm, uint32_t loop_hz)
+{
+    return ctrl_speed_pi_config_diag(pi, bases, pole_pairs, kp, ki, unit, out_limit_nm, loop_hz,
+                                     NULL);
+}
+
+int ctrl_speed_pi_config_diag(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pole_pairs,
+                              double kp, double ki, ctrl_speed_unit_t unit, double out_limit_nm,
+                              uint32_t loop_hz, ctrl_diag_t *why)
 {
     if (pi == NULL || bases == NULL || pole_pairs < 1 || loop_hz == 0u || !isfinite(kp) ||
         !isfinite(ki) || kp < 0.0 || ki < 0.0 || !isfinite(out_limit_nm) || out_limit_nm <= 0.0 ||
@@ -73,7 +92,8 @@ int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pol
     const double ki_ts_pu = ki * scale / (double)loop_hz;
     const double out_pu = out_limit_nm / bases->torque_nm;
     if (!(out_pu * 16777216.0 < 2147483647.0) || out_pu * 16777216.0 < 1.0) {
-        return CTRL_ERANGE;
+        return speed_pi_refuse(why, "speed-loop torque limit", out_pu, 0x1p-24, 128.0,
+                               "speed_out_max_nm, torque base");
     }
     const q24_t out_max = (q24_t)llround(out_pu * 16777216.0);
     /* integ <= out_max * 2^ki_shift must stay below 2^61 (no overflow of
@@ -87,9 +107,15 @@ int ctrl_speed_pi_config(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, int pol
     int32_t ki_m;
     uint8_t kp_s;
     uint8_t ki_s;
-    if (gain_q(kp_pu, 62u, &kp_m, &kp_s) != CTRL_OK ||
-        gain_q(ki_ts_pu, ki_max_shift, &ki_m, &ki_s) != CTRL_OK) {
-        return CTRL_ERANGE;
+    /* A gain rounds to 0 below 2^-(shift + 1) (gain_q); 2^30 pu and above is absurd. */
+    if (gain_q(kp_pu, 62u, &kp_m, &kp_s) != CTRL_OK) {
+        return speed_pi_refuse(why, "speed PI proportional gain", kp_pu, 0x1p-63, 0x1p30,
+                               "speed_kp, or inertia_kgm2 and the speed-loop bandwidth");
+    }
+    if (gain_q(ki_ts_pu, ki_max_shift, &ki_m, &ki_s) != CTRL_OK) {
+        return speed_pi_refuse(why, "speed PI integral gain x loop period", ki_ts_pu,
+                               ldexp(1.0, -(int)ki_max_shift - 1), 0x1p30,
+                               "speed_ki, or inertia_kgm2 and the speed-loop bandwidth");
     }
     pi->kp = kp_m;
     pi->kp_shift = kp_s;

@@ -293,8 +293,9 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     si->kp_nm_s_rad = kp * per_rad;
     si->ki_nm_rad = ki * per_rad;
     if (!(cfg->speed_out_max_nm > 0.0) ||
-        ctrl_speed_pi_config(&fw->speed_pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
-                             cfg->speed_out_max_nm, in->pwm_freq_hz / fw->mid_div) != CTRL_OK) {
+        ctrl_speed_pi_config_diag(&fw->speed_pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
+                                  cfg->speed_out_max_nm, in->pwm_freq_hz / fw->mid_div,
+                                  &fw->why) != CTRL_OK) {
         return FW_ERANGE;
     }
 
