@@ -733,7 +733,9 @@ def hdtc_pred_text(rpm, fs=10000.0):
             "prediction (hdtc, on the sampled errors, errs more). Checked by runs that change "
             "it (docs/algorithms.md): a regulator kept out of −1 leaves the one-vector offset "
             "(ΔTa − |ΔT0|)/2 of FST's note (T_sse −0.29 N·m at 750, +0.31 at 2250 r/min), and "
-            "no band removes it (--set h_T=0.3: +0.13 / +0.44; h_T=1: +0.29 / +0.72 N·m)")
+            "no band removes it (--set h_T=0.3: +0.13 / +0.44; h_T=1: +0.29 / +0.72 N·m); "
+            "FST's mean-error integrator, which hdtc_pred lacks, removes it (an experiment: "
+            "T_sse 0.000 N·m at both speeds)")
 
 
 def notes(S, names):
