@@ -5,6 +5,7 @@
 #include "speed_loop.h"
 
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -93,6 +94,9 @@ static void sim_limit_add(sim_run_t *r)
     if ((tm->fw_limit & 4u) != 0u) {
         r->lim_clipped_n++;
         r->lim_last = tm->fw_limit;
+    }
+    if ((tm->fw_limit & 8u) != 0u) {
+        r->lim_weak_n++;
     }
     r->tref_sum_nm += sim_torque_ref_nm(r);
     r->lim_n++;
@@ -930,6 +934,73 @@ int sim_run_all(sim_run_t *r, char *err, size_t errlen)
     return 0;
 }
 
+/* The tolerance of torque following: max(5 % of the reference, 2 % of the
+ * rated torque), the floor for small references whose mean the ripple
+ * resolves no better. */
+static double sim_torque_tolerance_nm(double tref_nm, double rated_nm)
+{
+    return fmax(0.05 * fabs(tref_nm), 0.02 * fabs(rated_nm));
+}
+
+/* Appends "; " (unless first) and the formatted text to buf of size cap. */
+static void sim_why_add(char *buf, size_t cap, const char *fmt, ...)
+{
+    const size_t n = strlen(buf);
+    if (n + 2u >= cap) {
+        return;
+    }
+    size_t k = n;
+    if (n > 0u) {
+        buf[k++] = ';';
+        buf[k++] = ' ';
+        buf[k] = '\0';
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    (void)vsnprintf(buf + k, cap - k, fmt, ap);
+    va_end(ap);
+}
+
+/* Torque mode, no fault: the plant's mean torque over the window against the
+ * mean reference applied (after the drive's limits). The simulator knows the
+ * true torque, the drive only its estimate: a miss is reported with the
+ * mechanisms known to cause one, so that no wrong torque goes without a
+ * word. */
+static void sim_torque_follow_check(sim_run_t *r, const metrics_result_t *mp)
+{
+    const sim_run_cfg_t *c = &r->cfg;
+    if (c->speed_mode || r->lim_n == 0u || !isnan(r->fault_time_s) ||
+        !isfinite(mp->torque_mean_nm)) {
+        return;
+    }
+    const double applied = r->tref_sum_nm / (double)r->lim_n;
+    const double miss = mp->torque_mean_nm - applied;
+    if (fabs(miss) <= sim_torque_tolerance_nm(applied, c->plant_machine.torque_rated_nm)) {
+        return;
+    }
+    char why[400] = "";
+    if (strcmp(c->ctrl->name, "fst") == 0) {
+        sim_why_add(why, sizeof why,
+                    "FST's mean-torque offset of one vector per period, T_ref + (dT_active - "
+                    "|dT_zero|)/2 (docs/algorithms.md; tunable f_i)");
+    }
+    if (r->lim_weak_n > 0u) {
+        sim_why_add(why, sizeof why, "the voltage limit (flux weakened in %.0f %% of the periods)",
+                    100.0 * (double)r->lim_weak_n / (double)r->lim_n);
+    }
+    if (c->plant_machine.dead_time_s > 0.0 || c->plant_machine.v_fwd_v > 0.0) {
+        sim_why_add(why, sizeof why, "the inverter's dead time (%.0f ns) and device drop (%.3g V)",
+                    c->plant_machine.dead_time_s * 1e9, c->plant_machine.v_fwd_v);
+    }
+    sim_warn(c->warnings,
+             "torque not followed: controller %s, plant mean torque %.4g N*m against the applied "
+             "reference %.4g N*m (%+.1f %%; tolerance max(5 %%, 2 %% of the rated %.4g N*m)), "
+             "requested %.4g N*m; known mechanism: %s",
+             c->ctrl->name, mp->torque_mean_nm, applied,
+             applied != 0.0 ? 100.0 * miss / fabs(applied) : 0.0, c->plant_machine.torque_rated_nm,
+             r->torque_ref_requested_nm, why[0] != '\0' ? why : "none known");
+}
+
 int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctrl)
 {
     if (!r->win_done && r->win_started) {
@@ -955,6 +1026,9 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
     }
     const int a = metrics_finish(&r->m_plant, plant);
     const int b = metrics_finish(&r->m_ctrl, ctrl);
+    if (a == 0) {
+        sim_torque_follow_check(r, plant);
+    }
     return (a == 0 && b == 0) ? 0 : -1;
 }
 
@@ -1052,6 +1126,15 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     sim_json_num(f, "flux_mean_wb", mp->flux_mean_wb);
     sim_json_num(f, "flux_ripple_wb", mp->flux_ripple_wb);
     sim_json_num(f, "torque_sse_nm", mp->torque_sse_nm);
+    /* The mean torque's error against the request as well as against the
+     * applied (limited) reference of T_sse: a drive that delivers nothing
+     * because its limit said so has T_sse 0 but not this. */
+    sim_json_num(f, "torque_err_request_nm",
+                 c->speed_mode ? NAN : mp->torque_mean_nm - r->torque_ref_requested_nm);
+    sim_json_num(f, "torque_err_applied_nm",
+                 c->speed_mode || r->lim_n == 0u
+                     ? NAN
+                     : mp->torque_mean_nm - r->tref_sum_nm / (double)r->lim_n);
     sim_json_num(f, "f_av_hz", mp->f_av_hz);
     sim_json_num(f, "thd_i_pct", mp->thd_i_pct);
     sim_json_num(f, "i1_amp_a", mp->i1_amp_a);

@@ -171,6 +171,7 @@ struct sim_run {
     uint8_t lim_last; /* fw_telemetry_t.fw_limit of the last clipped period */
     bool lim_warned;
     bool link_failed; /* the PIL link reported a fault (cfg.link->error) */
+    uint64_t lim_weak_n; /* periods of the window with the flux weakened (fw_limit bit 3) */
 };
 
 /* The pipeline configuration of a run (the controller's aside). */

@@ -509,7 +509,16 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
         fprintf(f, "  speed mode: reference %.1f r/min, window mean %s, at the end %s\n",
                 r->cfg.speed_ref_rpm, fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
                 fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
-    } else if (r->cfg.free_mech) {
+    } else if (r->lim_n > 0u) {
+        /* the mean torque against the request and the reference applied */
+        const double applied = r->tref_sum_nm / (double)r->lim_n;
+        fprintf(f, "  torque mode: requested %.4g N*m, applied %.4g N*m (mean); T_mean - request %s, "
+                "T_mean - applied %s\n",
+                r->torque_ref_requested_nm, applied,
+                fmt_num(b[10], 32, "%+.4f N*m", mp->torque_mean_nm - r->torque_ref_requested_nm),
+                fmt_num(b[11], 32, "%+.4f N*m", mp->torque_mean_nm - applied));
+    }
+    if (!r->cfg.speed_mode && r->cfg.free_mech) {
         fprintf(f, "  free mechanics: speed window mean %s, at the end %s\n",
                 fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
                 fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
