@@ -157,14 +157,16 @@ static int foc_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return foc_init_common(state, cfg, su, 1);
 }
 
-/* FOC reads no optional estimator output: rotor-frame currents and fluxes only. */
-CTRL_DESC_DEFINE(
+/* FOC reads no optional estimator output: rotor-frame currents and fluxes
+ * only. Its currents come from the torque (ctrl_foc_iref, or the flux circle
+ * of field weakening): no fixed flux reference (flux_free). */
+CTRL_DESC_DEFINE_FLUX(
     foc, "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
     FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_tunables, foc_cfg_default, foc_init,
-    ctrl_foc_reset, ctrl_foc_step, 0u);
+    ctrl_foc_reset, ctrl_foc_step, 0u, 1u);
 
 /* The hysteresis variant reads the angle at k+1. */
-CTRL_DESC_DEFINE(foc_hyst,
-                 "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
-                 FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_hyst_tunables, foc_cfg_default,
-                 foc_hyst_init, ctrl_foc_reset, ctrl_foc_step, CTRL_EST_SC_NEXT);
+CTRL_DESC_DEFINE_FLUX(
+    foc_hyst, "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
+    FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_hyst_tunables, foc_cfg_default, foc_hyst_init,
+    ctrl_foc_reset, ctrl_foc_step, CTRL_EST_SC_NEXT, 1u);

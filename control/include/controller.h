@@ -72,6 +72,10 @@ typedef struct ctrl_desc {
     /* Optional estimator outputs (CTRL_EST_* of estimator.h) this controller never
      * reads, so the pipeline can skip computing them; 0 = it may read all. */
     uint16_t est_unused;
+    /* 1: the controller forms its currents from the torque alone (MTPA, or
+     * the flux circle of field weakening) and holds no fixed flux reference
+     * (ctrl_params_t.psi_ref): the drive's limits then use MTPA for it. */
+    uint8_t flux_free;
 } ctrl_desc_t;
 
 /* Size of the caller's state and configuration blocks (the firmware's fw_t):
@@ -100,6 +104,12 @@ typedef struct ctrl_desc {
  * the controller reads (est_unused = the others). */
 #define CTRL_DESC_DEFINE(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_, init_,  \
                          reset_, step_, est_read)                                                  \
+    CTRL_DESC_DEFINE_FLUX(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_, init_, \
+                          reset_, step_, est_read, 0u)
+
+/* CTRL_DESC_DEFINE with ctrl_desc_t.flux_free. */
+#define CTRL_DESC_DEFINE_FLUX(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_,    \
+                              init_, reset_, step_, est_read, flux_free_)                          \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
         .name = #id,                                                                               \
         .title = title_,                                                                           \
@@ -112,6 +122,7 @@ typedef struct ctrl_desc {
         .reset = reset_,                                                                           \
         .step = step_,                                                                             \
         .est_unused = CTRL_EST_ONLY(est_read),                                                     \
+        .flux_free = flux_free_,                                                                   \
     }
 
 /* Registry (controller_registry.c; the entries are chosen at build time by

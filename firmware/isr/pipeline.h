@@ -237,11 +237,13 @@ typedef struct {
     } ctrl_cfg; /* SI configuration of the selected controller */
     ctrl_estimator_t est;
     ctrl_estimate_t estimate;
-    q24_t psi_pm_cfg;         /* the configured psi_pm, Q24 pu */
-    q24_t psi_band;           /* |estimate - configured| that engages the tracking, Q24 pu */
-    bool psi_engaged;         /* the estimate has left the band: params follow it */
-    ctrl_legs_t applied;      /* leg duties acting in [k, k+1): chosen at k-1 (or 0), before
-                               * the dead-time compensation */
+    q24_t psi_pm_cfg;    /* the configured psi_pm, Q24 pu */
+    q24_t psi_ref_cfg;   /* the machine's fixed flux reference, Q24 pu (0: MTPA); params.psi_ref
+                            holds it for a controller that holds it, 0 for a flux-free one */
+    q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
+    bool psi_engaged;    /* the estimate has left the band: params follow it */
+    ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0), before
+                          * the dead-time compensation */
     ctrl_deadtime_t deadtime; /* compensation of the written duties (dd 0: off) */
     ctrl_refs_t refs;
     q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */

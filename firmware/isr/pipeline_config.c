@@ -100,6 +100,7 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         CTRL_OK) {
         return FW_EINVAL;
     }
+    fw->psi_ref_cfg = fw->params.psi_ref;
     if ((uint64_t)fw->enc_cpr * (uint64_t)fw->params.pole_pairs > (uint64_t)INT32_MAX) {
         return FW_ERANGE;
     }
@@ -462,8 +463,15 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     } st;
     memset(&st, 0, sizeof st);
     memset(&fw->why, 0, sizeof fw->why);
+    /* A controller that forms its currents from the torque (FOC) holds no
+     * fixed flux reference: the field-weakening limit and its flux reference
+     * are then those of MTPA (a limit formed at a flux the controller does
+     * not hold would neither weaken its flux in time nor bound its torque). */
+    const q24_t psi_ref_old = fw->params.psi_ref;
+    fw->params.psi_ref = d->flux_free != 0u ? 0 : fw->psi_ref_cfg;
     const ctrl_setup_t setup = {fw->machine, &fw->bases, &fw->params, &fw->why};
     if (ctrl_init(d, st.bytes, cfg, &setup) != CTRL_OK) {
+        fw->params.psi_ref = psi_ref_old;
         return FW_ECTRL;
     }
     d->reset(st.bytes);
