@@ -43,7 +43,11 @@ class ReadmeTest(unittest.TestCase):
                                 "--duration", "0.06", "--metrics", js],
                                capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
-            self.assertNotIn("warning", r.stderr)
+            # FST's one-vector-per-period mean-torque offset is reported
+            # (README.md, "No wrong torque without a word"); nothing else.
+            other = [ln for ln in r.stderr.splitlines()
+                     if "warning" in ln and "torque not followed: controller fst" not in ln]
+            self.assertEqual(other, [], r.stderr)
             fired = re.search(r'"scenario_fired_s": \[([^\]]*)\]', open(js).read()).group(1)
             self.assertNotIn("null", fired, "an event of the example never fired")
 

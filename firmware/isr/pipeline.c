@@ -227,6 +227,7 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             ctrl_estimator_reset(&fw->est, &fw->params);
             ctrl_psi_track_reset(&fw->psi_track); /* from the current model at the first period */
             fw_mid_restart(fw);
+            fw_torque_follow_reset(&fw->tqf);
             fw->trim = 0;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
             hal_gate_enable(fw->hal, true);
@@ -439,6 +440,12 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     if (f == FW_FAULT_NONE) {
         f = mo->fault;
     }
+    if (f == FW_FAULT_NONE) {
+        /* the estimate at k answers the reference applied at k-1; none to
+         * trust on the sensorless start's forced angle */
+        f = fw_torque_follow_step(&fw->tqf, fw->torque_ref_now, est->now.torque,
+                                  sl == NULL || sl->out.mode == CTRL_SL_OBSERVER);
+    }
 
     if (hold != 0u) {
         /* the sensorless start's reference (above) */
@@ -490,7 +497,7 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
     fw->torque_ref_now = tref;
     tm->torque_max = torque_max;
-    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != t_req) + 8u * weak);
+    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != t_req) + 8u * weak + 16u * fw->tqf.warn);
 
     const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed

@@ -75,6 +75,7 @@
 #include "sensorless.h"
 #include "speed_pi.h"
 #include "speed_pi_config.h"
+#include "torque_follow.h"
 
 #define FW_OK 0
 #define FW_EINVAL (-1) /* NULL, bad machine or configuration */
@@ -110,7 +111,8 @@ typedef struct {
     q24_t torque_ref;     /* torque reference used at k (after the limits), Q24 pu */
     q24_t torque_max;     /* |torque| limit of this period (field_weak.h), Q24 pu */
     uint8_t fw_limit;     /* what bounds it: ctrl_fw_limit_t, + 4 when the request was
-                             clipped, + 8 when the flux reference is weakened */
+                             clipped, + 8 when the flux reference is weakened, + 16 while
+                             the torque misses its reference (torque_follow.h) */
     q24_t duty;           /* on-time of segment 0, Q24 fraction */
     q24_t legs[3];        /* leg duties written at k, Q24 fraction */
     uint32_t cycles;      /* ISR duration measured with hal_cycles */
@@ -207,6 +209,11 @@ typedef struct {
      * encoder and its protections unused, psi_adapt off (the observer's
      * correction needs the configured psi_pm). Default off. */
     bool sensorless;
+    /* Torque supervision (torque_follow.h): consecutive 50 ms windows in
+     * which the mean torque estimate misses the applied reference by more
+     * than max(5 %, 2 % of rated) before the fault torque_follow; 0 (the
+     * default): the telemetry warning only. */
+    uint32_t torque_follow_fault_windows;
 } fw_config_t;
 
 /* The speed loop and speed limits in force (SI, for reports; set by fw_init). */
@@ -279,6 +286,7 @@ typedef struct {
     fw_speed_info_t speed_info;
     fw_state_t sm;
     fw_protect_t prot;
+    fw_torque_follow_t tqf; /* torque supervision */
     /* calibration */
     uint32_t calib_samples, calib_n;
     uint32_t calib_sum[3];

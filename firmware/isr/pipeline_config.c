@@ -48,6 +48,7 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->dead_comp = true;
     c->dead_comp_band_a = 0.0;
     c->sensorless = false;
+    c->torque_follow_fault_windows = 0u; /* warning only */
 }
 
 size_t fw_explain(const fw_t *fw, char *buf, size_t cap)
@@ -265,6 +266,12 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
         return FW_ERANGE;
     }
+    fw_torque_follow_cfg_t tfc;
+    if (fw_torque_follow_config(&tfc, in->pwm_freq_hz, fw->params.torque_rated,
+                                cfg->torque_follow_fault_windows) != CTRL_OK) {
+        return FW_EINVAL;
+    }
+    fw_torque_follow_init(&fw->tqf, &tfc);
 
     /* Speed loop: one update per run of the medium task. */
     fw_speed_info_t *si = &fw->speed_info;

@@ -63,7 +63,8 @@ enum {
     FW_FAULT_OVERSPEED = 10,    /* |speed| above the overspeed level */
     FW_FAULT_COMMISSION = 11,   /* a commissioning step failed (cm_t.err names why) */
     FW_FAULT_SPEED_FOLLOW = 12, /* speed moves away from its reference at full torque */
-    FW_FAULT_COUNT = 13
+    FW_FAULT_TORQUE_FOLLOW = 13, /* mean torque estimate off the applied reference (torque_follow.h) */
+    FW_FAULT_COUNT = 14
 };
 
 /* Overspeed level relative to the machine's maximum speed (criteria above). */

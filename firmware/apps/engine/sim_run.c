@@ -452,6 +452,7 @@ void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_confi
         fc->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
     }
     fc->overspeed_rpm = c->overspeed_rpm;
+    fc->torque_follow_fault_windows = c->torque_follow_fault_windows;
     /* With an output filter the leg voltages are not the motor's: no voltage model. */
     fc->psi_adapt = c->psi_adapt && c->plant_machine.filter.type == PLANT_FILTER_NONE;
     /* The inverter's dead time and device drop, known to the firmware. */
@@ -1109,6 +1110,8 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
         fprintf(f, "  \"fw_limit\": \"%s\",\n", lim_names[tm->fw_limit & 3u]);
         fprintf(f, "  \"fw_clipped\": %u,\n  \"fw_weakening\": %u,\n", (tm->fw_limit >> 2) & 1u,
                 (tm->fw_limit >> 3) & 1u);
+        /* the firmware's torque supervision (torque_follow.h) at the end */
+        fprintf(f, "  \"torque_follow_warning\": %u,\n", (tm->fw_limit >> 4) & 1u);
     }
     sim_json_num(f, "speed_ref_rpm", sim_run_speed_ref_now(r));
     sim_json_num(f, "speed_imposed_rpm", c->free_mech ? NAN : sim_run_speed_rpm(r));

@@ -105,6 +105,7 @@ typedef struct {
     double speed_bw_hz, speed_pm_deg; /* sizing (0 = firmware defaults) */
     double speed_kp, speed_ki;        /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
     double overspeed_rpm;             /* 0 = 1.05 x rated speed */
+    uint32_t torque_follow_fault_windows; /* fw_config_t's (0: warning only) */
     bool stop_on_fault;               /* end the run at a fault (default false) */
     bool psi_adapt;                   /* fw_config_t.psi_adapt (default true) */
     bool dead_comp;                   /* fw_config_t.dead_comp (default true) */

@@ -53,7 +53,7 @@ typedef struct {
     int identify;
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
-    double speed_bw, speed_pm, speed_kp, speed_ki, overspeed;
+    double speed_bw, speed_pm, speed_kp, speed_ki, overspeed, tq_follow_fault;
     cli_span_t window, trace_window;
     int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, no_dead_comp,
         sensorless;
@@ -106,6 +106,10 @@ static const cli_opt_t k_opts[] = {
      "explicit speed PI integral gain, per mechanical rad (default 0 with --speed-kp)"},
     {"--overspeed-rpm", "R", K_REAL, 1, 1e6, "r/min", M_LOOP, NULL, NULL, F(overspeed),
      "overspeed trip level (default: machine file, else 1.05 x its maximum speed)"},
+    {"--torque-follow-fault", "N", K_UINT, 0, 1000, "windows", M_LOOP, NULL, NULL,
+     F(tq_follow_fault),
+     "fault after N consecutive 50 ms windows of the mean torque estimate off the applied "
+     "reference by more than max(5 %, 2 % of rated) (default 0: telemetry warning only)"},
     {"--duration", "S", K_REAL, 1e-4, 100, "s", M_LOOP, NULL, NULL, F(duration),
      "simulated time after arm (default 0.3)"},
     {"--window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, NULL, NULL, F(window),
@@ -791,6 +795,9 @@ int main(int argc, char **argv)
         cfg.speed_kp = c.speed_kp;
         cfg.speed_ki = c.speed_ki;
         cfg.speed_bw_hz = cfg.speed_pm_deg = 0.0;
+    }
+    if (is_given(given, "--torque-follow-fault")) {
+        cfg.torque_follow_fault_windows = (uint32_t)c.tq_follow_fault;
     }
     if (is_given(given, "--overspeed-rpm")) {
         if (!(c.overspeed > pm.speed_rated_rpm)) {
