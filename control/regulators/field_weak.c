@@ -112,13 +112,16 @@ static int fw_flux_at_least(int64_t x, q24_t w, q24_t b)
     return c < ((uint64_t)1 << 31) && x >= (int64_t)(c * c);
 }
 
-/* V^2 - (Rs I_max)^2 - 2 Rs w T (Q48; psi_max = sqrt of it / |w|) with
- * V = k_mod vdc_f / sqrt(3): every term below 2^62 in magnitude. Out of
+/* V^2 - (Rs I)^2 - 2 Rs w T (Q48; psi_max = sqrt of it / |w|) with
+ * V = k_mod vdc_f / sqrt(3), Rs I = min(Rs |T| / psi_pm, Rs I_max): every
+ * term below 2^62 in magnitude. Nonincreasing in |T| for w T >= 0 and at
+ * least its value at |T| for w T < 0 (the lazy region's corner). Out of
  * line: called from several places, not in the lazy path's usual period. */
 static FW_NOINLINE int64_t fw_volt_sq(const ctrl_fieldweak_t *s, q24_t vdc_f, q24_t omega, q24_t t)
 {
     const q24_t v = fx_mul_qn(vdc_f, s->v_frac, 30u);
-    return fw_sq48(v) - s->rs_i2 - (int64_t)s->two_rs * fx_mul(omega, t);
+    const q24_t rs_i = fx_min(fx_mul(fx_abs(t), s->rs_ipsi), s->rs_imax);
+    return fw_sq48(v) - fw_sq48(rs_i) - (int64_t)s->two_rs * fx_mul(omega, t);
 }
 
 /* fw_volt_sq of this period, formed once (lz_xv is cleared as the period
@@ -228,7 +231,7 @@ static FW_ALWAYS_INLINE void fw_limits(ctrl_fieldweak_t *s, const ctrl_params_t 
     out->limit = lim;
     out->clipped = t != t_req ? 1u : 0u;
     out->weakening = psi_max < psi_own ? 1u : 0u;
-    s->t_prev = t;
+    ctrl_fieldweak_t_prev(s, t);
     s->lz_xv = 0u;
 }
 
@@ -286,8 +289,21 @@ void ctrl_fieldweak_currents(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t 
         if (den > 0) {
             xn = fx_add(x, fx_div(fx_mul(r, pq), den));
         }
-        if (den <= 0 || xn < lo || xn > hi) {
+        /* When the step leaves the bracket, or stays at psi_q = 0 off the
+         * torque (psi_d = psi: the step is 0 there): the point of the flux
+         * circle whose psi_q gives t at this k, sqrt(psi^2 - (t / k)^2) -
+         * exact where k hardly moves (small torques, near psi_d = psi, where
+         * T(psi_d) is a square root's flank and Newton converges slowly) -
+         * if it is inside the bracket, else the bracket's midpoint. */
+        if (den <= 0 || xn < lo || xn > hi || (pq == 0 && r != 0)) {
             xn = fx_add(lo, fx_rshift32_round(fx_sub(hi, lo), 1u)); /* bisect */
+            if (kk > ta) {
+                const q24_t pq_t = fx_div(ta, kk); /* < 1 pu */
+                const q24_t xg = fw_sqrt48(psi2 - fw_sq48(pq_t));
+                if (xg > lo && xg < hi) {
+                    xn = xg;
+                }
+            }
         }
         x = xn;
     }

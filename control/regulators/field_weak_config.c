@@ -103,11 +103,11 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     const double c2 = 1.0 / ld - 1.0 / lq;
     const double vf = c->v_frac / sqrt(3.0);
     s->v_frac = (int32_t)lround(vf * (double)(1L << 30));
-    const double rs_i = rs * i;
-    s->rs_i2 = (int64_t)llround(rs_i * rs_i * 281474976710656.0); /* 2^48 */
     int rc = CTRL_OK;
     rc = rc ? rc : fw_q24(i, "current limit", &s->i_max, why, why_len);
     rc = rc ? rc : fw_q24(2.0 * rs, "2 Rs", &s->two_rs, why, why_len);
+    rc = rc ? rc : fw_q24(rs * i, "Rs I_max", &s->rs_imax, why, why_len);
+    rc = rc ? rc : fw_q24(rs / psi, "Rs / psi_pm", &s->rs_ipsi, why, why_len);
     rc = rc ? rc : fw_q24(psi, "psi_pm", &s->psi_pm, why, why_len);
     rc = rc ? rc : fw_q24(ld, "Ld", &s->ld, why, why_len);
     rc = rc ? rc : fw_q24(ld - lq, "Ld - Lq", &s->ld_m_lq, why, why_len);

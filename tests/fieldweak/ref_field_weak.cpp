@@ -10,7 +10,8 @@
  *
  * Checked per sample, each against the bound its Q formats predict
  * (docs/error-budget.md, "Field weakening"):
- *   psi_max   = sqrt(V^2 - (Rs I)^2 - 2 Rs w T_prev) / |w|, capped;
+ *   psi_max   = sqrt(V^2 - (Rs I)^2 - 2 Rs w T_prev) / |w|, capped, with
+ *               T_prev the low-passed torque, I = min(|T_prev| / psi_pm, I_max);
  *   T_lim(psi) at the fixed-point psi (the flux-circle part alone);
  *   the limit kind away from the decision boundaries;
  *   torque = clamp(request) and psi_ref = min(own reference, psi_max), exactly;
@@ -208,13 +209,14 @@ void run(const ctrl_machine_t &m, bool mtpa_mode, uint32_t fs, int n, std::mt199
         ctrl_fieldweak_out_t o0, o;
         // First period primes the filter (vdc exactly) and sets T_prev.
         ctrl_fieldweak_step(&s, &p, q(vdc), q(w), q(t0), q(pc), &o0);
+        const double tp = d(s.t_prev); // the low-passed torque the second period uses
         ctrl_fieldweak_step(&s, &p, q(vdc), q(w), q(t1), q(pc), &o);
         TEST_ASSERT_EQUAL_INT32(q(vdc), o.vdc);
         // psi_max
         const double wq = d(q(w));
         const double v = r.vf * d(q(vdc));
-        const double tp = d(o0.torque);
-        const double x = v * v - r.rs * r.rs * r.i * r.i - 2.0 * r.rs * wq * tp;
+        const double ri = std::min(r.rs * std::fabs(tp) / r.psi, r.rs * r.i);
+        const double x = v * v - ri * ri - 2.0 * r.rs * wq * tp;
         const double aw = std::fabs(wq);
         double pm = r.ceil;
         double e_psi = 1.0 * L;
@@ -223,8 +225,10 @@ void run(const ctrl_machine_t &m, bool mtpa_mode, uint32_t fs, int n, std::mt199
             // V: 0.5 LSB + vdc 2^-31 (v_frac in Q30); X: 2 V dV, the product
             // w T rounded (0.5 LSB) times 2 Rs, 2 Rs rounded times |w T|.
             const double dv = 0.5 * L + d(q(vdc)) * std::ldexp(1.0, -31);
+            // Rs I: Rs/psi_pm and the product rounded (0.5 LSB each, times |T|
+            // and 1), Rs I_max rounded: 2 Rs I dI on its square.
             const double e_x = 2.0 * v * dv + 2.0 * r.rs * 0.5 * L + std::fabs(wq * tp) * 0.5 * L +
-                               std::ldexp(1.0, -47);
+                               2.0 * ri * (1.0 + std::fabs(tp)) * L + std::ldexp(1.0, -47);
             const double sx = std::sqrt(std::max(x, 0.0));
             const double e_sx =
                 (sx > 0 ? std::min(e_x / (2.0 * sx), std::sqrt(e_x)) : std::sqrt(e_x)) + L;

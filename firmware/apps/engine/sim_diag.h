@@ -11,7 +11,7 @@
 #include <stdio.h>
 
 #define SIM_WARN_MAX 32u
-#define SIM_WARN_LEN 256u
+#define SIM_WARN_LEN 512u
 
 typedef struct {
     size_t n;       /* stored warnings */

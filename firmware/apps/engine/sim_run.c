@@ -982,8 +982,7 @@ static void sim_torque_follow_check(sim_run_t *r, const metrics_result_t *mp)
     char why[400] = "";
     if (strcmp(c->ctrl->name, "fst") == 0) {
         sim_why_add(why, sizeof why,
-                    "FST's mean-torque offset of one vector per period, T_ref + (dT_active - "
-                    "|dT_zero|)/2 (docs/algorithms.md; tunable f_i)");
+                    "FST's offset of one vector per period (docs/algorithms.md; tunable f_i)");
     }
     if (r->lim_weak_n > 0u) {
         sim_why_add(why, sizeof why, "the voltage limit (flux weakened in %.0f %% of the periods)",
@@ -995,10 +994,11 @@ static void sim_torque_follow_check(sim_run_t *r, const metrics_result_t *mp)
     }
     sim_warn(c->warnings,
              "torque not followed: controller %s, plant mean torque %.4g N*m against the applied "
-             "reference %.4g N*m (%+.1f %%; tolerance max(5 %%, 2 %% of the rated %.4g N*m)), "
+             "reference %.4g N*m (%+.1f %%, tolerance %.3g N*m: max(5 %%, 2 %% of rated)), "
              "requested %.4g N*m; known mechanism: %s",
              c->ctrl->name, mp->torque_mean_nm, applied,
-             applied != 0.0 ? 100.0 * miss / fabs(applied) : 0.0, c->plant_machine.torque_rated_nm,
+             applied != 0.0 ? 100.0 * miss / fabs(applied) : 0.0,
+             sim_torque_tolerance_nm(applied, c->plant_machine.torque_rated_nm),
              r->torque_ref_requested_nm, why[0] != '\0' ? why : "none known");
 }
 
