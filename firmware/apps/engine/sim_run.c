@@ -988,6 +988,10 @@ static void sim_torque_follow_check(sim_run_t *r, const metrics_result_t *mp)
         sim_why_add(why, sizeof why, "the voltage limit (flux weakened in %.0f %% of the periods)",
                     100.0 * (double)r->lim_weak_n / (double)r->lim_n);
     }
+    if (c->plant_machine.filter.type != PLANT_FILTER_NONE) {
+        sim_why_add(why, sizeof why, "the output filter between inverter and motor (%s)",
+                    c->plant_machine.filter.type == PLANT_FILTER_PASSIVE ? "passive" : "active");
+    }
     if (c->plant_machine.dead_time_s > 0.0 || c->plant_machine.v_fwd_v > 0.0) {
         sim_why_add(why, sizeof why, "the inverter's dead time (%.0f ns) and device drop (%.3g V)",
                     c->plant_machine.dead_time_s * 1e9, c->plant_machine.v_fwd_v);
