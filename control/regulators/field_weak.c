@@ -22,6 +22,7 @@ void ctrl_fieldweak_reset(ctrl_fieldweak_t *s)
     s->vdc_acc = 0;
     s->primed = 0u;
     s->t_prev = 0;
+    s->t_primed = 0u;
     s->psi_d = 0;
     s->own.valid = 0u;
     s->lz_w_max = 0;

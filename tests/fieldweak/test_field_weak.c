@@ -165,6 +165,52 @@ static void test_resistive_drop(void)
     TEST_ASSERT_TRUE(ob.psi_max > o.psi_max);
 }
 
+/* The torque of the Rs terms after a call. From a reset, the first call's
+ * torque is taken whole: the second call's limit is that of the torque it
+ * lets through (from 0 with 1/8 per call it was the flux of a much smaller
+ * torque for tens of calls). Where the limit bites on a high-resistance
+ * motor (GBM5208 at its rated speed, Rs I_max 35 % of the voltage) the
+ * torque settles on the limit's fixed point instead of alternating between
+ * full torque and none: after the second call (the Rs terms of the whole
+ * request leave no torque) never 0, constant within 50 calls, and there the
+ * torque the voltage allows at the flux of that torque. */
+static void test_rs_torque(void)
+{
+    setup(&ini_thesis_spmsm, -1.0);
+    ctrl_fieldweak_out_t o;
+    ctrl_fieldweak_reset(&S);
+    const q24_t t = q(1.5 / B.torque_nm);
+    ctrl_fieldweak_step(&S, &P, vdc_pu(), omega_pu(3400.0), t, 0, &o);
+    TEST_ASSERT_EQUAL_INT32(t, o.torque);
+    TEST_ASSERT_EQUAL_INT32(o.torque, S.t_prev);
+
+    setup(&ini_gbm5208_gimbal, -1.0);
+    ctrl_fieldweak_reset(&S);
+    const double rpm = M.speed_rated_rpm;
+    q24_t settled = 0;
+    for (int k = 0; k < 400; k++) {
+        ctrl_fieldweak_step(&S, &P, vdc_pu(), omega_pu(rpm), S.t_mtpa, 0, &o);
+        if (k >= 2) {
+            TEST_ASSERT_TRUE(o.torque > 0);
+        }
+        if (k == 50) {
+            settled = o.torque;
+        } else if (k > 50) {
+            TEST_ASSERT_EQUAL_INT32(settled, o.torque);
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT8(1u, o.clipped); /* the limit bites */
+    /* the fixed point: this torque's Rs terms, within the 1/8 step's truncation */
+    TEST_ASSERT_INT32_WITHIN(8, o.torque, S.t_prev);
+    const double rs = M.rs_ohm / B.r_ohm;
+    const double tp = d(S.t_prev);
+    const double i = fmin(M.current_rated_a / B.i_a, tp / (M.psi_pm_wb / B.psi_wb));
+    const double v = v_max() / B.v_v;
+    const double w = we(rpm) / B.w_rad_s;
+    const double psi = sqrt(v * v - rs * rs * i * i - 2.0 * rs * w * tp) / w;
+    TEST_ASSERT_DOUBLE_WITHIN(16 * LSB, psi, d(o.psi_max));
+}
+
 /* Below base speed: the current limit, MTPA (4.15), nothing weakened. */
 static void test_below_base(void)
 {
@@ -497,6 +543,7 @@ int main(void)
     RUN_TEST(test_config_refusals);
     RUN_TEST(test_psi_max_lossless);
     RUN_TEST(test_resistive_drop);
+    RUN_TEST(test_rs_torque);
     RUN_TEST(test_below_base);
     RUN_TEST(test_spmsm_field_weakening);
     RUN_TEST(test_ipmsm_mtpv);
