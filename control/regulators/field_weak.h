@@ -167,10 +167,10 @@ static inline int ctrl_fieldweak_in_region(const ctrl_fieldweak_t *s, q24_t vdc_
  * the step of the iteration limit -> torque -> limit, which converges
  * where the limit's slope in t_prev is above -15 (with t taken whole only
  * above -1: the limit alternated between full torque and none on a
- * high-resistance motor). Primed, because from 0 the
- * calls of the medium task (1 kHz) took tens of ms to reach the torque: the
- * flux limit of a smaller torque all that time (FST, thesis SPMSM, 3000
- * r/min, 2.041 N*m: its flux stayed 1 % high and the torque 6.9 % low). */
+ * high-resistance motor). Primed, because from 0 the calls of the medium
+ * task (1 kHz) took some 20 ms to reach the torque: the flux limit of a
+ * smaller torque all that time (FST, thesis SPMSM, 3000 r/min, 2.041 N*m:
+ * its flux stayed 1 % high and the torque 6.9 % low). */
 static inline void ctrl_fieldweak_t_prev(ctrl_fieldweak_t *s, q24_t t)
 {
     if (s->t_primed == 0u) {

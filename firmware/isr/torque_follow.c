@@ -8,6 +8,15 @@
 
 #define TF_SHIFT_MAX 15u
 
+/* Out of line, one call per period: inlined by the board image's link-time
+ * optimisation into the interrupt at -O2 it took 1 384 B, where the image
+ * with the settings store had 1 104 B left; called, 1 000 B. */
+#if defined(__GNUC__)
+#define TF_NOINLINE __attribute__((noinline))
+#else
+#define TF_NOINLINE
+#endif
+
 int fw_torque_follow_config(fw_torque_follow_cfg_t *cfg, uint32_t rate_hz, q24_t torque_rated,
                             uint32_t fault_windows)
 {
@@ -41,7 +50,8 @@ void fw_torque_follow_init(fw_torque_follow_t *s, const fw_torque_follow_cfg_t *
     fw_torque_follow_reset(s);
 }
 
-uint32_t fw_torque_follow_step(fw_torque_follow_t *s, q24_t t_ref, q24_t t_est, bool valid)
+TF_NOINLINE uint32_t fw_torque_follow_step(fw_torque_follow_t *s, q24_t t_ref, q24_t t_est,
+                                           bool valid)
 {
     if (!valid) {
         s->sum_err = 0;
@@ -69,7 +79,6 @@ uint32_t fw_torque_follow_step(fw_torque_follow_t *s, q24_t t_ref, q24_t t_est, 
     if (s->missed < UINT32_MAX) {
         s->missed++;
     }
-    return s->cfg.fault_windows != 0u && s->missed >= s->cfg.fault_windows
-               ? FW_FAULT_TORQUE_FOLLOW
-               : FW_FAULT_NONE;
+    return s->cfg.fault_windows != 0u && s->missed >= s->cfg.fault_windows ? FW_FAULT_TORQUE_FOLLOW
+                                                                           : FW_FAULT_NONE;
 }
