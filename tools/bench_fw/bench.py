@@ -57,13 +57,17 @@ def run(cmd, **kw):
     return r.stdout
 
 
-def configure(build, preset_vars, toolchain=None):
+def configure(build, preset_vars, toolchain=None, update=False):
+    """Configures build once; update=True sets preset_vars again on an
+    existing build (options that may have changed since)."""
     if not os.path.exists(os.path.join(build, "build.ninja")):
         cmd = ["cmake", "-S", ROOT, "-B", build, "-G", "Ninja"]
         if toolchain:
             cmd.append("-DCMAKE_TOOLCHAIN_FILE=" + toolchain)
         cmd += ["-D%s=%s" % kv for kv in preset_vars.items()]
         run(cmd)
+    elif update:
+        run(["cmake", "-S", ROOT, "-B", build] + ["-D%s=%s" % kv for kv in preset_vars.items()])
 
 
 def build(args):
