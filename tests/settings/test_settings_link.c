@@ -13,6 +13,7 @@
 
 #include "cmd.h"
 #include "fw_link.h"
+#include "link_text.h"
 #include "settings_flash_model.h"
 #include "sim_ident.h"
 #include "unity.h"
@@ -22,37 +23,17 @@ static sim_run_t run;
 static fw_link_t link;
 static fw_settings_t st;
 static sfm_t flash;
-static char out[16384];
-static size_t out_len;
+static link_text_t lt;
 static ctrl_machine_t conf_machine;
-
-static void capture(void *ctx, const uint8_t *b, size_t n)
-{
-    (void)ctx;
-    for (size_t i = 0; i < n; i++) {
-        if (out_len + 1u < sizeof out) {
-            out[out_len++] = b[i] != 0u ? (char)b[i] : '.';
-            out[out_len] = '\0';
-        }
-    }
-}
 
 static void send(const char *line)
 {
-    out_len = 0;
-    out[0] = '\0';
-    for (const char *p = line; *p != '\0'; p++) {
-        fw_link_rx(&link, (uint8_t)*p);
-    }
-    fw_link_rx(&link, (uint8_t)'\n');
+    link_text_send(&lt, &link, line);
 }
 
 static void periods(int n)
 {
-    for (int k = 0; k < n; k++) {
-        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
-        fw_link_poll(&link);
-    }
+    link_text_periods(&run, &link, n);
 }
 
 /* The application's side on the simulator: fw_init with the record's data. */
@@ -94,7 +75,7 @@ static void boot(void)
     st.apply = app_apply;
     st.apply_default = app_default;
     (void)fw_settings_boot(&st);
-    fw_link_init(&link, &run.fw, capture, NULL);
+    fw_link_init(&link, &run.fw, link_text_capture, &lt);
     fw_link_set_settings(&link, &st);
     periods(300); /* calibration after the re-initialisation */
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
@@ -132,7 +113,7 @@ static void test_ident_save_boot(void)
     TEST_ASSERT_NOT_NULL(strstr(st.msg, "no record in flash, compiled-in defaults"));
     send("config show");
     TEST_ASSERT_EQUAL_STRING("err 8 state settings: no record in flash, compiled-in defaults\r\n",
-                             out);
+                             lt.out);
 
     /* identify: the drive adopts the results (fw_commission_poll) */
     sim_ident_t id;
@@ -151,14 +132,14 @@ static void test_ident_save_boot(void)
 
     /* a controller and a tunable of the user's */
     send("ctrl select fst");
-    TEST_ASSERT_EQUAL_STRING("ok ctrl fst\r\n", out);
+    TEST_ASSERT_EQUAL_STRING("ok ctrl fst\r\n", lt.out);
     const char *tun = run.fw.ctrl->tunables[0].name;
     double lo = run.fw.ctrl->tunables[0].min, hi = run.fw.ctrl->tunables[0].max;
     double want = lo + 0.37 * (hi - lo);
     char line[96];
     (void)snprintf(line, sizeof line, "param set %s %.17g", tun, want);
     send(line);
-    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok", 2));
+    TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok", 2));
     double tv = 0.0;
     TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_get(&run.fw, tun, &tv));
 
@@ -170,29 +151,29 @@ static void test_ident_save_boot(void)
     const uint32_t ops = flash.ops;
     send("config save");
     TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, strncmp("err 8 state arm pending (ready): disarm first", out, 45), out);
+        0, strncmp("err 8 state arm pending (ready): disarm first", lt.out, 45), lt.out);
     TEST_ASSERT_EQUAL_UINT32(ops, flash.ops);
     periods(3);
     TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&run.fw));
     send("config save");
     TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, strncmp("err 8 state gates on (running): disarm first", out, 44), out);
+        0, strncmp("err 8 state gates on (running): disarm first", lt.out, 44), lt.out);
     TEST_ASSERT_EQUAL_UINT32(ops, flash.ops);
     /* a read too: an ECC error in it would turn the gates off (the NMI) */
     send("config show");
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp("err 8 state gates on (running)", out, 30), out);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp("err 8 state gates on (running)", lt.out, 30), lt.out);
     TEST_ASSERT_EQUAL_UINT32(ops, flash.ops);
     send("disarm");
     periods(3);
 
     send("config save");
-    TEST_ASSERT_EQUAL_STRING("ok saved record 1\r\n", out);
+    TEST_ASSERT_EQUAL_STRING("ok saved record 1\r\n", lt.out);
     send("config show");
-    TEST_ASSERT_EQUAL_INT(0, strncmp(out, "ok ", 3));
-    TEST_ASSERT_NOT_NULL(strstr(out, "  record=1\r\n"));
-    TEST_ASSERT_NOT_NULL(strstr(out, "  ctrl=fst\r\n"));
-    TEST_ASSERT_NOT_NULL(strstr(out, "  enc.dir=-1\r\n"));
-    TEST_ASSERT_NOT_NULL(strstr(out, "  m.rs_ohm="));
+    TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok ", 3));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  record=1\r\n"));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  ctrl=fst\r\n"));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  enc.dir=-1\r\n"));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  m.rs_ohm="));
 
     /* power cycle: the identified motor, the controller and its tunable */
     boot();
@@ -212,14 +193,14 @@ static void test_ident_save_boot(void)
 
     /* config default: the compiled-in data now, the flash unchanged */
     send("config default");
-    TEST_ASSERT_EQUAL_STRING("ok compiled-in defaults applied (flash unchanged)\r\n", out);
+    TEST_ASSERT_EQUAL_STRING("ok compiled-in defaults applied (flash unchanged)\r\n", lt.out);
     TEST_ASSERT_TRUE(same_double(conf_machine.rs_ohm, run.fw.machine_own.rs_ohm));
     send("config show");
-    TEST_ASSERT_NOT_NULL(strstr(out, "  record=1\r\n"));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  record=1\r\n"));
 
     /* config erase: nothing left; the next boot says so */
     send("config erase");
-    TEST_ASSERT_EQUAL_STRING("ok erased: compiled-in defaults from the next start\r\n", out);
+    TEST_ASSERT_EQUAL_STRING("ok erased: compiled-in defaults from the next start\r\n", lt.out);
     boot();
     TEST_ASSERT_NOT_NULL(strstr(st.msg, "no record in flash, compiled-in defaults"));
     TEST_ASSERT_TRUE(same_double(conf_machine.rs_ohm, run.fw.machine_own.rs_ohm));
@@ -247,7 +228,7 @@ static void test_refused_record_keeps_defaults(void)
     /* no settings store attached: the commands say so */
     fw_link_set_settings(&link, NULL);
     send("config save");
-    TEST_ASSERT_EQUAL_STRING("err 12 unsupported\r\n", out);
+    TEST_ASSERT_EQUAL_STRING("err 12 unsupported\r\n", lt.out);
 }
 
 int main(void)
