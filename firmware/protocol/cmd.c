@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "cmd_num.h"
+#include "help_text.h"
 #include "telemetry.h"
 
 #define CMD_SIG_DIGITS 7u /* significant digits of printed values */
@@ -239,21 +240,26 @@ static bool cmd_param_find(cmd_t *c, cmd_tok_t name, cmd_param_info_t *info)
 
 /* ---- commands ---- */
 
-static const char *const cmd_help_lines[] = {
-    "help                          this list",
-    "status                        drive state, controller, fault, speed, torque",
-    "arm | disarm | stop           enable / disable the gates (stop: any activity)",
-    "ctrl list | ctrl select NAME  controllers (select only when disarmed)",
-    "ref torque NM | ref speed RPM set the reference (and the control mode)",
-    "param list | param get NAME | param set NAME VALUE",
-    "fault | fault clear           latched fault; clear when disarmed",
-    "tel list | tel stop           telemetry signals / stop streaming",
-    "tel start SIG... [every N]    stream signals (or 'all') every Nth period",
-    "echo on | echo off            echo typed characters",
-    "ident run | resume | step NAME motor identification (ident status)",
-    "ident status | result | ini | apply  progress, values, machine file",
-    "bringup NAME | bringup status  bench checks: vbus gates sense encoder run",
-    "config save | show | erase | default  settings kept in flash",
+/* Syntax and what it does; the description is help text (help_text.h: left
+ * to the PC's documentation, PROTOCOL.md, where the image leaves it out). */
+static const struct {
+    const char *syntax;
+    const char *text;
+} cmd_help_lines[] = {
+    {"help", HELP_TEXT("this list")},
+    {"status", HELP_TEXT("drive state, controller, fault, speed, torque")},
+    {"arm | disarm | stop", HELP_TEXT("enable / disable the gates (stop: any activity)")},
+    {"ctrl list | ctrl select NAME", HELP_TEXT("controllers (select only when disarmed)")},
+    {"ref torque NM | ref speed RPM", HELP_TEXT("set the reference (and the control mode)")},
+    {"param list | param get NAME | param set NAME VALUE", NULL},
+    {"fault | fault clear", HELP_TEXT("latched fault; clear when disarmed")},
+    {"tel list | tel stop", HELP_TEXT("telemetry signals / stop streaming")},
+    {"tel start SIG... [every N]", HELP_TEXT("stream signals (or 'all') every Nth period")},
+    {"echo on | echo off", HELP_TEXT("echo typed characters")},
+    {"ident run | resume | step NAME", HELP_TEXT("motor identification (ident status)")},
+    {"ident status | result | ini | apply", HELP_TEXT("progress, values, machine file")},
+    {"bringup NAME | bringup status", HELP_TEXT("bench checks: vbus gates sense encoder run")},
+    {"config save | show | erase | default", HELP_TEXT("settings kept in flash")},
 };
 
 static void cmd_help(cmd_t *c)
@@ -262,7 +268,14 @@ static void cmd_help(cmd_t *c)
     cmd_ok_list(c, (uint32_t)n);
     for (size_t i = 0; i < n; i++) {
         cmd_item_begin(c);
-        cmd_out_str(c, cmd_help_lines[i]);
+        cmd_out_str(c, cmd_help_lines[i].syntax);
+        if (cmd_help_lines[i].text != NULL) {
+            /* the descriptions in one column, at least two spaces after the syntax */
+            do {
+                cmd_out_char(c, ' ');
+            } while (c->out_len < 32u || c->out[c->out_len - 2u] != ' ');
+            cmd_out_str(c, cmd_help_lines[i].text);
+        }
         cmd_out_flush(c);
     }
 }

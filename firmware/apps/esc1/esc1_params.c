@@ -16,6 +16,7 @@
 #include "cmd.h"
 #include "esc1_app.h"
 #include "g4_core.h"
+#include "help_text.h"
 
 double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m)
 {
@@ -240,11 +241,11 @@ ESC1_INDEX_GET(T_CAUSE, esc1_thr_get)
 
 #define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
     {                                                                                              \
-        {name, unit, help, lo, hi, false}, esc1_get_##F, esc1_set_##F                              \
+        {name, unit, HELP_TEXT(help), lo, hi, false}, esc1_get_##F, esc1_set_##F                   \
     }
 #define ESC1_RO(name, unit, help, get)                                                             \
     {                                                                                              \
-        {name, unit, help, 0.0, 0.0, true}, get, NULL                                              \
+        {name, unit, HELP_TEXT(help), 0.0, 0.0, true}, get, NULL                                   \
     }
 
 static const fw_link_param_t esc1_params[] = {
@@ -272,7 +273,7 @@ static const fw_link_param_t esc1_params[] = {
             "RCC_CSR reset flags at start-up >> 24: 2 option bytes, 4 pin, 8 brown-out, "
             "16 software, 32 watchdog",
             esc1_get_reset),
-    {{"b.temp_check", "-", "1 = board over-temperature trip on", 0.0, 1.0, false},
+    {{"b.temp_check", "-", HELP_TEXT("1 = board over-temperature trip on"), 0.0, 1.0, false},
      esc1_get_temp_check,
      esc1_set_temp_check},
     ESC1_RW("throttle.mode", "-", 0.0, 2.0, "PWM pad (PA15): 0 off, 1 torque, 2 speed", T_MODE),
