@@ -15,10 +15,13 @@ if(NOT TARGET pmsm_fw_proto)
   target_link_libraries(pmsm_fw_proto PUBLIC pmsm_control)
   pmsm_strict(pmsm_fw_proto)
   # The interpreter runs in the main loop, never per period: optimised for
-  # size on the targets (the board image's flash; -8.7 kB there).
+  # size on the targets (the board image's flash; -8.7 kB there). So does the
+  # telemetry's encoding (fw_link_poll: the samples the interrupt queued).
   if(NOT PMSM_TARGET STREQUAL "host")
     set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/cmd.c ${CMAKE_CURRENT_LIST_DIR}/cmd_num.c
                                 ${CMAKE_CURRENT_LIST_DIR}/text_fmt.c
+                                ${CMAKE_CURRENT_LIST_DIR}/telemetry.c
+                                ${CMAKE_CURRENT_LIST_DIR}/telemetry_frame.c
                                 PROPERTIES COMPILE_OPTIONS "-Os")
   endif()
 endif()
