@@ -256,32 +256,63 @@ static q24_t cm_re(q24_t x, double ob, double nb)
     return cm_q24((double)x * ob / nb / 16777216.0, &y) ? y : (x >= 0 ? FX_MAX : FX_MIN);
 }
 
+/* The results held in pu of cm_results_t.bases: the field, how many, its base
+ * (ctrl_bases_t) and its SI field in cm_si_t (CM_SI_NONE: only rebased).
+ * cm_rebase and cm_results_si walk it. */
+#define CM_R(f) ((uint16_t)offsetof(cm_results_t, f))
+#define CM_B(f) ((uint16_t)offsetof(ctrl_bases_t, f))
+#define CM_S(f) ((uint16_t)offsetof(cm_si_t, f))
+#define CM_SI_NONE 0xFFFFu
+static const struct {
+    uint16_t res, n, base, si;
+} cm_pu_fields[] = {
+    {CM_R(vbus), 1u, CM_B(v_v), CM_S(vbus_v)},
+    {CM_R(i_off), 3u, CM_B(i_a), CM_S(i_off_a)},
+    {CM_R(i_noise), 3u, CM_B(i_a), CM_S(i_noise_a)},
+    {CM_R(l_probe), 1u, CM_B(l_h), CM_S(l_probe_h)},
+    {CM_R(rs), 1u, CM_B(r_ohm), CM_S(rs_ohm)},
+    {CM_R(v_inv), 1u, CM_B(v_v), CM_S(v_inv_v)},
+    {CM_R(ld), 1u, CM_B(l_h), CM_S(ld_h)},
+    {CM_R(lq), 1u, CM_B(l_h), CM_S(lq_h)},
+    {CM_R(ld_raw), 1u, CM_B(l_h), CM_S(ld_raw_h)},
+    {CM_R(lq_raw), 1u, CM_B(l_h), CM_S(lq_raw_h)},
+    {CM_R(psi), 1u, CM_B(psi_wb), CM_S(psi_wb)},
+    {CM_R(psi_pos), 1u, CM_B(psi_wb), CM_S(psi_pos_wb)},
+    {CM_R(psi_neg), 1u, CM_B(psi_wb), CM_S(psi_neg_wb)},
+    {CM_R(omega_flux), 1u, CM_B(w_rad_s), CM_S(omega_flux_rad_s)},
+    {CM_R(acc_dw), 1u, CM_B(w_rad_s), CM_SI_NONE},
+    {CM_R(coast_w0), 1u, CM_B(w_rad_s), CM_SI_NONE},
+    {CM_R(coast_w1), 1u, CM_B(w_rad_s), CM_SI_NONE},
+    {CM_R(coast_wm), 1u, CM_B(w_rad_s), CM_SI_NONE},
+};
+#undef CM_R
+#undef CM_B
+#undef CM_S
+
+static double cm_base_at(const ctrl_bases_t *b, uint16_t off)
+{
+    double v;
+    memcpy(&v, (const char *)b + off, sizeof v);
+    return v;
+}
+
 void cm_rebase(cm_t *cm, const ctrl_bases_t *nb, bool enc_adopted)
 {
     cm_results_t *r = &cm->res;
     const ctrl_bases_t ob = r->bases;
-    r->vbus = cm_re(r->vbus, ob.v_v, nb->v_v);
-    for (int k = 0; k < 3; k++) {
-        r->i_off[k] = cm_re(r->i_off[k], ob.i_a, nb->i_a);
-        r->i_noise[k] = cm_re(r->i_noise[k], ob.i_a, nb->i_a);
+    for (size_t k = 0; k < sizeof cm_pu_fields / sizeof cm_pu_fields[0]; k++) {
+        const double o = cm_base_at(&ob, cm_pu_fields[k].base);
+        const double n = cm_base_at(nb, cm_pu_fields[k].base);
+        for (uint16_t j = 0; j < cm_pu_fields[k].n; j++) {
+            q24_t x;
+            char *f = (char *)r + cm_pu_fields[k].res + j * sizeof x;
+            memcpy(&x, f, sizeof x);
+            x = cm_re(x, o, n);
+            memcpy(f, &x, sizeof x);
+        }
     }
-    r->l_probe = cm_re(r->l_probe, ob.l_h, nb->l_h);
-    r->rs = cm_re(r->rs, ob.r_ohm, nb->r_ohm);
-    r->v_inv = cm_re(r->v_inv, ob.v_v, nb->v_v);
-    r->ld = cm_re(r->ld, ob.l_h, nb->l_h);
-    r->lq = cm_re(r->lq, ob.l_h, nb->l_h);
-    r->ld_raw = cm_re(r->ld_raw, ob.l_h, nb->l_h);
-    r->lq_raw = cm_re(r->lq_raw, ob.l_h, nb->l_h);
-    r->psi = cm_re(r->psi, ob.psi_wb, nb->psi_wb);
-    r->psi_pos = cm_re(r->psi_pos, ob.psi_wb, nb->psi_wb);
-    r->psi_neg = cm_re(r->psi_neg, ob.psi_wb, nb->psi_wb);
-    r->omega_flux = cm_re(r->omega_flux, ob.w_rad_s, nb->w_rad_s);
-    /* Inertia data: sum i_q (current) and speeds. */
+    /* Inertia data: sum i_q (current). */
     r->acc_torque_sum = (int64_t)floor((double)r->acc_torque_sum * ob.i_a / nb->i_a + 0.5);
-    r->acc_dw = cm_re(r->acc_dw, ob.w_rad_s, nb->w_rad_s);
-    r->coast_w0 = cm_re(r->coast_w0, ob.w_rad_s, nb->w_rad_s);
-    r->coast_w1 = cm_re(r->coast_w1, ob.w_rad_s, nb->w_rad_s);
-    r->coast_wm = cm_re(r->coast_wm, ob.w_rad_s, nb->w_rad_s);
     if (enc_adopted) {
         /* The drive now counts in the identified direction; the offset is
          * taken against the angle without the drive's offset, so it stays. */
@@ -296,28 +327,21 @@ void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double t
     const cm_results_t *r = &cm->res;
     const ctrl_bases_t *b = &r->bases;
     o->have = r->have;
-    o->vbus_v = cm_si(r->vbus, b->v_v);
-    for (int k = 0; k < 3; k++) {
-        o->i_off_a[k] = cm_si(r->i_off[k], b->i_a);
-        o->i_noise_a[k] = cm_si(r->i_noise[k], b->i_a);
+    for (size_t k = 0; k < sizeof cm_pu_fields / sizeof cm_pu_fields[0]; k++) {
+        const double base = cm_base_at(b, cm_pu_fields[k].base);
+        for (uint16_t j = 0; cm_pu_fields[k].si != CM_SI_NONE && j < cm_pu_fields[k].n; j++) {
+            q24_t x;
+            memcpy(&x, (const char *)r + cm_pu_fields[k].res + j * sizeof x, sizeof x);
+            const double v = cm_si(x, base);
+            memcpy((char *)o + cm_pu_fields[k].si + j * sizeof v, &v, sizeof v);
+        }
     }
-    o->l_probe_h = cm_si(r->l_probe, b->l_h);
     o->enc_dir = (enc_dir_cfg < 0 ? -1 : 1) * (r->enc_dir < 0 ? -1 : 1);
     o->enc_offset_deg = (double)r->enc_off / 4294967296.0 * 360.0;
     o->enc_cpr = r->enc_cpr;
     o->enc_cpr_cfg = cm->par.enc_cpr;
     o->unbalance = (double)r->unbalance / 16777216.0;
-    o->rs_ohm = cm_si(r->rs, b->r_ohm);
-    o->v_inv_v = cm_si(r->v_inv, b->v_v);
-    o->ld_h = cm_si(r->ld, b->l_h);
-    o->lq_h = cm_si(r->lq, b->l_h);
-    o->ld_raw_h = cm_si(r->ld_raw, b->l_h);
-    o->lq_raw_h = cm_si(r->lq_raw, b->l_h);
     o->salient = r->salient != 0u;
-    o->psi_wb = cm_si(r->psi, b->psi_wb);
-    o->psi_pos_wb = cm_si(r->psi_pos, b->psi_wb);
-    o->psi_neg_wb = cm_si(r->psi_neg, b->psi_wb);
-    o->omega_flux_rad_s = cm_si(r->omega_flux, b->w_rad_s);
     o->inertia_kgm2 = NAN;
     o->friction_nms = NAN;
     if ((r->have & CM_HAVE_MECH) != 0u && r->acc_dw > 0 && r->acc_n > 0u && pole_pairs > 0u) {
@@ -448,6 +472,13 @@ static void cm_add(cm_outcome_t *o, const char *label, double v, const char *uni
     }
 }
 
+/* A value in pu (or counts, an angle) with its kind's SI unit. */
+static void cm_add_pu(cm_outcome_t *o, const char *label, int32_t v, uint8_t kind,
+                      const ctrl_bases_t *b)
+{
+    cm_add(o, label, cm_value(v, kind, b), cm_units[kind]);
+}
+
 void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
 {
     memset(o, 0, sizeof *o);
@@ -471,8 +502,7 @@ void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
         const cm_detail_t *d = &cm_err_detail[cm->err];
         for (int k = 0; k < 3; k++) {
             if (d->label[k] != NULL) {
-                cm_add(o, d->label[k], cm_value(cm->detail[k], d->kind[k], b),
-                       cm_units[d->kind[k]]);
+                cm_add_pu(o, d->label[k], cm->detail[k], d->kind[k], b);
             }
         }
         return;
@@ -487,18 +517,18 @@ void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
             off = fmax(off, fabs(cm_si(r->i_off[k], rb->i_a)));
             sd = fmax(sd, cm_si(r->i_noise[k], rb->i_a));
         }
-        cm_add(o, "vbus", cm_si(r->vbus, rb->v_v), "V");
+        cm_add_pu(o, "vbus", r->vbus, K_V, rb);
         cm_add(o, "offset_max", off, "A");
         cm_add(o, "noise_max", sd, "A");
         break;
     }
     case CM_STEP_PROBE:
-        cm_add(o, "inductance", cm_si(r->l_probe, rb->l_h), "H");
+        cm_add_pu(o, "inductance", r->l_probe, K_H, rb);
         break;
     case CM_STEP_ENCODER:
-        cm_add(o, "direction", (double)r->enc_dir, "");
-        cm_add(o, "counts", (double)r->enc_cpr, "");
-        cm_add(o, "offset", cm_value((int32_t)r->enc_off, K_DEG, rb), "deg");
+        cm_add_pu(o, "direction", r->enc_dir, K_INT, rb);
+        cm_add_pu(o, "counts", (int32_t)r->enc_cpr, K_INT, rb);
+        cm_add_pu(o, "offset", (int32_t)r->enc_off, K_DEG, rb);
         break;
     case CM_STEP_SENSE:
         for (int k = 0; k < 3; k++) {
@@ -507,20 +537,20 @@ void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
         }
         break;
     case CM_STEP_RUN:
-        cm_add(o, "speed_gain", cm_si(cm->detail[0], b->w_rad_s), "rad/s");
-        cm_add(o, "periods", (double)cm->detail[1], "");
-        cm_add(o, "torque", cm_si(cm->detail[2], b->torque_nm), "N*m");
+        cm_add_pu(o, "speed_gain", cm->detail[0], K_RAD_S, b);
+        cm_add_pu(o, "periods", cm->detail[1], K_INT, b);
+        cm_add_pu(o, "torque", cm->detail[2], K_NM, b);
         break;
     default:
         /* A whole identification: its main figures. */
         if ((r->have & CM_HAVE_RS) != 0u) {
-            cm_add(o, "rs", cm_si(r->rs, rb->r_ohm), "Ohm");
+            cm_add_pu(o, "rs", r->rs, K_OHM, rb);
         }
         if ((r->have & CM_HAVE_LDQ) != 0u) {
-            cm_add(o, "ld", cm_si(r->ld, rb->l_h), "H");
+            cm_add_pu(o, "ld", r->ld, K_H, rb);
         }
         if ((r->have & CM_HAVE_FLUX) != 0u) {
-            cm_add(o, "psi", cm_si(r->psi, rb->psi_wb), "Wb");
+            cm_add_pu(o, "psi", r->psi, K_WB, rb);
         }
         break;
     }
