@@ -21,35 +21,46 @@ static int64_t cfg_round(double x)
     return (int64_t)(x >= 0.0 ? x + 0.5 : x - 0.5);
 }
 
+/* c[0] + z (c[1] + z (... + z c[n - 1])) by Horner's rule: the nested form's
+ * operations in its order (one loop instead of a call pair per term). */
+static double cfg_horner(const double *c, int n, double z)
+{
+    double p = c[n - 1];
+    for (int k = n - 2; k >= 0; k--) {
+        p = c[k] + z * p;
+    }
+    return p;
+}
+
 /* sin r, cos r for |r| <= pi/4: Taylor to r^17 and r^18 (the next terms are
  * below 1e-19 of the result), by Horner's rule in r^2. */
+static const double cfg_sin_coef[] = {
+    -1.0 / 6.0,        1.0 / 120.0,        -1.0 / 5040.0,          1.0 / 362880.0,
+    -1.0 / 39916800.0, 1.0 / 6227020800.0, -1.0 / 1307674368000.0, 1.0 / 355687428096000.0,
+};
+static const double cfg_cos_coef[] = {
+    -0.5,
+    1.0 / 24.0,
+    -1.0 / 720.0,
+    1.0 / 40320.0,
+    -1.0 / 3628800.0,
+    1.0 / 479001600.0,
+    -1.0 / 87178291200.0,
+    1.0 / 20922789888000.0,
+    -1.0 / 6402373705728000.0,
+};
+#define CFG_N(a) ((int)(sizeof(a) / sizeof((a)[0])))
+
 static double cfg_sin_kernel(double r)
 {
     const double z = r * r;
-    const double p =
-        -1.0 / 6.0 +
-        z * (1.0 / 120.0 +
-             z * (-1.0 / 5040.0 +
-                  z * (1.0 / 362880.0 +
-                       z * (-1.0 / 39916800.0 +
-                            z * (1.0 / 6227020800.0 +
-                                 z * (-1.0 / 1307674368000.0 + z * (1.0 / 355687428096000.0)))))));
-    return r + r * z * p;
+    return r + r * z * cfg_horner(cfg_sin_coef, CFG_N(cfg_sin_coef), z);
 }
 
 static double cfg_cos_kernel(double r)
 {
     const double z = r * r;
-    const double p =
-        -0.5 +
-        z * (1.0 / 24.0 +
-             z * (-1.0 / 720.0 +
-                  z * (1.0 / 40320.0 + z * (-1.0 / 3628800.0 +
-                                            z * (1.0 / 479001600.0 +
-                                                 z * (-1.0 / 87178291200.0 +
-                                                      z * (1.0 / 20922789888000.0 +
-                                                           z * (-1.0 / 6402373705728000.0))))))));
-    return 1.0 + z * p;
+    return 1.0 + z * cfg_horner(cfg_cos_coef, CFG_N(cfg_cos_coef), z);
 }
 
 void ctrl_cfg_sincos(double x, double *s, double *c)
@@ -103,6 +114,24 @@ double ctrl_cfg_cos(double x)
     return c;
 }
 
+/* e^r, |r| <= ln2 / 2: Taylor to r^13 (the next term < 5e-18). */
+static const double cfg_exp_coef[] = {
+    1.0,
+    1.0,
+    1.0 / 2.0,
+    1.0 / 6.0,
+    1.0 / 24.0,
+    1.0 / 120.0,
+    1.0 / 720.0,
+    1.0 / 5040.0,
+    1.0 / 40320.0,
+    1.0 / 362880.0,
+    1.0 / 3628800.0,
+    1.0 / 39916800.0,
+    1.0 / 479001600.0,
+    1.0 / 6227020800.0,
+};
+
 double ctrl_cfg_exp(double x)
 {
     if (!(x == x)) {
@@ -114,26 +143,11 @@ double ctrl_cfg_exp(double x)
     if (x < -708.0) {
         return 0.0;
     }
-    /* e^x = 2^k e^r, |r| <= ln2 / 2: Taylor to r^13 (the next term < 5e-18). */
+    /* e^x = 2^k e^r, |r| <= ln2 / 2 */
     const int64_t k = cfg_round(x * CFG_1_OVER_LN2);
     const double dk = (double)k;
     const double r = (x - dk * CFG_LN2_HI) - dk * CFG_LN2_LO;
-    const double p =
-        1.0 +
-        r * (1.0 +
-             r * (1.0 / 2.0 +
-                  r * (1.0 / 6.0 +
-                       r * (1.0 / 24.0 +
-                            r * (1.0 / 120.0 +
-                                 r * (1.0 / 720.0 +
-                                      r * (1.0 / 5040.0 +
-                                           r * (1.0 / 40320.0 +
-                                                r * (1.0 / 362880.0 +
-                                                     r * (1.0 / 3628800.0 +
-                                                          r * (1.0 / 39916800.0 +
-                                                               r * (1.0 / 479001600.0 +
-                                                                    r * (1.0 /
-                                                                         6227020800.0)))))))))))));
+    const double p = cfg_horner(cfg_exp_coef, CFG_N(cfg_exp_coef), r);
     /* 2^k exactly, k in [-1022, 1023]: the biased exponent alone */
     const uint64_t bits = (uint64_t)(k + 1023) << 52;
     double scale;
