@@ -144,12 +144,12 @@ static int svm_dtc_init(void *state, const void *cfg, const ctrl_setup_t *su)
         return rc;
     }
     s->kp = ctrl_q24_from_double(c->kp);
-    s->ki = (int32_t)llround(c->ki * 1073741824.0); /* Q30, ki <= 10 < 2: checked below */
+    s->ki = (int32_t)ctrl_cfg_llround(c->ki * 1073741824.0); /* Q30, ki <= 10 < 2: checked below */
     if (c->ki >= 1.99) {
         memset(s, 0, sizeof *s);
         return CTRL_ERANGE;
     }
-    s->inv_ts = (int32_t)llround(65536.0 / ts);
+    s->inv_ts = (int32_t)ctrl_cfg_llround(65536.0 / ts);
     s->ff = (uint8_t)(c->omega_ff >= 0.5);
     ctrl_svm_dtc_reset(s);
     return CTRL_OK;
@@ -172,8 +172,8 @@ int ctrl_hpdtc_timing_table(double tilt, uint8_t pts[HPDTC_LEVELS][HPDTC_SECTION
             a = a < 0.0 ? 0.0 : (a > 60.0 * deg ? 60.0 * deg : a);
             /* SVM dwell times: v = t1 V_k1 + t2 V_k2 (Ts = 1) gives
              * t1 = |v| sin(60 - a) / (|V_k| sin 60) = m sin(60 - a), t2 = m sin(a). */
-            long p1 = lround(HPDTC_POINTS * m * ctrl_cfg_sin(60.0 * deg - a));
-            long p2 = lround(HPDTC_POINTS * m * ctrl_cfg_sin(a));
+            long long p1 = ctrl_cfg_llround(HPDTC_POINTS * m * ctrl_cfg_sin(60.0 * deg - a));
+            long long p2 = ctrl_cfg_llround(HPDTC_POINTS * m * ctrl_cfg_sin(a));
             while (p1 + p2 > HPDTC_POINTS) { /* rounding only: never beyond the hexagon */
                 if (p1 >= p2) {
                     p1--;

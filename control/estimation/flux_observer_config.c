@@ -72,11 +72,11 @@ int ctrl_fobs_init(ctrl_fobs_t *o, const ctrl_params_t *p, const ctrl_bases_t *b
         }
         return CTRL_EINVAL;
     }
-    n.pll_ki = (int32_t)lround(ki);
+    n.pll_ki = (int32_t)ctrl_cfg_llround(ki);
     n.dt_frac = ctrl_q24_from_double(c->dead_time_s * fs);
     n.v_fwd = ctrl_q24_from_double(c->v_fwd_v / b->v_v);
-    n.inv_band =
-        (int32_t)lround(65536.0 / band_pu < 2147483647.0 ? 65536.0 / band_pu : 2147483647.0);
+    n.inv_band = (int32_t)ctrl_cfg_llround(65536.0 / band_pu < 2147483647.0 ? 65536.0 / band_pu
+                                                                            : 2147483647.0);
     n.psi_k = c->psi_tau_s > 0.0 ? ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-ts / c->psi_tau_s)) : 0;
     n.psi_speed_min =
         ctrl_q24_from_double(c->psi_speed_min * (double)p->speed_rated_e / (double)FX_ONE);

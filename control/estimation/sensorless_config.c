@@ -2,6 +2,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 #include "fx.h"
 #include "sensorless.h"
@@ -63,7 +64,8 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
     const double vdc = (double)p->vdc_nom * b->v_v / (double)FX_ONE;
     const double v = fmin(c->ia_i_frac * i_rated * l_mean * fs, 0.45 * vdc);
     const q24_t v_q = ctrl_q24_from_double(v / b->v_v);
-    if (ctrl_ia_init(&n->ia, v_q, (uint32_t)llround(c->ia_rounds), lq > ld ? 1 : -1) != 0) {
+    if (ctrl_ia_init(&n->ia, v_q, (uint32_t)ctrl_cfg_llround(c->ia_rounds), lq > ld ? 1 : -1) !=
+        0) {
         (void)ctrl_diag_in_range(why, "ia_i_frac", "", c->ia_i_frac, 1.0, 0.0);
         return CTRL_EINVAL;
     }
@@ -89,10 +91,11 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
         const double iq = (1.0 - f) * p->mtpa_iq[k] + f * p->mtpa_iq[k + 1];
         /* beta = atan2(-i_d, i_q) by the core's own fx_atan2 (|i| < 2^31 in
          * Q24: the table's values), not libm's: host and target alike */
-        n->pol_shift = fx_atan2((int32_t)llround(-id), (int32_t)llround(iq));
+        n->pol_shift = fx_atan2((int32_t)ctrl_cfg_llround(-id), (int32_t)ctrl_cfg_llround(iq));
     }
     n->zero_n = (uint32_t)ceil(1e-3 * fs); /* the current back to zero: 1 ms */
-    n->pol_min = (fx_angle_t)(uint32_t)llround(c->pol_min_frac * c->pol_deg / 360.0 * 4294967296.0);
+    n->pol_min =
+        (fx_angle_t)(uint32_t)ctrl_cfg_llround(c->pol_min_frac * c->pol_deg / 360.0 * 4294967296.0);
     return CTRL_OK;
 #endif
 }
@@ -158,7 +161,7 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
         if (!ctrl_diag_in_range(why, "damp_zeta", "", kd, 0.0, (double)CTRL_SL_KD_MAX)) {
             return CTRL_EINVAL;
         }
-        n.kd = (int64_t)llround(kd);
+        n.kd = (int64_t)ctrl_cfg_llround(kd);
     }
     if (sl_ia_init(&n, p, b, c, why) != CTRL_OK) {
         return CTRL_EINVAL;

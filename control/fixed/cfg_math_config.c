@@ -21,6 +21,15 @@ static int64_t cfg_round(double x)
     return (int64_t)(x >= 0.0 ? x + 0.5 : x - 0.5);
 }
 
+/* 2^n exactly, n in [-1022, 1023]: the biased exponent alone */
+static double cfg_pow2(int n)
+{
+    const uint64_t bits = (uint64_t)(n + 1023) << 52;
+    double v;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
 /* c[0] + z (c[1] + z (... + z c[n - 1])) by Horner's rule: the nested form's
  * operations in its order (one loop instead of a call pair per term). */
 static double cfg_horner(const double *c, int n, double z)
@@ -148,11 +157,50 @@ double ctrl_cfg_exp(double x)
     const double dk = (double)k;
     const double r = (x - dk * CFG_LN2_HI) - dk * CFG_LN2_LO;
     const double p = cfg_horner(cfg_exp_coef, CFG_N(cfg_exp_coef), r);
-    /* 2^k exactly, k in [-1022, 1023]: the biased exponent alone */
-    const uint64_t bits = (uint64_t)(k + 1023) << 52;
-    double scale;
-    memcpy(&scale, &bits, sizeof scale);
-    return p * scale;
+    return p * cfg_pow2((int)k); /* k in [-1022, 1023] */
+}
+
+double ctrl_cfg_ldexp(double x, int n)
+{
+    return n >= -1022 && n <= 1023 ? x * cfg_pow2(n) : NAN;
+}
+
+int ctrl_cfg_exponent(double x)
+{
+    if (!(x == x) || x == 0.0 || x - x != 0.0) { /* NaN, 0, +-inf */
+        return 0;
+    }
+    uint64_t bits;
+    int e = 0;
+    if (x > -0x1p-1022 && x < 0x1p-1022) { /* subnormal: scale into the normal range */
+        x *= 0x1p64;
+        e = -64;
+    }
+    memcpy(&bits, &x, sizeof bits);
+    return e + (int)((bits >> 52) & 0x7ffu) - 1022;
+}
+
+long long ctrl_cfg_llround(double x)
+{
+    if (!(x == x)) {
+        return 0;
+    }
+    if (x >= 0x1p63) {
+        return INT64_MAX;
+    }
+    if (x <= -0x1p63) {
+        return INT64_MIN;
+    }
+    /* the integer part (toward zero), then the remainder, exact: x and n
+     * differ by less than 1 and have the same sign (Sterbenz) */
+    long long n = (long long)x;
+    const double r = x - (double)n;
+    if (r >= 0.5) {
+        n++;
+    } else if (r <= -0.5) {
+        n--;
+    }
+    return n;
 }
 
 double ctrl_cfg_hypot(double x, double y)

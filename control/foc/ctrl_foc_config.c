@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_foc.h"
 #include "ctrl_foc_config.h"
 #include "ctrl_params.h"
@@ -85,13 +86,13 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
                                  FOC_KI_TS_MAX);
     }
     unsigned ki_shift = 30u;
-    while (ki_shift > 17u && ki_ts * ldexp(1.0, (int)ki_shift) >= 2147483000.0) {
+    while (ki_shift > 17u && ki_ts * ctrl_cfg_ldexp(1.0, (int)ki_shift) >= 2147483000.0) {
         ki_shift--;
     }
-    pi->kp = (int32_t)llround(kp * 1048576.0); /* Q20 */
+    pi->kp = (int32_t)ctrl_cfg_llround(kp * 1048576.0); /* Q20 */
     /* Q(24 + ki_shift): vdc_nom <= 32 pu (2^29), so lim <= 2^59 */
     pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << ki_shift);
-    pi->ki_ts = (int32_t)llround(ldexp(ki_ts, (int)ki_shift));
+    pi->ki_ts = (int32_t)ctrl_cfg_llround(ctrl_cfg_ldexp(ki_ts, (int)ki_shift));
     pi->ki_shift = (uint8_t)ki_shift;
     pi->integ = 0;
     return CTRL_OK;

@@ -26,4 +26,16 @@ double ctrl_cfg_exp(double x);
  * configuration magnitudes are far from 1e154). */
 double ctrl_cfg_hypot(double x, double y);
 
+/* x 2^n for n in [-1022, 1023]: a product by a power of two, exact wherever
+ * the result is a normal double (libm's ldexp, without its 0.4 KB). */
+double ctrl_cfg_ldexp(double x, int n);
+
+/* The binary exponent e of a finite x != 0, |x| in [2^(e-1), 2^e) (frexp's
+ * exponent); 0 for 0, infinities and NaN. */
+int ctrl_cfg_exponent(double x);
+
+/* x to the nearest integer, halves away from zero (llround's result for
+ * |x| < 2^63); NaN -> 0, beyond the int64 range the nearest end of it. */
+long long ctrl_cfg_llround(double x);
+
 #endif /* CTRL_CFG_MATH_H */

@@ -44,7 +44,7 @@ q24_t ctrl_q24_from_double(double pu)
     if (x <= -2147483648.0) {
         return FX_MIN;
     }
-    return (q24_t)llround(x); /* half away from zero */
+    return (q24_t)ctrl_cfg_llround(x); /* half away from zero */
 }
 
 double ctrl_q24_to_double(q24_t x)
@@ -131,7 +131,7 @@ static int mtpa_table(ctrl_params_t *p, double ld, double lq, double psi_pm, dou
         return CTRL_ERANGE;
     }
     p->mtpa_t_max = ctrl_q24_from_double(t_max);
-    p->mtpa_scale = (int32_t)llround(scale * 65536.0);
+    p->mtpa_scale = (int32_t)ctrl_cfg_llround(scale * 65536.0);
     return CTRL_OK;
 }
 
@@ -275,8 +275,9 @@ static int params_compute(ctrl_params_t *p, ctrl_bases_t *b, const ctrl_machine_
      * the inverse coefficient in Q26 (CTRL_DANGLE_SHIFT): an int32_t for
      * Ts_pu >= CTRL_TS_PU_MIN, >= 2^20 significant for Ts_pu <= 1.5. */
     const double k_ang = ts / CTRL_TWO_PI * 4294967296.0;
-    p->omega_to_dangle = (int32_t)llround(k_ang);
-    p->dangle_to_omega = (int32_t)llround(ldexp(16777216.0 / k_ang, (int)CTRL_DANGLE_SHIFT));
+    p->omega_to_dangle = (int32_t)ctrl_cfg_llround(k_ang);
+    p->dangle_to_omega =
+        (int32_t)ctrl_cfg_llround(ctrl_cfg_ldexp(16777216.0 / k_ang, (int)CTRL_DANGLE_SHIFT));
 
     if (ctrl_params_set_speed_lpf(p, CTRL_SPEED_LPF_HZ_DEFAULT) != CTRL_OK &&
         ctrl_params_set_speed_lpf(p, 0.25 * (double)fs_hz) != CTRL_OK) {

@@ -1,6 +1,7 @@
 /* Dead-time and device-drop compensation: SI -> fixed point (configuration). */
 #include <math.h>
 
+#include "ctrl_cfg_math.h"
 #include "deadtime.h"
 
 /* A leg against the motor's neutral, the other two legs' mean following it:
@@ -34,7 +35,8 @@ int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, cons
     n.dd = ctrl_q24_from_double(c->dead_time_s * fs + c->v_fwd_v / vdc_v);
     n.dt = ctrl_q24_from_double(c->dead_time_s * fs);
     n.high_prev = 0u;
-    n.inv_band = (int32_t)lround(fmin((double)(1u << CTRL_DT_BAND_SHIFT) / band_pu, 2147483647.0));
+    n.inv_band =
+        (int32_t)ctrl_cfg_llround(fmin((double)(1u << CTRL_DT_BAND_SHIFT) / band_pu, 2147483647.0));
     *d = n;
     return CTRL_OK;
 }

@@ -102,7 +102,7 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     const double c1 = psi / ld;
     const double c2 = 1.0 / ld - 1.0 / lq;
     const double vf = c->v_frac / sqrt(3.0);
-    s->v_frac = (int32_t)lround(vf * (double)(1L << 30));
+    s->v_frac = (int32_t)ctrl_cfg_llround(vf * (double)(1L << 30));
     int rc = CTRL_OK;
     rc = rc ? rc : fw_q24(i, "current limit", &s->i_max, why, why_len);
     rc = rc ? rc : fw_q24(2.0 * rs, "2 Rs", &s->two_rs, why, why_len);

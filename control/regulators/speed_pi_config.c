@@ -10,6 +10,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
 #include "speed_pi.h"
 #include "speed_pi_config.h"
@@ -24,20 +25,18 @@ static int gain_q(double g, unsigned max_shift, int32_t *mant, uint8_t *shift)
         *shift = 1u;
         return CTRL_OK;
     }
-    int e;
-    (void)frexp(g, &e);
-    int s = 31 - e;
+    int s = 31 - ctrl_cfg_exponent(g);
     if (s < 1) {
         return CTRL_ERANGE; /* gain >= 2^30 pu: absurd */
     }
     if (s > (int)max_shift) {
         s = (int)max_shift;
     }
-    double m = ldexp(g, s);
+    double m = ctrl_cfg_ldexp(g, s);
     if (m > 2147483647.0) {
         m = 2147483647.0;
     }
-    const long long r = llround(m);
+    const long long r = ctrl_cfg_llround(m);
     if (r == 0) {
         return CTRL_ERANGE;
     }
@@ -95,7 +94,7 @@ int ctrl_speed_pi_config_diag(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, in
         return speed_pi_refuse(why, "speed-loop torque limit", out_pu, 0x1p-24, 128.0,
                                "speed_out_max_nm, torque base");
     }
-    const q24_t out_max = (q24_t)llround(out_pu * 16777216.0);
+    const q24_t out_max = (q24_t)ctrl_cfg_llround(out_pu * 16777216.0);
     /* integ <= out_max * 2^ki_shift must stay below 2^61 (no overflow of
      * integ + e * ki_ts, each term < 2^62). */
     unsigned bits = 0u;
@@ -114,7 +113,7 @@ int ctrl_speed_pi_config_diag(ctrl_speed_pi_t *pi, const ctrl_bases_t *bases, in
     }
     if (gain_q(ki_ts_pu, ki_max_shift, &ki_m, &ki_s) != CTRL_OK) {
         return speed_pi_refuse(why, "speed PI integral gain x loop period", ki_ts_pu,
-                               ldexp(1.0, -(int)ki_max_shift - 1), 0x1p30,
+                               ctrl_cfg_ldexp(1.0, -(int)ki_max_shift - 1), 0x1p30,
                                "speed_ki, or inertia_kgm2 and the speed-loop bandwidth");
     }
     pi->kp = kp_m;
