@@ -27,8 +27,9 @@ int main(void)
     static const ctrl_machine_t machine = {
         "thesis_spmsm", 4,   0.901,  6.552e-3, 6.552e-3, 0.09427, 220.0,
         1.2e-4,         2.4, 3000.0, 4.2,      10.5,     0.0,     0.0};
-    const hal_info_t info = {10000u, 2500u,     12u, 15.75 / 2048.0, 440.0 / 4096.0, 10000u,
-                             false,  25000000u, 0u};
+    /* zero current at mid-scale, its tolerance the default (hal.h) */
+    const hal_info_t info = {
+        10000u, 2500u, 12u, 15.75 / 2048.0, 440.0 / 4096.0, 10000u, false, 25000000u, 0u, 0u, 0u};
     const ctrl_desc_t *desc = ctrl_at(0);
     if (desc == NULL) {
         return 0;
