@@ -203,19 +203,21 @@ static void fobs_pll(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_r)
     o->pll_theta += ctrl_angle_step(p, omega_i) + (fx_angle_t)(uint32_t)kpe;
 }
 
-/* The flux moved by the correction (corr_d, corr_q) of the frame (s, c). */
-static void fobs_move(ctrl_fobs_t *o, q24_t corr_d, q24_t corr_q, q24_t s, q24_t c)
+/* The flux (*a, *b: alpha, beta, Q48) moved by the correction (corr_d,
+ * corr_q) of the frame (s, c): inverse Park (3.7) inline, the same rounded and
+ * saturated sums as ctrl_inv_park (alpha = c d - s q, beta = s d + c q), then
+ * the clamp. One copy for the sensorless observer's correction and the
+ * encoder mode's pull. */
+static void fobs_move(int64_t *a, int64_t *b, q24_t corr_d, q24_t corr_q, q24_t s, q24_t c)
 {
-    /* Inverse Park (3.7) inline, the same rounded and saturated sums as
-     * ctrl_inv_park: alpha = c d - s q, beta = s d + c q. */
     const q24_t ca = fx_cross(c, s, corr_q, corr_d);
     const q24_t cb = fx_dot(s, c, corr_d, corr_q);
-    o->psi_alpha_acc = fobs_clamp(o->psi_alpha_acc + (int64_t)ca * FX_ONE);
-    o->psi_beta_acc = fobs_clamp(o->psi_beta_acc + (int64_t)cb * FX_ONE);
+    *a = fobs_clamp(*a + (int64_t)ca * FX_ONE);
+    *b = fobs_clamp(*b + (int64_t)cb * FX_ONE);
 }
 
-q24_t ctrl_fobs_pull_encoder(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t s, q24_t c, q24_t i_d,
-                             q24_t i_q)
+q24_t ctrl_fobs_pull_delta(const ctrl_fobs_t *o, const ctrl_params_t *p, const int64_t acc[2],
+                           q24_t s, q24_t c, q24_t i_d, q24_t i_q, int64_t delta[2])
 {
     /* The flux at k in the measured frame (Park (3.7)), towards the current
      * model (3.9) there. */
@@ -224,7 +226,11 @@ q24_t ctrl_fobs_pull_encoder(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t s, q2
     const q24_t ld_id = fx_mul(p->ld, i_d);
     const q24_t e_d = fx_sub(fx_add(ld_id, p->psi_pm), psi_d);
     const q24_t e_q = fx_sub(fx_mul(p->lq, i_q), psi_q);
-    fobs_move(o, fx_mul(o->kenc_ts, e_d), fx_mul(o->kenc_ts, e_q), s, c);
+    int64_t a = acc[0];
+    int64_t b = acc[1];
+    fobs_move(&a, &b, fx_mul(o->kenc_ts, e_d), fx_mul(o->kenc_ts, e_q), s, c);
+    delta[0] = a - acc[0]; /* |acc| < 2^62 (psi_track.h), |a| <= 127 2^48: no overflow */
+    delta[1] = b - acc[1];
     return fx_sub(psi_d, ld_id);
 }
 
@@ -242,7 +248,12 @@ void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_
     }
     q24_t pm; /* PM flux psi_d - Ld i_d of the flux at k */
     if (o->mode == CTRL_FOBS_ENCODER) {
-        pm = ctrl_fobs_pull_encoder(o, p, s, c, i_d, i_q);
+        /* towards the current model at the measured angle */
+        const int64_t acc[2] = {o->psi_alpha_acc, o->psi_beta_acc};
+        int64_t delta[2];
+        pm = ctrl_fobs_pull_delta(o, p, acc, s, c, i_d, i_q, delta);
+        o->psi_alpha_acc = acc[0] + delta[0];
+        o->psi_beta_acc = acc[1] + delta[1];
     } else {
         /* Magnitude of the active flux towards psi_a, along (psi_a, -(Ld - Lq) i_q). */
         const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
@@ -251,7 +262,8 @@ void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_
         const q24_t w = fx_abs(o->omega);
         const q24_t kts = fx_min(fx_add(o->k0_ts, fx_mul(o->kappa_ts, w)), CTRL_FOBS_KTS_MAX);
         const q24_t g = fx_mul(fx_mul(kts, fx_sub(psi_a, eta_d)), p->inv_psi_pm);
-        fobs_move(o, fx_mul(g, psi_a), fx_neg(fx_mul(g, fx_mul(o->dl, i_q))), s, c);
+        fobs_move(&o->psi_alpha_acc, &o->psi_beta_acc, fx_mul(g, psi_a),
+                  fx_neg(fx_mul(g, fx_mul(o->dl, i_q))), s, c);
         pm = o->psi_k != 0 ? fx_sub(psi_d, fx_mul(p->ld, i_d)) : 0;
     }
 

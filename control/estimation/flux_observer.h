@@ -142,12 +142,14 @@ void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_
                        q24_t i_d, q24_t i_q);
 
 /* The encoder-mode correction of ctrl_fobs_correct alone (no PLL, no
- * PM-flux EMA): the flux at k (psi_alpha/beta) pulled towards the current
- * model at the measured angle (s, c its sine and cosine, i_d, i_q the current
- * in that frame). Returns the PM flux psi_d - Ld i_d of the flux at k, the
- * EMA's input. */
-q24_t ctrl_fobs_pull_encoder(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t s, q24_t c, q24_t i_d,
-                             q24_t i_q);
+ * PM-flux EMA), without the move: the flux at k, acc (Q48, alpha and beta; its
+ * Q24 view in o->psi_alpha/beta), pulled towards the current model at the
+ * measured angle (s, c its sine and cosine, i_d, i_q the current in that
+ * frame); *delta (Q48) is what the pull adds (the clamped sum less acc, so that
+ * acc + delta is the pulled flux). Reads o, writes nothing of it. Returns the
+ * PM flux psi_d - Ld i_d of the flux at k, the EMA's input. */
+q24_t ctrl_fobs_pull_delta(const ctrl_fobs_t *o, const ctrl_params_t *p, const int64_t acc[2],
+                           q24_t s, q24_t c, q24_t i_d, q24_t i_q, int64_t delta[2]);
 
 /* One step of the PM-flux EMA towards pm (Q24 pu) with coefficient k (Q24). */
 void ctrl_fobs_psi_pm_step(ctrl_fobs_t *o, q24_t pm, q24_t k);

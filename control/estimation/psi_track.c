@@ -14,22 +14,27 @@ void ctrl_psi_track_reset(ctrl_psi_track_t *t)
 /* Correction towards the current model (3.9) at the measured angle in the
  * estimator's frame at k, and the PM-flux EMA where the voltage model is
  * reliable (the encoder's speed above the threshold): the observer's own
- * (ctrl_fobs_pull_encoder, ctrl_fobs_psi_pm_step) with the gains of N periods,
- * k_N and 1 - exp(-N Ts / tau); its PLL is not needed here. Returns whether
- * the estimate moved. */
-static bool psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
-                              const ctrl_estimate_t *est)
+ * (ctrl_fobs_pull_delta, ctrl_fobs_psi_pm_step) with the gains of N periods,
+ * k_N and 1 - exp(-N Ts / tau); its PLL is not needed here. */
+bool ctrl_psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                            const ctrl_psi_track_in_t *in, int64_t delta[2])
 {
     ctrl_fobs_t *const o = &t->obs;
-    const ctrl_mstate_t *n = &est->now;
-    o->psi_alpha = fx_round_sat(o->psi_alpha_acc, FX_QBITS);
-    o->psi_beta = fx_round_sat(o->psi_beta_acc, FX_QBITS);
-    const q24_t pm = ctrl_fobs_pull_encoder(o, p, n->sin_theta, n->cos_theta, n->i_d, n->i_q);
-    if (t->psi_k_n == 0 || fx_abs(est->omega_e) < t->speed_min) {
+    o->psi_alpha = fx_round_sat(in->acc[0], FX_QBITS);
+    o->psi_beta = fx_round_sat(in->acc[1], FX_QBITS);
+    const q24_t pm =
+        ctrl_fobs_pull_delta(o, p, in->acc, in->sin_theta, in->cos_theta, in->i_d, in->i_q, delta);
+    if (t->psi_k_n == 0 || fx_abs(in->omega_e) < t->speed_min) {
         return false;
     }
     ctrl_fobs_psi_pm_step(o, pm, t->psi_k_n);
     return true;
+}
+
+void ctrl_psi_track_add(ctrl_psi_track_t *t, const int64_t delta[2])
+{
+    t->obs.psi_alpha_acc += delta[0];
+    t->obs.psi_beta_acc += delta[1];
 }
 
 static void psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est)
@@ -41,8 +46,9 @@ static void psi_track_prime(ctrl_psi_track_t *t, const ctrl_params_t *p, const c
     t->until = (uint8_t)(t->div > 1u ? 2u : 1u); /* the first correction at the next step */
 }
 
-bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
-                         const ctrl_legs_t *applied, q24_t i_a, q24_t i_b)
+bool ctrl_psi_track_integrate(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                              const ctrl_estimate_t *est, const ctrl_legs_t *applied, q24_t i_a,
+                              q24_t i_b, ctrl_psi_track_in_t *due)
 {
     ctrl_fobs_t *const o = &t->obs;
     const ctrl_mstate_t *n = &est->now;
@@ -67,10 +73,18 @@ bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl
     }
     t->i_prev[0] = i_now[0];
     t->i_prev[1] = i_now[1];
-    bool moved = false;
+    bool is_due = false;
     if (--t->until == 0u) {
+        /* the flux at k (before the voltage of [k, k+1)) and the frame */
         t->until = t->div;
-        moved = psi_track_correct(t, p, est);
+        due->acc[0] = o->psi_alpha_acc;
+        due->acc[1] = o->psi_beta_acc;
+        due->sin_theta = n->sin_theta;
+        due->cos_theta = n->cos_theta;
+        due->i_d = n->i_d;
+        due->i_q = n->i_q;
+        due->omega_e = est->omega_e;
+        is_due = true;
     }
     /* the voltage of [k, k+1) */
     if (t->duty_v != 0u) {
@@ -86,5 +100,18 @@ bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl
         o->psi_alpha_acc += (int64_t)p->ts * v_alpha;
         o->psi_beta_acc += (int64_t)p->ts * v_beta;
     }
+    return is_due;
+}
+
+bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
+                         const ctrl_legs_t *applied, q24_t i_a, q24_t i_b)
+{
+    ctrl_psi_track_in_t due;
+    if (!ctrl_psi_track_integrate(t, p, est, applied, i_a, i_b, &due)) {
+        return false;
+    }
+    int64_t delta[2];
+    const bool moved = ctrl_psi_track_correct(t, p, &due, delta);
+    ctrl_psi_track_add(t, delta);
     return moved;
 }

@@ -17,7 +17,7 @@
  *                  of the estimator (its sin/cos, i_dq: no table look-up, no
  *                  angle), k_N = 1 - (1 - w_c Ts)^N, the N per-period
  *                  corrections in one, and the EMA with 1 - exp(-N Ts / tau):
- *                  the observer's ctrl_fobs_pull_encoder and
+ *                  the observer's ctrl_fobs_pull_delta and
  *                  ctrl_fobs_psi_pm_step with these gains.
  * N is the largest divider (<= CTRL_PSI_TRACK_DIV_MAX) with which the flux
  * turns at most a quarter turn between two corrections at twice the rated
@@ -55,6 +55,16 @@ typedef struct {
     uint8_t duty_v;  /* 1: the estimator's duty voltage (no dead time, no drop to remove) */
 } ctrl_psi_track_t;
 
+/* The correction's inputs at period 0 of N (ctrl_psi_track_integrate): the
+ * voltage model's flux at k and the estimator's frame, current and speed at k. */
+typedef struct {
+    int64_t acc[2];  /* flux at k (alpha, beta), Q48 pu */
+    q24_t sin_theta; /* the estimator's frame at k, Q24 */
+    q24_t cos_theta; /* Q24 */
+    q24_t i_d, i_q;  /* current at k in that frame, Q24 pu */
+    q24_t omega_e;   /* the estimator's (encoder) speed at k, Q24 pu */
+} ctrl_psi_track_in_t;
+
 /* Restart from the current model at the next step (keeps the settings and
  * the PM-flux estimate's gains; the estimate restarts from p->psi_pm). */
 void ctrl_psi_track_reset(ctrl_psi_track_t *t);
@@ -80,5 +90,22 @@ int ctrl_psi_track_setup(ctrl_psi_track_t *t, const ctrl_params_t *p);
  * line: inlined, the interrupt spent more on its registers than the call. */
 bool ctrl_psi_track_step(ctrl_psi_track_t *t, const ctrl_params_t *p, const ctrl_estimate_t *est,
                          const ctrl_legs_t *applied, q24_t i_a, q24_t i_b);
+
+/* ctrl_psi_track_step in two rates (the firmware's PWM interrupt and its
+ * medium-rate task): the same flux and estimates, the correction's step added
+ * later. ctrl_psi_track_integrate, every period: the integration; at period 0
+ * of N it returns true with *due the correction's inputs. ctrl_psi_track_correct,
+ * on those (the other rate): the correction's step of the flux into delta
+ * (Q48) and the EMA; true when the PM-flux estimate moved. ctrl_psi_track_add
+ * adds delta to the flux, at any period before the next correction's (the flux
+ * is an exact sum between two). Ownership: integrate and add write the flux
+ * (obs.psi_alpha_acc/beta_acc) and the counters, correct writes the EMA
+ * (obs.psi_pm_acc) and the flux's Q24 view (obs.psi_alpha/beta). */
+bool ctrl_psi_track_integrate(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                              const ctrl_estimate_t *est, const ctrl_legs_t *applied, q24_t i_a,
+                              q24_t i_b, ctrl_psi_track_in_t *due);
+bool ctrl_psi_track_correct(ctrl_psi_track_t *t, const ctrl_params_t *p,
+                            const ctrl_psi_track_in_t *in, int64_t delta[2]);
+void ctrl_psi_track_add(ctrl_psi_track_t *t, const int64_t delta[2]);
 
 #endif /* CONTROL_PSI_TRACK_H */

@@ -1,6 +1,7 @@
 /* The medium-rate task (pipeline.h; the two rates: docs/architecture.md).
- * Integer-only; runs once in mid_div PWM periods, after the interrupt that
- * triggered it and before the next one, on that interrupt's inputs. */
+ * Integer-only; runs once in mid_div PWM periods (and at period 0 of the
+ * PM-flux tracker's N), after the interrupt that triggered it and before the
+ * next one, on that interrupt's inputs. */
 #include "pipeline.h"
 
 /* The speed loop of one run: the PI on the speed error, its output clamped
@@ -25,6 +26,34 @@ static q24_t fw_mid_speed(fw_t *fw, const fw_mid_in_t *in, uint8_t *fault)
     return t;
 }
 
+/* The PM-flux tracker's correction and EMA (psi_track.h) on the interrupt's
+ * inputs of period 0 of its N; its estimate - which it only moves where the
+ * voltage model is reliable - once it has left the 2 % band around the
+ * configured value, into the parameters every consumer reads (the interrupt
+ * takes them with the flux's step at its next period): 1/psi_pm by a Newton
+ * step (y (2 - psi y)), the SPMSM's MTPA slope Lq/psi_pm. */
+static void fw_mid_psi(fw_t *fw, const ctrl_psi_track_in_t *in, fw_mid_out_t *out)
+{
+    const ctrl_params_t *const p = &fw->params;
+    out->psi_new = 0u;
+    if (!ctrl_psi_track_correct(&fw->psi_track, p, in, out->psi_delta)) {
+        return; /* no new estimate */
+    }
+    const q24_t psi = ctrl_fobs_psi_pm(&fw->psi_track.obs);
+    if (!fw->psi_engaged) {
+        if (fx_abs(fx_sub(psi, fw->psi_pm_cfg)) <= fw->psi_band) {
+            return; /* agrees with the configured value: nothing changes */
+        }
+        fw->psi_engaged = true;
+    }
+    if (psi > 0 && psi != p->psi_pm) {
+        out->psi_pm = psi;
+        out->inv_psi_pm = fx_mul(p->inv_psi_pm, fx_sub(2 * FX_ONE, fx_mul(psi, p->inv_psi_pm)));
+        out->mtpa_k = fx_mul(p->lq, out->inv_psi_pm);
+        out->psi_new = 1u;
+    }
+}
+
 void fw_medium(fw_t *fw)
 {
     if (fw == NULL || fw->mid_done == fw->mid_req) {
@@ -33,6 +62,18 @@ void fw_medium(fw_t *fw)
     const uint32_t done = fw->mid_done + 1u;
     const fw_mid_in_t *const in = &fw->mid_in[done & 1u];
     fw_mid_out_t *const out = &fw->mid_out[done & 1u];
+    if (in->run == 0u) {
+        /* the tracker's run alone: the last run's outputs stay in force */
+        *out = fw->mid_out[fw->mid_done & 1u];
+        out->fault = FW_FAULT_NONE;
+    }
+    if (in->track != 0u) {
+        fw_mid_psi(fw, &in->psi, out);
+    }
+    if (in->run == 0u) {
+        fw->mid_done = done;
+        return;
+    }
     if (in->reset != 0u) {
         ctrl_speed_pi_reset(&fw->speed_pi, 0);
         ctrl_fieldweak_reset(&fw->fwk);
@@ -65,5 +106,8 @@ void fw_medium(fw_t *fw)
     out->psi_ref = lim.psi_ref;
     out->limit = lim.limit;
     out->weakening = lim.weakening;
+    if (in->first != 0u) {
+        fw_mid_first_step(fw, in, out); /* before the run counts as ended */
+    }
     fw->mid_done = done;
 }

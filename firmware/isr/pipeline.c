@@ -7,11 +7,18 @@
 #include "plan.h"
 #include "svpwm.h"
 
+#if defined(__GNUC__)
+#define FW_NOINLINE __attribute__((noinline))
+#else
+#define FW_NOINLINE
+#endif
+
 static void fw_fault_now(fw_t *fw, uint32_t code)
 {
     /* Gates off before anything else, then latch the code. */
     hal_gate_enable(fw->hal, false);
     (void)fw_state_event(&fw->sm, FW_EV_FAULT, code);
+    fw->psi_due = 0u; /* the tracker restarts at the next arming */
     if (fw->cm.active != 0u) {
         cm_abort_fault(&fw->cm, code);
     }
@@ -93,10 +100,18 @@ static int64_t fw_signed32(uint32_t u)
 }
 
 /* A 32-bit counter difference u, read as two's complement, modulo m in
- * [0, m): fw_mod(fw_signed32(u), m) with one 32-bit division (the index
- * re-synchronisation runs once per revolution inside the interrupt). */
+ * [0, m): fw_mod(fw_signed32(u), m), m <= 2^31. The index re-synchronisation
+ * reduces the counts moved since the pulse, less than a turn: x in [-m, m)
+ * takes no division (it was one in the worst period's path); any other x one
+ * 32-bit division. */
 static uint32_t fw_mod_u32(uint32_t u, uint32_t m)
 {
+    if (u < m) {
+        return u; /* 0 <= x < m */
+    }
+    if (0u - u <= m) {
+        return u + m; /* -m <= x < 0: x + m (modulo 2^32, which m = 2^31 needs at x = -m) */
+    }
     if (u <= (uint32_t)INT32_MAX) {
         return u % m;
     }
@@ -202,6 +217,7 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
     }
     if (fw->req_disarm != 0u) {
         fw->req_disarm = 0u;
+        fw->psi_due = 0u;
         const bool cm = fw->sm.state == FW_STATE_COMMISSION;
         if (fw_state_event(&fw->sm, FW_EV_DISARM, 0u) && cm) {
             /* Stop: the step ends, gates off now. */
@@ -310,28 +326,32 @@ static inline void fw_pwm_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_leg
 }
 
 /* PM flux from the voltage model (fw_config_t.psi_adapt): the encoder-mode
- * observer on the estimator's frame (psi_track.h); its estimate - which it
- * only moves where the voltage model is reliable - once it has left the 2 %
- * band around the configured value into the parameters every consumer reads,
- * with 1/psi_pm by a Newton step (y (2 - psi y)) and the SPMSM's MTPA slope
- * Lq/psi_pm. */
+ * observer on the estimator's frame (psi_track.h), its integration here every
+ * period; at period 0 of its N the correction's inputs go to the medium task
+ * (fw_mid_trigger requests a run), whose correction, EMA and parameters
+ * (medium.c) fw_psi_apply takes at the next period. */
 static inline void fw_psi_track(fw_t *fw, const ctrl_meas_t *m, const ctrl_estimate_t *est)
 {
-    ctrl_params_t *const p = &fw->params;
-    if (!ctrl_psi_track_step(&fw->psi_track, p, est, &fw->applied, m->i_a, m->i_b)) {
-        return; /* no new estimate in this period */
-    }
-    const q24_t psi = ctrl_fobs_psi_pm(&fw->psi_track.obs);
-    if (!fw->psi_engaged) {
-        if (fx_abs(fx_sub(psi, fw->psi_pm_cfg)) <= fw->psi_band) {
-            return; /* agrees with the configured value: nothing changes */
-        }
-        fw->psi_engaged = true;
-    }
-    if (psi > 0 && psi != p->psi_pm) {
-        p->psi_pm = psi;
-        p->inv_psi_pm = fx_mul(p->inv_psi_pm, fx_sub(2 * FX_ONE, fx_mul(psi, p->inv_psi_pm)));
-        p->mtpa_k = fx_mul(p->lq, p->inv_psi_pm);
+    fw_mid_in_t *const in = &fw->mid_in[(fw->mid_req + 1u) & 1u]; /* the free slot */
+    fw->psi_due = ctrl_psi_track_integrate(&fw->psi_track, &fw->params, est, &fw->applied, m->i_a,
+                                           m->i_b, &in->psi)
+                      ? 1u
+                      : 0u;
+}
+
+/* The period after a tracker run (it has ended: checked at the period's
+ * start), before the estimate: the flux's step (exact: the flux is a sum
+ * between two corrections) and, when the estimate has moved out of the band,
+ * the parameters every consumer reads. Out of line: once in N periods. */
+static FW_NOINLINE void fw_psi_apply(fw_t *fw)
+{
+    fw->psi_due = 0u;
+    const fw_mid_out_t *const mo = &fw->mid_out[fw->mid_done & 1u];
+    ctrl_psi_track_add(&fw->psi_track, mo->psi_delta);
+    if (mo->psi_new != 0u) {
+        fw->params.psi_pm = mo->psi_pm;
+        fw->params.inv_psi_pm = mo->inv_psi_pm;
+        fw->params.mtpa_k = mo->mtpa_k;
     }
 }
 
@@ -349,18 +369,35 @@ static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
     sl->torque_est = fw->estimate.now.torque;
 }
 
+/* The medium task's run of the PM-flux tracker alone (its inputs are in the
+ * free slot, fw_psi_track): true. */
+static inline bool fw_mid_track_request(fw_t *fw)
+{
+    const uint32_t req = fw->mid_req + 1u;
+    fw_mid_in_t *const in = &fw->mid_in[req & 1u];
+    in->track = 1u;
+    in->run = 0u;
+    in->first = 0u;
+    fw->mid_req = req;
+    return true;
+}
+
 /* The DC link summed for the medium task; once in mid_div periods (or at
- * once, mid_count = 1) its inputs into the free slot: true, a run is due. */
+ * once, mid_count = 1) its inputs into the free slot, with the tracker's
+ * correction when due: true, a run is due. */
 static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req, uint8_t hold)
 {
     fw->mid_vdc_sum += est->vdc;
     fw->mid_n++;
     if (--fw->mid_count != 0u) {
-        return false;
+        return fw->psi_due != 0u && fw_mid_track_request(fw);
     }
     fw->mid_count = fw->mid_div;
     const uint32_t req = fw->mid_req + 1u;
     fw_mid_in_t *const in = &fw->mid_in[req & 1u];
+    in->track = fw->psi_due; /* its inputs are in the slot (fw_psi_track) */
+    in->run = 1u;
+    in->first = fw->mid_fresh == 0u ? 1u : 0u;
     in->vdc_sum = fw->mid_vdc_sum;
     in->n = fw->mid_n;
     in->omega_e = est->omega_e;
@@ -381,34 +418,20 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
     return true;
 }
 
-/* The first period after a reset (fw_init, arming, a commissioning step's
- * controller reset): the medium task's first run here, inside the interrupt,
- * so that this period already has the speed loop's output and the limits of
- * its own speed and DC link, as every later one has (a drive started at its
- * limit, the 80 kW IPMSM at its fixed-flux torque limit under m2ptfc, lost the
- * load angle after a first period at zero torque). Out of line: rare. */
-#if defined(__GNUC__)
-#define FW_NOINLINE __attribute__((noinline))
-#else
-#define FW_NOINLINE
-#endif
-static FW_NOINLINE void fw_mid_first_run(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req,
-                                         uint8_t hold)
-{
-    fw->mid_count = 1u;
-    (void)fw_mid_trigger(fw, est, t_req, hold);
-    fw_medium(fw);
-}
-
 /* The estimate, the torque reference within the medium task's limits, the
  * controller's step, the compare values; true when the medium task is due. */
-static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ctrl_meas_t *m)
+static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, q24_t tref, uint8_t hold,
+                                  const fw_mid_out_t *mo, q24_t *t_req);
+
+static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
     ctrl_angle_sl_t *const sl =
         fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
     if (sl != NULL) {
         fw_sl_inputs(fw, sl);
+    } else if (fw->psi_due != 0u) {
+        fw_psi_apply(fw);
     }
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, est);
     if (sl != NULL) {
@@ -428,13 +451,41 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * the forced q axis, the speed loop waiting, sensorless.h), or torque
      * mode's (torque_ref clamped by fw_set_torque_ref). */
     const uint8_t hold = sl != NULL && sl->out.mode != CTRL_SL_OBSERVER ? 1u : 0u;
-    q24_t tref = hold != 0u ? sl->out.torque_ref : fw->torque_ref_lim;
-    const bool first = fw->mid_fresh == 0u;
-    if (first) {
-        fw_mid_first_run(fw, est, tref, hold);
+    const q24_t tref = hold != 0u ? sl->out.torque_ref : fw->torque_ref_lim;
+    q24_t t_req = tref;
+    if (fw->mid_fresh == 0u) {
+        /* The first period after a reset (arming, a commissioning step's
+         * controller reset): the interrupt ends here; the medium task's run,
+         * due now, is its first, and then does the rest of this period
+         * (fw_mid_first_step: the torque reference, the controller's step, the
+         * compare values) before the next period: the same outputs, in the
+         * same period, as with all of it in the interrupt. The run comes
+         * before the step so that this period already has the speed loop's
+         * output and the limits of its own speed and DC link, as every later
+         * one has (a drive started at its limit, the 80 kW IPMSM at its
+         * fixed-flux torque limit under m2ptfc, lost the load angle after a
+         * first period at zero torque and the limits of standstill). */
+        fw->mid_count = 1u;
+        fw->mid_first = tm;
+    } else if (!fw_control_out(fw, tm, tref, hold, &fw->mid_out[fw->mid_done & 1u], &t_req)) {
+        return false; /* a fault: gates off */
     }
-    /* The medium task's last run. */
-    const fw_mid_out_t *const mo = &fw->mid_out[fw->mid_done & 1u];
+    return fw_mid_trigger(fw, est, t_req, hold);
+}
+
+/* The rest of the period after the estimate (fw_control; in the first period
+ * after a reset fw_mid_first_step): the protections on the estimate, the
+ * torque reference within the medium task's limits (mo, its last run), the
+ * controller's step, the compare values. False after a fault (gates off);
+ * *t_req: the torque reference before the limits, for the medium task. */
+static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, q24_t tref, uint8_t hold,
+                                  const fw_mid_out_t *mo, q24_t *t_req)
+{
+    hal_t *const hal = fw->hal;
+    const ctrl_meas_t *const m = &tm->meas;
+    ctrl_estimate_t *const est = &fw->estimate;
+    ctrl_angle_sl_t *const sl =
+        fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
     /* overspeed, or a slow protection of the medium task */
     uint32_t f = fw_protect_overspeed(&fw->prot, est->omega_e);
     if (f == FW_FAULT_NONE) {
@@ -477,8 +528,8 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
      * weakened to what the voltage allows (0 = the controller's own below
      * base speed, so nothing changes there): the medium task's (field_weak.h). */
     const q24_t torque_max = mo->torque_max;
-    const q24_t t_req = tref;
-    tref = fx_clamp(t_req, fx_neg(torque_max), torque_max);
+    *t_req = tref;
+    tref = fx_clamp(*t_req, fx_neg(torque_max), torque_max);
     /* Mean-torque trim in field weakening: with the flux at the voltage's
      * limit the torque rises slowly (little voltage beyond the back-EMF) and
      * falls fast, so a hysteresis or duty-ratio controller settles below its
@@ -497,7 +548,7 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
     fw->torque_ref_now = tref;
     tm->torque_max = torque_max;
-    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != t_req) + 8u * weak + 16u * fw->tqf.warn);
+    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != *t_req) + 8u * weak + 16u * fw->tqf.warn);
 
     const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed
@@ -519,7 +570,18 @@ static inline bool fw_control(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const ct
     tm->vec = has_plan ? out.plan.vec[0] : 0u;
     tm->duty = has_plan ? out.plan.dur[0] : 0;
     tm->torque_ref = tref;
-    return !first && fw_mid_trigger(fw, est, t_req, hold);
+    return true;
+}
+
+void fw_mid_first_step(fw_t *fw, const fw_mid_in_t *in, const fw_mid_out_t *mo)
+{
+    fw_telemetry_t *const tm = fw->mid_first;
+    q24_t t_req;
+    (void)fw_control_out(fw, tm, in->tref, in->hold, mo, &t_req);
+    /* the record's tail as the interrupt wrote it, after a fault here */
+    tm->state = (uint8_t)fw->sm.state;
+    tm->fault = (uint8_t)fw->sm.fault_code;
+    tm->gates = fw->sm.state == FW_STATE_RUNNING || fw->cm_gates != 0u ? 1u : 0u;
 }
 
 /* A running period: measurements, protections, control. */
@@ -542,7 +604,7 @@ static inline bool fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
         }
     }
     if (f == FW_FAULT_NONE) {
-        return fw_control(fw, hal, tm, m);
+        return fw_control(fw, tm, m);
     }
     fw_tm_no_estimate(tm);
     fw_pwm_off(fw, tm);
@@ -616,7 +678,7 @@ static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         }
         fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
         fw->ref_mode = FW_REF_TORQUE;
-        return fw_control(fw, hal, tm, m);
+        return fw_control(fw, tm, m);
     }
     ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
     /* uncompensated: the steps measure the inverter's error themselves */

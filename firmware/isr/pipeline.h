@@ -26,8 +26,14 @@
  * the speed PI, the speed-following protection, the field-weakening and MTPV
  * torque limit and flux reference (field_weak.h, on the DC link's mean over
  * the medium period); its outputs (fw_mid_out_t) act from period k+1 on. It
- * must end before the interrupt of k+1 (else FW_FAULT_DEADLINE). After a reset
- * (fw_init, arming) the interrupt runs it once itself, before the controller.
+ * must end before the interrupt of k+1 (else FW_FAULT_DEADLINE). In the first
+ * period after a reset (arming, a commissioning step's controller reset) the
+ * interrupt ends after the estimate and the task's run completes the period:
+ * the torque reference, the controller's step and the compare values
+ * (fw_mid_first_step), in time for k+1 as the interrupt's are. The PM-flux
+ * tracker's correction and EMA (psi_track.h) are the task's too: the
+ * interrupt requests a run at period 0 of the tracker's N and adds the
+ * correction's step at the next period.
  * fw_isr() is the two in that order: the host engine's and the tests'
  * scheduler.
  *
@@ -137,18 +143,24 @@ typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
  * mid_done up to mid_req; the interrupt reads mid_out[mid_done & 1]. A slot is
  * never written while the other side may read it. */
 typedef struct {
-    int64_t vdc_sum;   /* the estimator's DC link summed over n periods, Q24 pu */
-    uint32_t n;        /* periods summed since the last run (>= 1) */
-    q24_t omega_e;     /* electrical speed estimate at k, Q24 pu */
-    q24_t tref;        /* torque reference of k before the limits (torque mode, the
-                          sensorless start), Q24 pu */
-    q24_t torque_now;  /* torque reference of k after the limits (fw_t.torque_ref_now) */
-    q24_t speed_ref;   /* Q24 pu electrical */
-    q24_t bump_torque; /* bump: the torque the speed loop restarts from, Q24 pu */
-    uint8_t ref_mode;  /* fw_ref_mode_t of k */
-    uint8_t hold;      /* 1: the speed loop waits (sensorless start) */
-    uint8_t reset;     /* 1: arm or a commissioning reset: the task's state anew */
-    uint8_t bump;      /* 1: the speed loop restarts from bump_torque (sensorless handover) */
+    int64_t vdc_sum;         /* the estimator's DC link summed over n periods, Q24 pu */
+    uint32_t n;              /* periods summed since the last run (>= 1) */
+    q24_t omega_e;           /* electrical speed estimate at k, Q24 pu */
+    q24_t tref;              /* torque reference of k before the limits (torque mode, the
+                                sensorless start), Q24 pu */
+    q24_t torque_now;        /* torque reference of k after the limits (fw_t.torque_ref_now) */
+    q24_t speed_ref;         /* Q24 pu electrical */
+    q24_t bump_torque;       /* bump: the torque the speed loop restarts from, Q24 pu */
+    uint8_t ref_mode;        /* fw_ref_mode_t of k */
+    uint8_t hold;            /* 1: the speed loop waits (sensorless start) */
+    uint8_t reset;           /* 1: arm or a commissioning reset: the task's state anew */
+    uint8_t bump;            /* 1: the speed loop restarts from bump_torque (sensorless handover) */
+    uint8_t run;             /* 1: the speed loop and the limits run (the fields above); 0: the
+                                PM-flux tracker's run alone */
+    uint8_t first;           /* 1: the first period after a reset: after the run, the rest of
+                                that period (fw_mid_first_step) */
+    uint8_t track;           /* 1: the PM-flux tracker's correction on psi (period 0 of its N) */
+    ctrl_psi_track_in_t psi; /* track: the correction's inputs (psi_track.h) */
 } fw_mid_in_t;
 
 typedef struct {
@@ -159,6 +171,13 @@ typedef struct {
     uint8_t limit;     /* ctrl_fw_limit_t: what bounds torque_max */
     uint8_t weakening; /* 1: psi_ref is below the controller's own reference */
     uint8_t fault;     /* a slow protection's fault (FW_FAULT_*), latched by the interrupt */
+    /* A tracker run's (in.track): the flux's step, which the interrupt adds at
+     * its next period, and with psi_new the parameters it then takes. */
+    uint8_t psi_new;
+    int64_t psi_delta[2]; /* Q48 pu (ctrl_psi_track_add) */
+    q24_t psi_pm;         /* Q24 pu */
+    q24_t inv_psi_pm;     /* Q24, 1 / psi_pm */
+    q24_t mtpa_k;         /* Q24, Lq / psi_pm */
 } fw_mid_out_t;
 
 /* Start-up configuration (SI, read once by fw_init). */
@@ -248,7 +267,9 @@ typedef struct {
     q24_t psi_ref_cfg;   /* the machine's fixed flux reference, Q24 pu (0: MTPA); params.psi_ref
                             holds it for a controller that holds it, 0 for a flux-free one */
     q24_t psi_band;      /* |estimate - configured| that engages the tracking, Q24 pu */
-    bool psi_engaged;    /* the estimate has left the band: params follow it */
+    bool psi_engaged;    /* medium task: the estimate has left the band, params follow it */
+    uint8_t psi_due;     /* interrupt: the tracker's correction of this period is the medium
+                            task's (its step and parameters taken at the next period) */
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0), before
                           * the dead-time compensation */
     ctrl_deadtime_t deadtime; /* compensation of the written duties (dd 0: off) */
@@ -263,14 +284,15 @@ typedef struct {
     q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
     q24_t torque_ref_min; /* Q24 pu, fx_neg(torque_ref_max) (set with it) */
     /* The medium-rate task (medium.c) and the hand-over (fw_mid_in_t). */
-    uint32_t mid_div;    /* PWM periods per run (>= 1) */
-    uint32_t mid_count;  /* interrupt: periods to the next run, 1..mid_div (1: this one) */
-    int64_t mid_vdc_sum; /* interrupt: DC link summed since the last run, Q24 pu */
-    uint32_t mid_n;      /* interrupt: periods in mid_vdc_sum */
-    uint8_t mid_reset;   /* interrupt: the next run starts the task's state anew */
-    uint8_t mid_bump;    /* interrupt: the next run restarts the speed loop at mid_bump_t */
-    uint8_t mid_fresh;   /* interrupt: mid_out holds a run since the last reset (else
-                            the interrupt runs the task itself first) */
+    uint32_t mid_div;          /* PWM periods per run (>= 1) */
+    uint32_t mid_count;        /* interrupt: periods to the next run, 1..mid_div (1: this one) */
+    int64_t mid_vdc_sum;       /* interrupt: DC link summed since the last run, Q24 pu */
+    uint32_t mid_n;            /* interrupt: periods in mid_vdc_sum */
+    uint8_t mid_reset;         /* interrupt: the next run starts the task's state anew */
+    uint8_t mid_bump;          /* interrupt: the next run restarts the speed loop at mid_bump_t */
+    uint8_t mid_fresh;         /* interrupt: mid_out holds a run since the last reset (else the
+                                  period ends after the estimate, the task completes it) */
+    fw_telemetry_t *mid_first; /* the record of that first period (fw_mid_first_step) */
     q24_t mid_bump_t;
     fw_mid_in_t mid_in[2];      /* written by the interrupt only */
     fw_mid_out_t mid_out[2];    /* written by fw_medium only */
@@ -357,6 +379,10 @@ size_t fw_explain(const fw_t *fw, char *buf, size_t cap);
 bool fw_isr_fast(fw_t *fw);
 /* The medium-rate task (medium.c): one run on the inputs of the last trigger. */
 void fw_medium(fw_t *fw);
+/* The medium task's completion of the first period after a reset (pipeline.c;
+ * fw_medium only): the rest of that period after the estimate, with its run's
+ * outputs mo. */
+void fw_mid_first_step(fw_t *fw, const fw_mid_in_t *in, const fw_mid_out_t *mo);
 /* One PWM period with the medium task where due: fw_isr_fast, then fw_medium
  * (the scheduler of the host engine, the replay images and the tests). */
 void fw_isr(fw_t *fw);
