@@ -202,6 +202,18 @@ static void test_link_refusal_names_quantity_value_range(void)
  * calibrates and becomes ready; at 2048 (1.65 V, mid-scale) the offsets are
  * 505 counts off the board's expected code: fault adc_calibration, with the
  * measured offsets kept for the report (fw_link_offsets_text). */
+/* One control period as on the board: the ADC interrupt, then PendSV (lower
+ * priority, tail-chained) with the medium-rate task when the interrupt pended
+ * it (the first period after the arm is completed there). */
+static void control_period(void)
+{
+    esc1_control_isr(&esc);
+    if ((g4_model_get(G4_SCB + G4_SCB_ICSR) & G4_SCB_ICSR_PENDSVSET) != 0u) {
+        g4_model_put(G4_SCB + G4_SCB_ICSR, 0u);
+        fw_medium(&esc.fw);
+    }
+}
+
 static void calibrate_at(uint32_t code)
 {
     esc1_start();
@@ -274,13 +286,13 @@ static void test_link_reconfig_refused_while_gates_on(void)
 
     expect_prefix("ok", command("arm"));
     expect_config_refused("err 8 state arm pending (ready)", "err 8 state arm pending (ready)");
-    esc1_control_isr(&esc);
+    control_period();
     TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
     /* armed: the command layer refuses "ctrl select" itself (PROTOCOL.md) */
     expect_config_refused("err 8 state in running", "err 8 state disarm first");
     TEST_ASSERT_TRUE(esc.machine.rs_ohm == rs);
     expect_prefix("ok", command("disarm"));
-    esc1_control_isr(&esc);
+    control_period();
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
     TEST_ASSERT_EQUAL_STRING("ok m.rs_ohm 5", command("param set m.rs_ohm 5"));
 }
@@ -314,12 +326,7 @@ static void pulse_at(uint32_t ms, uint32_t width_us)
     esc1_throttle_poll(&esc);
     fw_watchdog_kick(&esc.fw);           /* the main loop's service */
     for (unsigned k = 0; k < 20u; k++) { /* 1 ms of control periods at 20 kHz */
-        esc1_control_isr(&esc);
-        /* PendSV (lower priority) runs the medium-rate task when pended */
-        if ((g4_model_get(G4_SCB + G4_SCB_ICSR) & G4_SCB_ICSR_PENDSVSET) != 0u) {
-            g4_model_put(G4_SCB + G4_SCB_ICSR, 0u);
-            fw_medium(&esc.fw);
-        }
+        control_period();
     }
 }
 
