@@ -155,6 +155,13 @@ double ctrl_q24_to_double(q24_t x);
  * [lo_pu, hi_pu]: CTRL_OK; else CTRL_ERANGE and *out unchanged. */
 int ctrl_q24_from_si(double si, double base, double lo_pu, double hi_pu, q24_t *out);
 
+/* The one MTPA solver (configuration time; SI or pu alike, the current in
+ * the units of psi_pm / L): the current vector of amplitude i maximising
+ * Te = i_q (psi_pm + (Ld - Lq) i_d) (3.10) on |i| = i,
+ *   i_d = (psi_pm - sqrt(psi_pm^2 + 8 dL^2 i^2)) / (4 dL),  dL = Lq - Ld != 0,
+ * i_d = 0 for dL = 0, i_q = sqrt(i^2 - i_d^2). */
+void ctrl_mtpa_split(double psi_pm, double ld, double lq, double i, double *i_d, double *i_q);
+
 /* Change the speed-filter cut-off (Hz, 0 < fc < fs/2): sets p->speed_lpf_k.
  * Returns CTRL_OK or CTRL_EINVAL. */
 int ctrl_params_set_speed_lpf(ctrl_params_t *p, double fc_hz);

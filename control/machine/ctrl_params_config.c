@@ -80,17 +80,22 @@ int ctrl_params_set_speed_lpf(ctrl_params_t *p, double fc_hz)
     return p->speed_lpf_k > 0 ? CTRL_OK : CTRL_EINVAL;
 }
 
-/* The one MTPA solver (pu, any Ld, Lq, psi_pm > 0): the current vector of
- * amplitude i maximising Te = i_q (psi_pm + (Ld - Lq) i_d) (3.10) on |i| = i,
- *   i_d = (psi_pm - sqrt(psi_pm^2 + 8 dL^2 i^2)) / (4 dL),  dL = Lq - Ld != 0,
- * i_d = 0 for dL = 0; returns i_d, i_q, Te and |psi_s|. */
+void ctrl_mtpa_split(double psi_pm, double ld, double lq, double i, double *i_d, double *i_q)
+{
+    const double dl = lq - ld;
+    const double d =
+        dl == 0.0 ? 0.0 : (psi_pm - sqrt(psi_pm * psi_pm + 8.0 * dl * dl * i * i)) / (4.0 * dl);
+    *i_d = d;
+    *i_q = sqrt(fmax(i * i - d * d, 0.0));
+}
+
+/* The MTPA point of amplitude i (pu, ctrl_mtpa_split): i_d, i_q, Te (3.10)
+ * and |psi_s|. */
 static void mtpa_point(double ld, double lq, double psi_pm, double i, double *id, double *iq,
                        double *te, double *psi)
 {
-    const double dl = lq - ld;
-    *id = dl == 0.0 ? 0.0 : (psi_pm - sqrt(psi_pm * psi_pm + 8.0 * dl * dl * i * i)) / (4.0 * dl);
-    *iq = sqrt(fmax(i * i - *id * *id, 0.0));
-    *te = *iq * (psi_pm - dl * *id);
+    ctrl_mtpa_split(psi_pm, ld, lq, i, id, iq);
+    *te = *iq * (psi_pm - (lq - ld) * *id);
     *psi = ctrl_cfg_hypot(psi_pm + ld * *id, lq * *iq);
 }
 

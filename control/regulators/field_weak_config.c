@@ -21,18 +21,6 @@ void ctrl_fieldweak_cfg_default(ctrl_fieldweak_cfg_t *c)
     }
 }
 
-void ctrl_fieldweak_mtpa_split(double psi_pm, double ld, double lq, double i, double *i_d,
-                               double *i_q)
-{
-    const double dl = lq - ld;
-    double d = 0.0;
-    if (dl > 0.0) {
-        d = (psi_pm - sqrt(psi_pm * psi_pm + 8.0 * dl * dl * i * i)) / (4.0 * dl);
-    }
-    *i_d = d;
-    *i_q = sqrt(fmax(i * i - d * d, 0.0));
-}
-
 static int fw_refuse(char *why, size_t n, int code, const char *what, double v, double lo,
                      double hi, const char *unit)
 {
@@ -96,7 +84,7 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     const double i = i_si / b->i_a;
     double md;
     double mq;
-    ctrl_fieldweak_mtpa_split(psi, ld, lq, i, &md, &mq);
+    ctrl_mtpa_split(psi, ld, lq, i, &md, &mq); /* Lq >= Ld: checked above */
     const double t_mtpa = psi * mq + (ld - lq) * md * mq;
     const double psi_mtpa = ctrl_cfg_hypot(ld * md + psi, lq * mq);
     const double c1 = psi / ld;

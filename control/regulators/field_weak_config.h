@@ -42,10 +42,4 @@ void ctrl_fieldweak_cfg_default(ctrl_fieldweak_cfg_t *c);
 int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, const ctrl_machine_t *m,
                         const ctrl_bases_t *b, const ctrl_params_t *p, char *why, size_t why_len);
 
-/* MTPA current amplitude split for a current i (SI or pu alike, same units as
- * the inductances and psi_pm): i_d = (psi - sqrt(psi^2 + 8 (Lq - Ld)^2 i^2)) /
- * (4 (Lq - Ld)), i_d = 0 for Ld = Lq. For configuration code and tests. */
-void ctrl_fieldweak_mtpa_split(double psi_pm, double ld, double lq, double i, double *i_d,
-                               double *i_q);
-
 #endif /* CONTROL_FIELD_WEAK_CONFIG_H */

@@ -97,7 +97,7 @@ struct Ref {
         margin = c.torque_margin;
         salient = lq > ld;
         double md, mq;
-        ctrl_fieldweak_mtpa_split(psi, ld, lq, i, &md, &mq);
+        ctrl_mtpa_split(psi, ld, lq, i, &md, &mq);
         t_mtpa = psi * mq + (ld - lq) * md * mq;
         psi_mtpa = std::hypot(ld * md + psi, lq * mq);
         c1 = psi / ld;

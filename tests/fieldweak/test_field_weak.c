@@ -230,7 +230,7 @@ static void test_below_base(void)
     setup(&ini_thesis_ipmsm80, -1.0);
     double id;
     double iq;
-    ctrl_fieldweak_mtpa_split(M.psi_pm_wb, M.ld_h, M.lq_h, M.current_rated_a, &id, &iq);
+    ctrl_mtpa_split(M.psi_pm_wb, M.ld_h, M.lq_h, M.current_rated_a, &id, &iq);
     const double t_m = 1.5 * M.pole_pairs * (M.psi_pm_wb * iq + (M.ld_h - M.lq_h) * id * iq);
     /* MTPA mode (the file's fixed 0.1837 Wb is tested below). */
     ctrl_params_t pm = P;
