@@ -6,8 +6,10 @@
  *     newlib-nano's printf family (3.4 KB; without _printf_float it skips %g
  *     silently, with it about 8 KB more) is not linked at all
  *     (tests/board/check_printf.py checks the image for it);
- *   - strcmp as a byte loop: newlib's is unrolled for speed (0.7 KB), and the
- *     image compares strings only in the command path, never per period.
+ *   - strcmp, strlen, strcpy and strncpy as byte loops: newlib's are unrolled
+ *     or word-wise for speed (strcmp 0.7 KB; the other three 0.5 KB), and the
+ *     image handles strings only in the command path and at start-up, never
+ *     per period.
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -40,4 +42,34 @@ int strcmp(const char *a, const char *b)
         q++;
     }
     return (int)*p - (int)*q;
+}
+
+size_t strlen(const char *s)
+{
+    const char *p = s;
+    while (*p != '\0') {
+        p++;
+    }
+    return (size_t)(p - s);
+}
+
+char *strcpy(char *restrict dst, const char *restrict src)
+{
+    char *d = dst;
+    while ((*d++ = *src++) != '\0') {
+    }
+    return dst;
+}
+
+char *strncpy(char *restrict dst, const char *restrict src, size_t n)
+{
+    /* C11 7.24.2.4: at most n characters; the rest of the n filled with nulls */
+    size_t i = 0;
+    for (; i < n && src[i] != '\0'; i++) {
+        dst[i] = src[i];
+    }
+    for (; i < n; i++) {
+        dst[i] = '\0';
+    }
+    return dst;
 }

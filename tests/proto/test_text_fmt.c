@@ -8,6 +8,7 @@
  */
 #include <limits.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -102,6 +103,33 @@ static void test_strcmp(void)
     TEST_ASSERT_TRUE(strcmp("", "x") < 0);
 }
 
+/* strlen, strcpy, strncpy (libc_small.c's in the target builds): C's
+ * contract. Called through volatile pointers, so that the compiler cannot
+ * fold them into constants. */
+static void test_str_copy_length(void)
+{
+    size_t (*volatile len)(const char *) = strlen;
+    char *(*volatile cpy)(char *, const char *) = strcpy;
+    char *(*volatile ncpy)(char *, const char *, size_t) = strncpy;
+    char buf[8];
+    TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)len(""));
+    TEST_ASSERT_EQUAL_UINT32(7u, (uint32_t)len("drr_d1x"));
+    memset(buf, 'x', sizeof buf);
+    TEST_ASSERT_EQUAL_PTR(buf, cpy(buf, "motor"));
+    TEST_ASSERT_EQUAL_STRING("motor", buf);
+    TEST_ASSERT_EQUAL_CHAR('x', buf[6]); /* nothing past the null */
+    /* shorter source: the rest of n filled with nulls, nothing beyond n */
+    memset(buf, 'x', sizeof buf);
+    TEST_ASSERT_EQUAL_PTR(buf, ncpy(buf, "ab", 5u));
+    TEST_ASSERT_EQUAL_MEMORY("ab\0\0\0xxx", buf, sizeof buf);
+    /* longer source: n characters, no null */
+    memset(buf, 'x', sizeof buf);
+    (void)ncpy(buf, "abcdefg", 3u);
+    TEST_ASSERT_EQUAL_MEMORY("abcxxxxx", buf, sizeof buf);
+    (void)ncpy(buf, "q", 0u);
+    TEST_ASSERT_EQUAL_CHAR('a', buf[0]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -110,5 +138,6 @@ int main(void)
     RUN_TEST(test_truncation);
     RUN_TEST(test_message_carries_value);
     RUN_TEST(test_strcmp);
+    RUN_TEST(test_str_copy_length);
     return UNITY_END();
 }
