@@ -361,36 +361,63 @@ void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double t
     }
 }
 
+/* The machine-file fragment: the result bit that gives each item, its field
+ * of cm_si_t and how that is read (mechanics only with a finite inertia > 0,
+ * the friction only when finite). */
+enum { CM_F_SI, CM_F_MILLI, CM_F_LINES, CM_F_INT, CM_F_FRICTION };
+#define CM_F(have, sec, key, kind, f)                                                              \
+    {                                                                                              \
+        have, kind, (uint16_t)offsetof(cm_si_t, f), sec, key                                       \
+    }
+static const struct {
+    uint8_t have, kind;
+    uint16_t off;
+    const char *section, *key;
+} cm_fragment[] = {
+    CM_F(CM_HAVE_RS, "machine", "rs_ohm", CM_F_SI, rs_ohm),
+    CM_F(CM_HAVE_LDQ, "machine", "ld_mh", CM_F_MILLI, ld_h),
+    CM_F(CM_HAVE_LDQ, "machine", "lq_mh", CM_F_MILLI, lq_h),
+    CM_F(CM_HAVE_FLUX, "machine", "psi_pm_wb", CM_F_SI, psi_wb),
+    CM_F(CM_HAVE_ENC, "sensors", "encoder_lines", CM_F_LINES, enc_cpr_cfg),
+    CM_F(CM_HAVE_ENC, "sensors", "encoder_offset_deg", CM_F_SI, enc_offset_deg),
+    CM_F(CM_HAVE_ENC, "sensors", "encoder_direction", CM_F_INT, enc_dir),
+    CM_F(CM_HAVE_MECH, "mechanics", "inertia_kgm2", CM_F_SI, inertia_kgm2),
+    CM_F(CM_HAVE_MECH, "mechanics", "friction_nms", CM_F_FRICTION, friction_nms),
+};
+#undef CM_F
+
 bool cm_fragment_item(const cm_si_t *r, size_t index, cm_item_t *it)
 {
-    cm_item_t all[10];
-    size_t n = 0;
-    if ((r->have & CM_HAVE_RS) != 0u) {
-        all[n++] = (cm_item_t){"machine", "rs_ohm", r->rs_ohm, false};
-    }
-    if ((r->have & CM_HAVE_LDQ) != 0u) {
-        all[n++] = (cm_item_t){"machine", "ld_mh", r->ld_h * 1e3, false};
-        all[n++] = (cm_item_t){"machine", "lq_mh", r->lq_h * 1e3, false};
-    }
-    if ((r->have & CM_HAVE_FLUX) != 0u) {
-        all[n++] = (cm_item_t){"machine", "psi_pm_wb", r->psi_wb, false};
-    }
-    if ((r->have & CM_HAVE_ENC) != 0u) {
-        all[n++] = (cm_item_t){"sensors", "encoder_lines", (double)(r->enc_cpr_cfg / 4u), true};
-        all[n++] = (cm_item_t){"sensors", "encoder_offset_deg", r->enc_offset_deg, false};
-        all[n++] = (cm_item_t){"sensors", "encoder_direction", (double)r->enc_dir, true};
-    }
-    if ((r->have & CM_HAVE_MECH) != 0u && isfinite(r->inertia_kgm2) && r->inertia_kgm2 > 0.0) {
-        all[n++] = (cm_item_t){"mechanics", "inertia_kgm2", r->inertia_kgm2, false};
-        if (isfinite(r->friction_nms)) {
-            all[n++] = (cm_item_t){"mechanics", "friction_nms", fmax(r->friction_nms, 0.0), false};
+    const bool mech = isfinite(r->inertia_kgm2) && r->inertia_kgm2 > 0.0;
+    for (size_t k = 0; k < sizeof cm_fragment / sizeof cm_fragment[0]; k++) {
+        const unsigned have = cm_fragment[k].have;
+        const uint8_t kind = cm_fragment[k].kind;
+        if ((r->have & have) == 0u || (have == CM_HAVE_MECH && !mech) ||
+            (kind == CM_F_FRICTION && !isfinite(r->friction_nms))) {
+            continue;
         }
+        if (index-- != 0u) {
+            continue;
+        }
+        const char *f = (const char *)r + cm_fragment[k].off;
+        double v;
+        uint32_t u;
+        int i;
+        if (kind == CM_F_LINES) {
+            memcpy(&u, f, sizeof u);
+            v = (double)(u / 4u);
+        } else if (kind == CM_F_INT) {
+            memcpy(&i, f, sizeof i);
+            v = (double)i;
+        } else {
+            memcpy(&v, f, sizeof v);
+            v = kind == CM_F_MILLI ? v * 1e3 : (kind == CM_F_FRICTION ? fmax(v, 0.0) : v);
+        }
+        *it = (cm_item_t){cm_fragment[k].section, cm_fragment[k].key, v,
+                          kind == CM_F_LINES || kind == CM_F_INT};
+        return true;
     }
-    if (index >= n) {
-        return false;
-    }
-    *it = all[index];
-    return true;
+    return false;
 }
 
 /* ---- outcome ---- */

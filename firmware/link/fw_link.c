@@ -1,6 +1,7 @@
 /* Serial link: cmd_ops_t on the pipeline, telemetry samples (see fw_link.h). */
 #include "fw_link.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -300,60 +301,80 @@ static void op_cm_status(void *ctx, cmd_cm_status_t *st)
     }
 }
 
-/* The measured values, in SI, in a fixed order. */
-typedef struct {
+/* The measured values, in SI, in a fixed order: the result bit that gives
+ * each, its field of cm_si_t and how that is read (the inertia and friction
+ * only with an inertia > 0). */
+enum { FW_R_SI, FW_R_MILLI, FW_R_INT, FW_R_U32, FW_R_BOOL };
+#define FW_R(have, key, unit, kind, f)                                                             \
+    {                                                                                              \
+        have, kind, (uint16_t)offsetof(cm_si_t, f), key, unit                                      \
+    }
+static const struct {
+    uint8_t have, kind;
+    uint16_t off;
     const char *key, *unit;
-    double value;
-} fw_link_result_t;
-
-static size_t fw_link_results(const fw_t *fw, fw_link_result_t out[16])
-{
-    cm_si_t r;
-    fw_commission_results(fw, &r);
-    size_t n = 0;
-    if ((r.have & CM_HAVE_VBUS) != 0u) {
-        out[n++] = (fw_link_result_t){"vbus_v", "V", r.vbus_v};
-    }
-    if ((r.have & CM_HAVE_LPROBE) != 0u) {
-        out[n++] = (fw_link_result_t){"probe_l_mh", "mH", r.l_probe_h * 1e3};
-    }
-    if ((r.have & CM_HAVE_ENC) != 0u) {
-        out[n++] = (fw_link_result_t){"encoder_direction", "", (double)r.enc_dir};
-        out[n++] = (fw_link_result_t){"encoder_offset_deg", "deg", r.enc_offset_deg};
-        out[n++] = (fw_link_result_t){"encoder_counts", "", (double)r.enc_cpr};
-    }
-    if ((r.have & CM_HAVE_RS) != 0u) {
-        out[n++] = (fw_link_result_t){"rs_ohm", "Ohm", r.rs_ohm};
-        out[n++] = (fw_link_result_t){"inverter_error_v", "V", r.v_inv_v};
-        out[n++] = (fw_link_result_t){"unbalance", "", r.unbalance};
-    }
-    if ((r.have & CM_HAVE_LDQ) != 0u) {
-        out[n++] = (fw_link_result_t){"ld_mh", "mH", r.ld_h * 1e3};
-        out[n++] = (fw_link_result_t){"lq_mh", "mH", r.lq_h * 1e3};
-        out[n++] = (fw_link_result_t){"salient", "", r.salient ? 1.0 : 0.0};
-    }
-    if ((r.have & CM_HAVE_FLUX) != 0u) {
-        out[n++] = (fw_link_result_t){"psi_pm_wb", "Wb", r.psi_wb};
-    }
-    if ((r.have & CM_HAVE_MECH) != 0u && r.inertia_kgm2 > 0.0) {
-        out[n++] = (fw_link_result_t){"inertia_kgm2", "kg*m^2", r.inertia_kgm2};
-        out[n++] = (fw_link_result_t){"friction_nms", "N*m*s", r.friction_nms};
-    }
-    return n;
-}
+} fw_link_results[] = {
+    FW_R(CM_HAVE_VBUS, "vbus_v", "V", FW_R_SI, vbus_v),
+    FW_R(CM_HAVE_LPROBE, "probe_l_mh", "mH", FW_R_MILLI, l_probe_h),
+    FW_R(CM_HAVE_ENC, "encoder_direction", "", FW_R_INT, enc_dir),
+    FW_R(CM_HAVE_ENC, "encoder_offset_deg", "deg", FW_R_SI, enc_offset_deg),
+    FW_R(CM_HAVE_ENC, "encoder_counts", "", FW_R_U32, enc_cpr),
+    FW_R(CM_HAVE_RS, "rs_ohm", "Ohm", FW_R_SI, rs_ohm),
+    FW_R(CM_HAVE_RS, "inverter_error_v", "V", FW_R_SI, v_inv_v),
+    FW_R(CM_HAVE_RS, "unbalance", "", FW_R_SI, unbalance),
+    FW_R(CM_HAVE_LDQ, "ld_mh", "mH", FW_R_MILLI, ld_h),
+    FW_R(CM_HAVE_LDQ, "lq_mh", "mH", FW_R_MILLI, lq_h),
+    FW_R(CM_HAVE_LDQ, "salient", "", FW_R_BOOL, salient),
+    FW_R(CM_HAVE_FLUX, "psi_pm_wb", "Wb", FW_R_SI, psi_wb),
+    FW_R(CM_HAVE_MECH, "inertia_kgm2", "kg*m^2", FW_R_SI, inertia_kgm2),
+    FW_R(CM_HAVE_MECH, "friction_nms", "N*m*s", FW_R_SI, friction_nms),
+};
+#undef FW_R
 
 static bool op_cm_result_at(void *ctx, size_t index, const char **key, double *value,
                             const char **unit)
 {
-    fw_link_result_t r[16];
-    const size_t n = fw_link_results(fw_link_of(ctx)->fw, r);
-    if (index >= n) {
-        return false;
+    cm_si_t r;
+    fw_commission_results(fw_link_of(ctx)->fw, &r);
+    for (size_t k = 0; k < sizeof fw_link_results / sizeof fw_link_results[0]; k++) {
+        const unsigned have = fw_link_results[k].have;
+        if ((r.have & have) == 0u || (have == CM_HAVE_MECH && !(r.inertia_kgm2 > 0.0))) {
+            continue;
+        }
+        if (index-- != 0u) {
+            continue;
+        }
+        const char *f = (const char *)&r + fw_link_results[k].off;
+        double v;
+        int i;
+        uint32_t u;
+        bool b;
+        switch (fw_link_results[k].kind) {
+        case FW_R_INT:
+            memcpy(&i, f, sizeof i);
+            v = (double)i;
+            break;
+        case FW_R_U32:
+            memcpy(&u, f, sizeof u);
+            v = (double)u;
+            break;
+        case FW_R_BOOL:
+            memcpy(&b, f, sizeof b);
+            v = b ? 1.0 : 0.0;
+            break;
+        default:
+            memcpy(&v, f, sizeof v);
+            if (fw_link_results[k].kind == FW_R_MILLI) {
+                v *= 1e3;
+            }
+            break;
+        }
+        *key = fw_link_results[k].key;
+        *value = v;
+        *unit = fw_link_results[k].unit;
+        return true;
     }
-    *key = r[index].key;
-    *value = r[index].value;
-    *unit = r[index].unit;
-    return true;
+    return false;
 }
 
 static bool op_cm_ini_at(void *ctx, size_t index, cmd_cm_item_t *item)
