@@ -115,7 +115,7 @@ static int op_param_get(void *ctx, const char *name, double *value)
     const fw_link_t *l = fw_link_of(ctx);
     const fw_link_param_t *p = fw_link_param(l, name);
     if (p != NULL) {
-        return p->get(l->params_ctx, value);
+        return p->get(l->params_ctx, p, value);
     }
     return fw_link_err(fw_tunable_get(l->fw, name, value));
 }
@@ -187,7 +187,7 @@ static int op_param_set(void *ctx, const char *name, double value)
     const fw_link_param_t *p = fw_link_param(l, name);
     if (p != NULL) {
         memset(&l->why, 0, sizeof l->why); /* the application sets it (fw_link_set_why) */
-        return p->set != NULL ? p->set(l->params_ctx, value) : CMD_E_READONLY;
+        return p->set != NULL ? p->set(l->params_ctx, p, value) : CMD_E_READONLY;
     }
     return fw_link_cfg_err(l, fw_tunable_set(l->fw, name, value));
 }

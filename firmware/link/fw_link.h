@@ -29,11 +29,14 @@ typedef void (*fw_link_write_fn)(void *ctx, const uint8_t *bytes, size_t len);
  * (PROTOCOL.md: "the firmware's own parameters"). Names must not collide with
  * tunables (use a prefix such as "m." or "b."). get/set return CMD_OK or a
  * cmd_err_t code; set is NULL when info.read_only. They run in the main loop. */
-typedef struct {
+typedef struct fw_link_param fw_link_param_t;
+struct fw_link_param {
     cmd_param_info_t info;
-    int (*get)(void *ctx, double *value);
-    int (*set)(void *ctx, double value);
-} fw_link_param_t;
+    /* p: this entry; its place in the application's table says which value
+     * (one function for many entries) */
+    int (*get)(void *ctx, const fw_link_param_t *p, double *value);
+    int (*set)(void *ctx, const fw_link_param_t *p, double value);
+};
 
 typedef struct {
     fw_t *fw;

@@ -150,14 +150,16 @@ static void test_fault_over_link(void)
  * interpreter's range check applies, a read-only one answers err 11, the
  * setter's refusal (err 8 while running) passes through. */
 static double app_value = 2.5;
-static int app_get(void *ctx, double *v)
+static int app_get(void *ctx, const fw_link_param_t *p, double *v)
 {
     (void)ctx;
+    (void)p;
     *v = app_value;
     return CMD_OK;
 }
-static int app_set(void *ctx, double v)
+static int app_set(void *ctx, const fw_link_param_t *p, double v)
 {
+    (void)p;
     const fw_t *fw = (const fw_t *)ctx;
     if (fw_state(fw) == FW_STATE_RUNNING) {
         return CMD_E_STATE;

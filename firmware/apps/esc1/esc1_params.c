@@ -79,8 +79,29 @@ static double *esc1_field(ctrl_machine_t *m, esc1_field_t f)
     }
 }
 
-static int esc1_get_field(esc1_t *s, esc1_field_t f, double *v)
+/* Throttle values reachable by index (esc1_thr_get / esc1_thr_set). */
+typedef enum { T_MODE, T_LOW, T_HIGH, T_DB, T_US, T_STATE, T_CAUSE } esc1_thr_field_t;
+
+/* Places in esc1_params: the machine fields at their esc1_field_t, the board
+ * values, the throttle's at P_T0 + esc1_thr_field_t. */
+enum {
+    P_FS = M_CPR + 1,
+    P_DUTY,
+    P_HW_TRIP,
+    P_TEMP,
+    P_TRIP,
+    P_RESET,
+    P_TEMP_CHECK,
+    P_T0,
+    ESC1_N_PARAMS = P_T0 + T_CAUSE + 1
+};
+static const fw_link_param_t esc1_params[ESC1_N_PARAMS];
+
+/* Machine data and the encoder: entries M_P .. M_CPR of esc1_params. */
+static int esc1_get_field(void *ctx, const fw_link_param_t *p, double *v)
 {
+    esc1_t *s = esc1_of(ctx);
+    const esc1_field_t f = (esc1_field_t)(p - esc1_params);
     if (f == M_P) {
         *v = (double)s->machine.pole_pairs;
     } else if (f == M_CPR) {
@@ -91,8 +112,10 @@ static int esc1_get_field(esc1_t *s, esc1_field_t f, double *v)
     return CMD_OK;
 }
 
-static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
+static int esc1_set_field(void *ctx, const fw_link_param_t *p, double v)
 {
+    esc1_t *s = esc1_of(ctx);
+    const esc1_field_t f = (esc1_field_t)(p - esc1_params);
     ctrl_machine_t m = s->machine;
     uint32_t cpr = s->encoder_cpr;
     if (f == M_P || f == M_CPR) {
@@ -111,54 +134,31 @@ static int esc1_set_field(esc1_t *s, esc1_field_t f, double v)
     return esc1_reconfigure(s, &m, cpr);
 }
 
-/* get/set functions per field (the link's callbacks take only a context). */
-#define ESC1_INDEX_GET(F, get)                                                                     \
-    static int esc1_get_##F(void *ctx, double *v)                                                  \
-    {                                                                                              \
-        return get(esc1_of(ctx), F, v);                                                            \
-    }
-#define ESC1_INDEX_FNS(F, get, set)                                                                \
-    ESC1_INDEX_GET(F, get)                                                                         \
-    static int esc1_set_##F(void *ctx, double v)                                                   \
-    {                                                                                              \
-        return set(esc1_of(ctx), F, v);                                                            \
-    }
-#define ESC1_FIELD_FNS(F) ESC1_INDEX_FNS(F, esc1_get_field, esc1_set_field)
-ESC1_FIELD_FNS(M_P)
-ESC1_FIELD_FNS(M_RS)
-ESC1_FIELD_FNS(M_LD)
-ESC1_FIELD_FNS(M_LQ)
-ESC1_FIELD_FNS(M_PSI)
-ESC1_FIELD_FNS(M_VDC)
-ESC1_FIELD_FNS(M_J)
-ESC1_FIELD_FNS(M_T)
-ESC1_FIELD_FNS(M_N)
-ESC1_FIELD_FNS(M_IR)
-ESC1_FIELD_FNS(M_IMAX)
-ESC1_FIELD_FNS(M_PSIREF)
-ESC1_FIELD_FNS(M_CPR)
-
-static int esc1_get_fs(void *ctx, double *v)
+static int esc1_get_fs(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     *v = (double)esc1_of(ctx)->hal.info.pwm_freq_hz;
     return CMD_OK;
 }
 
-static int esc1_get_duty_max(void *ctx, double *v)
+static int esc1_get_duty_max(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     const hal_info_t *i = &esc1_of(ctx)->hal.info;
     *v = (double)i->pwm_cmp_max / (double)i->period_counts;
     return CMD_OK;
 }
 
-static int esc1_get_hw_trip(void *ctx, double *v)
+static int esc1_get_hw_trip(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     *v = esc1_of(ctx)->hal.trip_current_a;
     return CMD_OK;
 }
 
-static int esc1_get_temp(void *ctx, double *v)
+static int esc1_get_temp(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     const double t = esc1_of(ctx)->temp_c;
     if (isnan(t)) {
         return CMD_E_FAILED; /* sensor open or shorted */
@@ -167,26 +167,30 @@ static int esc1_get_temp(void *ctx, double *v)
     return CMD_OK;
 }
 
-static int esc1_get_trip(void *ctx, double *v)
+static int esc1_get_trip(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     *v = (double)g4_hal_trip_cause(&esc1_of(ctx)->hal);
     return CMD_OK;
 }
 
-static int esc1_get_reset(void *ctx, double *v)
+static int esc1_get_reset(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     *v = (double)(esc1_of(ctx)->reset_csr >> 24);
     return CMD_OK;
 }
 
-static int esc1_get_temp_check(void *ctx, double *v)
+static int esc1_get_temp_check(void *ctx, const fw_link_param_t *p, double *v)
 {
+    (void)p;
     *v = esc1_of(ctx)->temp_check ? 1.0 : 0.0;
     return CMD_OK;
 }
 
-static int esc1_set_temp_check(void *ctx, double v)
+static int esc1_set_temp_check(void *ctx, const fw_link_param_t *p, double v)
 {
+    (void)p;
     if (v != 0.0 && v != 1.0) {
         return CMD_E_RANGE;
     }
@@ -196,11 +200,10 @@ static int esc1_set_temp_check(void *ctx, double v)
 
 /* [throttle] settings: changed only while the throttle has not armed the
  * drive; the decoder restarts (disarmed, waiting for the low end). */
-/* Throttle values reachable by index (esc1_thr_get / esc1_thr_set). */
-typedef enum { T_MODE, T_LOW, T_HIGH, T_DB, T_US, T_STATE, T_CAUSE } esc1_thr_field_t;
-
-static int esc1_thr_set(esc1_t *s, esc1_thr_field_t i, double v)
+static int esc1_thr_set(void *ctx, const fw_link_param_t *p, double v)
 {
+    esc1_t *s = esc1_of(ctx);
+    const esc1_thr_field_t i = (esc1_thr_field_t)(p - &esc1_params[P_T0]);
     if (v != floor(v)) {
         return CMD_E_RANGE;
     }
@@ -221,70 +224,83 @@ static int esc1_thr_set(esc1_t *s, esc1_thr_field_t i, double v)
     return CMD_OK;
 }
 
-static int esc1_thr_get(const esc1_t *s, esc1_thr_field_t i, double *v)
+static int esc1_thr_get(void *ctx, const fw_link_param_t *p, double *v)
 {
-    const thr_t *t = &s->thr;
+    const thr_t *t = &esc1_of(ctx)->thr;
+    const esc1_thr_field_t i = (esc1_thr_field_t)(p - &esc1_params[P_T0]);
     const uint32_t x[7] = {t->cfg.mode, t->cfg.low_us, t->cfg.high_us, t->cfg.deadband_us,
                            t->width_us, t->state,      t->cause};
     *v = (double)x[i];
     return CMD_OK;
 }
 
-ESC1_INDEX_FNS(T_MODE, esc1_thr_get, esc1_thr_set)
-ESC1_INDEX_FNS(T_LOW, esc1_thr_get, esc1_thr_set)
-ESC1_INDEX_FNS(T_HIGH, esc1_thr_get, esc1_thr_set)
-ESC1_INDEX_FNS(T_DB, esc1_thr_get, esc1_thr_set)
-
-ESC1_INDEX_GET(T_US, esc1_thr_get)
-ESC1_INDEX_GET(T_STATE, esc1_thr_get)
-ESC1_INDEX_GET(T_CAUSE, esc1_thr_get)
-
-#define ESC1_RW(name, unit, lo, hi, help, F)                                                       \
+#define ESC1_RW(name, unit, lo, hi, help, get, set)                                                \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), lo, hi, false}, esc1_get_##F, esc1_set_##F                   \
+        {name, unit, HELP_TEXT(help), lo, hi, false}, get, set                                     \
     }
 #define ESC1_RO(name, unit, help, get)                                                             \
     {                                                                                              \
         {name, unit, HELP_TEXT(help), 0.0, 0.0, true}, get, NULL                                   \
     }
 
-static const fw_link_param_t esc1_params[] = {
-    ESC1_RW("m.p", "-", 1.0, 50.0, "pole pairs (re-initialises, disarmed only)", M_P),
-    ESC1_RW("m.rs_ohm", "ohm", 0.001, 100.0, "stator resistance per phase", M_RS),
-    ESC1_RW("m.ld_h", "H", 1e-6, 1.0, "d inductance", M_LD),
-    ESC1_RW("m.lq_h", "H", 1e-6, 1.0, "q inductance", M_LQ),
-    ESC1_RW("m.psi_wb", "Wb", 1e-4, 1.0, "PM flux linkage, peak per phase", M_PSI),
-    ESC1_RW("m.vdc_v", "V", 8.0, 25.2, "nominal DC link (board max 25.2 V)", M_VDC),
-    ESC1_RW("m.j_kgm2", "kg*m^2", 1e-9, 1.0, "rotor inertia", M_J),
-    ESC1_RW("m.t_rated_nm", "N*m", 1e-4, 100.0, "rated torque (torque reference limit)", M_T),
-    ESC1_RW("m.n_rated_rpm", "r/min", 10.0, 100000.0, "rated speed", M_N),
-    ESC1_RW("m.i_rated_a", "A", 0.01, 40.0, "rated current, peak", M_IR),
-    ESC1_RW("m.i_max_a", "A", 0.01, 40.0, "over-current trip, peak (hw trip 1.5x, >= 8 A)", M_IMAX),
-    ESC1_RW("m.psi_ref_wb", "Wb", 0.0, 1.0, "stator flux reference, 0 = MTPA", M_PSIREF),
-    ESC1_RW("enc.cpr", "-", 4.0, 65535.0, "encoder counts per revolution (4 x lines)", M_CPR),
-    ESC1_RO("b.fs_hz", "Hz", "PWM and control frequency", esc1_get_fs),
-    ESC1_RO("b.duty_max", "-", "largest leg duty (low-side current sampling window)",
-            esc1_get_duty_max),
-    ESC1_RO("b.hw_trip_a", "A", "hardware over-current threshold (comparators)", esc1_get_hw_trip),
-    ESC1_RO("b.temp_c", "C", "board temperature (NTC, linear model)", esc1_get_temp),
-    ESC1_RO("b.trip", "-", "trip latch: 1 over-current, 2 system break, 4 board (temp)",
-            esc1_get_trip),
-    ESC1_RO("b.reset", "-",
-            "RCC_CSR reset flags at start-up >> 24: 2 option bytes, 4 pin, 8 brown-out, "
-            "16 software, 32 watchdog",
-            esc1_get_reset),
-    {{"b.temp_check", "-", HELP_TEXT("1 = board over-temperature trip on"), 0.0, 1.0, false},
-     esc1_get_temp_check,
-     esc1_set_temp_check},
-    ESC1_RW("throttle.mode", "-", 0.0, 2.0, "PWM pad (PA15): 0 off, 1 torque, 2 speed", T_MODE),
-    ESC1_RW("throttle.low_us", "us", 800.0, 1499.0, "pulse at zero (calibrated low end)", T_LOW),
-    ESC1_RW("throttle.high_us", "us", 1501.0, 2200.0, "pulse at full scale", T_HIGH),
-    ESC1_RW("throttle.deadband_us", "us", 0.0, 349.0, "zero up to low_us + this", T_DB),
-    ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_get_T_US),
-    ESC1_RO("throttle.state", "-", "0 disarmed (1 s at the low end arms), 1 armed, 2 lost",
-            esc1_get_T_STATE),
-    ESC1_RO("throttle.cause", "-", "last loss: 1 no pulse, 2 invalid pulses (100 ms)",
-            esc1_get_T_CAUSE),
+static const fw_link_param_t esc1_params[ESC1_N_PARAMS] = {
+    [M_P] = ESC1_RW("m.p", "-", 1.0, 50.0, "pole pairs (re-initialises, disarmed only)",
+                    esc1_get_field, esc1_set_field),
+    [M_RS] = ESC1_RW("m.rs_ohm", "ohm", 0.001, 100.0, "stator resistance per phase", esc1_get_field,
+                     esc1_set_field),
+    [M_LD] = ESC1_RW("m.ld_h", "H", 1e-6, 1.0, "d inductance", esc1_get_field, esc1_set_field),
+    [M_LQ] = ESC1_RW("m.lq_h", "H", 1e-6, 1.0, "q inductance", esc1_get_field, esc1_set_field),
+    [M_PSI] = ESC1_RW("m.psi_wb", "Wb", 1e-4, 1.0, "PM flux linkage, peak per phase",
+                      esc1_get_field, esc1_set_field),
+    [M_VDC] = ESC1_RW("m.vdc_v", "V", 8.0, 25.2, "nominal DC link (board max 25.2 V)",
+                      esc1_get_field, esc1_set_field),
+    [M_J] =
+        ESC1_RW("m.j_kgm2", "kg*m^2", 1e-9, 1.0, "rotor inertia", esc1_get_field, esc1_set_field),
+    [M_T] = ESC1_RW("m.t_rated_nm", "N*m", 1e-4, 100.0, "rated torque (torque reference limit)",
+                    esc1_get_field, esc1_set_field),
+    [M_N] = ESC1_RW("m.n_rated_rpm", "r/min", 10.0, 100000.0, "rated speed", esc1_get_field,
+                    esc1_set_field),
+    [M_IR] = ESC1_RW("m.i_rated_a", "A", 0.01, 40.0, "rated current, peak", esc1_get_field,
+                     esc1_set_field),
+    [M_IMAX] =
+        ESC1_RW("m.i_max_a", "A", 0.01, 40.0, "over-current trip, peak (hw trip 1.5x, >= 8 A)",
+                esc1_get_field, esc1_set_field),
+    [M_PSIREF] = ESC1_RW("m.psi_ref_wb", "Wb", 0.0, 1.0, "stator flux reference, 0 = MTPA",
+                         esc1_get_field, esc1_set_field),
+    [M_CPR] = ESC1_RW("enc.cpr", "-", 4.0, 65535.0, "encoder counts per revolution (4 x lines)",
+                      esc1_get_field, esc1_set_field),
+    [P_FS] = ESC1_RO("b.fs_hz", "Hz", "PWM and control frequency", esc1_get_fs),
+    [P_DUTY] = ESC1_RO("b.duty_max", "-", "largest leg duty (low-side current sampling window)",
+                       esc1_get_duty_max),
+    [P_HW_TRIP] = ESC1_RO("b.hw_trip_a", "A", "hardware over-current threshold (comparators)",
+                          esc1_get_hw_trip),
+    [P_TEMP] = ESC1_RO("b.temp_c", "C", "board temperature (NTC, linear model)", esc1_get_temp),
+    [P_TRIP] = ESC1_RO("b.trip", "-", "trip latch: 1 over-current, 2 system break, 4 board (temp)",
+                       esc1_get_trip),
+    [P_RESET] =
+        ESC1_RO("b.reset", "-",
+                "RCC_CSR reset flags at start-up >> 24: 2 option bytes, 4 pin, 8 brown-out, "
+                "16 software, 32 watchdog",
+                esc1_get_reset),
+    [P_TEMP_CHECK] = {{"b.temp_check", "-", HELP_TEXT("1 = board over-temperature trip on"), 0.0,
+                       1.0, false},
+                      esc1_get_temp_check,
+                      esc1_set_temp_check},
+    [P_T0 + T_MODE] =
+        ESC1_RW("throttle.mode", "-", 0.0, 2.0, "PWM pad (PA15): 0 off, 1 torque, 2 speed",
+                esc1_thr_get, esc1_thr_set),
+    [P_T0 + T_LOW] = ESC1_RW("throttle.low_us", "us", 800.0, 1499.0,
+                             "pulse at zero (calibrated low end)", esc1_thr_get, esc1_thr_set),
+    [P_T0 + T_HIGH] = ESC1_RW("throttle.high_us", "us", 1501.0, 2200.0, "pulse at full scale",
+                              esc1_thr_get, esc1_thr_set),
+    [P_T0 + T_DB] = ESC1_RW("throttle.deadband_us", "us", 0.0, 349.0, "zero up to low_us + this",
+                            esc1_thr_get, esc1_thr_set),
+    [P_T0 + T_US] = ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_thr_get),
+    [P_T0 + T_STATE] =
+        ESC1_RO("throttle.state", "-", "0 disarmed (1 s at the low end arms), 1 armed, 2 lost",
+                esc1_thr_get),
+    [P_T0 + T_CAUSE] = ESC1_RO("throttle.cause", "-",
+                               "last loss: 1 no pulse, 2 invalid pulses (100 ms)", esc1_thr_get),
 };
 
 void esc1_params_attach(esc1_t *s)

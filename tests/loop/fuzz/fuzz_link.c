@@ -158,44 +158,33 @@ static int fz_set(const fz_field_t *f, double v)
     return CMD_OK;
 }
 
-#define FZ_FNS(k)                                                                                  \
-    static int fz_get_##k(void *ctx, double *v)                                                    \
-    {                                                                                              \
-        (void)ctx;                                                                                 \
-        return fz_get(&fz_fields[k], v);                                                           \
-    }                                                                                              \
-    static int fz_set_##k(void *ctx, double v)                                                     \
-    {                                                                                              \
-        (void)ctx;                                                                                 \
-        return fz_set(&fz_fields[k], v);                                                           \
-    }
-FZ_FNS(0)
-FZ_FNS(1)
-FZ_FNS(2)
-FZ_FNS(3)
-FZ_FNS(4)
-FZ_FNS(5)
-FZ_FNS(6)
-FZ_FNS(7)
-FZ_FNS(8)
-FZ_FNS(9)
-FZ_FNS(10)
-FZ_FNS(11)
-FZ_FNS(12)
+/* One get and one set for every field: the entry's place in fz_params is the
+ * field's in fz_fields. */
+static fw_link_param_t fz_params[FZ_N_FIELDS];
+static int fz_get_p(void *ctx, const fw_link_param_t *p, double *v)
+{
+    (void)ctx;
+    return fz_get(&fz_fields[p - fz_params], v);
+}
+static int fz_set_p(void *ctx, const fw_link_param_t *p, double v)
+{
+    (void)ctx;
+    return fz_set(&fz_fields[p - fz_params], v);
+}
 
 #define FZ_P(k)                                                                                    \
     {                                                                                              \
-        {NULL, NULL, "machine data (re-initialises)", -1e15, 1e15, false}, fz_get_##k, fz_set_##k  \
+        {NULL, NULL, "machine data (re-initialises)", -1e15, 1e15, false}, fz_get_p, fz_set_p      \
     }
 /* m.p: any int (the core decides which pole pairs it takes). */
 #define FZ_P_INT(k)                                                                                \
     {                                                                                              \
-        {NULL, NULL, "pole pairs (re-initialises)", -2147483648.0, 2147483647.0, false},           \
-            fz_get_##k, fz_set_##k                                                                 \
+        {NULL, NULL, "pole pairs (re-initialises)", -2147483648.0, 2147483647.0, false}, fz_get_p, \
+            fz_set_p                                                                               \
     }
-static fw_link_param_t fz_params[] = {FZ_P_INT(0), FZ_P(1),  FZ_P(2), FZ_P(3), FZ_P(4),
-                                      FZ_P(5),     FZ_P(6),  FZ_P(7), FZ_P(8), FZ_P(9),
-                                      FZ_P(10),    FZ_P(11), FZ_P(12)};
+static fw_link_param_t fz_params[FZ_N_FIELDS] = {FZ_P_INT(0), FZ_P(1),  FZ_P(2), FZ_P(3), FZ_P(4),
+                                                 FZ_P(5),     FZ_P(6),  FZ_P(7), FZ_P(8), FZ_P(9),
+                                                 FZ_P(10),    FZ_P(11), FZ_P(12)};
 
 /* ---- invariants ---- */
 
