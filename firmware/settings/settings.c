@@ -15,7 +15,8 @@ typedef struct {
     uint16_t offset; /* offsetof(settings_t, field) */
     uint8_t type;    /* settings_type_t */
     uint8_t count;   /* array length (1 for a scalar) */
-    int32_t lo, hi;  /* integer types: the values accepted (inclusive) */
+    int16_t lo;      /* integer types: the values accepted (inclusive; */
+    uint16_t hi;     /* lo = hi = 0: every value of the type) */
 } settings_field_t;
 
 #define SF(key, field, type, lo, hi)                                                               \
@@ -49,7 +50,7 @@ static const settings_field_t settings_fields[] = {
     SF_F64("inv.v_fwd_v", v_fwd_v),
     SF("psi_adapt", psi_adapt, ST_U8, 0, 1),
     {"ctrl", (uint16_t)offsetof(settings_t, ctrl), ST_NAME, 1u, 0, 0},
-    SF("ctrl.n_tunables", n_tunables, ST_U8, 0, (int32_t)SETTINGS_TUNABLES_MAX),
+    SF("ctrl.n_tunables", n_tunables, ST_U8, 0, (uint16_t)SETTINGS_TUNABLES_MAX),
     {"", (uint16_t)offsetof(settings_t, tunable_name), ST_NAME, SETTINGS_TUNABLES_MAX, 0, 0},
     {"", (uint16_t)offsetof(settings_t, tunable_value), ST_F64, SETTINGS_TUNABLES_MAX, 0, 0},
     SF_F64("speed.bw_hz", speed_bw_hz),
