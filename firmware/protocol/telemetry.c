@@ -10,7 +10,7 @@
 
 #define TEL_SIG(name, unit, help, kind, field)                                                     \
     {                                                                                              \
-        name, unit, HELP_TEXT(help), kind, offsetof(tel_sample_t, field)                           \
+        name, unit, HELP_TEXT(help), kind, (uint16_t)offsetof(tel_sample_t, field)                 \
     }
 
 static const tel_signal_t tel_signals[TEL_SIG_COUNT] = {
@@ -67,7 +67,7 @@ double tel_signal_scale(size_t index, const ctrl_bases_t *b, int32_t pole_pairs)
     if (index >= (size_t)TEL_SIG_COUNT) {
         return 0.0;
     }
-    const tel_kind_t kind = tel_signals[index].kind;
+    const tel_kind_t kind = (tel_kind_t)tel_signals[index].kind;
     if (kind == TEL_KIND_INTEGER) {
         return 1.0;
     }

@@ -88,8 +88,8 @@ typedef struct {
     const char *name; /* lower case, used by "tel start" */
     const char *unit; /* SI unit after scaling ("" for integers) */
     const char *help;
-    tel_kind_t kind;
-    size_t offset; /* offsetof(tel_sample_t, field) */
+    uint8_t kind;    /* tel_kind_t */
+    uint16_t offset; /* offsetof(tel_sample_t, field) */
 } tel_signal_t;
 
 /* The signal table (const, in flash). NULL past the end. */
