@@ -73,8 +73,8 @@ typedef struct {
     const char *name; /* printable, no spaces, e.g. "h_T" */
     const char *unit; /* e.g. "N*m", "" when dimensionless */
     const char *help; /* one line (truncated in listings) */
+    bool read_only;   /* here, not last: the doubles then need no padding */
     double min, max;  /* accepted range (inclusive), checked before param_set */
-    bool read_only;
 } cmd_param_info_t;
 
 #define CMD_CM_IDENT 1u   /* an identification step */

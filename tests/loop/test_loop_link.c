@@ -168,8 +168,8 @@ static int app_set(void *ctx, const fw_link_param_t *p, double v)
     return CMD_OK;
 }
 static const fw_link_param_t app_params[] = {
-    {{"m.rs_ohm", "ohm", "stator resistance", 0.001, 100.0, false}, app_get, app_set},
-    {{"b.temp_c", "C", "board temperature", 0.0, 0.0, true}, app_get, NULL},
+    {{"m.rs_ohm", "ohm", "stator resistance", false, 0.001, 100.0}, app_get, app_set},
+    {{"b.temp_c", "C", "board temperature", true, 0.0, 0.0}, app_get, NULL},
 };
 
 static void test_application_parameters(void)

@@ -6,10 +6,10 @@ static const char *const mock_ctrl_names[] = {"bst", "fst", "drr"};
 #define MOCK_NCTRL 3
 
 static const cmd_param_info_t mock_params[MOCK_NPARAM] = {
-    {"h_T", "N*m", "torque hysteresis band (Table 4.7)", 0.0, 1.0, false},
-    {"lambda", "", "EMA factor (5.3)", 0.001, 1.0, false},
-    {"kp", "N*m*s/rad", "speed PI gain", -5.0, 5.0, false},
-    {"fs", "Hz", "control frequency", 1000.0, 40000.0, true},
+    {"h_T", "N*m", "torque hysteresis band (Table 4.7)", false, 0.0, 1.0},
+    {"lambda", "", "EMA factor (5.3)", false, 0.001, 1.0},
+    {"kp", "N*m*s/rad", "speed PI gain", false, -5.0, 5.0},
+    {"fs", "Hz", "control frequency", true, 1000.0, 40000.0},
 };
 
 static void mock_write(void *ctx, const char *s, size_t n)

@@ -236,11 +236,11 @@ static int esc1_thr_get(void *ctx, const fw_link_param_t *p, double *v)
 
 #define ESC1_RW(name, unit, lo, hi, help, get, set)                                                \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), lo, hi, false}, get, set                                     \
+        {name, unit, HELP_TEXT(help), false, lo, hi}, get, set                                     \
     }
 #define ESC1_RO(name, unit, help, get)                                                             \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), 0.0, 0.0, true}, get, NULL                                   \
+        {name, unit, HELP_TEXT(help), true, 0.0, 0.0}, get, NULL                                   \
     }
 
 static const fw_link_param_t esc1_params[ESC1_N_PARAMS] = {

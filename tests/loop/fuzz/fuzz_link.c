@@ -174,12 +174,12 @@ static int fz_set_p(void *ctx, const fw_link_param_t *p, double v)
 
 #define FZ_P(k)                                                                                    \
     {                                                                                              \
-        {NULL, NULL, "machine data (re-initialises)", -1e15, 1e15, false}, fz_get_p, fz_set_p      \
+        {NULL, NULL, "machine data (re-initialises)", false, -1e15, 1e15}, fz_get_p, fz_set_p      \
     }
 /* m.p: any int (the core decides which pole pairs it takes). */
 #define FZ_P_INT(k)                                                                                \
     {                                                                                              \
-        {NULL, NULL, "pole pairs (re-initialises)", -2147483648.0, 2147483647.0, false}, fz_get_p, \
+        {NULL, NULL, "pole pairs (re-initialises)", false, -2147483648.0, 2147483647.0}, fz_get_p, \
             fz_set_p                                                                               \
     }
 static fw_link_param_t fz_params[FZ_N_FIELDS] = {FZ_P_INT(0), FZ_P(1),  FZ_P(2), FZ_P(3), FZ_P(4),
