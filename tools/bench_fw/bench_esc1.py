@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Instructions of the B-G431B-ESC1's control interrupt, and what they mean at 170 MHz.
 
-    tools/bench --esc1 [--ctrl m2ptfc,foc,fst,drr] [--periods N] [--fs HZ] [--sensorless]
+    tools/bench --esc1 [--ctrl a,b] [--periods N] [--fs HZ] [--sensorless]
                        [--out FILE]
 
 The bench's method (tools/bench, README "Interrupt cost"): a host closed loop
@@ -54,7 +54,9 @@ def board_core_options():
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--ctrl", default="m2ptfc,foc,fst,drr")
+    ap.add_argument("--ctrl", default=",".join(
+        board_core_options().get("PMSM_CONTROLLERS", "m2ptfc;foc;fst;drr").split(";")),
+                    help="controllers (default: every one the board preset links)")
     ap.add_argument("--periods", type=int, default=2000)
     ap.add_argument("--speed", type=int, default=None,
                     help="r/min (default 750; %d with --sensorless)" % bench.SENSORLESS_RPM)
