@@ -18,7 +18,9 @@
 #include "g4_core.h"
 #include "help_text.h"
 
-double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m)
+/* Out of line: three callers, each inlined copy of its soft-double compares
+ * took more flash than a call. */
+__attribute__((noinline)) double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m)
 {
     double a = 1.5 * m->current_max_a;
     if (a < 8.0) {
