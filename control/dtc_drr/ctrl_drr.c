@@ -289,12 +289,19 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     const q24_t te = s->centre != 0u ? drr_t_start_c(s, t_k1, cn, dc) : t_k1;
 
     /* Virtual reference (5.3)-(5.4): gamma = EMA of T_ref - T_min, T_min being
-     * the torque where the active vector starts (see ctrl_drr_t_start). */
-    q24_t g = ctrl_drr_ema(s->gamma, fx_sub(tref, te), s->lambda);
-    if (s->gamma_max > 0) {
-        g = fx_clamp(g, -s->gamma_max, s->gamma_max);
+     * the torque where the active vector starts (see ctrl_drr_t_start). The
+     * EMA holds while the error exceeds one period's largest torque change,
+     * gamma_max (default A (5.9)) plus the zero vector's |B w / w_rn + rt|:
+     * such an error is a step's rise, not the offset gamma is for, and wound
+     * up into T_ref + gamma it carries a fixed flux past its pull-out
+     * (docs/algorithms.md, "Virtual-reference wind-up"). */
+    const q24_t chi = fx_sub(tref, te);
+    const q24_t band = fx_add(s->gamma_max, fx_abs(fx_add(fx_mul(s->kb, drr_lim(w)), s->rt)));
+    q24_t g = s->gamma;
+    if (s->gamma_max == 0 || fx_abs(chi) <= band) {
+        g = ctrl_drr_ema(g, chi, s->lambda);
+        s->gamma = g;
     }
-    s->gamma = g;
     const q24_t tv = fx_add(tref, g);
 
     /* Flux reference by MTPA (4.15) of the corrected demand (§5.4). */

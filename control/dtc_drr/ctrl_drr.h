@@ -48,7 +48,7 @@ typedef struct {
     q24_t dc_max;    /* (5.13) denominator clamp, < 0: |C| <= CTRL_DRR_C_MAX */
     q24_t lambda;    /* (5.4), Q24 */
     q24_t half_dpsi; /* dpsi_max / 2, pu flux */
-    q24_t gamma_max; /* pu torque; 0 = no limit */
+    q24_t gamma_max; /* pu torque: (5.4) holds while |error| > gamma_max + |kb w + rt| */
     q24_t r_ts;      /* Rs Ts / Ls, per period (Q24): resistive ZVV deviation; 0 = off */
     ctrl_vreplace_t vr;
     uint8_t pred_516;

@@ -46,7 +46,8 @@ static const ctrl_tunable_t drr_tunables[] = {
      offsetof(ctrl_drr_cfg_t, dpsi_max_wb), 0.0, 10.0},
     {"pred_516", "-", HELP_TEXT("torque prediction: 0 = estimator model (4.6)/(5.15), 1 = (5.16)"),
      offsetof(ctrl_drr_cfg_t, pred_516), 0.0, 1.0},
-    {"gamma_max", "N*m", HELP_TEXT("limit of |gamma| (5.4); 0 = none (thesis)"),
+    {"gamma_max", "N*m",
+     HELP_TEXT("EMA (5.4) holds while |error| > this + zero-vector step; 0 = A (5.9)"),
      offsetof(ctrl_drr_cfg_t, gamma_max_nm), 0.0, 1e5},
     {"centre", "-",
      HELP_TEXT("1 = centre-aligned PWM: T_e at the active-vector start (Fig. 5.4); 0 = AVV first"),
@@ -224,8 +225,9 @@ static int drr_init(void *state, const void *cfg, const ctrl_setup_t *su)
     const double dpsi = c->dpsi_max_wb > 0.0 ? c->dpsi_max_wb : CTRL_SQRT3 * m->vdc_v * ts / 3.0;
     rc = drr_q24(su, "DRR dpsi_max / 2", 0.5 * dpsi / b.psi_wb, 0.0, DRR_PU_MAX, &s->half_dpsi);
     if (rc == CTRL_OK) {
-        rc = drr_q24(su, "DRR gamma_max", c->gamma_max_nm / b.torque_nm, 0.0, DRR_PU_MAX,
-                     &s->gamma_max);
+        /* the error band of the EMA (5.4) at zero speed: A (5.9) */
+        const double g_max = c->gamma_max_nm > 0.0 ? c->gamma_max_nm : a_nm;
+        rc = drr_q24(su, "DRR gamma_max", g_max / b.torque_nm, 0.0, DRR_PU_MAX, &s->gamma_max);
     }
     if (rc != CTRL_OK) {
         return rc;

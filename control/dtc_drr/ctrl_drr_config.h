@@ -19,7 +19,7 @@ typedef struct {
     double sigma;        /* subsector width (4.19) of the replacement, rad; 0 = off */
     double dpsi_max_wb;  /* Delta psi_max of §5.3.5, Wb; 0 = sqrt(3) Vdc Ts / 3 */
     double pred_516;     /* 0: model prediction of T(k+1) (default); 1: (5.16) */
-    double gamma_max_nm; /* |gamma| limit, N*m; 0 = none (thesis) */
+    double gamma_max_nm; /* error band of the EMA (5.4), N*m; 0 = A (5.9) */
     double centre;       /* 1: plans realised centre-aligned (plan.h, default): T_e is
                             shifted to the active-vector start; 0: active vector first */
     double rs_dt;        /* 1: the zero-vector deviation includes -(Rs Ts/Ls) T_e of

@@ -76,8 +76,15 @@ void ctrl_m2ptfc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
 
     /* (6.8) sigma_T = lambda (T_ref - Te) + (1 - lambda) sigma_T(k-1). With
      * 0 < lambda <= FX_ONE (init) the product is at most 2^24 * 2^31 = 2^55
-     * in magnitude and its rounded Q24 value fits an int32_t: no saturation. */
-    s->sigma = fx_add(s->sigma, fx_mul_nosat(s->lambda, fx_sub(fx_sub(t_ref, te), s->sigma)));
+     * in magnitude and its rounded Q24 value fits an int32_t: no saturation.
+     * It holds while the error exceeds one period's largest torque change,
+     * A (5.9) plus the zero vector's |Te0(k+2) - Te(k+1)|: that is a step's
+     * rise, and wound up into T_ref + sigma_T it would carry a fixed flux past
+     * its pull-out (docs/algorithms.md, "Virtual-reference wind-up"). */
+    const q24_t chi = fx_sub(t_ref, te);
+    if (s->sigma_max == 0 || fx_abs(chi) <= fx_add(s->sigma_max, fx_abs(fx_sub(b.t0, t1)))) {
+        s->sigma = fx_add(s->sigma, fx_mul_nosat(s->lambda, fx_sub(chi, s->sigma)));
+    }
     const q24_t t_upper = fx_add(t_ref, s->sigma);
     const q24_t num = fx_sub(t_upper, te); /* numerator of (6.5) */
     const q24_t two_sigma = fx_add(s->sigma, s->sigma);

@@ -23,9 +23,10 @@
 
 typedef struct {
     ctrl_mpc_model_t model;
-    q24_t lambda;   /* Q24 */
-    q24_t sigma;    /* sigma_T of (6.8), Q24 pu */
-    uint8_t centre; /* 1: Te_c (**) in (6.5), (6.7), (6.8); 0: Te(k+1) */
+    q24_t lambda;    /* Q24 */
+    q24_t sigma;     /* sigma_T of (6.8), Q24 pu */
+    q24_t sigma_max; /* A (5.9), Q24 pu: (6.8) holds while |error| > A + |dTe0| */
+    uint8_t centre;  /* 1: Te_c (**) in (6.5), (6.7), (6.8); 0: Te(k+1) */
     ctrl_mpc_trace_t trace;
     /* ctrl_mpc_psi_ref2(params, ref), psi_ref^2 in Q24 pu^2 (ctrl_mpc_amp2
      * units), formed only when its inputs move (mtpa.h: the references, the

@@ -3,6 +3,7 @@
 #include <stddef.h>
 #include <string.h>
 
+#include "ctrl_drr_config.h"
 #include "ctrl_m2ptfc.h"
 #include "ctrl_m2ptfc_config.h"
 #include "ctrl_m2ptfc_model_config.h"
@@ -42,6 +43,13 @@ static int m2ptfc_init(void *state, const void *cfg, const ctrl_setup_t *setup)
     if (rc != CTRL_OK) {
         return rc;
     }
+    double a_nm;
+    double b_nm;
+    if (ctrl_drr_ab_si(setup->machine, 1.0 / (double)setup->params->fs_hz, &a_nm, &b_nm) !=
+        CTRL_OK) {
+        return CTRL_EINVAL;
+    }
+    s->sigma_max = ctrl_q24_from_double(a_nm / setup->bases->torque_nm);
     s->lambda = ctrl_q24_from_double(c->lambda);
     s->centre = c->centre != 0.0 ? 1u : 0u;
     ctrl_m2ptfc_reset(s);

@@ -234,8 +234,11 @@ void run_drr_reference(bool rs_dt)
         const double C = 2.0 * std::sqrt(3.0) * k.a / dc;
         // centre-aligned period: torque at the active-vector start, (5.12) C gamma
         const double te = t_k1 + 0.5 * (1.0 - d_last) * C * g_prev;
-        const double g = g_prev + k.lambda * ((tref - te) - g_prev); // (5.4)
-        const double tv = tref + g;                                  // (5.3)
+        // (5.4), holding while the error exceeds one period's largest change
+        const double band = k.a + std::fabs(k.kb * w + zr); // A (5.9) + the zero vector's
+        const bool hold = std::fabs(tref - te) > band;
+        const double g = hold ? g_prev : g_prev + k.lambda * ((tref - te) - g_prev);
+        const double tv = tref + g; // (5.3)
         const double lq = d(P.lq), ppm = d(P.psi_pm);
         const double psi_ref = std::sqrt(ppm * ppm + (lq * tv / ppm) * (lq * tv / ppm)); // (4.15)
         const double terr = tv - te;
@@ -297,6 +300,7 @@ void run_drr_reference(bool rs_dt)
 
         // boundary cases: decided by less than the rounding of the inputs
         const bool near = std::fabs(terr) < kEdge || std::fabs(perr) < kEdge || edge < kEdge ||
+                          std::fabs(std::fabs(tref - te) - band) < kEdge ||
                           std::fabs(std::fabs(perr) - k.half_dpsi) < kEdge ||
                           std::fabs(rel - k.sigma) < kEdge ||
                           std::fabs(rel - (kPi / 3.0 - k.sigma)) < kEdge ||

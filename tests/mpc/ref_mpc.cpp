@@ -349,7 +349,18 @@ static void run_m2ptfc(const ctrl_machine_t &mach, uint32_t fs, double centre, S
         rp.at(0, 0.0, &t0, &amp0, &tol0);
         const double d_num = LSB + (centre != 0.0 ? 0.5 * tol0 : 0.0); /* budget of up */
         const double te = centre != 0.0 ? rp.t1 + 0.5 * (t0 - rp.t1) : rp.t1;
-        const double sigma = 0.03 * (t_ref - te) + 0.97 * sigma_old; /* (6.8) */
+        /* (6.8), holding while the error exceeds one period's largest change:
+         * A (5.9) plus the zero vector's */
+        const double a_step = mach.pole_pairs * mach.vdc_v * mach.psi_pm_wb /
+                                  (static_cast<double>(fs) * mach.ld_h) / b.torque_nm +
+                              std::fabs(t0 - rp.t1);
+        if (std::fabs(std::fabs(t_ref - te) - a_step) < 4.0 * d_num) {
+            st.ties++; /* hold or not decided within the rounding of Te */
+            continue;
+        }
+        const double sigma = std::fabs(t_ref - te) > a_step
+                                 ? sigma_old
+                                 : 0.03 * (t_ref - te) + 0.97 * sigma_old; /* (6.8) */
         const int x = ref_sector(rp.psi1);
         if (x < 0) {
             st.ties++;

@@ -302,8 +302,16 @@ static void check_m2ptfc(const ctrl_machine_t *m, uint32_t fs, double centre)
         predict2(&p, &est, 1u, 0, &zero);
         const double t1 = d24(est.next.torque);
         const double te = centre != 0.0 ? t1 + 0.5 * (d24(zero.torque) - t1) : t1;
-        /* (6.8) */
-        const double sigma = sigma_old + 0.03 * (d24(ref.torque) - te - sigma_old);
+        /* (6.8), holding while the error exceeds one period's largest change:
+         * A (5.9) plus the zero vector's */
+        const double a_step =
+            m->pole_pairs * m->vdc_v * m->psi_pm_wb / ((double)fs * m->ld_h) / g_bases.torque_nm +
+            fabs(d24(zero.torque) - t1);
+        const double chi = d24(ref.torque) - te;
+        if (fabs(fabs(chi) - a_step) <= 4.0 * TOL_T) {
+            continue; /* hold or not decided within the budget */
+        }
+        const double sigma = fabs(chi) > a_step ? sigma_old : sigma_old + 0.03 * (chi - sigma_old);
         TEST_ASSERT_DOUBLE_WITHIN(TOL_T, sigma, d24(s.sigma));
         /* Candidates (6.7), unless T_ref + sigma_T and Te are within the budget. */
         const double num = d24(ref.torque) + sigma - te;
