@@ -39,7 +39,7 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->speed_kp = 0.0;
     c->speed_ki = 0.0;
     c->speed_unit = CTRL_SPEED_UNIT_RAD_S_MECH;
-    c->speed_out_max_nm = fw_torque_limit_nm(machine, NULL);
+    c->speed_out_max_nm = fw_torque_limit_nm(machine, ctrl, NULL);
     c->speed_loop_hz = 1000u;
     c->overspeed_rpm = 0.0;
     c->psi_adapt = true;

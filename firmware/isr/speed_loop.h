@@ -33,6 +33,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "controller.h"
 #include "ctrl_params.h"
 
 #define FW_SPEED_PM_DEFAULT_DEG 60.0
@@ -53,6 +54,7 @@ typedef struct {
 /*
  * The drive's torque limit (outer-loop output and torque-reference clamp):
  * the rated torque, and with a fixed stator-flux reference (psi_ref_wb > 0)
+ * held by controller ctrl (not flux_free; NULL counts as holding it)
  * at most FW_TORQUE_FLUX_MARGIN of the largest torque the linear model gives
  * at that flux, T_max(psi_ref) = max over i_d of 1.5 p i_q (psi_pm + (Ld - Lq) i_d)
  * on |psi| = psi_ref ((3.9), (3.10)): a DTC asked for more loses the load
@@ -61,7 +63,7 @@ typedef struct {
  * or 0 without a flux reference (may be NULL). Returns the limit in N*m.
  */
 #define FW_TORQUE_FLUX_MARGIN 0.95
-double fw_torque_limit_nm(const ctrl_machine_t *m, double *t_flux_max);
+double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, double *t_flux_max);
 
 /*
  * Gains for machine m (inertia), a speed loop at loop_hz and an encoder

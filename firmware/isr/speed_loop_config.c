@@ -88,7 +88,7 @@ static double fw_torque_on_flux(const ctrl_machine_t *m, double psi, double id)
     return 1.5 * (double)m->pole_pairs * iq * (m->psi_pm_wb + (m->ld_h - m->lq_h) * id);
 }
 
-double fw_torque_limit_nm(const ctrl_machine_t *m, double *t_flux_max)
+double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, double *t_flux_max)
 {
     if (t_flux_max != NULL) {
         *t_flux_max = 0.0;
@@ -97,7 +97,8 @@ double fw_torque_limit_nm(const ctrl_machine_t *m, double *t_flux_max)
         return 0.0;
     }
     double lim = m->torque_rated_nm;
-    const double psi = m->psi_ref_wb;
+    /* a controller without a fixed flux holds MTPA's limits (field_weak.h) */
+    const double psi = ctrl != NULL && ctrl->flux_free != 0u ? 0.0 : m->psi_ref_wb;
     if (psi > 0.0 && m->ld_h > 0.0 && m->lq_h > 0.0) {
         /* Scan the circle's i_d span, then refine around the best point. */
         const double lo = (-psi - m->psi_pm_wb) / m->ld_h;

@@ -161,7 +161,7 @@ static void test_runaway_trips_speed_follow(void)
     TEST_ASSERT_NOT_NULL(d);
     static sim_run_cfg_t c;
     sim_run_config_default(&c, &m, d);
-    const double t_lim = fw_torque_limit_nm(&c.ctrl_machine, NULL);
+    const double t_lim = fw_torque_limit_nm(&c.ctrl_machine, d, NULL);
     const double t_load = 1.05 * t_lim;
     const double t_step = 0.5;
     char text[160];

@@ -829,7 +829,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     }
     if (!c->speed_mode && fabs(c->torque_ref_nm) > r->torque_limit_nm) {
         double t_flux = 0.0;
-        const double t_lim = fw_torque_limit_nm(&c->ctrl_machine, &t_flux);
+        const double t_lim = fw_torque_limit_nm(&c->ctrl_machine, c->ctrl, &t_flux);
         char why[160];
         if (t_flux > 0.0 && t_lim < c->ctrl_machine.torque_rated_nm) {
             (void)snprintf(why, sizeof why,
