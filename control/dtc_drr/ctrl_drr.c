@@ -122,16 +122,21 @@ static q24_t drr_ratio01(int64_t num, int64_t den)
     return q > (uint32_t)FX_ONE ? FX_ONE : (q24_t)q;
 }
 
-/* ctrl_drr_duty with (cn, dc) = ctrl_drr_c_parts(s, omega_e). */
+/* The zero vector's torque deviation per period, B w / w_rn + rt ((5.6), (5.7)). */
+static q24_t drr_kbw(const ctrl_drr_state_t *s, q24_t omega_e)
+{
+    return fx_add(fx_mul(s->kb, drr_lim(omega_e)), drr_lim(s->rt));
+}
+
+/* ctrl_drr_duty with (cn, dc) = ctrl_drr_c_parts(s, omega_e), kbw = drr_kbw(s, omega_e). */
 static q24_t drr_duty_c(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
-                        q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t omega_e, q24_t cn, q24_t dc)
+                        q24_t psi_amp, q24_t t_err, q24_t gamma, q24_t kbw, q24_t cn, q24_t dc)
 {
     if (vec < 1u || vec > 6u || psi_amp <= 0) {
         return 0;
     }
     const q24_t e = drr_lim(t_err);
     const q24_t g = drr_lim(gamma);
-    const q24_t w = drr_lim(omega_e);
     const q24_t pamp = fx_min(psi_amp, DRR_LIM);
     const q24_t ux = ctrl_vec_dir_q24[vec][0];
     const q24_t uy = ctrl_vec_dir_q24[vec][1];
@@ -153,7 +158,6 @@ static q24_t drr_duty_c(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha,
      */
     const int64_t n48 = (int64_t)e * dc - ((int64_t)dc * 2 + cn) * g;
     const int64_t num = fx_rshift64_round(n48, FX_QBITS) * pamp;
-    const q24_t kbw = fx_add(fx_mul(s->kb, w), drr_lim(s->rt)); /* zero-vector deviation */
     const int64_t d48 = (int64_t)s->a * cross - (int64_t)kbw * pamp;
     const int64_t cg = fx_rshift64_round((int64_t)cn * g, FX_QBITS);
     const int64_t den = fx_rshift64_round(d48, FX_QBITS) * dc - cg * pamp;
@@ -176,7 +180,8 @@ q24_t ctrl_drr_duty(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24
     q24_t cn;
     q24_t dc;
     ctrl_drr_c_parts(s, omega_e, &cn, &dc);
-    return drr_duty_c(s, vec, psi_alpha, psi_beta, psi_amp, t_err, gamma, omega_e, cn, dc);
+    return drr_duty_c(s, vec, psi_alpha, psi_beta, psi_amp, t_err, gamma, drr_kbw(s, omega_e), cn,
+                      dc);
 }
 
 q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, q24_t psi_beta,
@@ -185,7 +190,7 @@ q24_t ctrl_drr_delta_t(const ctrl_drr_state_t *s, uint8_t vec, q24_t psi_alpha, 
     if (s == NULL) {
         return 0;
     }
-    const q24_t kbw = fx_add(fx_mul(s->kb, drr_lim(omega_e)), drr_lim(s->rt));
+    const q24_t kbw = drr_kbw(s, omega_e);
     if (vec < 1u || vec > 6u || psi_amp <= 0) {
         return fx_neg(kbw); /* zero vector: (5.16) third term */
     }
@@ -296,7 +301,8 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
      * up into T_ref + gamma it carries a fixed flux past its pull-out
      * (docs/algorithms.md, "Virtual-reference wind-up"). */
     const q24_t chi = fx_sub(tref, te);
-    const q24_t band = fx_add(s->gamma_max, fx_abs(fx_add(fx_mul(s->kb, drr_lim(w)), s->rt)));
+    const q24_t kbw = drr_kbw(s, w);
+    const q24_t band = fx_add(s->gamma_max, fx_abs(kbw));
     q24_t g = s->gamma;
     if (s->gamma_max == 0 || fx_abs(chi) <= band) {
         g = ctrl_drr_ema(g, chi, s->lambda);
@@ -314,8 +320,8 @@ void ctrl_drr_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     if (ctrl_drr_vreplace_active(s, psierr)) {
         vec = ctrl_vreplace(&s->vr, vec, nx->sector, nx->psi_alpha, nx->psi_beta); /* §5.3.5 */
     }
-    const q24_t duty = drr_duty_c(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, terr, g, w, cn,
-                                  dc); /* (5.14) */
+    const q24_t duty = drr_duty_c(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, terr, g, kbw,
+                                  cn, dc); /* (5.14) */
     if (s->pred_516 != 0u) {
         s->dt_sel = ctrl_drr_delta_t(s, vec, nx->psi_alpha, nx->psi_beta, nx->psi_amp, w);
     }
