@@ -7,18 +7,33 @@
 #include "fw_state.h"
 #include "unity.h"
 
+/* Machine file `file` of sim_host/machines into *m once (*loaded set). */
+static const sim_machine_t *loop_machine(sim_machine_t *m, int *loaded, const char *file)
+{
+    if (!*loaded) {
+        char path[512];
+        char err[256];
+        (void)snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
+        if (sim_machine_load(path, m, err, sizeof err) != 0) {
+            TEST_FAIL_MESSAGE(err);
+        }
+        *loaded = 1;
+    }
+    return m;
+}
+
 const sim_machine_t *loop_spmsm(void)
 {
     static sim_machine_t m;
     static int loaded;
-    if (!loaded) {
-        char err[256];
-        if (sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &m, err, sizeof err) != 0) {
-            TEST_FAIL_MESSAGE(err);
-        }
-        loaded = 1;
-    }
-    return &m;
+    return loop_machine(&m, &loaded, "thesis_spmsm.ini");
+}
+
+const sim_machine_t *loop_ipmsm80(void)
+{
+    static sim_machine_t m;
+    static int loaded;
+    return loop_machine(&m, &loaded, "thesis_ipmsm_80kw.ini");
 }
 
 void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torque_nm,

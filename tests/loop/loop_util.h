@@ -9,6 +9,8 @@
 
 /* Thesis SPMSM (sim_host/machines/thesis_spmsm.ini); aborts the test on error. */
 const sim_machine_t *loop_spmsm(void);
+/* Thesis 80 kW IPMSM (thesis_ipmsm_80kw.ini, as shipped); aborts the test on error. */
+const sim_machine_t *loop_ipmsm80(void);
 
 /* Dynamometer run of controller `name` at speed_rpm with a torque reference,
  * ADC noise off unless noise > 0; duration and window in seconds. */

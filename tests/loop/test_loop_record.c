@@ -181,15 +181,10 @@ static void test_dead_time_sensorless_foc(void)
  * same end state and metrics; no fault, the reversal reached within 5 %. */
 static void test_ipmsm80_sensorless_load_step(void)
 {
-    static sim_machine_t m80;
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_ipmsm_80kw.ini", &m80, err, sizeof err),
-        err);
     const ctrl_desc_t *d = ctrl_find("m2ptfc");
     TEST_ASSERT_NOT_NULL(d);
     sim_run_cfg_t c;
-    sim_run_config_default(&c, &m80, d);
+    sim_run_config_default(&c, loop_ipmsm80(), d);
     c.fs_hz = d->fs_default_hz;
     c.sensorless = true;
     c.free_mech = true;

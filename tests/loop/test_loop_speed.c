@@ -73,14 +73,9 @@ static void test_design_meets_its_crossover_and_margin(void)
 
 static void test_ipmsm80_speed_step(void)
 {
-    static sim_machine_t m80;
-    char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_ipmsm_80kw.ini", &m80, err, sizeof err),
-        err);
     const ctrl_desc_t *d = ctrl_find("m2ptfc");
     sim_run_cfg_t c;
-    sim_run_config_default(&c, &m80, d);
+    sim_run_config_default(&c, loop_ipmsm80(), d);
     c.fs_hz = d->fs_default_hz;
     c.free_mech = true;
     c.speed_mode = true;
