@@ -160,11 +160,28 @@ static void esc1_start(void)
     esc.hc.trip_current_a = esc1_hw_trip_a(b, &esc.machine);
     TEST_ASSERT_EQUAL_INT(G4_OK, g4_clock_init(b->hse_hz, b->sysclk_hz));
     TEST_ASSERT_EQUAL_INT(G4_OK, g4_hal_init(&esc.hal, b, &esc.hc));
-    fw_config_default(&esc.fc, &esc.machine, ctrl_find(ESC1_CTRL));
+    esc1_config_default(&esc.fc, b, &esc.machine, ctrl_find(ESC1_CTRL));
     TEST_ASSERT_EQUAL_INT(FW_OK, fw_init(&esc.fw, &esc.hal, &esc.fc));
     fw_link_init(&esc.link, &esc.fw, capture, NULL);
     esc1_params_attach(&esc);
     esc1_throttle_init(&esc, b->sysclk_hz);
+}
+
+/* The firmware knows the dead time TIM1 inserts: TIMx_BDTR.DTG as the HAL
+ * wrote it into the register model, in t_DTS = 1/SYSCLK (CKD = 0). The
+ * board's 500 ns at 170 MHz is 85 t_DTS exactly (RM0440, BDTR.DTG range
+ * 0xx), so 500 ns within rounding. The same after the machine is
+ * configured anew (the m.* parameters, `config default`). */
+static void test_config_carries_the_board_dead_time(void)
+{
+    esc1_start();
+    const uint32_t dtg = g4_rd(G4_TIM1 + G4_TIM_BDTR) & G4_TIM_BDTR_DTG_MASK;
+    const double dt_s = (double)g4_dtg_ticks((uint8_t)dtg) / (double)g4_board_esc1.sysclk_hz;
+    TEST_ASSERT_EQUAL_UINT32(85u, dtg);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, dt_s, esc.fc.dead_time_s);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 500e-9, esc.fc.dead_time_s);
+    TEST_ASSERT_EQUAL_INT(CMD_OK, esc1_reconfigure(&esc, &esc1_default_machine, ESC1_ENCODER_CPR));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, dt_s, esc.fc.dead_time_s);
 }
 
 /* Neighbours of the compiled-in gimbal motor the core cannot represent at
@@ -395,6 +412,7 @@ int main(void)
     RUN_TEST(test_default_machine_is_the_file);
     RUN_TEST(test_default_machine_within_the_board);
     RUN_TEST(test_core_and_every_controller_take_it);
+    RUN_TEST(test_config_carries_the_board_dead_time);
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
     RUN_TEST(test_throttle_arms_and_disarms_the_drive);

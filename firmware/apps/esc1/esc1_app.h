@@ -72,6 +72,14 @@ extern const ctrl_machine_t esc1_default_machine;
  * large share of the threshold), at most the board's peak rating. */
 double esc1_hw_trip_a(const g4_board_t *b, const ctrl_machine_t *m);
 
+/* The firmware's configuration for a machine on this board: fw_config_default
+ * with the dead time TIM1 inserts (TIMx_BDTR.DTG encoded from the board's
+ * dead_time_ns at f_DTS = SYSCLK, as g4_hal_init programs it). Without the
+ * duties' compensation (PMSM_DEAD_COMP off in the board preset) the flux
+ * observers take it out of the applied voltage themselves. */
+void esc1_config_default(fw_config_t *c, const g4_board_t *b, const ctrl_machine_t *m,
+                         const ctrl_desc_t *ctrl);
+
 /* Re-initialises the firmware with new machine data / encoder resolution
  * (drive not running; control interrupt masked meanwhile). On failure the
  * previous data are restored. Returns CMD_OK, CMD_E_STATE (running),

@@ -165,7 +165,7 @@ int main(void)
     if (hrc != G4_OK) {
         esc1_halt(s, "board init", g4_strerror(hrc), f_cpu);
     }
-    fw_config_default(&s->fc, &s->machine, ctrl_find(ESC1_CTRL));
+    esc1_config_default(&s->fc, b, &s->machine, ctrl_find(ESC1_CTRL));
     const int frc = fw_init(&s->fw, &s->hal, &s->fc);
     if (frc != FW_OK) {
         esc1_halt(s, "fw_init", fw_strerror(frc), f_cpu);

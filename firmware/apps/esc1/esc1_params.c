@@ -29,6 +29,18 @@ __attribute__((noinline)) double esc1_hw_trip_a(const g4_board_t *b, const ctrl_
     return a > b->current_peak_a ? b->current_peak_a : a;
 }
 
+void esc1_config_default(fw_config_t *c, const g4_board_t *b, const ctrl_machine_t *m,
+                         const ctrl_desc_t *ctrl)
+{
+    fw_config_default(c, m, ctrl);
+    /* A code g4_dtg_encode refuses has already stopped g4_hal_init (board
+     * init halts), so the board never runs with the 0 left here then. */
+    uint8_t dtg = 0;
+    if (g4_dtg_encode(b->sysclk_hz, b->dead_time_ns, &dtg) == G4_OK) {
+        c->dead_time_s = (double)g4_dtg_ticks(dtg) / (double)b->sysclk_hz;
+    }
+}
+
 static esc1_t *esc1_of(void *ctx)
 {
     return (esc1_t *)ctx;
@@ -340,7 +352,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->fc = *cfg;
         s->fc.machine = &s->machine;
     } else {
-        fw_config_default(&s->fc, &s->machine, ctrl);
+        esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
     }
     int rc = fw_init(&s->fw, &s->hal, &s->fc);
     if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
@@ -353,7 +365,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->machine = old;
         s->encoder_cpr = old_cpr;
         s->hal.info.encoder_counts_per_rev = old_cpr;
-        fw_config_default(&s->fc, &s->machine, ctrl);
+        esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
     } else {

@@ -52,7 +52,7 @@ static int esc1_settings_default(void *ctx)
 {
     esc1_t *s = (esc1_t *)ctx;
     fw_config_t c;
-    fw_config_default(&c, &esc1_default_machine, ctrl_find(ESC1_CTRL));
+    esc1_config_default(&c, s->hal.board, &esc1_default_machine, ctrl_find(ESC1_CTRL));
     return esc1_reconfigure_cfg(s, &esc1_default_machine, ESC1_ENCODER_CPR, &c);
 }
 
