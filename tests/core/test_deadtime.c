@@ -17,6 +17,8 @@
 #include "deadtime.h"
 #include "unity.h"
 
+#include "../plant/ini_machines.h"
+
 static ctrl_params_t p;
 static ctrl_bases_t b;
 
@@ -28,25 +30,11 @@ void tearDown(void)
 {
 }
 
-static const ctrl_machine_t outrunner = {
-    .name = "outrunner_24v",
-    .pole_pairs = 7,
-    .rs_ohm = 0.461,
-    .ld_h = 64e-6,
-    .lq_h = 64e-6,
-    .psi_pm_wb = 0.664e-3,
-    .vdc_v = 24.0,
-    .inertia_kgm2 = 3e-6,
-    .torque_rated_nm = 0.0418,
-    .speed_rated_rpm = 6000.0,
-    .current_rated_a = 6.0,
-    .current_max_a = 10.0,
-    .psi_ref_wb = 0.0,
-};
+static const ctrl_machine_t *const outrunner = &ini_outrunner_24v;
 
 static ctrl_deadtime_t setup(double td_s, double vf_v, double band_a)
 {
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &outrunner, 20000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, outrunner, 20000u));
     const ctrl_deadtime_config_t c = {td_s, vf_v, band_a};
     ctrl_deadtime_t d;
     ctrl_diag_t why;
@@ -232,7 +220,7 @@ static void test_angle(void)
 
 static void test_refused(void)
 {
-    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &outrunner, 20000u));
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, outrunner, 20000u));
     ctrl_deadtime_t d;
     ctrl_diag_t why;
     const ctrl_deadtime_config_t big = {20e-6, 0.0, 1.0}; /* beyond Ts / 4 = 12.5 us */
@@ -242,7 +230,7 @@ static void test_refused(void)
     TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_deadtime_init(&d, &nan_band, &p, &b, &why));
     TEST_ASSERT_EQUAL_STRING("band_a", why.quantity);
     /* the default band: half of Vdc / (6 L fs) = 1.5625 A */
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1.5625, ctrl_deadtime_band_default(&outrunner, 20000.0));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1.5625, ctrl_deadtime_band_default(outrunner, 20000.0));
 }
 
 int main(void)

@@ -1,7 +1,8 @@
 /*
  * The shipped machine files sim_host/machines/{thesis_spmsm,
- * thesis_ipmsm_80kw, chapter_ipmsm, mj5208_drone, gbm5208_gimbal}.ini
- * (the thesis's and the chapter's machines and two small motors) as
+ * thesis_ipmsm_80kw, chapter_ipmsm, mj5208_drone, gbm5208_gimbal,
+ * outrunner_24v}.ini (the thesis's and the chapter's machines and three
+ * small motors) as
  * ctrl_machine_t, for the unit tests that configure a controller without the
  * INI loader (also built for the QEMU target, no file access).
  * tests/plant/test_plant_files.c checks every field against the INI files.
@@ -96,6 +97,24 @@ static const ctrl_machine_t ini_gbm5208_gimbal = {
     .speed_rated_rpm = 190.0,
     .current_rated_a = 0.3,
     .current_max_a = 1.0,
+    .psi_ref_wb = 0.0,
+};
+
+/* 24 V outrunner with 500 ns dead time (the file's derivation: 7 pole pairs,
+ * Rs 0.461 ohm, L 64 uH, psi_pm 0.664 mWb; rated 6 A, 0.0418 N*m). */
+static const ctrl_machine_t ini_outrunner_24v = {
+    .name = "outrunner_24v",
+    .pole_pairs = 7,
+    .rs_ohm = 0.461,
+    .ld_h = 64e-6,
+    .lq_h = 64e-6,
+    .psi_pm_wb = 0.664e-3,
+    .vdc_v = 24.0,
+    .inertia_kgm2 = 1e-5,
+    .torque_rated_nm = 0.0418,
+    .speed_rated_rpm = 6000.0,
+    .current_rated_a = 6.0,
+    .current_max_a = 10.0,
     .psi_ref_wb = 0.0,
 };
 

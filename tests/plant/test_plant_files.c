@@ -176,6 +176,7 @@ static void test_ini_mirror_header(void)
     check_mirror("chapter_ipmsm.ini", &ini_chapter_ipmsm);
     check_mirror("mj5208_drone.ini", &ini_mj5208_drone);
     check_mirror("gbm5208_gimbal.ini", &ini_gbm5208_gimbal);
+    check_mirror("outrunner_24v.ini", &ini_outrunner_24v);
 }
 
 static void test_ini_bad_input(void)
