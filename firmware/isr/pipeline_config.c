@@ -244,7 +244,7 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         cfg->overspeed_rpm > 0.0 ? cfg->overspeed_rpm : FW_OVERSPEED_REL * n_max;
     fw->speed_info.speed_ref_max_rpm = fw->speed_info.overspeed_rpm / FW_OVERSPEED_REL;
     if (fw_protect_config(&pc, fw->machine, &fw->bases, in->pwm_freq_hz, fw->enc_cpr,
-                          in->cycle_clock_hz, fw->speed_info.overspeed_rpm) != CTRL_OK) {
+                          in->cycle_clock_hz, fw->speed_info.overspeed_rpm, &fw->why) != CTRL_OK) {
         return FW_EINVAL;
     }
     /* The medium-rate task's rate: fs / mid_div, mid_div >= 1 rounded to the

@@ -63,7 +63,8 @@ enum {
     FW_FAULT_OVERSPEED = 10,    /* |speed| above the overspeed level */
     FW_FAULT_COMMISSION = 11,   /* a commissioning step failed (cm_t.err names why) */
     FW_FAULT_SPEED_FOLLOW = 12, /* speed moves away from its reference at full torque */
-    FW_FAULT_TORQUE_FOLLOW = 13, /* mean torque estimate off the applied reference (torque_follow.h) */
+    FW_FAULT_TORQUE_FOLLOW =
+        13, /* mean torque estimate off the applied reference (torque_follow.h) */
     FW_FAULT_COUNT = 14
 };
 
@@ -136,11 +137,13 @@ typedef struct {
  * machine (current_max_a, vdc_v, torque_rated_nm, inertia_kgm2, pole pairs),
  * the control frequency, the encoder resolution, the ADC-side bases and the
  * overspeed level (mechanical r/min, > 0).
- * Returns CTRL_OK or CTRL_EINVAL for missing or non-physical data.
+ * Returns CTRL_OK, or CTRL_EINVAL / CTRL_ERANGE for missing, non-physical or
+ * unrepresentable data with *why (if not NULL) naming the quantity, its value
+ * and its range.
  */
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
                       uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
-                      double overspeed_rpm);
+                      double overspeed_rpm, ctrl_diag_t *why);
 
 /* Largest trip level the current check takes (64 pu): then i_c = -(i_a + i_b)
  * of two in-range phases stays below 2^31 and one unsigned compare decides. */

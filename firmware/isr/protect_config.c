@@ -2,6 +2,7 @@
  * Protection thresholds from SI data (configuration time only: double is
  * allowed here, never in the per-period path). Derivations in protect.h.
  */
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -37,28 +38,33 @@ double fw_speed_max_rpm(const ctrl_machine_t *m)
 
 int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl_bases_t *b,
                       uint32_t fs_hz, uint32_t enc_counts_per_rev, uint32_t cycle_clock_hz,
-                      double overspeed_rpm)
+                      double overspeed_rpm, ctrl_diag_t *why)
 {
-    if (cfg == NULL || m == NULL || b == NULL || fs_hz == 0u || enc_counts_per_rev == 0u) {
-        return CTRL_EINVAL;
+    if (cfg == NULL || m == NULL || b == NULL || fs_hz == 0u || enc_counts_per_rev == 0u ||
+        !(b->i_a > 0.0) || !(b->v_v > 0.0) || !(b->w_rad_s > 0.0) || m->pole_pairs <= 0) {
+        return CTRL_EINVAL; /* no bases: the machine's own check refused it first */
     }
+    /* The machine's own check (ctrl_params_init) has named these before. */
     if (!(m->current_max_a > 0.0) || !(m->vdc_v > 0.0) || !(m->inertia_kgm2 > 0.0) ||
-        !(m->torque_rated_nm >= 0.0) || m->pole_pairs <= 0 || !(b->i_a > 0.0) || !(b->v_v > 0.0) ||
-        !isfinite(m->current_max_a) || !isfinite(m->inertia_kgm2) || !(overspeed_rpm > 0.0) ||
-        !isfinite(overspeed_rpm) || !(b->w_rad_s > 0.0)) {
+        !(m->torque_rated_nm >= 0.0) || !isfinite(m->current_max_a) || !isfinite(m->inertia_kgm2)) {
         return CTRL_EINVAL;
     }
-    /* Overspeed in Q24 pu electrical speed; must fit below 2^31 (< 128 pu). */
+    /* Overspeed in Q24 pu electrical speed; must fit below 2^31 (< 128 pu):
+     * a maximum speed far above the rated one (the speed base) is refused. */
     const double w_max_pu = ctrl_rpm_to_elec(overspeed_rpm, m->pole_pairs) / b->w_rad_s;
-    if (!(w_max_pu < 127.0)) {
-        return CTRL_EINVAL;
+    if (!(overspeed_rpm > 0.0) || !(w_max_pu < 127.0)) {
+        return ctrl_diag_refuse(why, CTRL_EINVAL, "overspeed level", "r/min", overspeed_rpm, 0.0,
+                                127.0 * b->w_rad_s * 60.0 / (CTRL_TWO_PI * (double)m->pole_pairs),
+                                "127 x the speed base: speed_rated_rpm, speed_max_rpm");
     }
     cfg->omega_max = ctrl_q24_from_double(w_max_pu);
     cfg->follow_periods = fs_hz / 20u; /* speed following: 50 ms */
     const double fs = (double)fs_hz;
-    if (ctrl_q24_from_si(m->current_max_a, b->i_a, 0.0, ctrl_q24_to_double(FW_PROTECT_I_MAX_LIM),
-                         &cfg->i_max) != CTRL_OK) {
-        return CTRL_ERANGE; /* the trip level must fit the check (protect.h) */
+    const double i_lim_pu = ctrl_q24_to_double(FW_PROTECT_I_MAX_LIM);
+    if (ctrl_q24_from_si(m->current_max_a, b->i_a, 0.0, i_lim_pu, &cfg->i_max) != CTRL_OK) {
+        /* the trip level must fit the check (protect.h) */
+        return ctrl_diag_refuse(why, CTRL_ERANGE, "current_max_a", "A", m->current_max_a, 0.0,
+                                i_lim_pu * b->i_a, "64 x the current base");
     }
     cfg->vdc_max = ctrl_q24_from_double(FW_VDC_MAX_REL * m->vdc_v / b->v_v);
     cfg->vdc_min = ctrl_q24_from_double(FW_VDC_MIN_REL * m->vdc_v / b->v_v);

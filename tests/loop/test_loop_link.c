@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "fw_link.h"
 #include "link_text.h"
 #include "loop_util.h"
@@ -229,6 +230,32 @@ static void test_max_speed_refusal_is_named(void)
     TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
 }
 
+/* A machine whose overspeed level is beyond the Q24 speed's 127 x the speed
+ * base (thesis SPMSM, rated speed 3000 r/min, the speed base, and a declared
+ * maximum of 400000 r/min: 1.05 x 400000 / 3000 = 140 pu): the refusal
+ * names the level, its value and the largest the check can represent (it
+ * came without a reason: found by the link's fuzzer). */
+static void test_overspeed_refusal_is_named(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    ctrl_machine_t m = run.fw.machine_own;
+    m.speed_max_rpm = 400000.0;
+    fw_config_t fc = run.fw.cfg;
+    fc.machine = &m;
+    fc.ctrl = run.fw.ctrl;
+    fc.ctrl_cfg = NULL;
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&run.fw, &run.hal, &fc));
+    TEST_ASSERT_EQUAL_STRING("overspeed level", run.fw.why.quantity);
+    TEST_ASSERT_EQUAL_DOUBLE(FW_OVERSPEED_REL * m.speed_max_rpm, run.fw.why.value);
+    /* 127 pu of electrical speed in mechanical r/min */
+    const double lim = 127.0 * run.fw.bases.w_rad_s / (double)m.pole_pairs * 60.0 / (2.0 * CTRL_PI);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * lim, lim, run.fw.why.max);
+    TEST_ASSERT_TRUE(run.fw.why.value > run.fw.why.max);
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+}
+
 /* A machine with an inertia of 1e-15 kg*m^2 (link fuzzer: param set m.j_kgm2
  * 1e-15): the encoder's plausible second difference, a_max Ts^2, is beyond
  * int32_t; the jump limit saturates instead of converting an out-of-range
@@ -283,6 +310,7 @@ int main(void)
     RUN_TEST(test_telemetry_frames);
     RUN_TEST(test_fault_over_link);
     RUN_TEST(test_max_speed_refusal_is_named);
+    RUN_TEST(test_overspeed_refusal_is_named);
     RUN_TEST(test_tiny_inertia_encoder_limits);
     return UNITY_END();
 }
