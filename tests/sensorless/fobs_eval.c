@@ -159,6 +159,7 @@ int fobs_eval_run(const fobs_eval_cfg_t *c, fobs_eval_res_t *res, char *err, siz
     rc.win_start_s = c->win_start_s;
     rc.win_end_s = c->win_end_s;
     rc.calib_samples = 256u;
+    rc.arm_delay_periods = c->arm_delay_periods;
     /* The observers here take the duties the drive wrote (fw.applied) as the
      * inverter's input and model its error themselves: the drive's own
      * dead-time compensation off, so that fw.applied is what was written. */

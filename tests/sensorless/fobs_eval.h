@@ -31,8 +31,9 @@ typedef struct {
     double noise_counts;                 /* ADC noise sigma (counts) */
     bool has_fobs;                       /* fobs overrides the observer defaults */
     ctrl_fobs_config_t fobs;
-    double stat_min_speed; /* statistics where |speed| >= this share of rated (0.1) */
-    FILE *csv;             /* per-period record, may be NULL */
+    double stat_min_speed;      /* statistics where |speed| >= this share of rated (0.1) */
+    unsigned arm_delay_periods; /* periods ready before the arm (sim_run_cfg_t's) */
+    FILE *csv;                  /* per-period record, may be NULL */
 } fobs_eval_cfg_t;
 
 typedef struct {

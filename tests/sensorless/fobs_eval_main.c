@@ -5,7 +5,7 @@
  *             [--duration S] [--window A:B] [--rs-scale X] [--l-scale X]
  *             [--psi-scale X] [--dead-time-ns N] [--v-fwd V] [--compensate]
  *             [--noise COUNTS] [--k0 RAD_S] [--kappa K] [--kenc RAD_S]
- *             [--pll-hz HZ] [--psi-tau S] [--csv FILE]
+ *             [--pll-hz HZ] [--psi-tau S] [--arm-delay PERIODS] [--csv FILE]
  * Prints one line of key=value results.
  */
 #include <stdio.h>
@@ -89,6 +89,8 @@ int main(int argc, char **argv)
             pll = atof(v);
         } else if (OPT("--psi-tau")) {
             psi_tau = atof(v);
+        } else if (OPT("--arm-delay")) {
+            c.arm_delay_periods = (unsigned)atoi(v);
         } else if (OPT("--csv")) {
             c.csv = fopen(v, "w");
         } else {

@@ -344,9 +344,11 @@ int sim_run_period(sim_run_t *r)
     if (!r->armed) {
         /* Boot and calibration: gates off, no bookkeeping; armed (with the
          * run's references) right after the period that ends the
-         * calibration, so the first gated period is the next one. */
+         * calibration, or arm_delay_periods periods later, so the first
+         * gated period is the next one. */
         const int rc = sim_period_raw(r);
-        if (rc == 0 && r->cfg.auto_arm && fw_state(&r->fw) == FW_STATE_READY) {
+        if (rc == 0 && r->cfg.auto_arm && fw_state(&r->fw) == FW_STATE_READY &&
+            r->ready_periods++ >= r->cfg.arm_delay_periods) {
             sim_arm(r);
         }
         return rc;
@@ -729,6 +731,12 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (c->trace_decimation == 0u) {
         return sim_err(err, errlen, "trace decimation must be >= 1");
     }
+    if (c->arm_delay_periods > SIM_ARM_DELAY_MAX) {
+        char msg[96];
+        (void)snprintf(msg, sizeof msg, "arm delay %lu periods out of range [0, %u]",
+                       (unsigned long)c->arm_delay_periods, (unsigned)SIM_ARM_DELAY_MAX);
+        return sim_err(err, errlen, msg);
+    }
     if (!(c->load_passive_nm >= 0.0) || !isfinite(c->load_passive_nm)) {
         return sim_err(err, errlen, "passive load must be a finite magnitude >= 0 N*m");
     }
@@ -876,7 +884,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         return 0; /* the caller runs the periods from boot on (sim_run_period) */
     }
     /* Boot and offset calibration with the gates off, then the arm. */
-    const uint32_t max_boot = c->calib_samples + 16u;
+    const uint32_t max_boot = c->calib_samples + 16u + c->arm_delay_periods;
     for (uint32_t k = 0; k < max_boot && !r->armed; k++) {
         if (sim_run_period(r) != 0) {
             if (r->link_failed) {

@@ -5,8 +5,10 @@
  * host simulator (./tools/sim, the tests) and the PIL images in QEMU.
  *
  * Time line: the firmware boots and calibrates its ADC offsets with the gates
- * off (calib_samples periods, plant running: imposed speed or coasting), then
- * it is armed; scenario time t = 0 is the arm instant. Traces and metrics use
+ * off (calib_samples periods, plant running: imposed speed or coasting), waits
+ * arm_delay_periods periods ready (0 by default: a test moves the arm instant
+ * against the rotor, the noise and the switching with it), then it is armed;
+ * scenario time t = 0 is the arm instant. Traces and metrics use
  * scenario time. In free mechanics the load torque is applied from t = 0 (a
  * constant load on the unpowered rotor would spin it backwards meanwhile).
  *
@@ -50,6 +52,8 @@
 #include "sim_scenario.h"
 
 #define SIM_MAX_SETS 32u
+/* The longest wait between the calibration and the arm (one second at 64 kHz). */
+#define SIM_ARM_DELAY_MAX 65536u
 
 typedef struct sim_run sim_run_t;
 
@@ -113,6 +117,7 @@ typedef struct {
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
     bool auto_arm;                /* arm with the references above once calibrated (default) */
+    uint32_t arm_delay_periods;   /* auto_arm: periods the drive stays ready before the arm (0) */
     bool kick_watchdog;           /* kick after each ISR (default; a target's main loop does it) */
     void (*after_isr)(void *ctx); /* called right after fw_isr, may be NULL */
     void *after_isr_ctx;
@@ -137,6 +142,8 @@ struct sim_run {
     bool has_scn;
     bool armed;   /* the run's arm instant has passed */
     double t_arm; /* plant time of the arm instant */
+    /* Periods ended in the ready state before the arm (cfg.arm_delay_periods). */
+    uint32_t ready_periods;
     double t_end;
     double obs_dt;
     metrics_acc_t m_plant, m_ctrl;
