@@ -361,10 +361,39 @@ void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double t
     }
 }
 
+bool cm_si_has(const cm_si_t *r, uint32_t have)
+{
+    return (r->have & have) != 0u &&
+           (have != CM_HAVE_MECH || (isfinite(r->inertia_kgm2) && r->inertia_kgm2 > 0.0));
+}
+
+double cm_si_field(const cm_si_t *r, size_t off, cm_field_t kind)
+{
+    const char *f = (const char *)r + off;
+    double v;
+    int i;
+    uint32_t u;
+    bool b;
+    switch (kind) {
+    case CM_FIELD_INT:
+        memcpy(&i, f, sizeof i);
+        return (double)i;
+    case CM_FIELD_U32:
+        memcpy(&u, f, sizeof u);
+        return (double)u;
+    case CM_FIELD_BOOL:
+        memcpy(&b, f, sizeof b);
+        return b ? 1.0 : 0.0;
+    default:
+        memcpy(&v, f, sizeof v);
+        return kind == CM_FIELD_MILLI ? v * 1e3 : v;
+    }
+}
+
 /* The machine-file fragment: the result bit that gives each item, its field
- * of cm_si_t and how that is read (mechanics only with a finite inertia > 0,
- * the friction only when finite). */
-enum { CM_F_SI, CM_F_MILLI, CM_F_LINES, CM_F_INT, CM_F_FRICTION };
+ * of cm_si_t and how that is read (a cm_field_t, or the encoder's lines:
+ * counts / 4, or the friction: only when finite, >= 0). */
+enum { CM_F_LINES = CM_FIELD_COUNT, CM_F_FRICTION };
 #define CM_F(have, sec, key, kind, f)                                                              \
     {                                                                                              \
         have, kind, (uint16_t)offsetof(cm_si_t, f), sec, key                                       \
@@ -374,47 +403,39 @@ static const struct {
     uint16_t off;
     const char *section, *key;
 } cm_fragment[] = {
-    CM_F(CM_HAVE_RS, "machine", "rs_ohm", CM_F_SI, rs_ohm),
-    CM_F(CM_HAVE_LDQ, "machine", "ld_mh", CM_F_MILLI, ld_h),
-    CM_F(CM_HAVE_LDQ, "machine", "lq_mh", CM_F_MILLI, lq_h),
-    CM_F(CM_HAVE_FLUX, "machine", "psi_pm_wb", CM_F_SI, psi_wb),
+    CM_F(CM_HAVE_RS, "machine", "rs_ohm", CM_FIELD_SI, rs_ohm),
+    CM_F(CM_HAVE_LDQ, "machine", "ld_mh", CM_FIELD_MILLI, ld_h),
+    CM_F(CM_HAVE_LDQ, "machine", "lq_mh", CM_FIELD_MILLI, lq_h),
+    CM_F(CM_HAVE_FLUX, "machine", "psi_pm_wb", CM_FIELD_SI, psi_wb),
     CM_F(CM_HAVE_ENC, "sensors", "encoder_lines", CM_F_LINES, enc_cpr_cfg),
-    CM_F(CM_HAVE_ENC, "sensors", "encoder_offset_deg", CM_F_SI, enc_offset_deg),
-    CM_F(CM_HAVE_ENC, "sensors", "encoder_direction", CM_F_INT, enc_dir),
-    CM_F(CM_HAVE_MECH, "mechanics", "inertia_kgm2", CM_F_SI, inertia_kgm2),
+    CM_F(CM_HAVE_ENC, "sensors", "encoder_offset_deg", CM_FIELD_SI, enc_offset_deg),
+    CM_F(CM_HAVE_ENC, "sensors", "encoder_direction", CM_FIELD_INT, enc_dir),
+    CM_F(CM_HAVE_MECH, "mechanics", "inertia_kgm2", CM_FIELD_SI, inertia_kgm2),
     CM_F(CM_HAVE_MECH, "mechanics", "friction_nms", CM_F_FRICTION, friction_nms),
 };
 #undef CM_F
 
 bool cm_fragment_item(const cm_si_t *r, size_t index, cm_item_t *it)
 {
-    const bool mech = isfinite(r->inertia_kgm2) && r->inertia_kgm2 > 0.0;
     for (size_t k = 0; k < sizeof cm_fragment / sizeof cm_fragment[0]; k++) {
-        const unsigned have = cm_fragment[k].have;
         const uint8_t kind = cm_fragment[k].kind;
-        if ((r->have & have) == 0u || (have == CM_HAVE_MECH && !mech) ||
+        if (!cm_si_has(r, cm_fragment[k].have) ||
             (kind == CM_F_FRICTION && !isfinite(r->friction_nms))) {
             continue;
         }
         if (index-- != 0u) {
             continue;
         }
-        const char *f = (const char *)r + cm_fragment[k].off;
         double v;
-        uint32_t u;
-        int i;
         if (kind == CM_F_LINES) {
-            memcpy(&u, f, sizeof u);
-            v = (double)(u / 4u);
-        } else if (kind == CM_F_INT) {
-            memcpy(&i, f, sizeof i);
-            v = (double)i;
+            v = (double)((uint32_t)cm_si_field(r, cm_fragment[k].off, CM_FIELD_U32) / 4u);
+        } else if (kind == CM_F_FRICTION) {
+            v = fmax(cm_si_field(r, cm_fragment[k].off, CM_FIELD_SI), 0.0);
         } else {
-            memcpy(&v, f, sizeof v);
-            v = kind == CM_F_MILLI ? v * 1e3 : (kind == CM_F_FRICTION ? fmax(v, 0.0) : v);
+            v = cm_si_field(r, cm_fragment[k].off, (cm_field_t)kind);
         }
         *it = (cm_item_t){cm_fragment[k].section, cm_fragment[k].key, v,
-                          kind == CM_F_LINES || kind == CM_F_INT};
+                          kind == CM_F_LINES || kind == CM_FIELD_INT};
         return true;
     }
     return false;

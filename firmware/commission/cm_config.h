@@ -82,6 +82,24 @@ typedef struct {
 
 void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double ts_s, cm_si_t *o);
 
+/* Whether r holds the results of the result bit `have` (CM_HAVE_*): measured,
+ * and for the mechanics an inertia that is finite and > 0. */
+bool cm_si_has(const cm_si_t *r, uint32_t have);
+
+/* How a field of cm_si_t is read by cm_si_field. */
+typedef enum {
+    CM_FIELD_SI,    /* double, as stored */
+    CM_FIELD_MILLI, /* double x 1e3 (H -> mH) */
+    CM_FIELD_INT,   /* int */
+    CM_FIELD_U32,   /* uint32_t */
+    CM_FIELD_BOOL,  /* bool, as 0 or 1 */
+    CM_FIELD_COUNT
+} cm_field_t;
+
+/* The field of r at byte offset off (offsetof(cm_si_t, field)) as a double,
+ * read as kind says. */
+double cm_si_field(const cm_si_t *r, size_t off, cm_field_t kind);
+
 /* Item `index` (0..) of the machine-file fragment: section and key as in
  * sim_host's machine files, the value in the file's unit (integer: print
  * without decimals). Only measured values are listed. False past the end. */

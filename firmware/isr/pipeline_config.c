@@ -423,7 +423,7 @@ int fw_commission_apply(fw_t *fw)
     if ((r.have & CM_HAVE_FLUX) != 0u) {
         m.psi_pm_wb = r.psi_wb;
     }
-    if ((r.have & CM_HAVE_MECH) != 0u && isfinite(r.inertia_kgm2) && r.inertia_kgm2 > 0.0) {
+    if (cm_si_has(&r, CM_HAVE_MECH)) {
         m.inertia_kgm2 = r.inertia_kgm2;
     }
     const ctrl_machine_t old = fw->machine_own;

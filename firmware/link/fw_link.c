@@ -302,9 +302,7 @@ static void op_cm_status(void *ctx, cmd_cm_status_t *st)
 }
 
 /* The measured values, in SI, in a fixed order: the result bit that gives
- * each, its field of cm_si_t and how that is read (the inertia and friction
- * only with an inertia > 0). */
-enum { FW_R_SI, FW_R_MILLI, FW_R_INT, FW_R_U32, FW_R_BOOL };
+ * each, its field of cm_si_t and how that is read (cm_si_has, cm_si_field). */
 #define FW_R(have, key, unit, kind, f)                                                             \
     {                                                                                              \
         have, kind, (uint16_t)offsetof(cm_si_t, f), key, unit                                      \
@@ -314,20 +312,20 @@ static const struct {
     uint16_t off;
     const char *key, *unit;
 } fw_link_results[] = {
-    FW_R(CM_HAVE_VBUS, "vbus_v", "V", FW_R_SI, vbus_v),
-    FW_R(CM_HAVE_LPROBE, "probe_l_mh", "mH", FW_R_MILLI, l_probe_h),
-    FW_R(CM_HAVE_ENC, "encoder_direction", "", FW_R_INT, enc_dir),
-    FW_R(CM_HAVE_ENC, "encoder_offset_deg", "deg", FW_R_SI, enc_offset_deg),
-    FW_R(CM_HAVE_ENC, "encoder_counts", "", FW_R_U32, enc_cpr),
-    FW_R(CM_HAVE_RS, "rs_ohm", "Ohm", FW_R_SI, rs_ohm),
-    FW_R(CM_HAVE_RS, "inverter_error_v", "V", FW_R_SI, v_inv_v),
-    FW_R(CM_HAVE_RS, "unbalance", "", FW_R_SI, unbalance),
-    FW_R(CM_HAVE_LDQ, "ld_mh", "mH", FW_R_MILLI, ld_h),
-    FW_R(CM_HAVE_LDQ, "lq_mh", "mH", FW_R_MILLI, lq_h),
-    FW_R(CM_HAVE_LDQ, "salient", "", FW_R_BOOL, salient),
-    FW_R(CM_HAVE_FLUX, "psi_pm_wb", "Wb", FW_R_SI, psi_wb),
-    FW_R(CM_HAVE_MECH, "inertia_kgm2", "kg*m^2", FW_R_SI, inertia_kgm2),
-    FW_R(CM_HAVE_MECH, "friction_nms", "N*m*s", FW_R_SI, friction_nms),
+    FW_R(CM_HAVE_VBUS, "vbus_v", "V", CM_FIELD_SI, vbus_v),
+    FW_R(CM_HAVE_LPROBE, "probe_l_mh", "mH", CM_FIELD_MILLI, l_probe_h),
+    FW_R(CM_HAVE_ENC, "encoder_direction", "", CM_FIELD_INT, enc_dir),
+    FW_R(CM_HAVE_ENC, "encoder_offset_deg", "deg", CM_FIELD_SI, enc_offset_deg),
+    FW_R(CM_HAVE_ENC, "encoder_counts", "", CM_FIELD_U32, enc_cpr),
+    FW_R(CM_HAVE_RS, "rs_ohm", "Ohm", CM_FIELD_SI, rs_ohm),
+    FW_R(CM_HAVE_RS, "inverter_error_v", "V", CM_FIELD_SI, v_inv_v),
+    FW_R(CM_HAVE_RS, "unbalance", "", CM_FIELD_SI, unbalance),
+    FW_R(CM_HAVE_LDQ, "ld_mh", "mH", CM_FIELD_MILLI, ld_h),
+    FW_R(CM_HAVE_LDQ, "lq_mh", "mH", CM_FIELD_MILLI, lq_h),
+    FW_R(CM_HAVE_LDQ, "salient", "", CM_FIELD_BOOL, salient),
+    FW_R(CM_HAVE_FLUX, "psi_pm_wb", "Wb", CM_FIELD_SI, psi_wb),
+    FW_R(CM_HAVE_MECH, "inertia_kgm2", "kg*m^2", CM_FIELD_SI, inertia_kgm2),
+    FW_R(CM_HAVE_MECH, "friction_nms", "N*m*s", CM_FIELD_SI, friction_nms),
 };
 #undef FW_R
 
@@ -337,40 +335,11 @@ static bool op_cm_result_at(void *ctx, size_t index, const char **key, double *v
     cm_si_t r;
     fw_commission_results(fw_link_of(ctx)->fw, &r);
     for (size_t k = 0; k < sizeof fw_link_results / sizeof fw_link_results[0]; k++) {
-        const unsigned have = fw_link_results[k].have;
-        if ((r.have & have) == 0u || (have == CM_HAVE_MECH && !(r.inertia_kgm2 > 0.0))) {
+        if (!cm_si_has(&r, fw_link_results[k].have) || index-- != 0u) {
             continue;
-        }
-        if (index-- != 0u) {
-            continue;
-        }
-        const char *f = (const char *)&r + fw_link_results[k].off;
-        double v;
-        int i;
-        uint32_t u;
-        bool b;
-        switch (fw_link_results[k].kind) {
-        case FW_R_INT:
-            memcpy(&i, f, sizeof i);
-            v = (double)i;
-            break;
-        case FW_R_U32:
-            memcpy(&u, f, sizeof u);
-            v = (double)u;
-            break;
-        case FW_R_BOOL:
-            memcpy(&b, f, sizeof b);
-            v = b ? 1.0 : 0.0;
-            break;
-        default:
-            memcpy(&v, f, sizeof v);
-            if (fw_link_results[k].kind == FW_R_MILLI) {
-                v *= 1e3;
-            }
-            break;
         }
         *key = fw_link_results[k].key;
-        *value = v;
+        *value = cm_si_field(&r, fw_link_results[k].off, (cm_field_t)fw_link_results[k].kind);
         *unit = fw_link_results[k].unit;
         return true;
     }

@@ -2,8 +2,11 @@
  * Commissioning helpers (firmware/commission/cm_core.c) on their own: the
  * duty grid and the applied-voltage record the identification relies on,
  * exact integer ratios and means, the regulator's limit, the step table and
- * its prerequisites. Host and QEMU (integer code, bit-exact on both).
+ * its prerequisites, the results' reader (cm_si_field). Host and QEMU
+ * (integer code, bit-exact on both).
  */
+#include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "../core/machines.h"
@@ -172,6 +175,33 @@ static void test_abort(void)
     TEST_ASSERT_EQUAL_UINT32(0u, cm.res.have & CM_HAVE_LPROBE);
 }
 
+/* The results' reader: each kind from its field's own type, and which
+ * results are listed (the mechanics only with a finite inertia > 0). */
+static void test_si_field(void)
+{
+    cm_si_t r;
+    memset(&r, 0, sizeof r);
+    r.have = CM_HAVE_ENC | CM_HAVE_LDQ | CM_HAVE_MECH;
+    r.enc_dir = -1;
+    r.enc_cpr = 4000000001u; /* beyond INT32_MAX: read unsigned */
+    r.salient = true;
+    r.ld_h = 0.375e-3;
+    r.lq_h = 1.5;
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, cm_si_field(&r, offsetof(cm_si_t, enc_dir), CM_FIELD_INT));
+    TEST_ASSERT_EQUAL_DOUBLE(4000000001.0,
+                             cm_si_field(&r, offsetof(cm_si_t, enc_cpr), CM_FIELD_U32));
+    TEST_ASSERT_EQUAL_DOUBLE(1.0, cm_si_field(&r, offsetof(cm_si_t, salient), CM_FIELD_BOOL));
+    TEST_ASSERT_EQUAL_DOUBLE(0.375, cm_si_field(&r, offsetof(cm_si_t, ld_h), CM_FIELD_MILLI));
+    TEST_ASSERT_EQUAL_DOUBLE(1.5, cm_si_field(&r, offsetof(cm_si_t, lq_h), CM_FIELD_SI));
+    TEST_ASSERT_TRUE(cm_si_has(&r, CM_HAVE_ENC));
+    TEST_ASSERT_FALSE(cm_si_has(&r, CM_HAVE_RS));
+    const double inertia[4] = {NAN, INFINITY, 0.0, 2e-5};
+    for (int k = 0; k < 4; k++) {
+        r.inertia_kgm2 = inertia[k];
+        TEST_ASSERT_EQUAL_INT(k == 3, cm_si_has(&r, CM_HAVE_MECH));
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -182,5 +212,6 @@ int main(void)
     RUN_TEST(test_prepare_needs);
     RUN_TEST(test_names);
     RUN_TEST(test_abort);
+    RUN_TEST(test_si_field);
     return UNITY_END();
 }
