@@ -7,16 +7,23 @@
 #include "fw_state.h"
 #include "unity.h"
 
-/* Machine file `file` of sim_host/machines into *m once (*loaded set). */
+sim_machine_t loop_machine_file(const char *file)
+{
+    sim_machine_t m;
+    char path[512];
+    char err[256];
+    (void)snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
+    if (sim_machine_load(path, &m, err, sizeof err) != 0) {
+        TEST_FAIL_MESSAGE(err);
+    }
+    return m;
+}
+
+/* Machine file `file` into *m once (*loaded set). */
 static const sim_machine_t *loop_machine(sim_machine_t *m, int *loaded, const char *file)
 {
     if (!*loaded) {
-        char path[512];
-        char err[256];
-        (void)snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
-        if (sim_machine_load(path, m, err, sizeof err) != 0) {
-            TEST_FAIL_MESSAGE(err);
-        }
+        *m = loop_machine_file(file);
         *loaded = 1;
     }
     return m;
@@ -36,13 +43,13 @@ const sim_machine_t *loop_ipmsm80(void)
     return loop_machine(&m, &loaded, "thesis_ipmsm_80kw.ini");
 }
 
-void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torque_nm,
-              double duration_s, double win_start_s)
+void loop_cfg_machine(sim_run_cfg_t *c, const sim_machine_t *m, const char *name, uint32_t fs,
+                      double speed_rpm, double torque_nm, double duration_s, double win_start_s)
 {
     const ctrl_desc_t *d = ctrl_find(name);
     TEST_ASSERT_NOT_NULL_MESSAGE(d, name);
-    sim_run_config_default(c, loop_spmsm(), d);
-    c->fs_hz = d->fs_default_hz;
+    sim_run_config_default(c, m, d);
+    c->fs_hz = fs != 0u ? fs : d->fs_default_hz;
     c->hal.pwm_freq_hz = c->fs_hz;
     c->speed_rpm = speed_rpm;
     c->torque_ref_nm = torque_nm;
@@ -52,12 +59,29 @@ void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torqu
     c->calib_samples = 64u;
 }
 
+void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torque_nm,
+              double duration_s, double win_start_s)
+{
+    loop_cfg_machine(c, loop_spmsm(), name, 0u, speed_rpm, torque_nm, duration_s, win_start_s);
+}
+
 void loop_start(sim_run_t *r, const sim_run_cfg_t *c)
 {
     char err[256];
     if (sim_run_init(r, c, err, sizeof err) != 0) {
         TEST_FAIL_MESSAGE(err);
     }
+}
+
+void loop_run_metrics(sim_run_t *r, const sim_run_cfg_t *c, metrics_result_t *mp)
+{
+    loop_start(r, c);
+    char err[256];
+    if (sim_run_all(r, err, sizeof err) != 0) {
+        TEST_FAIL_MESSAGE(err);
+    }
+    metrics_result_t mc;
+    TEST_ASSERT_EQUAL_INT(0, sim_run_metrics(r, mp, &mc));
 }
 
 void loop_scenario(sim_scenario_t *s, const char *text, const char *name)

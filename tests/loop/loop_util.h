@@ -12,8 +12,14 @@ const sim_machine_t *loop_spmsm(void);
 /* Thesis 80 kW IPMSM (thesis_ipmsm_80kw.ini, as shipped); aborts the test on error. */
 const sim_machine_t *loop_ipmsm80(void);
 
-/* Dynamometer run of controller `name` at speed_rpm with a torque reference,
- * ADC noise off unless noise > 0; duration and window in seconds. */
+/* Machine file `file` of sim_host/machines; fails the test on error. */
+sim_machine_t loop_machine_file(const char *file);
+/* Dynamometer run of controller `name` on machine m at fs (0: the
+ * controller's default) and speed_rpm with a torque reference; duration and
+ * window (to the end) in seconds, 64 calibration samples. */
+void loop_cfg_machine(sim_run_cfg_t *c, const sim_machine_t *m, const char *name, uint32_t fs,
+                      double speed_rpm, double torque_nm, double duration_s, double win_start_s);
+/* The same on the thesis SPMSM at the controller's default rate. */
 void loop_cfg(sim_run_cfg_t *c, const char *name, double speed_rpm, double torque_nm,
               double duration_s, double win_start_s);
 
@@ -22,6 +28,9 @@ void loop_scenario(sim_scenario_t *s, const char *text, const char *name);
 
 /* Initialise the run; fails the test with the message on error. */
 void loop_start(sim_run_t *r, const sim_run_cfg_t *c);
+/* Initialise, run to the end and take the plant-grid metrics; fails the test
+ * with the message on error. */
+void loop_run_metrics(sim_run_t *r, const sim_run_cfg_t *c, metrics_result_t *mp);
 
 /* Result of a speed-reversal run (thesis Figs. 4.14, 5.12, 6.17). */
 typedef struct {

@@ -18,6 +18,7 @@
 #include <stdio.h>
 
 #include "fw_state.h"
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -36,42 +37,14 @@ void tearDown(void)
     sim_run_free(&run);
 }
 
-static sim_machine_t load(void)
-{
-    sim_machine_t m;
-    char err[256];
-    if (sim_machine_load(PMSM_MACHINES_DIR "/outrunner_24v.ini", &m, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    return m;
-}
-
 /* T_sse / T_ref of one run. */
 static double rel_sse(const sim_machine_t *m, const char *ctrl, uint32_t fs, bool comp)
 {
-    const ctrl_desc_t *d = ctrl_find(ctrl);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, ctrl);
     sim_run_cfg_t c;
-    sim_run_config_default(&c, m, d);
-    c.fs_hz = fs;
-    c.hal.pwm_freq_hz = fs;
-    c.speed_rpm = SPEED_RPM;
-    c.torque_ref_nm = T_REF_NM;
-    c.duration_s = 0.12;
-    c.win_start_s = 0.04;
-    c.win_end_s = 0.12;
-    c.calib_samples = 64u;
+    loop_cfg_machine(&c, m, ctrl, fs, SPEED_RPM, T_REF_NM, 0.12, 0.04);
     c.dead_comp = comp;
-    char err[256];
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    if (sim_run_all(&run, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
     metrics_result_t mp;
-    metrics_result_t mc;
-    TEST_ASSERT_EQUAL_INT(0, sim_run_metrics(&run, &mp, &mc));
+    loop_run_metrics(&run, &c, &mp);
     char msg[160];
     snprintf(msg, sizeof msg, "%s: fault %s", ctrl, fw_fault_name(fw_fault(&run.fw)));
     TEST_ASSERT_EQUAL_INT_MESSAGE(FW_STATE_RUNNING, fw_state(&run.fw), msg);
@@ -93,7 +66,7 @@ static void check(const sim_machine_t *m, const char *ctrl, uint32_t fs)
 
 static void test_outrunner_compensated(void)
 {
-    const sim_machine_t m = load();
+    const sim_machine_t m = loop_machine_file("outrunner_24v.ini");
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 500e-9, m.dead_time_s);
     check(&m, "m2ptfc", 20000u);
     check(&m, "drr", 20000u);
@@ -103,7 +76,7 @@ static void test_outrunner_compensated(void)
 
 static void test_outrunner_uncompensated_misses(void)
 {
-    const sim_machine_t m = load();
+    const sim_machine_t m = loop_machine_file("outrunner_24v.ini");
     TEST_ASSERT_TRUE_MESSAGE(rel_sse(&m, "m2ptfc", 20000u, false) > BOUND_REL,
                              "m2ptfc without compensation within the bound: dead time not acting");
     TEST_ASSERT_TRUE_MESSAGE(rel_sse(&m, "foc", 20000u, false) > BOUND_REL,

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "fw_state.h"
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -51,37 +52,13 @@ typedef struct {
     unsigned capped_legs; /* legs limited */
 } cap_result_t;
 
-static sim_machine_t load(const char *file)
-{
-    sim_machine_t m;
-    char path[512];
-    char err[256];
-    snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
-    if (sim_machine_load(path, &m, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    return m;
-}
-
 static cap_result_t run_cap(const sim_machine_t *m, const char *ctrl, double rpm, double cap)
 {
-    const ctrl_desc_t *d = ctrl_find(ctrl);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, ctrl);
     sim_run_cfg_t c;
-    sim_run_config_default(&c, m, d);
-    c.fs_hz = 20000u;
-    c.hal.pwm_freq_hz = 20000u;
+    /* the thesis SPMSM test point (2.4 N*m rated) */
+    loop_cfg_machine(&c, m, ctrl, 20000u, rpm, 1.8, 0.06, 0.02);
     c.hal.duty_max = cap;
-    c.speed_rpm = rpm;
-    c.torque_ref_nm = 1.8; /* the thesis SPMSM test point (2.4 N*m rated) */
-    c.duration_s = 0.06;
-    c.win_start_s = 0.02;
-    c.win_end_s = c.duration_s;
-    c.calib_samples = 64u;
-    char err[256];
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
+    loop_start(&run, &c);
     const fw_t *fw = &run.fw;
     const double i_base = run.fw.bases.i_a;
     const double ts = 1.0 / (double)c.fs_hz;
@@ -144,7 +121,7 @@ static cap_result_t run_cap(const sim_machine_t *m, const char *ctrl, double rpm
 
 static void check(const char *ctrl, double rpm)
 {
-    const sim_machine_t m = load("thesis_spmsm.ini");
+    const sim_machine_t m = loop_machine_file("thesis_spmsm.ini");
     const cap_result_t free_run = run_cap(&m, ctrl, rpm, 1.0);
     const cap_result_t capped = run_cap(&m, ctrl, rpm, CAP_ESC1);
     char msg[240];

@@ -30,6 +30,7 @@
 #include "board_esc1.h"
 #include "fw_state.h"
 #include "g4_adc.h"
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -47,53 +48,25 @@ void tearDown(void)
     sim_run_free(&run);
 }
 
-static sim_machine_t load(const char *file)
-{
-    sim_machine_t m;
-    char path[512];
-    char err[256];
-    snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
-    if (sim_machine_load(path, &m, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    return m;
-}
-
 static double no_load_rpm(const sim_machine_t *m)
 {
     const double w_m0 = m->vdc_v / (sqrt(3.0) * m->pole_pairs * m->psi_pm_wb);
     return w_m0 * 60.0 / (2.0 * PI_D);
 }
 
-/* Dynamometer run at 20 % of the no-load speed, half the rated torque. */
+/* Dynamometer run at 20 % of the no-load speed, half the rated torque (the
+ * ADC's full scale i_fullscale_a, 0: hal/sim's default). */
 static void steady_adc(const sim_machine_t *m, const char *ctrl, uint32_t fs, double duration_s,
                        double win_start_s, double i_fullscale_a)
 {
-    const ctrl_desc_t *d = ctrl_find(ctrl);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, ctrl);
     sim_run_cfg_t c;
-    sim_run_config_default(&c, m, d);
-    c.fs_hz = fs;
-    c.hal.pwm_freq_hz = fs;
-    c.speed_rpm = 0.2 * no_load_rpm(m);
-    c.torque_ref_nm = 0.5 * m->torque_rated_nm;
-    c.duration_s = duration_s;
-    c.win_start_s = win_start_s;
-    c.win_end_s = duration_s;
-    c.calib_samples = 64u;
+    loop_cfg_machine(&c, m, ctrl, fs, 0.2 * no_load_rpm(m), 0.5 * m->torque_rated_nm, duration_s,
+                     win_start_s);
     if (i_fullscale_a > 0.0) {
         c.hal.i_fullscale_a = i_fullscale_a;
     }
-    char err[256];
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-    if (sim_run_all(&run, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
     metrics_result_t mp;
-    metrics_result_t mc;
-    TEST_ASSERT_EQUAL_INT(0, sim_run_metrics(&run, &mp, &mc));
+    loop_run_metrics(&run, &c, &mp);
     const double tref = c.torque_ref_nm;
     const double sse = tref - mp.torque_mean_nm;
     printf("  %-15s %-6s %2u kHz %7.1f r/min  ADC %5.1f mA/count  T_ref %.4f N*m  T_sse %+.5f N*m "
@@ -110,52 +83,50 @@ static void steady_adc(const sim_machine_t *m, const char *ctrl, uint32_t fs, do
     sim_run_free(&run);
 }
 
-static void steady(const sim_machine_t *m, const char *ctrl, uint32_t fs, double duration_s,
-                   double win_start_s)
+/* The four controllers: m2ptfc, drr and foc at 20 kHz, fst at 40 kHz. */
+static void steady_all(const sim_machine_t *m, double duration_s, double win_start_s,
+                       double i_fullscale_a)
 {
-    steady_adc(m, ctrl, fs, duration_s, win_start_s, 0.0);
+    static const struct {
+        const char *ctrl;
+        uint32_t fs;
+    } k[] = {{"m2ptfc", 20000u}, {"drr", 20000u}, {"foc", 20000u}, {"fst", 40000u}};
+    for (size_t j = 0; j < sizeof k / sizeof k[0]; j++) {
+        steady_adc(m, k[j].ctrl, k[j].fs, duration_s, win_start_s, i_fullscale_a);
+    }
 }
 
 /* mj5208: f_e = 170 Hz at 1459 r/min; window 50 ms = 8.5 electrical turns. */
 static void test_mj5208_drone(void)
 {
-    const sim_machine_t m = load("mj5208_drone.ini");
+    const sim_machine_t m = loop_machine_file("mj5208_drone.ini");
     /* the file's data: Kv 304 r/min/V on 24 V, the 14-bit encoder */
     TEST_ASSERT_DOUBLE_WITHIN(1.0, 304.0 * 24.0, no_load_rpm(&m));
     TEST_ASSERT_EQUAL_INT(4096, m.encoder_lines);
-    steady(&m, "m2ptfc", 20000u, 0.08, 0.03);
-    steady(&m, "drr", 20000u, 0.08, 0.03);
-    steady(&m, "foc", 20000u, 0.08, 0.03);
-    steady(&m, "fst", 40000u, 0.08, 0.03);
+    steady_all(&m, 0.08, 0.03, 0.0);
 }
 
 /* GBM5208: f_e = 11.2 Hz at 61 r/min; window 150 ms = 1.7 electrical turns,
  * 10 periods of the sixth harmonic. */
 static void test_gbm5208_gimbal(void)
 {
-    const sim_machine_t m = load("gbm5208_gimbal.ini");
+    const sim_machine_t m = loop_machine_file("gbm5208_gimbal.ini");
     /* the file's data: Kv 25.5 r/min/V on 12 V, the 14-bit encoder */
     TEST_ASSERT_DOUBLE_WITHIN(0.1, 25.5 * 12.0, no_load_rpm(&m));
     TEST_ASSERT_EQUAL_INT(4096, m.encoder_lines);
-    steady(&m, "m2ptfc", 20000u, 0.2, 0.05);
-    steady(&m, "drr", 20000u, 0.2, 0.05);
-    steady(&m, "foc", 20000u, 0.2, 0.05);
-    steady(&m, "fst", 40000u, 0.2, 0.05);
+    steady_all(&m, 0.2, 0.05, 0.0);
 }
 
 /* The gimbal motor on the ESC1 board's current scale: +-(A per count) 2^11. */
 static void test_gbm5208_gimbal_esc1_current_scale(void)
 {
-    const sim_machine_t m = load("gbm5208_gimbal.ini");
+    const sim_machine_t m = loop_machine_file("gbm5208_gimbal.ini");
     const g4_board_t *b = &g4_board_esc1;
     const double a_per_count =
         b->vref / (double)G4_ADC_FULL_SCALE / (fabs(b->sense_gain) * b->shunt_ohm);
     TEST_ASSERT_DOUBLE_WITHIN(0.5e-3, 29.4e-3, a_per_count);
     const double fullscale = a_per_count * 2048.0;
-    steady_adc(&m, "m2ptfc", 20000u, 0.2, 0.05, fullscale);
-    steady_adc(&m, "drr", 20000u, 0.2, 0.05, fullscale);
-    steady_adc(&m, "foc", 20000u, 0.2, 0.05, fullscale);
-    steady_adc(&m, "fst", 40000u, 0.2, 0.05, fullscale);
+    steady_all(&m, 0.2, 0.05, fullscale);
 }
 
 int main(void)
