@@ -100,6 +100,21 @@ static void check_lines(const double want[3], const ctrl_legs_t *w, uint32_t hig
     TEST_ASSERT_DOUBLE_WITHIN(2e-4, want[1] - want[2], a[1] - a[2]);
 }
 
+/* The duties want[] through the compensation after a period that ended as
+ * high_prev says; the line voltages checked (currents' signs pos). */
+static ctrl_legs_t apply_checked(ctrl_deadtime_t *d, const ctrl_estimate_t *e, const double want[3],
+                                 uint32_t high_prev, const bool pos[3])
+{
+    ctrl_legs_t l;
+    for (int x = 0; x < 3; x++) {
+        l.duty[x] = ctrl_q24_from_double(want[x]);
+    }
+    d->high_prev = high_prev;
+    ctrl_deadtime_apply(d, e, &l);
+    check_lines(want, &l, high_prev, pos, 0.01);
+    return l;
+}
+
 static void test_off(void)
 {
     ctrl_deadtime_t d = setup(0.0, 0.0, 1.0);
@@ -118,17 +133,11 @@ static void test_pulses(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-7, 0.01, q(d.dd));
     ctrl_estimate_t e = est_currents(4.0, -1.5); /* i_c = -2.5 A */
     const double want[3] = {0.6, 0.45, 0.3};
-    ctrl_legs_t l;
-    for (int x = 0; x < 3; x++) {
-        l.duty[x] = ctrl_q24_from_double(want[x]);
-    }
-    d.high_prev = 0u;
-    ctrl_deadtime_apply(&d, &e, &l);
+    const bool pos[3] = {true, false, false};
+    const ctrl_legs_t l = apply_checked(&d, &e, want, 0u, pos);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.61, q(l.duty[0]));
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.44, q(l.duty[1]));
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.29, q(l.duty[2]));
-    const bool pos[3] = {true, false, false};
-    check_lines(want, &l, 0u, pos, 0.01);
 }
 
 /* Within the band the correction is proportional: 0.25 A of 0.5 A: half. */
@@ -149,37 +158,21 @@ static void test_clamped(void)
     ctrl_deadtime_t d = setup(500e-9, 0.0, 0.5);
     ctrl_estimate_t e = est_currents(-2.0, 3.0); /* i_c = -1 A */
     const bool pos[3] = {false, true, false};
-    ctrl_legs_t l;
     /* a: high all period after a period that ended high, i < 0: written
      * below 1, so that it ends low (no late falling edge next period) */
     const double want[3] = {1.0, 0.6, 0.4};
-    for (int x = 0; x < 3; x++) {
-        l.duty[x] = ctrl_q24_from_double(want[x]);
-    }
-    d.high_prev = 1u;
-    ctrl_deadtime_apply(&d, &e, &l);
+    ctrl_legs_t l = apply_checked(&d, &e, want, 1u, pos);
     TEST_ASSERT_TRUE(l.duty[0] < FX_ONE);
-    check_lines(want, &l, 1u, pos, 0.01);
     /* b: high all period after a low end, i > 0: its late rising edge made
      * up by the other legs' pulses */
     const double want2[3] = {0.5, 1.0, 0.3};
-    for (int x = 0; x < 3; x++) {
-        l.duty[x] = ctrl_q24_from_double(want2[x]);
-    }
-    d.high_prev = 0u;
-    ctrl_deadtime_apply(&d, &e, &l);
+    l = apply_checked(&d, &e, want2, 0u, pos);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 1.0, q(l.duty[1]));
-    check_lines(want2, &l, 0u, pos, 0.01);
     /* a pulse after a period that ended high, i < 0: its late falling edge
      * at the start taken off too */
     const double want3[3] = {0.5, 0.2, 0.1};
-    for (int x = 0; x < 3; x++) {
-        l.duty[x] = ctrl_q24_from_double(want3[x]);
-    }
-    d.high_prev = 1u;
-    ctrl_deadtime_apply(&d, &e, &l);
+    l = apply_checked(&d, &e, want3, 1u, pos);
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.48, q(l.duty[0]));
-    check_lines(want3, &l, 1u, pos, 0.01);
     /* a leg at 0 stays 0 */
     l.duty[0] = 0;
     l.duty[1] = FX_ONE / 2;
