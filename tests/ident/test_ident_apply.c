@@ -44,14 +44,7 @@ static void test_identify_and_apply(void)
     char err[256];
     TEST_ASSERT_EQUAL_INT_MESSAGE(
         0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &spm, err, sizeof err), err);
-    plant = spm;
-    plant.encoder_offset_deg = 137.0;
-    plant.encoder_direction = -1;
-    conf = spm;
-    conf.rs_ohm *= 1.3;
-    conf.ld_h *= 0.7;
-    conf.lq_h *= 0.8;
-    conf.psi_pm_wb *= 1.2;
+    sim_ident_case(&spm, &plant, &conf);
     TEST_ASSERT_EQUAL_INT_MESSAGE(
         0, sim_ident_setup(&run, &plant, &conf, ctrl_find("m2ptfc"), 2.0, 1u, err, sizeof err),
         err);
@@ -81,7 +74,7 @@ static void test_identify_and_apply(void)
     fw_commission_results(&run.fw, &r);
     TEST_ASSERT_EQUAL_INT(-1, r.enc_dir);
     TEST_ASSERT_TRUE(fabs(ang_deg(r.enc_offset_deg * 3.14159265358979323846 / 180.0,
-                                  137.0 * 3.14159265358979323846 / 180.0)) <= 2.0);
+                                  SIM_IDENT_CASE_OFFSET_DEG * 3.14159265358979323846 / 180.0)) <= 2.0);
     TEST_ASSERT_TRUE(rel(r.rs_ohm, m->rs_ohm) < 1e-6);
     bool seen_psi = false, seen_dir = false;
     cm_item_t it;

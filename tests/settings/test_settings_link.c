@@ -86,14 +86,7 @@ void setUp(void)
     char err[256];
     TEST_ASSERT_EQUAL_INT_MESSAGE(
         0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &spm, err, sizeof err), err);
-    plant = spm;
-    plant.encoder_offset_deg = 137.0;
-    plant.encoder_direction = -1;
-    conf = spm;
-    conf.rs_ohm *= 1.3;
-    conf.ld_h *= 0.7;
-    conf.lq_h *= 0.8;
-    conf.psi_pm_wb *= 1.2;
+    sim_ident_case(&spm, &plant, &conf);
     sfm_init(&flash, 1u);
 }
 

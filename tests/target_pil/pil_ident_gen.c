@@ -42,14 +42,7 @@ int main(int argc, char **argv)
     if (sim_machine_load(machine, &spm, err, sizeof err) != 0) {
         return die(err, NULL);
     }
-    plant = spm;
-    plant.encoder_offset_deg = 137.0;
-    plant.encoder_direction = -1;
-    conf = spm;
-    conf.rs_ohm *= 1.3;
-    conf.ld_h *= 0.7;
-    conf.lq_h *= 0.8;
-    conf.psi_pm_wb *= 1.2;
+    sim_ident_case(&spm, &plant, &conf);
     const ctrl_desc_t *d = ctrl_find("m2ptfc");
     if (d == NULL) {
         return die("m2ptfc is not registered", NULL);

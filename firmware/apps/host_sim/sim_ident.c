@@ -17,6 +17,18 @@ static int sim_ierr(char *err, size_t errlen, const char *msg)
     return -1;
 }
 
+void sim_ident_case(const sim_machine_t *m, sim_machine_t *plant, sim_machine_t *conf)
+{
+    *plant = *m;
+    plant->encoder_offset_deg = SIM_IDENT_CASE_OFFSET_DEG;
+    plant->encoder_direction = -1;
+    *conf = *m;
+    conf->rs_ohm *= 1.3;
+    conf->ld_h *= 0.7;
+    conf->lq_h *= 0.8;
+    conf->psi_pm_wb *= 1.2;
+}
+
 int sim_ident_setup(sim_run_t *r, const sim_machine_t *plant, const sim_machine_t *ctrl,
                     const ctrl_desc_t *d, double theta0, uint64_t seed, char *err, size_t errlen)
 {

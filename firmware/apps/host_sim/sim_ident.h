@@ -42,6 +42,13 @@ typedef struct {
     bool applied;          /* the drive adopted the results (fw_commission_apply) */
 } sim_ident_t;
 
+/* The identification's test case on machine m, what the commissioning must
+ * find out: the plant's encoder SIM_IDENT_CASE_OFFSET_DEG (electrical) off
+ * and counting backwards; the drive configured with Rs x 1.3, Ld x 0.7,
+ * Lq x 0.8 and psi_pm x 1.2 of m's. */
+#define SIM_IDENT_CASE_OFFSET_DEG 137.0
+void sim_ident_case(const sim_machine_t *m, sim_machine_t *plant, sim_machine_t *conf);
+
 /* Configure and initialise a run for identification: the plant `plant` on
  * free mechanics from electrical angle theta0 at rest, the firmware
  * configured with `ctrl` (its parameters and [sensors]) and controller d,
