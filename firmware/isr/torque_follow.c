@@ -8,9 +8,8 @@
 
 #define TF_SHIFT_MAX 15u
 
-/* Out of line, one call per period: inlined by the board image's link-time
- * optimisation into the interrupt at -O2 it took 1 384 B, where the image
- * with the settings store had 1 104 B left; called, 1 000 B. */
+/* The window's end out of line: the board image's link-time optimisation
+ * would inline it at its one call in the interrupt (torque_follow.h). */
 #if defined(__GNUC__)
 #define TF_NOINLINE __attribute__((noinline))
 #else
@@ -50,20 +49,8 @@ void fw_torque_follow_init(fw_torque_follow_t *s, const fw_torque_follow_cfg_t *
     fw_torque_follow_reset(s);
 }
 
-TF_NOINLINE uint32_t fw_torque_follow_step(fw_torque_follow_t *s, q24_t t_ref, q24_t t_est,
-                                           bool valid)
+TF_NOINLINE uint32_t fw_torque_follow_window(fw_torque_follow_t *s)
 {
-    if (!valid) {
-        s->sum_err = 0;
-        s->sum_ref = 0;
-        s->n = 0u;
-        return FW_FAULT_NONE;
-    }
-    s->sum_err += (int64_t)t_est - t_ref;
-    s->sum_ref += t_ref < 0 ? -(int64_t)t_ref : (int64_t)t_ref;
-    if (++s->n < ((uint32_t)1 << s->cfg.shift)) {
-        return FW_FAULT_NONE;
-    }
     const int64_t e = s->sum_err < 0 ? -s->sum_err : s->sum_err;
     const int64_t floor = (int64_t)s->cfg.tol_rated << s->cfg.shift;
     const bool miss = e * 20 > s->sum_ref && e > floor; /* |e| <= 2^47: 20 |e| fits */
