@@ -37,11 +37,6 @@ int ctrl_estimator_set_angle_src(ctrl_estimator_t *e, const ctrl_params_t *p,
     return CTRL_OK;
 }
 
-void *ctrl_estimator_angle_state(ctrl_estimator_t *e)
-{
-    return e != NULL ? e->src_state.bytes : NULL;
-}
-
 void ctrl_estimator_set_outputs(ctrl_estimator_t *e, unsigned outputs)
 {
     if (outputs & CTRL_EST_SECTOR_NOW) {
@@ -141,6 +136,7 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     in->vdc = vdc;
     fx_angle_t th;
     q24_t omega;
+    const ctrl_angle_frame_t *fr = NULL;
     if (e->src == &ctrl_angle_encoder) {
         /* the usual source, called directly (inline; its own output record,
          * which the compiler keeps in registers) */
@@ -151,15 +147,24 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
         omega = ang.omega;
     } else {
         ctrl_angle_out_t ang;
+        ang.frame = NULL;
         e->src->update(e->src_state.bytes, p, in, &ang);
         th = ang.theta;
         omega = ang.omega;
+        fr = ang.frame;
     }
 
-    /* The one table sine/cosine of the period; the turn over the period. */
+    /* The one table sine/cosine of the period, unless the source formed it
+     * at th (the sensorless observer: the same values, not formed twice). */
     q24_t s;
     q24_t c;
-    fx_sincos_inline(th, &s, &c);
+    if (fr != NULL) {
+        s = fr->sin_theta;
+        c = fr->cos_theta;
+    } else {
+        fx_sincos_inline(th, &s, &c);
+    }
+    /* The turn over the period. */
     const int32_t dth = fx_u2i(ctrl_angle_step(p, omega));
     int32_t rc;
     int32_t rs;

@@ -160,8 +160,10 @@ void ctrl_fobs_voltage(ctrl_fobs_t *o, const ctrl_legs_t *legs, q24_t vdc, q24_t
  * (S1(37)-(38): the resistive drop at the average of the two samples). */
 static int64_t fobs_axis(const ctrl_params_t *p, int64_t acc, q24_t v, q24_t i_prev, q24_t i)
 {
-    const int64_t i_sum = (int64_t)i_prev + i;
-    const int64_t inc = (int64_t)p->ts * v - fx_rshift64_round((int64_t)p->ts_rs * i_sum, 1u);
+    /* Ts Rs (i_prev + i) as two products summed (SMULL, SMLAL): 0 <= ts_rs <
+     * 2^31 and |i| <= 2^31, each below 2^62 in magnitude, the sum below 2^63 */
+    const int64_t rs_sum = (int64_t)p->ts_rs * i_prev + (int64_t)p->ts_rs * i;
+    const int64_t inc = (int64_t)p->ts * v - fx_rshift64_round(rs_sum, 1u);
     return fobs_clamp(acc + inc);
 }
 
@@ -256,7 +258,6 @@ void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_
         o->psi_beta_acc = acc[1] + delta[1];
     } else {
         /* Magnitude of the active flux towards psi_a, along (psi_a, -(Ld - Lq) i_q). */
-        const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
         const q24_t eta_d = fx_dot(c, s, o->eta_alpha, o->eta_beta);
         const q24_t psi_a = fx_add(p->psi_pm, fx_mul(o->dl, i_d));
         const q24_t w = fx_abs(o->omega);
@@ -264,7 +265,12 @@ void ctrl_fobs_correct(ctrl_fobs_t *o, const ctrl_params_t *p, fx_angle_t theta_
         const q24_t g = fx_mul(fx_mul(kts, fx_sub(psi_a, eta_d)), p->inv_psi_pm);
         fobs_move(&o->psi_alpha_acc, &o->psi_beta_acc, fx_mul(g, psi_a),
                   fx_neg(fx_mul(g, fx_mul(o->dl, i_q))), s, c);
-        pm = o->psi_k != 0 ? fx_sub(psi_d, fx_mul(p->ld, i_d)) : 0;
+        pm = 0;
+        if (o->psi_k != 0) {
+            /* formed only for the PM-flux estimate that reads it */
+            const q24_t psi_d = fx_dot(c, s, o->psi_alpha, o->psi_beta);
+            pm = fx_sub(psi_d, fx_mul(p->ld, i_d));
+        }
     }
 
     fobs_pll(o, p, theta_r);
@@ -286,6 +292,8 @@ fx_angle_t ctrl_fobs_update(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_alph
     /* Park (3.7) inline, the same rounded and saturated sums as ctrl_park. */
     const q24_t i_d = fx_dot(c, s, i_alpha, i_beta);
     const q24_t i_q = fx_cross(c, s, i_alpha, i_beta);
+    o->frame.sin_theta = s;
+    o->frame.cos_theta = c;
     ctrl_fobs_correct(o, p, th_r, s, c, i_d, i_q);
     return th;
 }

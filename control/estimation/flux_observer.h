@@ -63,6 +63,7 @@
 
 #include <stdint.h>
 
+#include "angle_source.h"
 #include "ctrl_params.h"
 #include "ctrl_types.h"
 #include "fx.h"
@@ -100,6 +101,7 @@ typedef struct {
     q24_t omega;                         /* speed: the PLL's frequency, Q24 pu electrical */
     int64_t psi_pm_acc;                  /* PM-flux estimate, Q48 pu */
     ctrl_legs_t legs_prev;               /* duties of the period before (edges at its end) */
+    ctrl_angle_frame_t frame;            /* ctrl_fobs_update's sin, cos of the reference angle */
     uint8_t primed;                      /* 0 until ctrl_fobs_reset */
 } ctrl_fobs_t;
 
@@ -156,7 +158,8 @@ void ctrl_fobs_psi_pm_step(ctrl_fobs_t *o, q24_t pm, q24_t k);
 
 /* ctrl_fobs_integrate, fx_sincos of the reference angle (the flux angle, or
  * theta_enc in CTRL_FOBS_ENCODER), Park of i, ctrl_fobs_correct. Returns the
- * flux angle. */
+ * flux angle; the frame at the reference angle stays in frame (the
+ * estimator's too, ctrl_angle_out_t). */
 fx_angle_t ctrl_fobs_update(ctrl_fobs_t *o, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
                             q24_t i_alpha, q24_t i_beta, fx_angle_t theta_enc);
 

@@ -166,6 +166,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
     const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
     const q24_t w_obs = o->omega; /* ctrl_fobs_omega without the call */
     out->handover = 0u;
+    out->obs_frame = 0u;
     out->theta_obs = th_obs;
 
 #if CTRL_SL_INITIAL_ANGLE
@@ -177,6 +178,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
     if (s->mode == CTRL_SL_OBSERVER) {
         out->mode = CTRL_SL_OBSERVER;
         out->theta = th_obs;
+        out->obs_frame = 1u;
         s->w_f = fx_add(s->w_f, fx_mul(p->speed_lpf_k, fx_sub(w_obs, s->w_f)));
         out->omega = s->w_f;
         out->torque_ref = 0;
@@ -229,6 +231,7 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
         o->kappa_ts = s->kappa_ts;
         out->mode = CTRL_SL_OBSERVER;
         out->theta = th_obs;
+        out->obs_frame = 1u;
         out->omega = w_obs;
         out->torque_ref = 0;
         out->handover = 1u;
@@ -261,6 +264,12 @@ static void angle_sl_update(void *state, const ctrl_params_t *p, const ctrl_angl
                    s->torque_est, &s->out);
     out->theta = s->out.theta;
     out->omega = s->out.omega;
+    /* In the observer's mode its angle (the reference angle of its
+     * correction, CTRL_FOBS_SENSORLESS as ctrl_sl_init sets it) is the
+     * estimator's: the frame it formed is the estimator's too. */
+    if (s->out.obs_frame != 0u) {
+        out->frame = &s->sl.obs.frame;
+    }
 }
 
 const ctrl_angle_src_t ctrl_angle_sensorless = {
@@ -275,8 +284,19 @@ const ctrl_angle_src_t ctrl_angle_sensorless = {
     .update = angle_sl_update,
 };
 
-void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, q24_t vdc, q24_t i_a,
-                           q24_t i_b)
+void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, const ctrl_estimate_t *est,
+                           q24_t vdc, q24_t i_a, q24_t i_b)
 {
-    ctrl_fobs_voltage(&s->sl.obs, legs, vdc, i_a, i_b, &s->v_alpha, &s->v_beta);
+    ctrl_fobs_t *const o = &s->sl.obs;
+    if (o->dt_frac == 0 && o->v_fwd == 0) {
+        /* No inverter error to remove: ctrl_fobs_voltage's ctrl_legs_voltage,
+         * vdc times (4.4) of the duties, which the estimator formed with the
+         * same rounding (est->u_alpha, u_beta; duties in [0, 1], where
+         * ctrl_plan_dur and the clamp to [-2, 2) change nothing). */
+        o->legs_prev = *legs;
+        s->v_alpha = fx_mul(vdc, est->u_alpha);
+        s->v_beta = fx_mul(vdc, est->u_beta);
+        return;
+    }
+    ctrl_fobs_voltage(o, legs, vdc, i_a, i_b, &s->v_alpha, &s->v_beta);
 }

@@ -119,6 +119,7 @@ typedef struct {
     q24_t omega;           /* the speed for the estimator and the speed loop, Q24 pu */
     uint8_t mode;          /* CTRL_SL_* */
     uint8_t handover;      /* 1 in the period the observer took over */
+    uint8_t obs_frame;     /* 1: theta is the observer's angle (obs.frame is its frame) */
     q24_t torque_ref;      /* forced mode: the torque reference to apply, Q24 pu */
     fx_angle_t theta_obs;  /* the observer's angle (also while forced) */
     q24_t v_alpha, v_beta; /* CTRL_SL_DETECT: the voltage to apply, Q24 pu */
@@ -161,10 +162,11 @@ typedef struct {
 
 extern const ctrl_angle_src_t ctrl_angle_sensorless;
 
-/* After the period's estimate: the voltage the leg duties acting in [k, k+1)
- * give at the DC link vdc(k) with the phase currents i_a, i_b at k (Q24 pu),
- * for the next update. */
-void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, q24_t vdc, q24_t i_a,
-                           q24_t i_b);
+/* After the period's estimate est: the voltage the leg duties acting in
+ * [k, k+1) (legs, each in [0, FX_ONE], those est was formed with) give at the
+ * DC link vdc(k) with the phase currents i_a, i_b at k (Q24 pu), for the
+ * next update. */
+void ctrl_angle_sl_voltage(ctrl_angle_sl_t *s, const ctrl_legs_t *legs, const ctrl_estimate_t *est,
+                           q24_t vdc, q24_t i_a, q24_t i_b);
 
 #endif /* CONTROL_SENSORLESS_H */

@@ -33,14 +33,25 @@ typedef struct {
     q24_t vdc;             /* DC link at k */
 } ctrl_angle_in_t;
 
-/* What it returns: the d-axis angle and the electrical speed at k. */
+/* The frame at an angle as a source may have formed it for its own use:
+ * its sin and cos (fx_sincos, Q24). */
 typedef struct {
-    fx_angle_t theta; /* electrical angle of the d axis */
-    q24_t omega;      /* electrical speed, Q24 pu (positive: theta increasing) */
+    q24_t sin_theta, cos_theta;
+} ctrl_angle_frame_t;
+
+/* What it returns: the d-axis angle and the electrical speed at k; frame:
+ * NULL (the estimator's default), or the frame at theta, which the
+ * estimator then takes instead of forming it again (the same values:
+ * fx_sincos is a function of the angle alone). */
+typedef struct {
+    fx_angle_t theta;                /* electrical angle of the d axis */
+    q24_t omega;                     /* electrical speed, Q24 pu (positive: theta increasing) */
+    const ctrl_angle_frame_t *frame; /* NULL, or the frame at theta */
 } ctrl_angle_out_t;
 
-#define CTRL_ANGLE_STATE_MAX                                                                       \
-    320 /* bytes of a source's state (estimator.h): the sensorless one, 296 */
+/* bytes of a source's state (estimator.h): the sensorless one, 328 with the
+ * initial angle */
+#define CTRL_ANGLE_STATE_MAX 336
 
 typedef struct ctrl_angle_src {
     const char *name;     /* "encoder", "forced", ... */

@@ -78,8 +78,12 @@ void ctrl_estimator_reset(ctrl_estimator_t *e, const ctrl_params_t *p);
 int ctrl_estimator_set_angle_src(ctrl_estimator_t *e, const ctrl_params_t *p,
                                  const ctrl_angle_src_t *src);
 
-/* The selected source's state (e.g. for ctrl_angle_forced_set). */
-void *ctrl_estimator_angle_state(ctrl_estimator_t *e);
+/* The selected source's state (e.g. for ctrl_angle_forced_set); inline, as
+ * the interrupt reads the sensorless source's every period. */
+static inline void *ctrl_estimator_angle_state(ctrl_estimator_t *e)
+{
+    return e != NULL ? e->src_state.bytes : NULL;
+}
 
 /* Choose the optional outputs (CTRL_EST_*; a sector implies the stator-frame
  * flux it is taken from, I_AB_NEXT the sine and cosine at k+1). */

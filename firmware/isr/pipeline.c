@@ -420,14 +420,19 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
 
 /* The estimate, the torque reference within the medium task's limits, the
  * controller's step, the compare values; true when the medium task is due. */
-static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, q24_t tref, uint8_t hold,
-                                  const fw_mid_out_t *mo, q24_t *t_req);
+static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t *sl, q24_t tref,
+                                  uint8_t hold, const fw_mid_out_t *mo, q24_t *t_req);
+
+/* The sensorless angle source's state (fw_config_t.sensorless), else NULL. */
+static inline ctrl_angle_sl_t *fw_sl(fw_t *fw)
+{
+    return fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
+}
 
 static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m)
 {
     ctrl_estimate_t *const est = &fw->estimate;
-    ctrl_angle_sl_t *const sl =
-        fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
+    ctrl_angle_sl_t *const sl = fw_sl(fw);
     if (sl != NULL) {
         fw_sl_inputs(fw, sl);
     } else if (fw->psi_due != 0u) {
@@ -436,7 +441,7 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
     ctrl_estimator_update(&fw->est, &fw->params, m, &fw->applied, est);
     if (sl != NULL) {
         /* the voltage of [k, k+1) for the observer's next period */
-        ctrl_angle_sl_voltage(sl, &fw->applied, m->vdc, m->i_a, m->i_b);
+        ctrl_angle_sl_voltage(sl, &fw->applied, est, m->vdc, m->i_a, m->i_b);
     } else if (fw->cfg.psi_adapt && fw->sm.state == FW_STATE_RUNNING) {
         fw_psi_track(fw, m, est);
     }
@@ -467,7 +472,7 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
          * first period at zero torque and the limits of standstill). */
         fw->mid_count = 1u;
         fw->mid_first = tm;
-    } else if (!fw_control_out(fw, tm, tref, hold, &fw->mid_out[fw->mid_done & 1u], &t_req)) {
+    } else if (!fw_control_out(fw, tm, sl, tref, hold, &fw->mid_out[fw->mid_done & 1u], &t_req)) {
         return false; /* a fault: gates off */
     }
     return fw_mid_trigger(fw, est, t_req, hold);
@@ -478,14 +483,12 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
  * torque reference within the medium task's limits (mo, its last run), the
  * controller's step, the compare values. False after a fault (gates off);
  * *t_req: the torque reference before the limits, for the medium task. */
-static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, q24_t tref, uint8_t hold,
-                                  const fw_mid_out_t *mo, q24_t *t_req)
+static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t *sl, q24_t tref,
+                                  uint8_t hold, const fw_mid_out_t *mo, q24_t *t_req)
 {
     hal_t *const hal = fw->hal;
     const ctrl_meas_t *const m = &tm->meas;
     ctrl_estimate_t *const est = &fw->estimate;
-    ctrl_angle_sl_t *const sl =
-        fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
     /* overspeed, or a slow protection of the medium task */
     uint32_t f = fw_protect_overspeed(&fw->prot, est->omega_e);
     if (f == FW_FAULT_NONE) {
@@ -577,7 +580,7 @@ void fw_mid_first_step(fw_t *fw, const fw_mid_in_t *in, const fw_mid_out_t *mo)
 {
     fw_telemetry_t *const tm = fw->mid_first;
     q24_t t_req;
-    (void)fw_control_out(fw, tm, in->tref, in->hold, mo, &t_req);
+    (void)fw_control_out(fw, tm, fw_sl(fw), in->tref, in->hold, mo, &t_req);
     /* the record's tail as the interrupt wrote it, after a fault here */
     tm->state = (uint8_t)fw->sm.state;
     tm->fault = (uint8_t)fw->sm.fault_code;
