@@ -56,7 +56,8 @@ static q24_t fw_mtpv_psid(const ctrl_fieldweak_t *s, q24_t psi)
     return fx_neg(fx_div(fx_mul(fx_add(s->c2, s->c2), psi2), fx_add(s->c1, fw_sqrt48(rad))));
 }
 
-q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_t *limit)
+q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, q24_t margin,
+                                    uint8_t *limit)
 {
     const int64_t psi2 = fw_sq48(psi);
     const q24_t psid_v = fw_mtpv_psid(s, psi);
@@ -100,7 +101,7 @@ q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_
     if (limit != 0) {
         *limit = lim;
     }
-    return fx_min(fx_max(t, 0), fx_mul(s->t_margin, t_v));
+    return fx_min(fx_max(t, 0), fx_mul(margin, t_v));
 }
 
 /* psi_max >= b (b > 0, w > 0) without the root and the division: when
@@ -219,7 +220,10 @@ static FW_ALWAYS_INLINE void fw_limits(ctrl_fieldweak_t *s, const ctrl_params_t 
         lim = CTRL_FW_LIMIT_CURRENT;
     } else {
         const q24_t psi_lim = psi_fix > 0 ? fx_min(psi_fix, psi_max) : psi_max;
-        t_lim = ctrl_fieldweak_torque_at_flux(s, psi_lim, &lim);
+        /* braking (w T_req < 0) on a fixed flux: the braking margin (header) */
+        const int brake = psi_fix > 0 && ((omega > 0 && t_req < 0) || (omega < 0 && t_req > 0));
+        t_lim = ctrl_fieldweak_torque_at_flux(s, psi_lim, brake ? s->t_margin_brake : s->t_margin,
+                                              &lim);
         if (psi_lim < psi_max) {
             lim = CTRL_FW_LIMIT_FLUX; /* the fixed reference, not the voltage */
         }

@@ -43,7 +43,12 @@
  *     circle and voltage ellipse), 0 if the flux circle has no point inside
  *     the current circle, and never above torque_margin * T_mtpv: a
  *     torque controller holding |psi_s| fixed loses the load angle at the
- *     MTPV point (dT/d delta = 0) and the torque collapses.
+ *     MTPV point (dT/d delta = 0) and the torque collapses. Braking on a
+ *     fixed flux reference (w T_req < 0) the margin is torque_margin_brake:
+ *     there the zero vector turns the rotor away from a standing flux, which
+ *     carries the load angle toward the pull-out, not away from it, and a
+ *     step's overshoot or the flux's ripple (its sag) reaches the peak from a
+ *     lower torque than motoring.
  * The flux reference is min(the controller's own (MTPA (4.15) / table, or the
  * fixed reference), psi_max) for the limited torque; every function of it is
  * continuous in speed, DC link and torque, so entering and leaving field
@@ -93,7 +98,8 @@ typedef struct {
     q24_t c1_sq;    /* c1^2 */
     q24_t c2_sq8;   /* 8 c2^2 */
     q24_t t_margin; /* fraction of the MTPV torque allowed, Q24 in (0, 1] */
-    q24_t vdc_k;    /* DC-link EMA coefficient per period, Q24 */
+    q24_t t_margin_brake; /* the same braking (w T < 0) on a fixed flux, Q24 in (0, 1] */
+    q24_t vdc_k;          /* DC-link EMA coefficient per period, Q24 */
     /* state */
     int64_t vdc_acc;      /* filtered DC link, Q48 */
     uint8_t primed;       /* vdc_acc holds a sample */
@@ -232,8 +238,10 @@ static inline void ctrl_fieldweak_step_lazy(ctrl_fieldweak_t *s, const ctrl_para
 }
 
 /* Torque limit and its kind at flux amplitude psi in field weakening (the
- * flux-circle part above); for tests and tools. */
-q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, uint8_t *limit);
+ * flux-circle part above), at most margin (Q24, s->t_margin or
+ * s->t_margin_brake) of the MTPV torque; for tests and tools. */
+q24_t ctrl_fieldweak_torque_at_flux(const ctrl_fieldweak_t *s, q24_t psi, q24_t margin,
+                                    uint8_t *limit);
 
 /*
  * Current references (FOC) for torque t at the flux reference psi_ref of

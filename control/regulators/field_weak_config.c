@@ -17,6 +17,7 @@ void ctrl_fieldweak_cfg_default(ctrl_fieldweak_cfg_t *c)
         c->v_frac = CTRL_FW_VFRAC_DEFAULT;
         c->current_max_a = 0.0;
         c->torque_margin = CTRL_FW_TORQUE_MARGIN_DEFAULT;
+        c->torque_margin_brake = CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT;
         c->vdc_lpf_hz = CTRL_FW_VDC_LPF_HZ_DEFAULT;
     }
 }
@@ -62,6 +63,10 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     if (!(c->torque_margin > 0.0 && c->torque_margin <= 1.0)) {
         return fw_refuse(why, why_len, CTRL_EINVAL, "torque_margin", c->torque_margin, 0.0, 1.0,
                          "");
+    }
+    if (!(c->torque_margin_brake > 0.0 && c->torque_margin_brake <= 1.0)) {
+        return fw_refuse(why, why_len, CTRL_EINVAL, "torque_margin_brake", c->torque_margin_brake,
+                         0.0, 1.0, "");
     }
     if (!(c->vdc_lpf_hz > 0.0 && c->vdc_lpf_hz < 0.5 * fs)) {
         return fw_refuse(why, why_len, CTRL_EINVAL, "vdc_lpf_hz", c->vdc_lpf_hz, 0.0, 0.5 * fs,
@@ -112,6 +117,9 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     rc = rc ? rc : fw_q24(c1 * c1, "(psi_pm/Ld)^2", &s->c1_sq, why, why_len);
     rc = rc ? rc : fw_q24(8.0 * c2 * c2, "8 (1/Ld - 1/Lq)^2", &s->c2_sq8, why, why_len);
     rc = rc ? rc : fw_q24(c->torque_margin, "torque_margin", &s->t_margin, why, why_len);
+    rc = rc ? rc
+            : fw_q24(c->torque_margin_brake, "torque_margin_brake", &s->t_margin_brake, why,
+                     why_len);
     rc = rc ? rc
             : fw_q24(1.0 - ctrl_cfg_exp(-2.0 * CTRL_PI * c->vdc_lpf_hz / fs),
                      "DC-link filter coefficient", &s->vdc_k, why, why_len);

@@ -66,6 +66,15 @@ typedef struct {
 double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, double *t_flux_max);
 
 /*
+ * The same limit in regenerative braking (w T < 0), with the braking margin
+ * CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT (field_weak_config.h) in place of
+ * FW_TORQUE_FLUX_MARGIN; the field weakening's period limit applies it
+ * (field_weak.h). 80 kW IPMSM at 0.1837 Wb: 0.88 x 383.7 = 337.7 N*m.
+ */
+double fw_torque_limit_brake_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl,
+                                double *t_flux_max);
+
+/*
  * Gains for machine m (inertia), a speed loop at loop_hz and an encoder
  * speed filter at lpf_hz. Fills d's results (and the defaults it used).
  * Returns CTRL_OK, or CTRL_EINVAL with a message naming the quantity, its

@@ -5,6 +5,7 @@
 
 #include "ctrl_cfg_math.h"
 #include "ctrl_units.h"
+#include "field_weak_config.h"
 #include "speed_loop.h"
 
 #define FW_SL_DEG (CTRL_PI / 180.0)
@@ -88,7 +89,9 @@ static double fw_torque_on_flux(const ctrl_machine_t *m, double psi, double id)
     return 1.5 * (double)m->pole_pairs * iq * (m->psi_pm_wb + (m->ld_h - m->lq_h) * id);
 }
 
-double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, double *t_flux_max)
+/* fw_torque_limit_nm with the flux margin given. */
+static double fw_torque_limit_at(const ctrl_machine_t *m, const ctrl_desc_t *ctrl,
+                                 double *t_flux_max, double margin)
 {
     if (t_flux_max != NULL) {
         *t_flux_max = 0.0;
@@ -129,9 +132,20 @@ double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, doub
         if (t_flux_max != NULL) {
             *t_flux_max = tmax;
         }
-        if (FW_TORQUE_FLUX_MARGIN * tmax < lim) {
-            lim = FW_TORQUE_FLUX_MARGIN * tmax;
+        if (margin * tmax < lim) {
+            lim = margin * tmax;
         }
     }
     return lim;
+}
+
+double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, double *t_flux_max)
+{
+    return fw_torque_limit_at(m, ctrl, t_flux_max, FW_TORQUE_FLUX_MARGIN);
+}
+
+double fw_torque_limit_brake_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl,
+                                double *t_flux_max)
+{
+    return fw_torque_limit_at(m, ctrl, t_flux_max, CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT);
 }

@@ -83,7 +83,7 @@ long kind_checked = 0, kind_skipped = 0;
 
 // Exact pu model of one machine from the SI data and the SI bases.
 struct Ref {
-    double psi, ld, lq, rs, i, vf, ceil, t_mtpa, psi_mtpa, margin, c1, c2;
+    double psi, ld, lq, rs, i, vf, ceil, t_mtpa, psi_mtpa, margin, margin_brake, c1, c2;
     bool salient;
     Ref(const ctrl_machine_t &m, const ctrl_bases_t &b, const ctrl_fieldweak_cfg_t &c)
     {
@@ -95,6 +95,7 @@ struct Ref {
         vf = c.v_frac / std::sqrt(3.0);
         ceil = psi + lq * i;
         margin = c.torque_margin;
+        margin_brake = c.torque_margin_brake;
         salient = lq > ld;
         double md, mq;
         ctrl_mtpa_split(psi, ld, lq, i, &md, &mq);
@@ -115,9 +116,10 @@ struct Ref {
         t = pq * (c1 - c2 * pd);
         id = (pd - psi) / ld;
     }
-    // Torque limit on the flux circle p (field_weak.h), its kind, and the
-    // distance of p from the decisions (for the kind check).
-    double t_at_flux(double p, int &kind, double &margin_dist) const
+    // Torque limit on the flux circle p (field_weak.h) at most marg of its
+    // MTPV torque, its kind, and the distance of p from the decisions (for
+    // the kind check).
+    double t_at_flux(double p, double marg, int &kind, double &margin_dist) const
     {
         double tv, idv;
         mtpv(p, tv, idv);
@@ -143,7 +145,7 @@ struct Ref {
                 kind = CTRL_FW_LIMIT_VOLTAGE;
             }
         }
-        return std::min(std::max(t, 0.0), margin * tv);
+        return std::min(std::max(t, 0.0), marg * tv);
     }
     // Bound of the fixed-point torque limit at p (pu): the MTPV part rounds c1,
     // c2, psi^2 and forms two roots and a division (a few LSB on quantities of
@@ -245,7 +247,9 @@ void run(const ctrl_machine_t &m, bool mtpa_mode, uint32_t fs, int n, std::mt199
             const double pl = d(fix > 0 ? std::min(fix, o.psi_max) : o.psi_max);
             int kind;
             double dist;
-            const double tl = r.t_at_flux(pl, kind, dist);
+            // braking (w T < 0) on a fixed flux: the braking margin
+            const bool brake = fix > 0 && ((q(w) > 0 && q(t1) < 0) || (q(w) < 0 && q(t1) > 0));
+            const double tl = r.t_at_flux(pl, brake ? r.margin_brake : r.margin, kind, dist);
             w_t.add(std::fabs(d(o.torque_max) - tl), r.t_bound(pl));
             if (fix > 0 && q(pl) < o.psi_max) {
                 kind = CTRL_FW_LIMIT_FLUX;

@@ -2,6 +2,7 @@
 #include "sim_run.h"
 
 #include "ctrl_units.h"
+#include "field_weak_config.h"
 #include "speed_loop.h"
 
 #include <math.h>
@@ -819,6 +820,8 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
         return -1;
     }
     r->torque_limit_nm = ctrl_q24_to_double(r->fw.torque_ref_max) * r->fw.bases.torque_nm;
+    r->torque_limit_brake_nm =
+        fmin(r->torque_limit_nm, fw_torque_limit_brake_nm(&c->ctrl_machine, c->ctrl, NULL));
     if (r->has_scn && sim_scenario_check(r, err, errlen) != 0) {
         return -1;
     }
@@ -852,6 +855,23 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
                  "(%s): the firmware clamps it to %g N*m",
                  c->torque_ref_nm, r->torque_limit_nm, r->torque_limit_nm, why,
                  copysign(r->torque_limit_nm, c->torque_ref_nm));
+    }
+    /* Regenerative braking (the imposed or initial speed against the torque)
+     * on a fixed flux: the field weakening's period limit holds the lower
+     * braking margin (field_weak.h). */
+    const double t_brake = r->torque_limit_brake_nm;
+    if (!c->speed_mode && c->speed_rpm * c->torque_ref_nm < 0.0 &&
+        fabs(c->torque_ref_nm) > t_brake && t_brake < r->torque_limit_nm) {
+        double t_flux = 0.0;
+        (void)fw_torque_limit_brake_nm(&c->ctrl_machine, c->ctrl, &t_flux);
+        sim_warn(c->warnings,
+                 "torque reference %g N*m is outside the drive's braking torque limit %g N*m at "
+                 "%g r/min (%g %% of %.4g N*m, the most %s gives at its flux reference %g Wb: "
+                 "braking, the zero vector carries the load angle toward the pull-out): the "
+                 "firmware limits it to %g N*m",
+                 c->torque_ref_nm, t_brake, c->speed_rpm,
+                 100.0 * CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT, t_flux, c->ctrl_machine.name,
+                 c->ctrl_machine.psi_ref_wb, copysign(t_brake, c->torque_ref_nm));
     }
 
     const double ts = 1.0 / (double)c->fs_hz;
@@ -1111,6 +1131,7 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
                  c->speed_mode || r->lim_n == 0u ? NAN
                                                  : (double)r->lim_clipped_n / (double)r->lim_n);
     sim_json_num(f, "torque_limit_nm", r->torque_limit_nm);
+    sim_json_num(f, "torque_limit_brake_nm", r->torque_limit_brake_nm);
     {
         /* Field weakening at the end of the run (pipeline.h fw_telemetry_t):
          * the torque limit of the last period and what set it. */

@@ -106,14 +106,14 @@ typedef struct {
     engine_hal_config_t hal;           /* filled by sim_run_config_default, adjustable */
     uint32_t calib_samples;
     /* Speed loop and overspeed (fw_config_t; from the machine file by default). */
-    double speed_bw_hz, speed_pm_deg; /* sizing (0 = firmware defaults) */
-    double speed_kp, speed_ki;        /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
-    double overspeed_rpm;             /* 0 = 1.05 x rated speed */
+    double speed_bw_hz, speed_pm_deg;     /* sizing (0 = firmware defaults) */
+    double speed_kp, speed_ki;            /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
+    double overspeed_rpm;                 /* 0 = 1.05 x rated speed */
     uint32_t torque_follow_fault_windows; /* fw_config_t's (0: warning only) */
-    bool stop_on_fault;               /* end the run at a fault (default false) */
-    bool psi_adapt;                   /* fw_config_t.psi_adapt (default true) */
-    bool dead_comp;                   /* fw_config_t.dead_comp (default true) */
-    bool sensorless;                  /* fw_config_t.sensorless (default false) */
+    bool stop_on_fault;                   /* end the run at a fault (default false) */
+    bool psi_adapt;                       /* fw_config_t.psi_adapt (default true) */
+    bool dead_comp;                       /* fw_config_t.dead_comp (default true) */
+    bool sensorless;                      /* fw_config_t.sensorless (default false) */
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
     bool auto_arm;                /* arm with the references above once calibrated (default) */
@@ -158,6 +158,7 @@ struct sim_run {
     uint8_t vec_now;                /* vector acting in the present period (chosen at k-1) */
     double duty_now;                /* its on-time fraction */
     double torque_limit_nm;         /* the firmware's torque-reference clamp */
+    double torque_limit_brake_nm;   /* its braking limit (w T < 0, field_weak.h) */
     double torque_ref_requested_nm; /* last torque reference asked for (torque mode) */
     double fault_time_s;            /* scenario time of the first fault, NaN if none */
     /* Estimator against the plant at the control instants of the window where
@@ -178,7 +179,7 @@ struct sim_run {
     double lim_min_nm, tref_sum_nm;
     uint8_t lim_last; /* fw_telemetry_t.fw_limit of the last clipped period */
     bool lim_warned;
-    bool link_failed; /* the PIL link reported a fault (cfg.link->error) */
+    bool link_failed;    /* the PIL link reported a fault (cfg.link->error) */
     uint64_t lim_weak_n; /* periods of the window with the flux weakened (fw_limit bit 3) */
 };
 
