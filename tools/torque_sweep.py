@@ -5,10 +5,11 @@ say why not?
 For every machine file (default: every shipped sim_host/machines/*.ini, as
 shipped), every controller (default m2ptfc, drr, fst, foc), speeds 0.1, 0.5,
 0.9 and 1.3 x the rated speed (those above the machine's maximum speed are left
-out) and torque requests of 50 % and 90 % of the theoretical envelope at that
-speed (tools/envelope.py: rated current, 92 % of Vdc/sqrt(3), Rs included),
-one dynamometer run of 0.3 s (metrics window 0.15:0.3 s) of ./tools/sim in
-torque mode. A run
+out), both halves - motoring (torque along the rotation) and regenerative
+braking (against it) - and torque requests of 50 % and 90 % of the theoretical
+envelope of that half at that speed (tools/envelope.py: rated current, 92 % of
+Vdc/sqrt(3), Rs included), one dynamometer run of 0.3 s (metrics window
+0.15:0.3 s) of ./tools/sim in torque mode from zero torque. A run
 
   meets      when |T_mean - T_request| <= max(5 % of |T_request|, 2 % of rated),
   is warned  when it misses but the simulator's warnings (or a fault) say so,
@@ -25,19 +26,22 @@ the simulator prints):
     (psi_ref_wb > 0: every DTC and MPC method; FOC forms its currents from the
     torque and holds none), the most torque the motor gives on that flux
     circle, T_max(psi_ref) ((3.9), (3.10), the MTPV point of the circle), times
-    the drive's margin FLUX_MARGIN: past the circle's peak dT/d(load angle) < 0
-    and a controller holding |psi_s| loses the load angle.
+    the drive's margin FLUX_MARGIN (braking FLUX_MARGIN_BRAKE): past the
+    circle's peak dT/d(load angle) < 0 and a controller holding |psi_s| loses
+    the load angle.
 A request above the lower of the two is "limited": the drive must state that
-limit (the JSON's torque_limit_nm within 0.5 %) and warn naming its reason,
+limit (the JSON's torque_limit_nm, braking torque_limit_brake_nm, within
+0.5 %) and warn naming its reason,
 else the run is a defect ("limit-wrong"); the limit then takes the request's
 place in meets / warned / silent (a miss against it needs a warning of its own).
 
 usage: tools/torque_sweep.py [--machines A.ini,B.ini] [--controllers a,b]
-                             [--speeds 0.1,0.5] [--fracs 0.5,0.9] [--jobs N]
+                             [--speeds 0.1,0.5] [--fracs 0.5,0.9]
+                             [--halves motoring,braking] [--jobs N]
                              [--json OUT.json] [--check]
 --check: exit status 1 when a run is silent, bites, or the simulator fails.
-The full sweep (8 machine files x 4 controllers x up to 4 speeds x 2 requests)
-takes a few minutes on two cores; CI runs a subset (tests/loop/CMakeLists.txt).
+The full sweep (8 machine files x 4 controllers x up to 4 speeds x 2 halves x
+2 requests) takes a few minutes on two cores; CI runs a subset (tests/loop/CMakeLists.txt).
 """
 import argparse
 import concurrent.futures as cf
@@ -61,28 +65,51 @@ FRACS = (0.5, 0.9)
 TOL_REL = 0.05  # of the request
 TOL_RATED = 0.02  # of the rated torque
 # Warnings of the simulator that are a drive limit acting on the request.
-LIMIT_WORDS = ("was limited to", "outside the drive's torque limit")
+LIMIT_WORDS = ("was limited to", "outside the drive's torque limit",
+               "outside the drive's braking torque limit")
 # The drive's margin below T_max(psi_ref) (firmware/isr/speed_loop.h,
 # FW_TORQUE_FLUX_MARGIN): the load angle's ripple must stay below the peak.
 FLUX_MARGIN = 0.95
+# The same in regenerative braking (control/regulators/field_weak_config.h,
+# CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT): there the zero vector carries the load
+# angle toward the pull-out.
+FLUX_MARGIN_BRAKE = 0.88
+HALVES = ("motoring", "braking")
 # Controllers that hold no fixed flux reference (they form the currents from
 # the torque; the drive's limits are then MTPA's).
 FLUX_FREE = ("foc",)
 
 
-def stated_limit(mfile, ctrl):
+def flux_voltage_max(m, w, t):
+    """Largest flux amplitude the voltage allows at electrical speed w and
+    torque t (the drive's field weakening, control/regulators/field_weak.h):
+    sqrt(V^2 - (Rs I)^2 - 2 Rs w T/(1.5 p)) / |w|, V = 92 % of Vdc/sqrt(3),
+    I = |T| / (1.5 p psi_pm) at most the rated current; inf at standstill."""
+    if w == 0.0:
+        return float("inf")
+    v = env.default_limits(m).v_max
+    i = min(abs(t) / (1.5 * m.p * m.psi), m.i_rated)
+    x = v * v - (m.rs * i) ** 2 - 2.0 * m.rs * w * t / (1.5 * m.p)
+    return math.sqrt(max(x, 0.0)) / abs(w)
+
+
+def stated_limit(mfile, ctrl, brake=False, rpm=0.0, tref=0.0):
     """(limit in N*m, reason words the warning must contain) of the physical
-    limits below the envelope (module docstring), or (inf, None)."""
+    limits below the envelope (module docstring), or (inf, None); brake: a
+    regenerative-braking request. The flux circle is the file's reference, or
+    where the voltage allows less at rpm and tref (field weakening) the
+    voltage's ("voltage limit")."""
     m = env.load_machine(mfile)
     cp = configparser.ConfigParser(inline_comment_prefixes=(";", "#"))
     cp.read(mfile)
     psi_ref = cp.getfloat("rated", "psi_ref_wb", fallback=0.0)
     lim, why = m.torque_rated, "rated torque"
     if psi_ref > 0.0 and ctrl not in FLUX_FREE:
-        i_d, i_q = env.mtpv_flux_point(m, psi_ref)
-        t_flux = FLUX_MARGIN * env.torque(m, i_d, i_q)
+        psi_v = flux_voltage_max(m, env.rpm_to_we(m, rpm), tref)
+        i_d, i_q = env.mtpv_flux_point(m, min(psi_ref, psi_v))
+        t_flux = (FLUX_MARGIN_BRAKE if brake else FLUX_MARGIN) * env.torque(m, i_d, i_q)
         if t_flux < lim:
-            lim, why = t_flux, "flux reference"
+            lim, why = t_flux, "flux reference" if psi_ref <= psi_v else "voltage limit"
     return (lim, why) if math.isfinite(lim) and lim > 0 else (float("inf"), None)
 
 
@@ -91,7 +118,9 @@ def sim_cmd(args):
     return [exe] if exe else [os.path.join(ROOT, "tools", "sim")]
 
 
-def points(mfile, speeds, fracs):
+def points(mfile, speeds, fracs, halves=HALVES):
+    """(speed, fraction, request, rated torque) of each run; the speed is
+    positive, a braking request negative."""
     m = env.load_machine(mfile)
     lim = env.default_limits(m)
     out = []
@@ -99,11 +128,13 @@ def points(mfile, speeds, fracs):
         rpm = s * m.speed_rated_rpm
         if m.speed_max_rpm > 0 and rpm > m.speed_max_rpm * (1 + 1e-9):
             continue
-        t_env = env.max_torque(m, lim, env.rpm_to_we(m, rpm)).torque
-        if t_env <= 0:
-            continue
-        for f in fracs:
-            out.append((rpm, f, f * t_env, m.torque_rated))
+        for half in halves:
+            sign = -1 if half == "braking" else +1
+            t_env = env.max_torque(m, lim, env.rpm_to_we(m, rpm), sign=sign).torque
+            if t_env * sign <= 0:
+                continue
+            for f in fracs:
+                out.append((rpm, f, f * t_env, m.torque_rated))
     return out
 
 
@@ -116,7 +147,9 @@ def run_one(args, job):
                            "--window", "0.15:0.3", "--metrics", path]
     r = subprocess.run(cmd, capture_output=True, text=True)
     res = {"machine": os.path.basename(mfile), "controller": ctrl, "rpm": rpm, "frac": frac,
-           "request_nm": tref, "rated_nm": t_rated, "exit": r.returncode}
+           "request_nm": tref, "rated_nm": t_rated, "exit": r.returncode,
+           "half": "braking" if tref * rpm < 0.0 else "motoring"}
+    brake = res["half"] == "braking"
     try:
         with open(path) as f:
             mj = json.load(f)
@@ -129,7 +162,7 @@ def run_one(args, job):
     t = mj.get("torque_mean_nm")
     warns = mj.get("warnings", [])
     res.update(t_mean=t, warnings=warns, fault=mj.get("fault"))
-    lim, why = stated_limit(mfile, ctrl)
+    lim, why = stated_limit(mfile, ctrl, brake, rpm, tref)
     limited = abs(tref) > lim * (1 + 1e-9)
     # a limited request is met when the stated limit is delivered
     t_goal = math.copysign(lim, tref) if limited else tref
@@ -140,7 +173,13 @@ def run_one(args, job):
     bites = bool(named) and not limited
     res["limited"] = why if limited else None
     if limited:
+        # a drive that states no braking limit states its one limit for both;
+        # in field weakening the limit is the period's (torque_max_nm)
         lim_json = mj.get("torque_limit_nm")
+        if brake and mj.get("torque_limit_brake_nm") is not None:
+            lim_json = mj["torque_limit_brake_nm"]
+        if why == "voltage limit":
+            lim_json = mj.get("torque_max_nm")
         res["expected_limit_nm"] = lim
         if not (lim_json is not None and abs(lim_json - lim) <= 0.005 * lim
                 and any(why in w for w in named)):
@@ -165,6 +204,7 @@ def main():
     ap.add_argument("--controllers", default=",".join(CONTROLLERS))
     ap.add_argument("--speeds", default=",".join(str(s) for s in SPEEDS))
     ap.add_argument("--fracs", default=",".join(str(f) for f in FRACS))
+    ap.add_argument("--halves", default=",".join(HALVES))
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", default="")
     ap.add_argument("--check", action="store_true")
@@ -174,10 +214,21 @@ def main():
     ctrls = [c for c in args.controllers.split(",") if c]
     speeds = [float(s) for s in args.speeds.split(",")]
     fracs = [float(f) for f in args.fracs.split(",")]
-    jobs = [(mf, c) + p for mf in mfiles for p in points(mf, speeds, fracs) for c in ctrls]
+    halves = [h for h in args.halves.split(",") if h]
+    bad = [h for h in halves if h not in HALVES]
+    if bad:
+        ap.error(f"--halves {','.join(bad)}: allowed {', '.join(HALVES)}")
+    jobs = [(mf, c) + p for mf in mfiles for p in points(mf, speeds, fracs, halves)
+            for c in ctrls]
     with cf.ThreadPoolExecutor(max_workers=max(args.jobs, 1)) as ex:
         results = list(ex.map(lambda j: run_one(args, j), jobs))
     counts = {}
+    for h in halves:
+        rs = [r for r in results if r["half"] == h]
+        hc = {}
+        for r in rs:
+            hc[r["verdict"]] = hc.get(r["verdict"], 0) + 1
+        print(f"  {h}: {len(rs)} runs: " + ", ".join(f"{k} {v}" for k, v in sorted(hc.items())))
     for r in results:
         counts[r["verdict"]] = counts.get(r["verdict"], 0) + 1
         flag = r["verdict"] if r["verdict"] not in ("meets", "limited") else ""
