@@ -7,20 +7,15 @@
 #include "ctrl_m2ptfc_model_config.h"
 
 /* value_SI / machine_SI for an override, 1 when the override is off (0);
- * an override outside [0, max] (the tunable's range) is refused. */
-static int model_ratio(double override, double max, double machine, double *ratio)
+ * an override outside [0, max] (the tunable's range) is refused, named. The
+ * machine value is > 0 here (ctrl_params_init; Rs = 0 is taken apart). */
+static int model_ratio(const ctrl_setup_t *setup, const char *name, const char *unit,
+                       double override, double max, double machine, double *ratio)
 {
     if (!(override >= 0.0) || !isfinite(override) || override > max) {
-        return CTRL_EINVAL;
+        return ctrl_setup_refuse(setup, CTRL_EINVAL, name, unit, override, 0.0, max);
     }
-    if (override == 0.0) {
-        *ratio = 1.0;
-        return CTRL_OK;
-    }
-    if (!(machine > 0.0) || !isfinite(machine)) {
-        return CTRL_EINVAL; /* an override needs the machine value to scale from */
-    }
-    *ratio = override / machine;
+    *ratio = override == 0.0 || !(machine > 0.0) ? 1.0 : override / machine;
     return CTRL_OK;
 }
 
@@ -34,16 +29,26 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
     double k_ld;
     double k_lq;
     double k_psi;
-    if (model_ratio(c->rs_ohm, CTRL_MPC_RS_MODEL_MAX, mc->rs_ohm, &k_rs) != CTRL_OK ||
-        model_ratio(c->ld_h, CTRL_MPC_LPSI_MODEL_MAX, mc->ld_h, &k_ld) != CTRL_OK ||
-        model_ratio(c->lq_h, CTRL_MPC_LPSI_MODEL_MAX, mc->lq_h, &k_lq) != CTRL_OK ||
-        model_ratio(c->psi_pm_wb, CTRL_MPC_LPSI_MODEL_MAX, mc->psi_pm_wb, &k_psi) != CTRL_OK) {
-        return CTRL_EINVAL;
+    int rc =
+        model_ratio(setup, "rs_model", "ohm", c->rs_ohm, CTRL_MPC_RS_MODEL_MAX, mc->rs_ohm, &k_rs);
+    rc =
+        rc ? rc
+           : model_ratio(setup, "ld_model", "H", c->ld_h, CTRL_MPC_LPSI_MODEL_MAX, mc->ld_h, &k_ld);
+    rc =
+        rc ? rc
+           : model_ratio(setup, "lq_model", "H", c->lq_h, CTRL_MPC_LPSI_MODEL_MAX, mc->lq_h, &k_lq);
+    rc = rc ? rc
+            : model_ratio(setup, "psi_pm_model", "Wb", c->psi_pm_wb, CTRL_MPC_LPSI_MODEL_MAX,
+                          mc->psi_pm_wb, &k_psi);
+    if (rc != CTRL_OK) {
+        return rc;
     }
     /* Ts in pu from the SI data (not the rounded params->ts: one rounding of
      * Ts 2/3 and Ts Rs instead of two). */
     const double ts = setup->bases->w_rad_s / (double)params->fs_hz;
-    const double rs = ctrl_q24_to_double(params->rs) * k_rs;
+    /* A lossless machine (Rs = 0) has no Rs to scale: the override in pu. */
+    const double rs =
+        mc->rs_ohm > 0.0 ? ctrl_q24_to_double(params->rs) * k_rs : c->rs_ohm / setup->bases->r_ohm;
     const double inv_ld = ctrl_q24_to_double(params->inv_ld) / k_ld;
     const double inv_lq = ctrl_q24_to_double(params->inv_lq) / k_lq;
     const double psi_pm = ctrl_q24_to_double(params->psi_pm) * k_psi;

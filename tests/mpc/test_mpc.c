@@ -617,6 +617,38 @@ static void test_bad_input(void)
     TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
 }
 
+/* The k+2 model's Rs override on a lossless machine (Rs = 0, which the core
+ * accepts): nothing to scale the override from, so it is taken in pu of the
+ * resistance base, Ts Rs_model exactly as (6.10) wants it (the link refused
+ * it with no reason: found by the link's fuzzer); an override outside its
+ * range is refused naming the tunable, its value and the range. */
+static void test_model_rs_on_lossless_machine(void)
+{
+    ctrl_machine_t m = ini_thesis_spmsm;
+    m.rs_ohm = 0.0;
+    ctrl_params_t p;
+    params_for(&m, 10000u, &p);
+    ctrl_m2ptfc_cfg_t c;
+    ctrl_m2ptfc_t s;
+    ctrl_desc_m2ptfc.cfg_default(&c, &m);
+    c.model.rs_ohm = 0.5;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
+    const double ts_rs = g_bases.w_rad_s / 10000.0 * 0.5 / g_bases.r_ohm;
+    TEST_ASSERT_DOUBLE_WITHIN(1.0 / 16777216.0, ts_rs, d24(s.model.ts_rs));
+    c.model.rs_ohm = 0.0; /* the machine's: no resistive term */
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, init_for(&ctrl_desc_m2ptfc, &s, &c, &p));
+    TEST_ASSERT_EQUAL_INT32(0, s.model.ts_rs);
+
+    ctrl_diag_t why;
+    memset(&why, 0, sizeof why);
+    const ctrl_setup_t su = {g_machine, &g_bases, &p, &why};
+    c.model.rs_ohm = CTRL_MPC_RS_MODEL_MAX * 2.0;
+    TEST_ASSERT_EQUAL_INT(CTRL_EINVAL, ctrl_init(&ctrl_desc_m2ptfc, &s, &c, &su));
+    TEST_ASSERT_EQUAL_STRING("rs_model", why.quantity);
+    TEST_ASSERT_EQUAL_DOUBLE(CTRL_MPC_RS_MODEL_MAX * 2.0, why.value);
+    TEST_ASSERT_EQUAL_DOUBLE(CTRL_MPC_RS_MODEL_MAX, why.max);
+}
+
 /* Every chapter-6 descriptor: NULL state / cfg / params refused, NaN and
  * out-of-range SI values refused at init (each tunable's own [min, max], also
  * when written into the cfg directly), NULL tolerated by cfg_default and
@@ -856,6 +888,7 @@ int main(void)
     RUN_TEST(test_zeta_in_pu);
     RUN_TEST(test_bad_input);
     RUN_TEST(test_bad_input_all);
+    RUN_TEST(test_model_rs_on_lossless_machine);
     RUN_TEST(test_sigma_ema);
     RUN_TEST(test_t_eval);
     RUN_TEST(test_psi_ref2);
