@@ -25,10 +25,10 @@ int ctrl_mpc_model_init(ctrl_mpc_model_t *m, const ctrl_mpc_model_cfg_t *c,
     const ctrl_machine_t *mc = setup->machine;
     const ctrl_params_t *params = setup->params;
     memset(m, 0, sizeof *m);
-    double k_rs;
-    double k_ld;
-    double k_lq;
-    double k_psi;
+    double k_rs = 1.0;
+    double k_ld = 1.0;
+    double k_lq = 1.0;
+    double k_psi = 1.0;
     int rc =
         model_ratio(setup, "rs_model", "ohm", c->rs_ohm, CTRL_MPC_RS_MODEL_MAX, mc->rs_ohm, &k_rs);
     rc =
