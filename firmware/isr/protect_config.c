@@ -54,7 +54,7 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
     const double w_max_pu = ctrl_rpm_to_elec(overspeed_rpm, m->pole_pairs) / b->w_rad_s;
     if (!(overspeed_rpm > 0.0) || !(w_max_pu < 127.0)) {
         return ctrl_diag_refuse(why, CTRL_EINVAL, "overspeed level", "r/min", overspeed_rpm, 0.0,
-                                127.0 * b->w_rad_s * 60.0 / (CTRL_TWO_PI * (double)m->pole_pairs),
+                                ctrl_elec_to_rpm(127.0 * b->w_rad_s, m->pole_pairs),
                                 "127 x the speed base: speed_rated_rpm, speed_max_rpm");
     }
     cfg->omega_max = ctrl_q24_from_double(w_max_pu);

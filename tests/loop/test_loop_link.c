@@ -207,23 +207,35 @@ static void test_application_parameters(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, app_value);
 }
 
+/* The thesis SPMSM's drive started (drr) and its machine data, to change. */
+static ctrl_machine_t start_drr_machine(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    return run.fw.machine_own;
+}
+
+/* fw_init of the running drive's configuration with machine data m. */
+static int reinit_with_machine(const ctrl_machine_t *m)
+{
+    fw_config_t fc = run.fw.cfg;
+    fc.machine = m;
+    fc.ctrl = run.fw.ctrl;
+    fc.ctrl_cfg = NULL;
+    return fw_init(&run.fw, &run.hal, &fc);
+}
+
 /* A machine whose declared maximum speed is below its rated speed (thesis
  * SPMSM, 3750 r/min, rated set to 10000): the refusal names the quantity, its
  * value and the range, as "err 10 failed" passes it on (it came without a
  * reason: found by the link's fuzzer). */
 static void test_max_speed_refusal_is_named(void)
 {
-    sim_run_cfg_t c;
-    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
-    loop_start(&run, &c);
-    ctrl_machine_t m = run.fw.machine_own;
+    ctrl_machine_t m = start_drr_machine();
     TEST_ASSERT_TRUE(m.speed_max_rpm > 0.0);
     m.speed_rated_rpm = 10000.0;
-    fw_config_t fc = run.fw.cfg;
-    fc.machine = &m;
-    fc.ctrl = run.fw.ctrl;
-    fc.ctrl_cfg = NULL;
-    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&run.fw, &run.hal, &fc));
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, reinit_with_machine(&m));
     TEST_ASSERT_EQUAL_STRING("maximum speed", run.fw.why.quantity);
     TEST_ASSERT_EQUAL_DOUBLE(3750.0, run.fw.why.value);
     TEST_ASSERT_EQUAL_DOUBLE(10000.0, run.fw.why.min);
@@ -237,20 +249,13 @@ static void test_max_speed_refusal_is_named(void)
  * came without a reason: found by the link's fuzzer). */
 static void test_overspeed_refusal_is_named(void)
 {
-    sim_run_cfg_t c;
-    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
-    loop_start(&run, &c);
-    ctrl_machine_t m = run.fw.machine_own;
+    ctrl_machine_t m = start_drr_machine();
     m.speed_max_rpm = 400000.0;
-    fw_config_t fc = run.fw.cfg;
-    fc.machine = &m;
-    fc.ctrl = run.fw.ctrl;
-    fc.ctrl_cfg = NULL;
-    TEST_ASSERT_EQUAL_INT(FW_EINVAL, fw_init(&run.fw, &run.hal, &fc));
+    TEST_ASSERT_EQUAL_INT(FW_EINVAL, reinit_with_machine(&m));
     TEST_ASSERT_EQUAL_STRING("overspeed level", run.fw.why.quantity);
     TEST_ASSERT_EQUAL_DOUBLE(FW_OVERSPEED_REL * m.speed_max_rpm, run.fw.why.value);
     /* 127 pu of electrical speed in mechanical r/min */
-    const double lim = 127.0 * run.fw.bases.w_rad_s / (double)m.pole_pairs * 60.0 / (2.0 * CTRL_PI);
+    const double lim = ctrl_elec_to_rpm(127.0 * run.fw.bases.w_rad_s, m.pole_pairs);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * lim, lim, run.fw.why.max);
     TEST_ASSERT_TRUE(run.fw.why.value > run.fw.why.max);
     TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
