@@ -42,19 +42,6 @@ void g4_gpio_write(g4_pin_t p, bool high)
     g4_wr(g4_gpio_base(p.port) + G4_GPIO_BSRR, high ? G4_BIT(p.pin) : G4_BIT(p.pin + 16u));
 }
 
-int g4_usart_brr(uint32_t f_ck_hz, uint32_t baud, uint32_t *brr)
-{
-    if (baud == 0u) {
-        return G4_E_CONFIG;
-    }
-    const uint32_t v = (f_ck_hz + baud / 2u) / baud;
-    if (v < 16u || v > 0xFFFFu) {
-        return G4_E_CONFIG;
-    }
-    *brr = v;
-    return G4_OK;
-}
-
 void g4_usart2_init(uint32_t brr)
 {
     g4_set(G4_RCC + G4_RCC_APB1ENR1, G4_RCC_APB1ENR1_USART2EN);
@@ -63,20 +50,6 @@ void g4_usart2_init(uint32_t brr)
     g4_wr(G4_USART2 + G4_USART_BRR, brr);
     g4_wr(G4_USART2 + G4_USART_CR1,
           G4_USART_CR1_UE | G4_USART_CR1_RE | G4_USART_CR1_TE | G4_USART_CR1_RXNEIE);
-}
-
-int g4_iwdg_config(uint32_t timeout_ms, uint32_t f_lsi_hz, uint32_t *pr, uint32_t *rlr)
-{
-    for (uint32_t p = 0u; p <= 6u; p++) {
-        const uint64_t div = 4ull << p;
-        const uint64_t ticks = ((uint64_t)timeout_ms * f_lsi_hz + div * 1000u - 1u) / (div * 1000u);
-        if (ticks >= 1u && ticks <= 4096u) {
-            *pr = p;
-            *rlr = (uint32_t)ticks - 1u;
-            return G4_OK;
-        }
-    }
-    return G4_E_CONFIG;
 }
 
 int g4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)

@@ -1,76 +1,8 @@
-/* Timers: PWM time base, dead time, TIM1 PWM, TIM4 encoder (g4_tim.h). */
+/* Timers: TIM1 PWM, TIM4 encoder, TIM2 capture (g4_tim.h). */
 #include "g4_tim.h"
 
 #include "g4_core.h"
 #include "g4_regs.h"
-
-int g4_pwm_timing(uint32_t f_tim_hz, uint32_t fs_hz, g4_pwm_timing_t *t)
-{
-    if (t == 0 || fs_hz == 0u || f_tim_hz < 4u * fs_hz) {
-        return G4_E_CONFIG;
-    }
-    for (uint32_t div = 1u; div <= 65536u; div++) {
-        const uint64_t den = 2ull * fs_hz * div;
-        if (f_tim_hz % den != 0u) {
-            continue;
-        }
-        const uint64_t arr = f_tim_hz / den;
-        if (arr <= 0xFFFFu && arr >= 2u) {
-            t->psc = div - 1u;
-            t->arr = (uint32_t)arr;
-            t->fs_hz = fs_hz;
-            return G4_OK;
-        }
-    }
-    return G4_E_CONFIG;
-}
-
-int g4_dtg_encode(uint32_t f_dts_hz, uint32_t dead_ns, uint8_t *dtg)
-{
-    if (dtg == 0 || f_dts_hz == 0u) {
-        return G4_E_CONFIG;
-    }
-    /* Requested dead time in t_DTS, rounded up. */
-    const uint64_t ticks = ((uint64_t)dead_ns * f_dts_hz + 999999999u) / 1000000000u;
-    if (ticks <= 127u) {
-        *dtg = (uint8_t)ticks;
-    } else if (ticks <= 254u) {
-        const uint64_t k = (ticks + 1u) / 2u; /* 64..127 steps of 2 t_DTS */
-        *dtg = (uint8_t)(0x80u | (uint32_t)(k - 64u));
-    } else if (ticks <= 504u) {
-        const uint64_t k = (ticks + 7u) / 8u; /* 32..63 steps of 8 t_DTS */
-        *dtg = (uint8_t)(0xC0u | (uint32_t)(k - 32u));
-    } else if (ticks <= 1008u) {
-        const uint64_t k = (ticks + 15u) / 16u; /* 32..63 steps of 16 t_DTS */
-        *dtg = (uint8_t)(0xE0u | (uint32_t)(k - 32u));
-    } else {
-        return G4_E_CONFIG;
-    }
-    return G4_OK;
-}
-
-uint32_t g4_dtg_ticks(uint8_t dtg)
-{
-    if ((dtg & 0x80u) == 0u) {
-        return dtg;
-    }
-    if ((dtg & 0xC0u) == 0x80u) {
-        return (64u + (dtg & 0x3Fu)) * 2u;
-    }
-    if ((dtg & 0xE0u) == 0xC0u) {
-        return (32u + (dtg & 0x1Fu)) * 8u;
-    }
-    return (32u + (dtg & 0x1Fu)) * 16u;
-}
-
-uint32_t g4_filter_cycles(uint32_t code)
-{
-    /* {sampling divider, N}; code 0 = no filter. */
-    static const uint8_t div[16] = {1, 1, 1, 1, 2, 2, 4, 4, 8, 8, 16, 16, 16, 32, 32, 32};
-    static const uint8_t n[16] = {0, 2, 4, 8, 6, 8, 6, 8, 6, 8, 5, 6, 8, 5, 6, 8};
-    code &= 0xFu;
-    return (uint32_t)div[code] * n[code];
-}
 
 void g4_tim1_pwm_init(const g4_tim1_cfg_t *c)
 {
@@ -201,26 +133,4 @@ bool g4_tim2_capture_read(uint32_t *width, uint32_t *period)
     g4_wr(G4_TIM2 + G4_TIM_SR,
           ~(G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_CC1OF | G4_TIM_SR_CC2OF));
     return true;
-}
-
-static int32_t g4_s16(uint16_t u)
-{
-    return u <= 0x7FFFu ? (int32_t)u : (int32_t)u - 65536;
-}
-
-uint32_t g4_enc_extend(g4_enc_ext_t *e, uint16_t cnt)
-{
-    if (!e->primed) {
-        e->primed = true;
-        e->count = (uint32_t)g4_s16(cnt);
-    } else {
-        e->count += (uint32_t)g4_s16((uint16_t)(cnt - e->last));
-    }
-    e->last = cnt;
-    return e->count;
-}
-
-uint32_t g4_enc_at_capture(const g4_enc_ext_t *e, uint16_t cnt, uint16_t ccr)
-{
-    return e->count - (uint32_t)g4_s16((uint16_t)(cnt - ccr));
 }

@@ -11,34 +11,31 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-/* Centre-aligned time base: the counter runs 0 -> ARR -> 0, so one PWM period
- * is 2 ARR (PSC + 1) timer clocks: f_PWM = f_TIM / (2 ARR (PSC + 1)). */
-typedef struct {
-    uint32_t psc;   /* TIMx_PSC (divider - 1) */
-    uint32_t arr;   /* TIMx_ARR = compare value for 100 % duty */
-    uint32_t fs_hz; /* f_PWM, exactly the requested one */
-} g4_pwm_timing_t;
+#include "g4_core.h"
+#include "stm32_calc.h"
 
-/* PSC = 0 when ARR fits 16 bits, else the smallest prescaler; the period must
- * be a whole number of timer clocks (f_TIM divisible by 2 fs (PSC + 1)),
- * otherwise G4_E_CONFIG (the control period would not be 1/fs exactly). */
-int g4_pwm_timing(uint32_t f_tim_hz, uint32_t fs_hz, g4_pwm_timing_t *t);
+_Static_assert(G4_OK == STM32_OK && G4_E_CONFIG == STM32_E_CONFIG, "shared return codes");
 
-/* Dead time, TIMx_BDTR.DTG[7:0] (t_DTS = 1/f_DTS, CKD = 0 so f_DTS = f_TIM):
- *   DTG[7:5] = 0xx:  DT = DTG[7:0] x t_DTS                      0 .. 127 t_DTS
- *   DTG[7:5] = 10x:  DT = (64 + DTG[5:0]) x 2 t_DTS            128 .. 254 t_DTS
- *   DTG[7:5] = 110:  DT = (32 + DTG[4:0]) x 8 t_DTS            256 .. 504 t_DTS
- *   DTG[7:5] = 111:  DT = (32 + DTG[4:0]) x 16 t_DTS           512 .. 1008 t_DTS
- * The encoding never gives less than the requested time (rounded up to the
- * range's step). G4_OK, or G4_E_CONFIG above 1008 t_DTS. */
-int g4_dtg_encode(uint32_t f_dts_hz, uint32_t dead_ns, uint8_t *dtg);
-/* Dead time of a DTG code, in t_DTS. */
-uint32_t g4_dtg_ticks(uint8_t dtg);
-
-/* Digital filter codes (TIMx_BDTR.BKF, TIMx_CCMRx.ICxF, same table): the
- * delay of a code in f_DTS cycles (sampling divider x N events), e.g.
- * 0011 = f_CK_INT, N = 8 -> 8; 1010 = f_DTS/16, N = 5 -> 80. */
-uint32_t g4_filter_cycles(uint32_t code);
+/* The time base, dead-time encoding and filter codes are the same arithmetic
+ * as the other STM32 families' (hal/stm32/stm32_calc.h); the G4 names of
+ * them follow. */
+typedef stm32_pwm_timing_t g4_pwm_timing_t;
+static inline int g4_pwm_timing(uint32_t f_tim_hz, uint32_t fs_hz, g4_pwm_timing_t *t)
+{
+    return stm32_pwm_timing(f_tim_hz, fs_hz, t);
+}
+static inline int g4_dtg_encode(uint32_t f_dts_hz, uint32_t dead_ns, uint8_t *dtg)
+{
+    return stm32_dtg_encode(f_dts_hz, dead_ns, dtg);
+}
+static inline uint32_t g4_dtg_ticks(uint8_t dtg)
+{
+    return stm32_dtg_ticks(dtg);
+}
+static inline uint32_t g4_filter_cycles(uint32_t code)
+{
+    return stm32_filter_cycles(code);
+}
 
 /* TIM1 as the inverter's PWM. */
 typedef struct {
@@ -85,18 +82,16 @@ void g4_tim2_capture_init(uint32_t psc, uint32_t icf);
  * first) and period (CCR1, whose read clears CC1IF), ticks; false if not. */
 bool g4_tim2_capture_read(uint32_t *width, uint32_t *period);
 
-/* 16-bit hardware counter extended to the 32-bit count of hal.h: the signed
- * 16-bit difference since the last read is added (valid while the encoder
- * moves less than 32768 counts between two reads, i.e. below
- * 32768 fs / cpr revolutions per second). The first read is sign-extended. */
-typedef struct {
-    uint32_t count; /* extended count */
-    uint16_t last;  /* last hardware value */
-    bool primed;
-} g4_enc_ext_t;
-uint32_t g4_enc_extend(g4_enc_ext_t *e, uint16_t cnt);
-/* Extended count at a capture taken by the hardware at `ccr` (16 bits), given
- * the extended count at the present hardware value `cnt`. */
-uint32_t g4_enc_at_capture(const g4_enc_ext_t *e, uint16_t cnt, uint16_t ccr);
+/* The 16-bit encoder counter extended to the 32-bit count of hal.h
+ * (stm32_calc.h). */
+typedef stm32_enc_ext_t g4_enc_ext_t;
+static inline uint32_t g4_enc_extend(g4_enc_ext_t *e, uint16_t cnt)
+{
+    return stm32_enc_extend(e, cnt);
+}
+static inline uint32_t g4_enc_at_capture(const g4_enc_ext_t *e, uint16_t cnt, uint16_t ccr)
+{
+    return stm32_enc_at_capture(e, cnt, ccr);
+}
 
 #endif /* HAL_STM32G4_G4_TIM_H */
