@@ -20,6 +20,7 @@
 
 #include "g4_regs.h"
 #include "g4_startup.h"
+#include "stm32_startup.h"
 
 extern uint32_t __stack_top__;
 extern uint32_t __data_start__, __data_end__, __data_load__;
@@ -111,6 +112,10 @@ __attribute__((used)) void g4_fault_halt(void)
         /* The independent watchdog resets the chip (gates off from reset). */
     }
 }
+
+/* The fault path under the name the shared library glue calls
+ * (hal/stm32/stm32_syscalls.c: _exit). */
+void stm32_fault_halt(void) __attribute__((noreturn, alias("g4_fault_halt")));
 
 /* Default hook: nothing more to do. */
 __attribute__((weak)) void g4_board_fault_hook(void)

@@ -1,15 +1,17 @@
 /*
- * newlib system calls of an STM32G4 image: no console (the serial link is the
- * application's), a heap between the end of .bss and the reserved stack
- * (stm32g431cb.ld), no file system: every other call fails with an errno.
- * _exit turns the gates off and waits for the watchdog.
+ * newlib system calls of an STM32 image (G4 and F4 alike): no console (the
+ * serial link is the application's), a heap between the end of .bss and the
+ * reserved stack (__heap_start__ .. __heap_end__ of the chip's linker
+ * script), no file system: every other call fails with an errno. _exit turns
+ * the gates off and waits for the watchdog (stm32_fault_halt, the chip
+ * start-up's).
  */
 #include <errno.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <sys/stat.h>
 
-#include "g4_startup.h"
+#include "stm32_startup.h"
 
 #undef errno
 extern int errno;
@@ -57,7 +59,7 @@ void *_sbrk(ptrdiff_t incr)
 void _exit(int code)
 {
     (void)code;
-    g4_fault_halt();
+    stm32_fault_halt();
 }
 
 int _close(int fd)
