@@ -65,6 +65,7 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->stop_on_fault = false;
     c->psi_adapt = true;
     c->dead_comp = true;
+    c->comp_dead_time_s = -1.0;
     c->sensorless = false;
     c->speed_bw_hz = m->speed_bw_hz;
     c->speed_pm_deg = m->speed_pm_deg;
@@ -130,8 +131,14 @@ static void sim_observer(void *ctx, const plant_t *p)
     if (t >= r->cfg.win_start_s && t <= r->cfg.win_end_s) {
         metrics_add(&r->m_plant, t, tq, tref, psi, i_abc[0]);
         metrics_add_voltage(&r->m_plant, t, v_abc[0]);
-        r->speed_sum_rpm += plant_omega_m(p) * 60.0 / (2.0 * CTRL_PI);
+        const double rpm = plant_omega_m(p) * 60.0 / (2.0 * CTRL_PI);
+        r->speed_sum_rpm += rpm;
         r->speed_n++;
+        if (r->cfg.speed_mode) {
+            const double e = rpm - sim_run_speed_ref_now(r);
+            r->speed_err_sum2 += e * e;
+            r->speed_err_max = fmax(r->speed_err_max, fabs(e));
+        }
     }
     if (r->cfg.trace != NULL && (r->obs_count % r->cfg.trace_decimation) == 0u &&
         t >= r->cfg.trace_start_s && t <= r->cfg.trace_end_s) {
@@ -460,7 +467,8 @@ void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_confi
     fc->psi_adapt = c->psi_adapt && c->plant_machine.filter.type == PLANT_FILTER_NONE;
     /* The inverter's dead time and device drop, known to the firmware. */
     fc->sensorless = c->sensorless;
-    fc->dead_time_s = c->plant_machine.dead_time_s;
+    fc->dead_time_s =
+        c->comp_dead_time_s >= 0.0 ? c->comp_dead_time_s : c->plant_machine.dead_time_s;
     fc->v_fwd_v = c->plant_machine.v_fwd_v;
     fc->dead_comp = c->dead_comp;
     /* The firmware's encoder configuration (the control machine's [sensors]). */
@@ -1186,6 +1194,10 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : NAN;
     sim_json_num(f, "speed_mean_rpm", mean_rpm);
     sim_json_num(f, "speed_end_rpm", sim_run_speed_rpm(r));
+    const bool spd_err = c->speed_mode && r->speed_n > 0u;
+    sim_json_num(f, "speed_err_rms_rpm",
+                 spd_err ? sqrt(r->speed_err_sum2 / (double)r->speed_n) : NAN);
+    sim_json_num(f, "speed_err_max_rpm", spd_err ? r->speed_err_max : NAN);
     double ea;
     double em;
     double es;

@@ -114,6 +114,10 @@ typedef struct {
     bool psi_adapt;                       /* fw_config_t.psi_adapt (default true) */
     bool dead_comp;                       /* fw_config_t.dead_comp (default true) */
     bool sensorless;                      /* fw_config_t.sensorless (default false) */
+    /* The dead time the firmware's compensation assumes, s; < 0 (default): the
+     * plant's, a perfectly known inverter. A production spread sets the plant's
+     * and keeps this at the nominal value. */
+    double comp_dead_time_s;
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
     bool auto_arm;                /* arm with the references above once calibrated (default) */
@@ -154,6 +158,9 @@ struct sim_run {
     bool obs_on;          /* plant observer installed */
     double speed_sum_rpm; /* mean speed in the window (free-mode THD) */
     uint64_t speed_n;
+    /* Speed mode: the true speed against the firmware's speed reference on the
+     * plant grid of the window (sum of squares, largest magnitude, r/min). */
+    double speed_err_sum2, speed_err_max;
     int plant_rc;
     uint8_t vec_now;                /* vector acting in the present period (chosen at k-1) */
     double duty_now;                /* its on-time fraction */

@@ -32,7 +32,7 @@ enum {
     SIM_EXIT_FAULT = 3  /* the drive faulted (tripped); metrics and trace up to the fault */
 };
 
-typedef enum { K_FLAG, K_REAL, K_UINT, K_TEXT, K_SPAN, K_SET } cli_kind_t;
+typedef enum { K_FLAG, K_REAL, K_UINT, K_TEXT, K_SPAN, K_SET, K_ABC } cli_kind_t;
 /* Which kind of run an option belongs to. */
 typedef enum { M_ANY, M_LOOP, M_REPLAY, M_INFO, M_IDENT } cli_mode_t;
 /* Closed-loop options that also apply to --identify. */
@@ -42,6 +42,11 @@ static const char *const k_ident_loop_opts[] = {"--control-machine", "--controll
 typedef struct {
     double start, end;
 } cli_span_t;
+
+/* One value per phase (K_ABC: "A,B,C", each in the option's range). */
+typedef struct {
+    double v[3];
+} cli_abc_t;
 
 /* Parsed values (one field per option, kind by k_opts). */
 typedef struct {
@@ -54,6 +59,8 @@ typedef struct {
     double fs, speed_rpm, load_nm, load_passive_nm, torque_ref, speed_ref, duration, seed;
     double decim, theta0, id0, iq0;
     double speed_bw, speed_pm, speed_kp, speed_ki, overspeed, tq_follow_fault;
+    double comp_dead_time_ns;
+    cli_abc_t current_gain_err;
     cli_span_t window, trace_window;
     int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, no_dead_comp,
         sensorless;
@@ -137,6 +144,13 @@ static const cli_opt_t k_opts[] = {
     {"--no-dead-comp", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(no_dead_comp),
      "no dead-time and device-drop compensation of the duties (the machine file's [inverter] "
      "dead_time_ns, v_fwd_v; docs/algorithms.md)"},
+    {"--comp-dead-time-ns", "NS", K_REAL, 0, 1e5, "ns", M_LOOP, NULL, "--no-dead-comp",
+     F(comp_dead_time_ns),
+     "the dead time the firmware's compensation assumes (default: the machine file's, a "
+     "perfectly known inverter; a production spread varies the file's and keeps this nominal)"},
+    {"--current-gain-err", "A,B,C", K_ABC, -0.25, 0.25, "", M_LOOP, NULL, NULL, F(current_gain_err),
+     "relative gain error of the current sensors of phases a, b, c: each reads (1 + g) i "
+     "(default 0,0,0)"},
     {"--sensorless", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(sensorless),
      "no encoder: angle and speed from the stator-flux observer, forced-angle start-up "
      "(docs/algorithms.md, \"Sensorless start-up\")"},
@@ -216,7 +230,7 @@ static void usage(FILE *f)
         (void)snprintf(lhs, sizeof lhs, "%s%s%s", o->name, o->metavar ? " " : "",
                        o->metavar ? o->metavar : "");
         fprintf(f, "  %-26s %s", lhs, o->help);
-        if (o->kind == K_REAL || o->kind == K_UINT) {
+        if (o->kind == K_REAL || o->kind == K_UINT || o->kind == K_ABC) {
             if (o->hi < 1e15) {
                 fprintf(f, " [%g, %g]%s%s", o->lo, o->hi, o->unit[0] ? " " : "", o->unit);
             }
@@ -288,6 +302,33 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
         a[colon - v] = '\0';
         if (parse_number(a, &sp->start) != 0 || parse_number(colon + 1, &sp->end) != 0) {
             return die("%s expects START:END in seconds, got '%s'", o->name, v);
+        }
+        return 0;
+    }
+    case K_ABC: {
+        cli_abc_t *abc = dst;
+        char buf[192];
+        if (strlen(v) >= sizeof buf) {
+            return die("%s expects %s, got '%.40s...'", o->name, o->metavar, v);
+        }
+        memcpy(buf, v, strlen(v) + 1);
+        char *p = buf;
+        for (int k = 0; k < 3; k++) {
+            char *comma = strchr(p, ',');
+            if ((k < 2) != (comma != NULL)) {
+                return die("%s expects three numbers %s, got '%s'", o->name, o->metavar, v);
+            }
+            if (comma != NULL) {
+                *comma = '\0';
+            }
+            if (parse_number(p, &abc->v[k]) != 0) {
+                return die("%s expects three numbers %s, got '%s'", o->name, o->metavar, v);
+            }
+            if (abc->v[k] < o->lo || abc->v[k] > o->hi) {
+                return die("%s %s: phase %c's %g is out of range: allowed [%g, %g]", o->name, v,
+                           'a' + k, abc->v[k], o->lo, o->hi);
+            }
+            p = comma != NULL ? comma + 1 : p;
         }
         return 0;
     }
@@ -516,7 +557,8 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
     } else if (r->lim_n > 0u) {
         /* the mean torque against the request and the reference applied */
         const double applied = r->tref_sum_nm / (double)r->lim_n;
-        fprintf(f, "  torque mode: requested %.4g N*m, applied %.4g N*m (mean); T_mean - request %s, "
+        fprintf(f,
+                "  torque mode: requested %.4g N*m, applied %.4g N*m (mean); T_mean - request %s, "
                 "T_mean - applied %s\n",
                 r->torque_ref_requested_nm, applied,
                 fmt_num(b[10], 32, "%+.4f N*m", mp->torque_mean_nm - r->torque_ref_requested_nm),
@@ -780,6 +822,12 @@ int main(int argc, char **argv)
     cfg.stop_on_fault = !c.continue_on_fault;
     cfg.psi_adapt = !c.no_psi_adapt;
     cfg.dead_comp = c.no_dead_comp == 0;
+    if (is_given(given, "--comp-dead-time-ns")) {
+        cfg.comp_dead_time_s = c.comp_dead_time_ns * 1e-9;
+    }
+    for (int k = 0; k < 3; k++) {
+        cfg.hal.adc_gain_err[k] = c.current_gain_err.v[k];
+    }
     cfg.sensorless = c.sensorless != 0;
     if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
         /* The command line's sizing replaces the machine file's speed loop. */
