@@ -75,7 +75,7 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
     s->speed_out_max_nm = c->speed_out_max_nm;
     s->speed_loop_hz = c->speed_loop_hz;
     s->overspeed_rpm = c->overspeed_rpm;
-    s->thr_mode = SETTINGS_THR_OFF;
+    fw_settings_thr_capture(s, NULL);
     cm_si_t r;
     fw_commission_results(fw, &r);
     s->id_have = r.have;
@@ -87,6 +87,51 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
     s->id_enc_offset_deg = fw_settings_finite(r.enc_offset_deg);
     s->id_enc_dir = (int8_t)(r.enc_dir > 0 ? 1 : (r.enc_dir < 0 ? -1 : 0));
     s->id_enc_cpr = r.enc_cpr;
+}
+
+void fw_settings_thr_capture(settings_t *s, const thr_config_t *c)
+{
+    thr_config_t d;
+    if (c == NULL) {
+        thr_config_default(&d);
+        c = &d;
+    }
+    s->thr_mode = c->mode;
+    s->thr_low_us = c->low_us;
+    s->thr_high_us = c->high_us;
+    s->thr_deadband_us = c->deadband_us;
+    s->thr_stored = 1u;
+}
+
+int fw_settings_thr_config(const settings_t *s, thr_config_t *c, char *why, size_t cap)
+{
+    thr_config_default(c);
+    if (s->thr_stored == 0u) {
+        return FW_OK;
+    }
+    c->mode = s->thr_mode;
+    c->low_us = s->thr_low_us;
+    c->high_us = s->thr_high_us;
+    c->deadband_us = s->thr_deadband_us;
+    const int bad = thr_config_check(c);
+    if (bad == 0) {
+        return FW_OK;
+    }
+    /* each field's range as thr_config_check has it; the dead band's upper
+     * end is below half the span of the (then valid) end points */
+    static const struct {
+        char name[12];
+        uint16_t lo, hi;
+    } f[] = {{"mode", 0u, THR_MODE_SPEED},
+             {"low_us", THR_PULSE_MIN_US, THR_LOW_MAX_US},
+             {"high_us", THR_HIGH_MIN_US, THR_PULSE_MAX_US},
+             {"deadband_us", 0u, 0u}};
+    const unsigned v[] = {c->mode, c->low_us, c->high_us, c->deadband_us};
+    const unsigned k = (unsigned)bad - 1u;
+    const unsigned hi =
+        bad == THR_BAD_DEADBAND ? (unsigned)(c->high_us - c->low_us - 1u) / 2u : f[k].hi;
+    (void)snprintf(why, cap, "throttle.%s = %u outside [%u, %u]", f[k].name, v[k], f[k].lo, hi);
+    return FW_EINVAL;
 }
 
 int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, void *cfg_buf,

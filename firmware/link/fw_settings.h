@@ -18,6 +18,7 @@
 #include "pipeline.h"
 #include "settings.h"
 #include "settings_store.h"
+#include "throttle.h"
 
 #define FW_SETTINGS_MSG_MAX 112u
 
@@ -31,7 +32,9 @@ typedef struct {
     int (*apply)(void *ctx, const settings_t *s, char *why, size_t cap);
     /* The compiled-in defaults (not running): CMD_OK or a cmd_err_t code. */
     int (*apply_default)(void *ctx);
-    /* Optional: the application's own fields of the record (throttle). */
+    /* Optional: the application's own fields of the record, after
+     * fw_settings_capture (an application with a throttle input stores it
+     * with fw_settings_thr_capture; without one the record says "off"). */
     void (*capture)(void *ctx, settings_t *s);
     void *ctx;
     char msg[FW_SETTINGS_MSG_MAX]; /* the last operation's message */
@@ -39,8 +42,18 @@ typedef struct {
 
 /* The firmware's configuration as a record: machine, encoder, inverter,
  * controller and its tunables, speed loop and limits, identification
- * results (throttle: off, the application's capture fills it). */
+ * results; the throttle input as fw_settings_thr_capture(s, NULL) gives it
+ * (off), which the application's capture replaces with its own. */
 void fw_settings_capture(const fw_t *fw, settings_t *s);
+
+/* The throttle input into the record (c NULL: an image without one: the
+ * defaults, mode off); thr_stored = 1. */
+void fw_settings_thr_capture(settings_t *s, const thr_config_t *c);
+/* The throttle input a record gives: its fields (thr_stored), or the
+ * defaults for a record that holds none (format 1). FW_OK, or FW_EINVAL when
+ * thr_config_check refuses them, with the field, its value and its range in
+ * why ("throttle.low_us = 0 outside [800, 1499]"). */
+int fw_settings_thr_config(const settings_t *s, thr_config_t *c, char *why, size_t cap);
 
 /* The machine and configuration a record gives: *m from s, *c =
  * fw_config_default(m, the controller of s) with s's values, the controller's

@@ -266,7 +266,7 @@ settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, u
     if (settings_get(buf + len - 4u, 4u) != settings_crc32(buf, len - 4u)) {
         return SETTINGS_E_CRC;
     }
-    if (fmt < SETTINGS_FORMAT) {
+    if (fmt < SETTINGS_FORMAT_MIN) {
         return SETTINGS_E_OLD;
     }
     if (fmt > SETTINGS_FORMAT) {
@@ -306,6 +306,12 @@ settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, u
             p += sz;
         }
     }
+    /* Format 1: the throttle fields were never written (settings.h) */
+    t.thr_stored = fmt >= 2u ? 1u : 0u;
+    if (t.thr_stored == 0u) {
+        t.thr_mode = 0u;
+        t.thr_low_us = t.thr_high_us = t.thr_deadband_us = 0u;
+    }
     /* the controller's name is required; the tunables in use have names */
     if (t.ctrl[0] == '\0') {
         return SETTINGS_E_VALUE;
@@ -326,7 +332,8 @@ bool settings_item_at(const settings_t *s, size_t index, settings_item_t *it)
     size_t i = 0;
     for (size_t k = 0; k < SETTINGS_NFIELDS; k++) {
         const settings_field_t *f = &settings_fields[k];
-        if (f->count != 1u) {
+        if (f->count != 1u || (s->thr_stored == 0u && f->offset >= offsetof(settings_t, thr_mode) &&
+                               f->offset <= offsetof(settings_t, thr_deadband_us))) {
             continue;
         }
         if (i++ != index) {

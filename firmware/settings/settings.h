@@ -18,9 +18,13 @@
  *  len-4 u32 CRC-32 (IEEE 802.3: reflected 0xEDB88320, init and xorout
  *      0xFFFFFFFF) of every byte before it
  * A record of another format version is refused with its version named
- * (settings_decode: SETTINGS_E_OLD / SETTINGS_E_NEW): this firmware reads
- * format 1 only, the first one; a later format adds its migration from the
- * earlier ones in settings_decode.
+ * (settings_decode: SETTINGS_E_OLD / SETTINGS_E_NEW). This firmware writes
+ * format 2 and reads formats 1 and 2, which have the same layout: format 1's
+ * writers never stored the throttle input (its four fields hold zeroes, which
+ * no throttle check accepts), so a format-1 record is read with thr_stored = 0
+ * and its throttle fields cleared, and the firmware keeps the throttle's
+ * defaults (fw_settings_thr_config). A later format adds its migration from
+ * the earlier ones in settings_decode.
  */
 #ifndef FIRMWARE_SETTINGS_SETTINGS_H
 #define FIRMWARE_SETTINGS_SETTINGS_H
@@ -30,7 +34,8 @@
 #include <stdint.h>
 
 #define SETTINGS_MAGIC 0x53534D50u /* "PMSS" in memory order */
-#define SETTINGS_FORMAT 1u
+#define SETTINGS_FORMAT 2u         /* written; read: SETTINGS_FORMAT_MIN .. SETTINGS_FORMAT */
+#define SETTINGS_FORMAT_MIN 1u     /* format 1: no throttle input stored (thr_stored = 0) */
 #define SETTINGS_HDR_SIZE 16u
 #define SETTINGS_NAME_MAX 16u     /* controller and tunable names, NUL included */
 #define SETTINGS_TUNABLES_MAX 12u /* tunables kept per record (by name) */
@@ -70,9 +75,14 @@ typedef struct {
     double speed_out_max_nm;
     uint32_t speed_loop_hz;
     double overspeed_rpm;
-    /* throttle input: mode, calibrated end points, dead band */
+    /* throttle input: mode, calibrated end points, dead band (the values of
+     * thr_config_t, firmware/throttle/throttle.h, which checks them) */
     uint8_t thr_mode; /* settings_thr_mode_t */
     uint16_t thr_low_us, thr_high_us, thr_deadband_us;
+    /* Not in the layout: 1 when the record holds the throttle input (format 2
+     * on); 0 for a format-1 record, whose throttle fields are then cleared and
+     * not listed (settings_item_at). settings_encode ignores it. */
+    uint8_t thr_stored;
     /* identification results (cm_si_t; informational: what is applied is the
      * machine above, after "ident apply") */
     uint32_t id_have; /* CM_HAVE_* bits */
@@ -118,7 +128,8 @@ settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, u
 /* Field-by-field listing for "config show": the index-th field's key and
  * value as text (numbers in shortest round-trip-safe form are the caller's:
  * here the double's value through *num, integers through *num exactly, names
- * through *text). Returns false past the end. */
+ * through *text); the throttle fields only when s->thr_stored. Returns false
+ * past the end. */
 typedef struct {
     const char *key;  /* e.g. "m.rs_ohm" */
     const char *text; /* non-NULL for a name field */

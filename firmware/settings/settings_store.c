@@ -127,8 +127,11 @@ size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap)
     }
     int n;
     if (scan->page >= 0) {
-        n = snprintf(out, cap, "settings: record %lu (page %d) applied",
-                     (unsigned long)scan->seq[scan->page], scan->page);
+        /* a format-1 record has no throttle input (settings.h): said, as the
+         * throttle then runs on its defaults */
+        n = snprintf(out, cap, "settings: record %lu (page %d%s) applied",
+                     (unsigned long)scan->seq[scan->page], scan->page,
+                     scan->format[scan->page] < 2u ? ", format 1: throttle input not stored" : "");
     } else {
         unsigned p = 0;
         while (p < 2u && scan->status[p] == SETTINGS_E_EMPTY) {
@@ -145,9 +148,9 @@ size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap)
             }
             if (scan->status[p] == SETTINGS_E_OLD || scan->status[p] == SETTINGS_E_NEW) {
                 n = snprintf(out, cap,
-                             "settings: page %u: record format %u (this firmware reads %u), "
-                             "refused; compiled-in defaults",
-                             p, (unsigned)scan->format[p], SETTINGS_FORMAT);
+                             "settings: page %u: record format %u (this firmware reads %u to "
+                             "%u), refused; compiled-in defaults",
+                             p, (unsigned)scan->format[p], SETTINGS_FORMAT_MIN, SETTINGS_FORMAT);
             } else {
                 n = snprintf(out, cap,
                              "settings: page %u: %s, no valid record; compiled-in defaults", p,

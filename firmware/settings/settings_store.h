@@ -73,7 +73,8 @@ int settings_store_erase(const settings_flash_t *f, uint8_t *buf, size_t cap);
 
 /* One line about a load: "settings: record 12 (page 1) applied" /
  * "settings: no record in flash, compiled-in defaults" / "settings: page 0:
- * format 2 (this firmware reads 1), refused; compiled-in defaults". */
+ * record format 3 (this firmware reads 1 to 2), refused; compiled-in
+ * defaults"; a format-1 record's line says that it holds no throttle input. */
 size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap);
 
 /* One line about a save/erase code: "ok", "page 1: PROGERR", ... */

@@ -14,16 +14,16 @@ void thr_config_default(thr_config_t *c)
 int thr_config_check(const thr_config_t *c)
 {
     if (c->mode > THR_MODE_SPEED) {
-        return 1;
+        return THR_BAD_MODE;
     }
-    if (c->low_us < THR_PULSE_MIN_US || c->low_us >= 1500u) {
-        return 2;
+    if (c->low_us < THR_PULSE_MIN_US || c->low_us > THR_LOW_MAX_US) {
+        return THR_BAD_LOW;
     }
-    if (c->high_us <= 1500u || c->high_us > THR_PULSE_MAX_US) {
-        return 3;
+    if (c->high_us < THR_HIGH_MIN_US || c->high_us > THR_PULSE_MAX_US) {
+        return THR_BAD_HIGH;
     }
     if (2u * (uint32_t)c->deadband_us >= (uint32_t)(c->high_us - c->low_us)) {
-        return 4;
+        return THR_BAD_DEADBAND;
     }
     return 0;
 }

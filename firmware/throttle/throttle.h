@@ -33,6 +33,12 @@
 
 #define THR_PULSE_MIN_US 800u
 #define THR_PULSE_MAX_US 2200u
+/* The calibrated end points lie on either side of the centre pulse: low_us in
+ * [THR_PULSE_MIN_US, THR_LOW_MAX_US], high_us in [THR_HIGH_MIN_US,
+ * THR_PULSE_MAX_US] (thr_config_check). */
+#define THR_CENTRE_US 1500u
+#define THR_LOW_MAX_US (THR_CENTRE_US - 1u)
+#define THR_HIGH_MIN_US (THR_CENTRE_US + 1u)
 #define THR_PERIOD_MIN_US 2000u  /* 500 Hz: 490 Hz + 2 % */
 #define THR_PERIOD_MAX_US 22000u /* 45 Hz: 50 Hz - 10 % */
 #define THR_ARM_LOW_MS 1000u
@@ -86,8 +92,9 @@ typedef struct {
 } thr_out_t;
 
 /* 0 when the settings are usable, else the index of the first bad one
- * (1 mode, 2 low_us, 3 high_us, 4 deadband_us): low_us in [800, 1500),
- * high_us in (1500, 2200], deadband_us < (high_us - low_us) / 2. */
+ * (THR_BAD_MODE, _LOW, _HIGH, _DEADBAND): mode <= THR_MODE_SPEED, low_us in
+ * [800, 1500), high_us in (1500, 2200], deadband_us < (high_us - low_us) / 2. */
+enum { THR_BAD_MODE = 1, THR_BAD_LOW = 2, THR_BAD_HIGH = 3, THR_BAD_DEADBAND = 4 };
 int thr_config_check(const thr_config_t *c);
 void thr_config_default(thr_config_t *c);
 

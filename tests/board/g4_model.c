@@ -9,6 +9,10 @@
 #define G4_DEFINE_ARRAY(N, n, addr, bytes) uint32_t g4_mem_##n[(bytes) / 4u];
 G4_PERIPHS(G4_DEFINE_ARRAY)
 #undef G4_DEFINE_ARRAY
+/* The two settings pages (g4_flash.h): non-volatile, so g4_model_reset (a
+ * power cycle) keeps them; erased (0xFF) until the first g4_model_reset. */
+uint32_t g4_mem_flash_settings[2u * G4_FLASH_PAGE_SIZE / 4u];
+static bool g4_model_flash_blank;
 
 g4_model_t g4_model;
 
@@ -19,7 +23,8 @@ typedef struct {
 } g4_region_t;
 
 #define G4_REGION(N, n, addr, bytes) {#N, (uintptr_t)g4_mem_##n, (bytes)},
-static const g4_region_t g4_regions[] = {G4_PERIPHS(G4_REGION)};
+static const g4_region_t g4_regions[] = {G4_PERIPHS(G4_REGION){
+    "FLASHMEM", (uintptr_t)g4_mem_flash_settings, sizeof g4_mem_flash_settings}};
 #undef G4_REGION
 #define G4_N_REGIONS (sizeof g4_regions / sizeof g4_regions[0])
 
@@ -40,6 +45,10 @@ void g4_model_reset(void)
     G4_PERIPHS(G4_CLEAR)
 #undef G4_CLEAR
     memset(&g4_model, 0, sizeof g4_model);
+    if (!g4_model_flash_blank) {
+        g4_model_flash_blank = true;
+        memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
+    }
     g4_model.adc_regular = 128u;
     /* Every modelled register starts at its RM0440 reset value, so that a
      * whole-register write that clobbers a bit shows in the image. */
@@ -220,6 +229,50 @@ void g4_trace_write(uintptr_t reg, uint32_t value)
             *(uint32_t *)(adc + G4_ADC_DR) = g4_model.adc_regular;
         }
         *c = v & ~(G4_ADC_CR_ADCAL | G4_ADC_CR_ADSTART);
+        return;
+    }
+    /* Flash (RM0440 sec. 3.3.5-3.3.8, simply: operations end at once, BSY
+     * never reads set): KEY1 then KEY2 clears FLASH_CR.LOCK; a locked
+     * FLASH_CR ignores writes; STRT with PER erases page PNB (the settings
+     * pages hold memory, other pages are not modelled); with PG set a word
+     * written into the settings pages programs it (bits only go 1 -> 0). The
+     * detailed model of the interface is tests/board/test_g4_flash.c's. */
+    if (reg == G4_FLASH + G4_FLASH_SR) {
+        *c &= ~(value & 0xFFFFu); /* the flags are rc_w1 */
+        return;
+    }
+    if (reg == G4_FLASH + G4_FLASH_ECCR) {
+        const uint32_t w1c = G4_FLASH_ECCR_ECCC | G4_FLASH_ECCR_ECCD;
+        *c = ((*c & ~(value & w1c)) & ~G4_FLASH_ECCR_ECCIE) | (value & G4_FLASH_ECCR_ECCIE);
+        return;
+    }
+    if (reg == G4_FLASH + G4_FLASH_KEYR) {
+        if (value == G4_FLASH_KEY2 && g4_model.flash_key1) {
+            g4_mem_flash[G4_FLASH_CR / 4u] &= ~G4_FLASH_CR_LOCK;
+        }
+        g4_model.flash_key1 = value == G4_FLASH_KEY1;
+        return;
+    }
+    if (reg == G4_FLASH + G4_FLASH_CR) {
+        if ((*c & G4_FLASH_CR_LOCK) != 0u) {
+            return;
+        }
+        *c = value & ~G4_FLASH_CR_STRT;
+        const uint32_t page = (value & G4_FLASH_CR_PNB_MASK) >> G4_FLASH_CR_PNB_POS;
+        if ((value & (G4_FLASH_CR_STRT | G4_FLASH_CR_PER)) ==
+                (G4_FLASH_CR_STRT | G4_FLASH_CR_PER) &&
+            page >= G4_FLASH_SETTINGS_PAGE) {
+            memset(
+                &g4_mem_flash_settings[(page - G4_FLASH_SETTINGS_PAGE) * G4_FLASH_PAGE_SIZE / 4u],
+                0xFF, G4_FLASH_PAGE_SIZE);
+        }
+        return;
+    }
+    if (reg >= (uintptr_t)g4_mem_flash_settings &&
+        reg < (uintptr_t)g4_mem_flash_settings + sizeof g4_mem_flash_settings) {
+        if ((g4_mem_flash[G4_FLASH_CR / 4u] & G4_FLASH_CR_PG) != 0u) {
+            *c &= value;
+        }
         return;
     }
     /* USART ICR clears ISR flags. */

@@ -40,11 +40,14 @@ typedef struct {
     /* state the model keeps */
     bool rcr_before_cen;
     bool rcr_written;
+    bool flash_key1; /* FLASH_KEYR: KEY1 was the last key written */
 } g4_model_t;
 
 extern g4_model_t g4_model;
 
-/* Every register to its RM0440 reset value; clears the log and the switches. */
+/* Every register to its RM0440 reset value; clears the log and the switches.
+ * The settings pages (g4_mem_flash_settings) keep their content, as the flash
+ * does across a power cycle (erased before the first reset). */
 void g4_model_reset(void);
 /* The TIM1 break interrupt would be taken (again): BIE and a break flag set. */
 bool g4_model_break_pending(void);

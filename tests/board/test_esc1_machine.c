@@ -25,6 +25,7 @@
 #include "esc1_report.h"
 #include "g4_clock.h"
 #include "g4_core.h"
+#include "g4_flash.h"
 #include "g4_model.h"
 #include "sim_machine.h"
 #include "unity.h"
@@ -112,7 +113,8 @@ static void test_core_and_every_controller_take_it(void)
 /* ---- the link on the board's code path ---- */
 
 static esc1_t esc;
-static char reply[4][160];
+#define MAX_REPLY 96u
+static char reply[MAX_REPLY][160];
 static size_t n_reply;
 
 static void capture(void *ctx, const uint8_t *bytes, size_t len)
@@ -123,7 +125,7 @@ static void capture(void *ctx, const uint8_t *bytes, size_t len)
     for (size_t k = 0; k < len; k++) {
         if (bytes[k] == '\n') {
             line[n > 0 && line[n - 1] == '\r' ? n - 1 : n] = '\0';
-            if (n_reply < 4u) {
+            if (n_reply < MAX_REPLY) {
                 memcpy(reply[n_reply++], line, sizeof line);
             }
             n = 0;
@@ -133,7 +135,8 @@ static void capture(void *ctx, const uint8_t *bytes, size_t len)
     }
 }
 
-static const char *command(const char *text)
+/* Every reply line of a command (the first: "ok ..." or "err ..."). */
+static size_t command_lines(const char *text)
 {
     n_reply = 0;
     for (const char *c = text; *c != '\0'; c++) {
@@ -141,12 +144,28 @@ static const char *command(const char *text)
     }
     fw_link_rx(&esc.link, '\r');
     fw_link_poll(&esc.link);
-    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, n_reply, text);
+    return n_reply;
+}
+
+static const char *command(const char *text)
+{
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, command_lines(text), text);
     return reply[0];
 }
 
+/* The fault path of g4_startup.c (g4_flash.c's NMI takes it for anything but
+ * a settings read's ECC error): counted. */
+static unsigned fault_paths;
+void g4_fault_handler(void);
+void g4_fault_handler(void)
+{
+    fault_paths++;
+}
+
 /* As esc1_main.c: board HAL, fw_init with the compiled-in motor, the link and
- * its application parameters (on the register model, no interrupts). */
+ * its application parameters, the throttle, the settings record in flash
+ * applied (on the register model, no interrupts). g4_model_reset is a power
+ * cycle: the flash's settings pages keep their content. */
 static void esc1_start(void)
 {
     g4_model_reset();
@@ -165,6 +184,7 @@ static void esc1_start(void)
     fw_link_init(&esc.link, &esc.fw, capture, NULL);
     esc1_params_attach(&esc);
     esc1_throttle_init(&esc, b->sysclk_hz);
+    esc1_settings_start(&esc);
 }
 
 /* The firmware knows the dead time TIM1 inserts: TIMx_BDTR.DTG as the HAL
@@ -406,6 +426,95 @@ static void test_throttle_rearms_only_from_its_low_end(void)
     TEST_ASSERT_EQUAL_UINT8(THR_WAIT_LOW, esc.thr.state);
 }
 
+/* Every throttle field set over the link, saved, the board powered off and on
+ * (the register model reset, the flash kept): the same input arms the drive
+ * at the calibrated low end (1100 us, which the defaults' 1000 + 30 us would
+ * not take as low) and maps a pulse with the calibrated end points and dead
+ * band; "config show" lists throttle values that thr_config_check accepts. */
+static void test_throttle_survives_a_power_cycle(void)
+{
+    memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings); /* a new board */
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.low_us 1100", command("param set throttle.low_us 1100"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.high_us 1900",
+                             command("param set throttle.high_us 1900"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.deadband_us 40",
+                             command("param set throttle.deadband_us 40"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.mode 1", command("param set throttle.mode 1"));
+    TEST_ASSERT_EQUAL_STRING("ok saved record 1", command("config save"));
+
+    calibrate_at(2553u); /* power cycle */
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_STRING("settings: record 1 (page 0) applied", esc.settings.msg);
+    TEST_ASSERT_EQUAL_STRING("ok throttle.mode 1 -", command("param get throttle.mode"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.low_us 1100 us", command("param get throttle.low_us"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.high_us 1900 us", command("param get throttle.high_us"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.deadband_us 40 us",
+                             command("param get throttle.deadband_us"));
+    uint32_t ms = 0u;
+    for (; ms < 1100u; ms++) {
+        pulse_at(ms, 1100u);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
+    for (; ms < 1200u; ms++) {
+        pulse_at(ms, 1520u);
+    }
+    /* (1520 - 1140) / (1900 - 1140) of the torque limit, Q24 */
+    const q24_t want = fx_mul((q24_t)((380ll << 24) / 760), esc.fw.torque_ref_max);
+    TEST_ASSERT_EQUAL_INT32(want, esc.fw.torque_ref);
+    expect_prefix("ok", command("disarm"));
+    control_period();
+
+    /* "config show": the record's throttle values, each one the checks take */
+    const size_t n = command_lines("config show");
+    TEST_ASSERT_TRUE(n > 2u);
+    thr_config_t c;
+    thr_config_default(&c);
+    unsigned seen = 0u;
+    for (size_t k = 1; k < n; k++) {
+        unsigned v;
+        char key[32];
+        if (sscanf(reply[k], " thr.%31[a-z_]=%u", key, &v) != 2) {
+            continue;
+        }
+        seen++;
+        if (strcmp(key, "mode") == 0) {
+            c.mode = (uint8_t)v;
+        } else if (strcmp(key, "low_us") == 0) {
+            c.low_us = (uint16_t)v;
+        } else if (strcmp(key, "high_us") == 0) {
+            c.high_us = (uint16_t)v;
+        } else if (strcmp(key, "deadband_us") == 0) {
+            c.deadband_us = (uint16_t)v;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT(4u, seen);
+    TEST_ASSERT_EQUAL_INT(0, thr_config_check(&c));
+    TEST_ASSERT_EQUAL_UINT16(1100u, c.low_us);
+    TEST_ASSERT_EQUAL_UINT16(1900u, c.high_us);
+    TEST_ASSERT_EQUAL_UINT16(40u, c.deadband_us);
+    TEST_ASSERT_EQUAL_UINT8(1u, c.mode);
+
+    /* "config default": the compiled-in throttle (off) as well */
+    expect_prefix("ok", command("config default"));
+    TEST_ASSERT_EQUAL_STRING("ok throttle.mode 0 -", command("param get throttle.mode"));
+
+    /* a record whose throttle the checks refuse (written past the link):
+     * refused as a whole at start-up, naming the field, its value, its range */
+    settings_t rec = esc.settings.rec;
+    rec.thr_low_us = 700u;
+    TEST_ASSERT_EQUAL_INT(SETTINGS_STORE_OK,
+                          settings_store_save(&esc.settings.flash, esc.settings.buf,
+                                              sizeof esc.settings.buf, &rec, NULL));
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_STRING("settings: record 2 refused: throttle.low_us = 700 outside [800, "
+                             "1499]; compiled-in defaults",
+                             esc.settings.msg);
+    TEST_ASSERT_EQUAL_UINT(0u, fault_paths);
+    memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -419,5 +528,6 @@ int main(void)
     RUN_TEST(test_throttle_rearms_only_from_its_low_end);
     RUN_TEST(test_link_reconfig_refused_while_gates_on);
     RUN_TEST(test_bringup_sense_says_the_offsets);
+    RUN_TEST(test_throttle_survives_a_power_cycle);
     return UNITY_END();
 }

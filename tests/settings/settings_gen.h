@@ -91,6 +91,7 @@ static inline void sgen_settings(uint32_t *x, settings_t *s)
     s->thr_low_us = (uint16_t)sgen_rand(x);
     s->thr_high_us = (uint16_t)sgen_rand(x);
     s->thr_deadband_us = (uint16_t)sgen_rand(x);
+    s->thr_stored = 1u; /* format 2 on */
     s->id_have = sgen_rand(x);
     s->id_enc_dir = (int8_t)((int)(sgen_rand(x) % 3u) - 1);
     s->id_enc_cpr = sgen_rand(x);

@@ -275,7 +275,8 @@ static void test_other_format_refused_with_message(void)
     TEST_ASSERT_EQUAL_HEX8(0x5Au, ((uint8_t *)&got)[0]); /* nothing read into it */
     char msg[160];
     settings_load_message(&scan, msg, sizeof msg);
-    TEST_ASSERT_NOT_NULL(strstr(msg, "page 1: record format 0 (this firmware reads 1), refused"));
+    TEST_ASSERT_NOT_NULL(
+        strstr(msg, "page 1: record format 0 (this firmware reads 1 to 2), refused"));
     TEST_ASSERT_NOT_NULL(strstr(msg, "compiled-in defaults"));
 }
 

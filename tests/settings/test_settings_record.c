@@ -162,7 +162,7 @@ static void test_other_formats_refused(void)
     settings_t s;
     sgen_settings(&x, &s);
     const size_t len = settings_encode(&s, 9u, rec, sizeof rec);
-    const uint16_t formats[] = {0u, 2u, 3u, 0x7FFFu, 0xFFFFu};
+    const uint16_t formats[] = {0u, 3u, 0x7FFFu, 0xFFFFu};
     for (unsigned i = 0; i < sizeof formats / sizeof formats[0]; i++) {
         memcpy(rec2, rec, len);
         rec2[4] = (uint8_t)formats[i];
@@ -172,7 +172,8 @@ static void test_other_formats_refused(void)
         settings_t d;
         uint32_t seq = 0;
         const settings_status_t st = settings_decode(rec2, len, &d, &seq, &fmt);
-        TEST_ASSERT_EQUAL_INT(formats[i] < SETTINGS_FORMAT ? SETTINGS_E_OLD : SETTINGS_E_NEW, st);
+        TEST_ASSERT_EQUAL_INT(formats[i] < SETTINGS_FORMAT_MIN ? SETTINGS_E_OLD : SETTINGS_E_NEW,
+                              st);
         TEST_ASSERT_EQUAL_UINT16(formats[i], fmt);
         assert_refused(rec2, len, st);
     }
@@ -182,6 +183,47 @@ static void test_other_formats_refused(void)
     rec2[7] = (uint8_t)((len - 8u) >> 8);
     recrc(rec2, len - 8u);
     assert_refused(rec2, len, SETTINGS_E_LENGTH);
+}
+
+/* Format 1 (the first firmware's, which never wrote the throttle input: its
+ * fields held zeroes) is read with the same layout, its throttle fields
+ * cleared and marked as not stored, and not listed; format 2 keeps them. */
+static void test_format1_read_without_throttle(void)
+{
+    uint32_t x = 8u;
+    settings_t s;
+    sgen_settings(&x, &s);
+    s.thr_mode = 1u;
+    s.thr_low_us = 1100u;
+    const size_t len = settings_encode(&s, 4u, rec, sizeof rec);
+    TEST_ASSERT_EQUAL_UINT8(2u, rec[4]);
+    settings_t d;
+    uint32_t seq = 0;
+    uint16_t fmt = 0;
+    TEST_ASSERT_EQUAL_INT(SETTINGS_OK, settings_decode(rec, len, &d, &seq, &fmt));
+    TEST_ASSERT_EQUAL_UINT8(1u, d.thr_stored);
+    TEST_ASSERT_EQUAL_UINT16(1100u, d.thr_low_us);
+    rec[4] = 1u;
+    recrc(rec, len);
+    memset(&d, 0xA5, sizeof d);
+    TEST_ASSERT_EQUAL_INT(SETTINGS_OK, settings_decode(rec, len, &d, &seq, &fmt));
+    TEST_ASSERT_EQUAL_UINT16(1u, fmt);
+    TEST_ASSERT_EQUAL_UINT32(4u, seq);
+    TEST_ASSERT_EQUAL_UINT8(0u, d.thr_stored);
+    TEST_ASSERT_EQUAL_UINT8(0u, d.thr_mode);
+    TEST_ASSERT_EQUAL_UINT16(0u, d.thr_low_us);
+    TEST_ASSERT_EQUAL_MEMORY(&s.rs_ohm, &d.rs_ohm, sizeof s.rs_ohm); /* the rest kept */
+    TEST_ASSERT_EQUAL_STRING(s.ctrl, d.ctrl);
+    settings_item_t it;
+    size_t listed[2] = {0u, 0u};
+    for (unsigned stored = 0; stored < 2u; stored++) {
+        d.thr_stored = (uint8_t)stored;
+        for (size_t n = 0; settings_item_at(&d, n, &it); n++) {
+            TEST_ASSERT_TRUE(stored == 1u || strncmp(it.key, "thr.", 4) != 0);
+            listed[stored]++;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT(listed[0] + 4u, listed[1]);
 }
 
 static void test_valid_crc_random_bodies(void)
@@ -276,6 +318,7 @@ int main(void)
     RUN_TEST(test_bit_flips_refused);
     RUN_TEST(test_truncated_refused);
     RUN_TEST(test_other_formats_refused);
+    RUN_TEST(test_format1_read_without_throttle);
     RUN_TEST(test_valid_crc_random_bodies);
     RUN_TEST(test_erased_and_garbage);
     RUN_TEST(test_listing);

@@ -5,9 +5,11 @@
  * running, not commissioning, no arm pending: "err 8 state in <state>");
  * every change re-initialises the firmware (state boot -> calibration ->
  * ready, controller tunables back to their defaults) and moves the hardware
- * over-current threshold with m.i_max_a. Nothing is stored across a reset:
- * after power-up the compiled-in machine (esc1_default_machine, generated from
- * its machine file: esc1_app.h) is active again.
+ * over-current threshold with m.i_max_a. What "config save" stores
+ * (esc1_settings.c: the machine, the encoder, the controller, the throttle
+ * input) is applied after the next power-up; without a record, or after
+ * "config erase", the compiled-in machine (esc1_default_machine, generated
+ * from its machine file: esc1_app.h) and the throttle's defaults are.
  */
 #include <math.h>
 #include <string.h>
@@ -303,10 +305,10 @@ static const fw_link_param_t esc1_params[ESC1_N_PARAMS] = {
     [P_T0 + T_MODE] =
         ESC1_RW("throttle.mode", "-", 0.0, 2.0, "PWM pad (PA15): 0 off, 1 torque, 2 speed",
                 esc1_thr_get, esc1_thr_set),
-    [P_T0 + T_LOW] = ESC1_RW("throttle.low_us", "us", 800.0, 1499.0,
+    [P_T0 + T_LOW] = ESC1_RW("throttle.low_us", "us", THR_PULSE_MIN_US, THR_LOW_MAX_US,
                              "pulse at zero (calibrated low end)", esc1_thr_get, esc1_thr_set),
-    [P_T0 + T_HIGH] = ESC1_RW("throttle.high_us", "us", 1501.0, 2200.0, "pulse at full scale",
-                              esc1_thr_get, esc1_thr_set),
+    [P_T0 + T_HIGH] = ESC1_RW("throttle.high_us", "us", THR_HIGH_MIN_US, THR_PULSE_MAX_US,
+                              "pulse at full scale", esc1_thr_get, esc1_thr_set),
     [P_T0 + T_DB] = ESC1_RW("throttle.deadband_us", "us", 0.0, 349.0, "zero up to low_us + this",
                             esc1_thr_get, esc1_thr_set),
     [P_T0 + T_US] = ESC1_RO("throttle.us", "us", "last valid pulse width", esc1_thr_get),

@@ -32,18 +32,25 @@ static int esc1_flash_program(void *ctx, unsigned page, uint32_t off, const uint
 }
 
 /* The record's machine, encoder and configuration, through the same path as a
- * parameter change (esc1_reconfigure_cfg: previous data kept on a refusal). */
+ * parameter change (esc1_reconfigure_cfg: previous data kept on a refusal),
+ * and its throttle input, checked first so that a refused record changes
+ * nothing. The decoder restarts disarmed (the saving and the loading are
+ * refused while the gates are on or an arm is pending). */
 static int esc1_settings_apply(void *ctx, const settings_t *rec, char *why, size_t cap)
 {
     esc1_t *s = (esc1_t *)ctx;
     ctrl_machine_t m;
     fw_config_t c;
-    if (fw_settings_config(rec, &m, &c, s->ctrl_cfg.bytes, why, cap) != FW_OK) {
+    thr_config_t tc;
+    if (fw_settings_thr_config(rec, &tc, why, cap) != FW_OK ||
+        fw_settings_config(rec, &m, &c, s->ctrl_cfg.bytes, why, cap) != FW_OK) {
         return CMD_E_FAILED;
     }
     const int rc = esc1_reconfigure_cfg(s, &m, rec->enc_cpr, &c);
     if (rc != CMD_OK) {
         (void)fw_explain(&s->fw, why, cap);
+    } else {
+        thr_init(&s->thr, &tc, s->now_ms);
     }
     return rc;
 }
@@ -53,7 +60,19 @@ static int esc1_settings_default(void *ctx)
     esc1_t *s = (esc1_t *)ctx;
     fw_config_t c;
     esc1_config_default(&c, s->hal.board, &esc1_default_machine, ctrl_find(ESC1_CTRL));
-    return esc1_reconfigure_cfg(s, &esc1_default_machine, ESC1_ENCODER_CPR, &c);
+    const int rc = esc1_reconfigure_cfg(s, &esc1_default_machine, ESC1_ENCODER_CPR, &c);
+    if (rc == CMD_OK) {
+        thr_config_t tc;
+        thr_config_default(&tc);
+        thr_init(&s->thr, &tc, s->now_ms);
+    }
+    return rc;
+}
+
+/* "config save": the throttle input in force. */
+static void esc1_settings_capture(void *ctx, settings_t *rec)
+{
+    fw_settings_thr_capture(rec, &((esc1_t *)ctx)->thr.cfg);
 }
 
 void esc1_settings_start(esc1_t *s)
@@ -67,6 +86,7 @@ void esc1_settings_start(esc1_t *s)
     st->flash.strerror = g4_flash_strerror;
     st->apply = esc1_settings_apply;
     st->apply_default = esc1_settings_default;
+    st->capture = esc1_settings_capture;
     st->ctx = s;
     g4_flash_set_clock(s->hal.board->sysclk_hz); /* started only when the clock is up */
     (void)fw_settings_boot(st);
