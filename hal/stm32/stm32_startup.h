@@ -8,6 +8,14 @@
 #ifndef HAL_STM32_STM32_STARTUP_H
 #define HAL_STM32_STM32_STARTUP_H
 
+/* The C run-time set-up, the reset handler's first call: the FPU (CP10,
+ * CP11) enabled before any floating-point instruction (ARMv7-M ARM B3.2.20,
+ * CPACR), .data copied from flash, .bss zeroed (the linker script's
+ * __data_start__/__data_end__/__data_load__, __bss_start__/__bss_end__),
+ * MemManage, BusFault and UsageFault taken by their own handlers (SHCSR),
+ * the static constructors run (__libc_init_array). */
+void stm32_crt_init(void);
+
 /* Gates off, then wait for the independent watchdog; never returns. The
  * chip's start-up defines it. */
 void stm32_fault_halt(void) __attribute__((noreturn));

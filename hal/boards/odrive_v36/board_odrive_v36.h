@@ -1,0 +1,16 @@
+/*
+ * ODrive v3.6, axis M0 (ODrive Firmware/Board/v3, HW_VERSION 3.6, the 56 V
+ * variant): STM32F405RG at 168 MHz from an 8 MHz crystal, two TI DRV8301
+ * gate drivers (one per axis) sharing EN_GATE and nFAULT, on SPI3; low-side
+ * shunts on phases B and C, amplified by M0's DRV8301; UART4 on GPIO1/2.
+ * This image drives axis M0; axis M1's gate inputs and its brake-resistor
+ * switch are held off.
+ */
+#ifndef HAL_BOARDS_ODRIVE_V36_BOARD_ODRIVE_V36_H
+#define HAL_BOARDS_ODRIVE_V36_BOARD_ODRIVE_V36_H
+
+#include "f4_board.h"
+
+extern const f4_board_t f4_board_odrive_v36;
+
+#endif /* HAL_BOARDS_ODRIVE_V36_BOARD_ODRIVE_V36_H */
