@@ -7,6 +7,9 @@ samples, text responses, some frames damaged by a dropped or flipped byte)
 and the list of what it contains; the Python decoder must return every
 undamaged frame with the same values, drop every damaged one, keep the text
 lines, and agree with the C signal table.
+Also the console's helpers without a target: the build progress bar
+(build_progress.py) and the web server's rules (console_web.py: what a
+watching page may send, the phases of a flash run).
 """
 import os
 import struct
@@ -16,7 +19,9 @@ import tempfile
 import unittest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import build_progress as bp  # noqa: E402
 import console_proto as cp  # noqa: E402
+import console_web as cw  # noqa: E402
 
 GEN = None
 
@@ -149,6 +154,60 @@ class RecordedStreamTest(unittest.TestCase):
         last = rows[-1].split(",")
         self.assertAlmostEqual(float(last[2]),
                                (self.samples[clean[-1]][0] - tick) / self.meta[2], places=9)
+
+
+class BuildProgressTest(unittest.TestCase):
+    def test_counts_the_build_not_its_preamble_nor_an_inner_build(self):
+        now = [0.0]
+        out = open(os.devnull, "w")
+        self.addCleanup(out.close)
+        bar = bp.Bar("building x", out, tty=False, clock=lambda: now[0])
+        self.assertFalse(bar.feed("[0/2] Re-checking globbed directories..."))
+        now[0] = 4.0
+        self.assertTrue(bar.feed("[2/5] Building C object a.obj"))
+        # 4 s for 2 steps: 3 steps left take about 6 s
+        self.assertIn("2/5", bar.text())
+        self.assertIn("~0:06 left", bar.text())
+        # a build inside a step prints its own status lines when the step ends
+        self.assertFalse(bar.feed("[1/60] Building C object inner.o"))
+        self.assertFalse(bar.feed("[60/60] Linking inner"))
+        self.assertFalse(bar.feed("ninja: no work to do."))
+        self.assertTrue(bar.feed("[5/5] Linking C executable x.elf"))
+        self.assertEqual((bar.done, bar.total), (5, 5))
+        self.assertNotIn("left", bar.text())
+
+    def test_run_reports_status_and_tail(self):
+        rc, tail = bp.run_with_bar(["sh", "-c", "printf '[1/2] a\\n[2/2] b\\nboom\\n'; exit 3"],
+                                   "building t", out=open(os.devnull, "w"))
+        self.assertEqual(rc, 3)
+        self.assertEqual(tail[-1], "boom")
+
+
+class WebRulesTest(unittest.TestCase):
+    def test_a_watching_page_may_read_only(self):
+        for line in ("status", "help", "fault", "param list", "param get h_T", "tel list",
+                     "ctrl list", "ident status", "ident result", "ident ini", "bringup status"):
+            self.assertTrue(cw.reads_only(line), line)
+        for line in ("", "arm", "fault clear", "param set h_T 0.1", "ctrl select bst", "stop",
+                     "ident run", "bringup gates", "tel start speed", "config save", "disarm",
+                     "ref speed 100", "statusx", "config show"):
+            self.assertFalse(cw.reads_only(line), line)
+
+    def test_flash_phases_of_an_openocd_run(self):
+        pct, phases = 0, []
+        for line in ("tools/flash: programming pmsm-esc1.elf with openocd",
+                     "Open On-Chip Debugger 0.12.0", "** Programming Started **",
+                     "** Programming Finished **", "** Verify Started **", "** Verified OK **",
+                     "** Resetting Target **", "tools/flash: pmsm-esc1.elf written and verified"):
+            phase, pct2 = cw.flash_progress(line, pct)
+            self.assertGreaterEqual(pct2, pct)
+            pct = pct2
+            if phase:
+                phases.append(phase)
+        self.assertEqual(pct, 100)
+        self.assertEqual(phases[-1], "done")
+        self.assertIn("verifying", phases)
+        self.assertEqual(cw.flash_progress("  12/24 pages written", 20), ("writing", 40))
 
 
 if __name__ == "__main__":

@@ -15,26 +15,35 @@ Safety:
 - it listens on 127.0.0.1 unless --bind says otherwise; every request carries
   the token printed at start (a random 128-bit value), or it is refused (403);
   a WebSocket must also come from a page of this server (Origin);
-- one page controls, the others watch: a watcher's commands are refused, but
+- one page controls, the others watch: a watcher may send the commands that
+  only read (READ_ONLY: status, param list, ...), its others are refused, but
   STOP is obeyed from every page;
 - a command that energises the motor (arm, ident run/resume/step, bringup) is
   refused unless the page says the user confirmed it;
 - when the controlling page has been silent for --page-timeout seconds (tab
   closed, network gone, page frozen: its heartbeat stops), the drive gets
-  `stop` (gates off) and control is free again.
+  `stop` (gates off) and control is free again;
+- the firmware page flashes a board through tools/flash (the controlling page
+  only, confirmed, one run at a time, the drive stopped first); its output
+  reaches every page line by line with the phase it shows.
 """
 import asyncio
 import json
 import os
 import queue
+import re
 import secrets
+import subprocess
 import sys
 import threading
 import time
 
 import console_proto as cp
 
-WEB_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "web")
+TOOLS = os.path.dirname(os.path.abspath(__file__))
+WEB_DIR = os.path.join(TOOLS, "web")
+FLASH = os.path.join(TOOLS, "flash")
+STATIC_TYPES = {".js": "application/javascript", ".css": "text/css"}
 PUSH_PERIOD_S = 1.0 / 30.0   # samples and status reach the pages 30 times a second
 POLL_PERIOD_S = 0.25         # `status` when the line is idle
 CM_STATES = ("commission",)  # state names in which the commissioning status is polled
@@ -42,6 +51,43 @@ CM_STATES = ("commission",)  # state names in which the commissioning status is 
 # First words (and second, for ident) of commands that put voltage on the motor.
 ENERGISING = {("arm",), ("ident", "run"), ("ident", "resume"), ("ident", "step"), ("bringup",)}
 NOT_ENERGISING_BRINGUP = {"status"}
+
+
+# Commands that only read (firmware/PROTOCOL.md): a watching page may send them.
+# One word alone, or the first two words (any arguments after: `param get NAME`).
+READ_ONLY = {("status",), ("help",), ("fault",), ("param", "list"), ("param", "get"),
+             ("tel", "list"), ("ctrl", "list"), ("ident", "status"), ("ident", "result"),
+             ("ident", "ini"), ("bringup", "status")}
+
+# Phases of a flash run: a text in a line of tools/flash --progress (its own,
+# openocd's `program ... verify reset`, st-flash's `write`) and the share of
+# the run done when it appears.
+FLASH_PHASES = [
+    ("tools/flash: programming", "connecting to the probe", 5),
+    ("Programming Started", "writing", 20), ("Attempting to write", "writing", 20),
+    ("Programming Finished", "written", 60),
+    ("Verify Started", "verifying", 70), ("Starting verification", "verifying", 70),
+    ("Verified OK", "verified", 90),
+    ("Resetting Target", "resetting the board", 95),
+    ("written and verified", "done", 100),
+]
+PAGES_WRITTEN = re.compile(r"(\d+)/(\d+) pages written")  # st-flash: 20 % .. 60 %
+
+
+def flash_progress(line, pct):
+    """(phase or None, percent) after a line of tools/flash --progress."""
+    for text, phase, p in FLASH_PHASES:
+        if text in line:
+            return phase, max(pct, p)
+    m = PAGES_WRITTEN.search(line)
+    if m and int(m.group(2)) > 0:
+        return "writing", max(pct, 20 + 40 * int(m.group(1)) // int(m.group(2)))
+    return None, pct
+
+
+def reads_only(line):
+    w = line.split()
+    return (len(w) == 1 and (w[0],) in READ_ONLY) or (len(w) >= 2 and tuple(w[:2]) in READ_ONLY)
 
 
 def energises(line):
@@ -158,6 +204,7 @@ class LinkWorker(threading.Thread):
             names = cp.signal_names(f.mask)
             units = dict(cp.SIGNALS)
             self.emit({"type": "meta", "signals": names, "units": [units.get(n, "") for n in names],
+                       "scales": [s if s != 0.0 else 1.0 for s in f.scales],
                        "fs_hz": f.fs_hz, "every": f.every})
             return
         meta = self.rec.meta
@@ -210,6 +257,7 @@ class WebConsole:
         self.link = LinkWorker(tr, args.timeout, self._emit_threadsafe)
         self.last_status = {}
         self.meta = None
+        self.flashing = False     # a tools/flash run is under way
 
     # ---- events from the link thread
     def _emit_threadsafe(self, ev):
@@ -303,13 +351,79 @@ class WebConsole:
         if not (self._authorised(request) and self._host_ok(request)):
             return web.Response(status=403, text="console: token missing or wrong\n")
         name = request.match_info["name"]
-        types = {"console.js": "application/javascript", "console.css": "text/css",
-                 "plot.js": "application/javascript"}
-        if name not in types:
+        ext = os.path.splitext(name)[1]
+        # The page's own files only: a plain name in tools/web/, no path.
+        if not re.fullmatch(r"[a-z0-9_]+\.(js|css)", name) or \
+                not os.path.isfile(os.path.join(WEB_DIR, name)):
             return web.Response(status=404)
         with open(os.path.join(WEB_DIR, name), encoding="utf-8") as fh:
-            return web.Response(text=fh.read(), content_type=types[name],
+            return web.Response(text=fh.read(), content_type=STATIC_TYPES[ext],
                                 headers={"Cache-Control": "no-store"})
+
+    # ---- the firmware page
+    def _flash_argv(self, *opts):
+        argv = [FLASH] + list(opts)
+        if self.args.flash_tool:
+            argv += ["--tool", self.args.flash_tool]
+        if self.args.flash_image:
+            argv.append(self.args.flash_image)
+        return argv
+
+    def flash_info(self):
+        """What a flash would write and with what: the image (tools/flash
+        --which), its size and time, and the programmer's command or why
+        there is none (tools/flash --dry-run)."""
+        info = {"image": None, "bytes": None, "mtime": None, "command": None, "problem": None}
+        r = subprocess.run(self._flash_argv("--which"), stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+        if r.returncode == 0:
+            info["image"] = r.stdout.strip()
+            try:
+                st = os.stat(info["image"])
+                info["bytes"], info["mtime"] = st.st_size, st.st_mtime
+            except OSError:
+                pass
+        r = subprocess.run(self._flash_argv("--dry-run"), stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True)
+        if r.returncode == 0:
+            info["command"] = r.stdout.strip()
+        else:
+            info["problem"] = (r.stderr.strip().splitlines() or ["tools/flash exited %d" %
+                                                                r.returncode])[-1]
+        return info
+
+    async def _flash(self, page):
+        """One tools/flash --progress run; every line to every page with its phase."""
+        self.flashing = True
+        pct = 0
+        last = ""
+        try:
+            if self.link.gone is None:
+                self.link.submit("stop", "page%d" % page)  # flashing resets the board
+            await self._broadcast({"type": "flash", "start": True, "page": page,
+                                   "info": self.flash_info()})
+            proc = await asyncio.create_subprocess_exec(
+                *self._flash_argv("--progress"), stdout=asyncio.subprocess.PIPE,
+                stderr=asyncio.subprocess.STDOUT)
+            while True:
+                raw = await proc.stdout.readline()
+                if not raw:
+                    break
+                line = raw.decode("utf-8", "replace").rstrip()
+                if not line:
+                    continue
+                last = line
+                phase, pct = flash_progress(line, pct)
+                await self._broadcast({"type": "flash", "line": line, "phase": phase, "pct": pct})
+            rc = await proc.wait()
+        except OSError as e:
+            rc, last = 1, "tools/flash: cannot run: %s" % e
+        finally:
+            self.flashing = False
+        # tools/flash: 0 written and verified, 1 set-up or image, 2 no probe, 3 programmer failed
+        await self._broadcast({"type": "flash", "done": True, "rc": rc, "ok": rc == 0,
+                               "pct": 100 if rc == 0 else pct,
+                               "verdict": last if rc != 0 else "written and verified"})
 
     async def h_ws(self, request):
         from aiohttp import web, WSMsgType
@@ -328,7 +442,8 @@ class WebConsole:
                               "page_timeout_s": self.args.page_timeout,
                               "target_pid": self.tr.proc.pid if self.tr.proc else None,
                               "status": self.last_status, "meta": self.meta,
-                              "gone": self.link.gone})
+                              "gone": self.link.gone, "flash": self.flash_info(),
+                              "read_only": sorted(" ".join(k) for k in READ_ONLY)})
         await self._announce_roles()
         try:
             async for msg in ws:
@@ -367,14 +482,31 @@ class WebConsole:
                 await self._send(ws, {"type": "refused", "line": "",
                                       "why": "another page controls the drive"})
             return
+        if kind == "flash":
+            if ws is not self.controller:
+                await self._send(ws, {"type": "refused", "line": "flash",
+                                      "why": "this page watches; another page controls the drive"})
+            elif m.get("confirm") is not True:
+                await self._send(ws, {"type": "refused", "line": "flash",
+                                      "why": "flashing replaces the board's firmware: confirm it first"})
+            elif self.flashing:
+                await self._send(ws, {"type": "refused", "line": "flash",
+                                      "why": "a flash run is already under way"})
+            else:
+                asyncio.ensure_future(self._flash(page))
+            return
+        if kind == "flash_info":
+            await self._send(ws, {"type": "flash_info", "info": self.flash_info()})
+            return
         if kind != "cmd":
             return
         line = str(m.get("line", "")).strip()
         if not line:
             return
-        if ws is not self.controller:
+        if ws is not self.controller and not reads_only(line):
             await self._send(ws, {"type": "refused", "line": line,
-                                  "why": "this page watches; another page controls the drive"})
+                                  "why": "this page watches (it may read: status, param list, "
+                                         "...); another page controls the drive"})
             return
         if energises(line) and m.get("confirm") is not True:
             await self._send(ws, {"type": "refused", "line": line,

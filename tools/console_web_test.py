@@ -13,10 +13,17 @@ what the page plots and shows):
   - speed mode, 1000 r/min, arm through the confirmation dialog: the plotted
     speed reaches 1000 r/min (within 3 %: the speed loop's ripple and the
     estimate's quantisation are a few r/min);
+  - the plots of signals at rest (zero or flat) get axes of their own size,
+    at least 2 % of a per-unit step (the least span the META frame's scale
+    gives), with round ticks;
   - a tunable set out of range shows the firmware's own `err 4 range [min, max]`
     in the parameter's row;
   - STOP gives state=ready;
-  - a second page watches: its `arm` is refused;
+  - the firmware page without an ST-LINK (tools/flash sees no probe): the
+    page says so, in red, and nothing was written; with a probe (a stand-in
+    programmer on PATH that prints openocd's lines) it follows the phases to
+    "written and verified";
+  - a second page watches: its `arm` is refused, its `status` answered;
   - the controlling page lost (browser gone) with the drive armed: the drive is
     stopped within the page time-out;
   - QEMU killed: the page says "target gone"; the server neither crashes nor
@@ -41,6 +48,15 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CONSOLE = os.path.join(HERE, "console")
 PAGE_TIMEOUT_S = 1.5
 SPEED_RPM = 1000.0
+
+
+# What openocd prints for `program IMAGE verify reset exit` (its phases).
+FAKE_OPENOCD = '''#!/bin/sh
+echo "Open On-Chip Debugger 0.12.0 (stand-in)"
+sleep 0.3; echo "** Programming Started **"; sleep 0.5
+echo "** Programming Finished **"; echo "** Verify Started **"; sleep 0.5
+echo "** Verified OK **"; echo "** Resetting Target **"
+'''
 
 
 class Fail(Exception):
@@ -130,23 +146,34 @@ def http_status(url):
 
 async def watcher_checks(ws_url, expect_stop_within):
     """A second page (a plain WebSocket client): it is told it watches, its
-    `arm` is refused, and it sees the drive stopped once the controlling page
-    is gone. Returns the seconds from the browser's end to state=ready."""
+    `arm` is refused, its `status` is answered (a watcher reads), and it sees
+    the drive stopped once the controlling page is gone. Returns the seconds
+    from the browser's end to state=ready."""
     import aiohttp
     async with aiohttp.ClientSession() as s:
         async with s.ws_connect(ws_url, origin=ws_url.replace("ws://", "http://").split("/ws")[0]) as ws:
-            role = refused = None
+            role = refused = page = answered = None
             end = time.monotonic() + 20
             await ws.send_str(json.dumps({"type": "cmd", "line": "arm", "confirm": True}))
-            while time.monotonic() < end and (role is None or refused is None):
+            await ws.send_str(json.dumps({"type": "cmd", "line": "status"}))
+            while time.monotonic() < end and (role is None or refused is None or answered is None):
                 m = json.loads((await ws.receive(timeout=20)).data)
                 if m["type"] == "role":
-                    role = m["role"]
+                    role, page = m["role"], m["page"]
                 if m["type"] == "refused" and m["line"] == "arm":
                     refused = m["why"]
+                if m["type"] == "refused" and m["line"] == "status":
+                    raise Fail("second page: status refused (%s)" % m["why"])
+                if (m["type"] == "reply" and m["line"] == "status" and page is not None and
+                        m["origin"] == "page%d" % page):
+                    answered = m["lines"]
             if role != "watch" or refused is None:
                 raise Fail("second page: role %r, arm refused %r" % (role, refused))
-            print("  watcher: role=watch, arm refused (%s)" % refused)
+            if not answered or not answered[0].startswith("ok") or \
+                    not any(l.strip().startswith("state=") for l in answered):
+                raise Fail("second page: status not answered (%r)" % answered)
+            print("  watcher: role=watch, arm refused (%s); status answered (%s)" %
+                  (refused, [l.strip() for l in answered if "state=" in l][0]))
             # Hand over to the caller, who ends the controlling browser now.
             yield_at = time.monotonic()
             await ws.send_str(json.dumps({"type": "heartbeat"}))
@@ -164,6 +191,73 @@ async def watcher_checks(ws_url, expect_stop_within):
             raise Fail("the drive was not stopped after the controlling page was lost")
 
 
+def check_rest_axes(wd):
+    """At rest (ready, nothing turns) the plotted signals are zero or flat: each
+    chart's axis is at least 2 % of a per-unit step of its signals (META
+    scale x 2^24; one count for the integer-coded ones) and its ticks are round."""
+    time.sleep(1.0)  # a few frames drawn
+    charts = wd.js("const c = consoleState.charts; return c.groups.map((g, j) => ({names: "
+                   "g.map((k) => c.series.names[k]), scales: g.map((k) => c.series.scales[k]), "
+                   "axis: c.axes[j]}))")
+    for ch in charts:
+        ax = ch["axis"]
+        need = max(1.0 if abs(sc) == 1.0 else 0.02 * abs(sc) * 2 ** 24 for sc in ch["scales"])
+        span = ax["hi"] - ax["lo"]
+        mant = ax["step"] / 10 ** __import__("math").floor(__import__("math").log10(ax["step"]))
+        if not (span >= need * (1 - 1e-9)) or not any(abs(mant - m) < 1e-6 for m in (1, 2, 2.5, 5)):
+            raise Fail("chart %s at rest: axis %r, least span %g" % (ch["names"], ax, need))
+    print("  at rest: %d charts, axes e.g. %s [%g, %g] step %g" % (
+        len(charts), charts[0]["names"][0], charts[0]["axis"]["lo"], charts[0]["axis"]["hi"],
+        charts[0]["axis"]["step"]))
+
+
+def check_firmware_page(wd, usb):
+    """The firmware page: no probe -> the page's error; a probe -> the phases."""
+    wd.click('button[data-tab="tab-fw"]')
+    flash = lambda: wd.js("return consoleState.flash")
+    wait_for("the image the page would flash", lambda: (flash().get("info") or {}).get("image"), 20)
+
+    def start_flash():
+        wd.click("#fw-flash")
+        if wd.js("return document.getElementById('modal').classList.contains('hidden')"):
+            raise Fail("flash did not ask for a confirmation")
+        wd.click("#modal-ok")
+        wait_for("the flash run to start", lambda: not flash()["done"], 20, 0.02)
+
+    start_flash()
+    f = wait_for("the flash run's end", lambda: flash()["done"] and flash(), 60)
+    shown = wd.js("const v = document.getElementById('fw-verdict');"
+                  "return [v.textContent, getComputedStyle(v).color]")
+    if f["ok"] or f["rc"] != 2 or "no ST-LINK probe found" not in f["verdict"] or \
+            "no ST-LINK probe found" not in shown[0] or shown[1] != "rgb(183, 28, 28)":
+        raise Fail("firmware page without a probe: %r, shown %r" % (f, shown))
+    print("  firmware page, no probe: %s" % shown[0])
+    dev = os.path.join(usb, "1-1")  # an ST-LINK/V2-1 appears
+    os.makedirs(dev)
+    with open(os.path.join(dev, "idVendor"), "w") as fh:
+        fh.write("0483\n")
+    with open(os.path.join(dev, "idProduct"), "w") as fh:
+        fh.write("374b\n")
+    seen = []
+    start_flash()
+    end = time.monotonic() + 60
+    while time.monotonic() < end:
+        f = flash()
+        if f["phase"] and (not seen or seen[-1] != (f["phase"], f["pct"])):
+            seen.append((f["phase"], f["pct"]))
+        if f["done"]:
+            break
+        time.sleep(0.05)
+    phases = [p for p, _ in seen]
+    if not f["done"] or not f["ok"] or f["pct"] != 100 or "writing" not in phases or \
+            "verifying" not in phases or [q for _, q in seen] != sorted(q for _, q in seen):
+        raise Fail("firmware page with a probe: %r, phases seen %r" % (f, seen))
+    print("  firmware page, probe (stand-in openocd): %s -> %s" % (
+        " -> ".join("%s %d%%" % x for x in seen), wd.js(
+            "return document.getElementById('fw-verdict').textContent")))
+    wd.click('button[data-tab="tab-cmd"]')
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("elf")
@@ -177,11 +271,28 @@ def main():
                    "chromium-driver)")
     tmp = tempfile.mkdtemp(prefix="console-web-")
     url_file = os.path.join(tmp, "url")
+    # The firmware page's world: an image to write, no ST-LINK on the USB the
+    # server sees (PMSM_FLASH_USB_ROOT, so a probe on this machine is never
+    # touched), and on its PATH a stand-in openocd that prints the real one's
+    # lines for `program ... verify reset`, pausing between them.
+    usb = os.path.join(tmp, "usb")
+    os.makedirs(usb)
+    fake_bin = os.path.join(tmp, "bin")
+    os.makedirs(fake_bin)
+    with open(os.path.join(fake_bin, "openocd"), "w") as fh:
+        fh.write(FAKE_OPENOCD)
+    os.chmod(os.path.join(fake_bin, "openocd"), 0o755)
+    image = os.path.join(tmp, "pmsm-esc1.elf")
+    with open(image, "wb") as fh:
+        fh.write(b"\x7fELF" + bytes(60))
+    env = dict(os.environ, PMSM_FLASH_USB_ROOT=usb,
+               PATH=fake_bin + os.pathsep + os.environ.get("PATH", ""))
     # The emulated target (QEMU runs flat out) yields to the browser, as a
     # user's machine would give the page the priority.
     server = subprocess.Popen(["nice", "-n", "10", CONSOLE, "--web", "--qemu", a.elf, "--port", "0",
-                               "--page-timeout", str(PAGE_TIMEOUT_S), "--url-file", url_file],
-                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                               "--page-timeout", str(PAGE_TIMEOUT_S), "--url-file", url_file,
+                               "--flash-image", image, "--flash-tool", "openocd"],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env)
     dport = free_port()
     cd = subprocess.Popen([driver, "--port=%d" % dport], stdout=subprocess.DEVNULL,
                           stderr=subprocess.DEVNULL)
@@ -217,6 +328,7 @@ def main():
             raise Fail("state after calibration: %s" % s["state"])
         wait_for("telemetry with speed", lambda: "speed" in ((st() or {}).get("meta") or []), 60)
         print("  connected, controlling, calibrated, streaming")
+        check_rest_axes(wd)
 
         # Speed mode, 1000 r/min, arm with the confirmation.
         wd.js("document.getElementById('mode').value = 'speed';")
@@ -272,6 +384,8 @@ def main():
         wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready" and
                  (st() or {}).get("armed") == "0", 30)
         print("  STOP -> state=ready")
+
+        check_firmware_page(wd, usb)
 
         # Second page; then the controlling page is lost with the drive armed.
         wd.click("#arm")

@@ -7,14 +7,18 @@
   with the image and exits 0; without an ST-LINK (PMSM_FLASH_USB_ROOT at an
   empty directory, so a probe on this machine is never touched) it exits 2
   with one line that says no ST-LINK probe was found; a fake ST-LINK entry
-  (vendor 0483, product 374b) gets past that check in --dry-run; an unknown
-  option and a missing image fail with a message.
+  (vendor 0483, product 374b) gets past that check in --dry-run; with it and a
+  stand-in openocd on PATH (it prints openocd's program/verify lines, pausing
+  between them), --progress streams those lines as they come, before the
+  verdict; --which names the image; an unknown option and a missing image
+  fail with a message.
 """
 import os
 import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
 
 def run(args, env=None):
@@ -22,6 +26,36 @@ def run(args, env=None):
     e.update(env or {})
     r = subprocess.run(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=e)
     return r.returncode, r.stdout, r.stderr
+
+
+FAKE_OPENOCD = '''#!/bin/sh
+echo "Open On-Chip Debugger (stand-in)"
+echo "** Programming Started **"; sleep 0.4
+echo "** Programming Finished **"; echo "** Verify Started **"; sleep 0.4
+echo "** Verified OK **"; echo "** Resetting Target **"
+'''
+
+
+def check_progress(flash, elf, usb, check):
+    """--progress streams the programmer's lines while it runs: the first
+    arrives before the programmer ends (0.8 s of pauses), the verdict last."""
+    with tempfile.TemporaryDirectory() as bindir:
+        fake = os.path.join(bindir, "openocd")
+        with open(fake, "w") as fh:
+            fh.write(FAKE_OPENOCD)
+        os.chmod(fake, 0o755)
+        env = dict(os.environ, PMSM_FLASH_USB_ROOT=usb, PATH=bindir + os.pathsep + os.environ["PATH"])
+        t0 = time.monotonic()
+        p = subprocess.Popen([flash, "--progress", "--tool", "openocd", elf], stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True, env=env)
+        seen = []
+        for line in p.stdout:
+            seen.append((time.monotonic() - t0, line.rstrip()))
+        rc = p.wait()
+        started = [t for t, l in seen if "Programming Started" in l]
+        check(rc == 0 and started and started[0] < seen[-1][0] - 0.5 and
+              "written and verified" in seen[-1][1] and any("Verified OK" in l for _, l in seen),
+              "--progress: the programmer's lines as they come, then the verdict", repr(seen))
 
 
 def main():
@@ -59,6 +93,9 @@ def main():
         open(os.path.join(dev, "idProduct"), "w").write("374b\n")
         rc, out, err = run([flash, "--dry-run", elf], {"PMSM_FLASH_USB_ROOT": usb})
         check(rc == 0, "a probe present: --dry-run still only prints", out + err)
+        check_progress(flash, elf, usb, check)
+    rc, out, err = run([flash, "--which", "--tool", "st-flash", elf])
+    check(rc == 0 and out.strip() == elf[:-4] + ".bin", "--which: st-flash writes the .bin", out + err)
     rc, out, err = run([flash, "--bogus"])
     check(rc != 0 and "unknown option" in err, "unknown option refused", out + err)
     rc, out, err = run([flash, "--dry-run", "/nonexistent/pmsm-esc1.elf"])

@@ -13,10 +13,24 @@ const DEFAULT_SIGNALS = ['speed', 'speed_ref', 'torque', 'torque_ref', 'i_d', 'i
 const S = {
   ws: null, connected: false, role: null, page: null, gone: null, target: '',
   status: {}, counters: { frames: 0, bad: 0, lost: 0 }, meta: null, signals: [],
-  params: [], ctrls: [], cm: null, replies: [], autostarted: false,
-  recording: null, history: [], histPos: 0, paramMsg: {},
+  ctrls: [], cm: null, replies: [], autostarted: false,
+  recording: null, history: [], histPos: 0,
 };
 window.consoleState = S;
+
+// Extension points for the page's other scripts (params.js, firmware.js, and
+// any later view): replyHooks get every command reply, msgHooks[type] every
+// server message of that type, renderHooks run after each render.
+const replyHooks = [];
+const msgHooks = {};
+const renderHooks = [];
+window.pmsm = {
+  S, $, command: (l, o) => command(l, o), log: (t, c) => log(t, c), send: (m) => send(m),
+  confirmThen: (t, a) => confirmThen(t, a), listLines: (m) => listLines(m),
+  onReply: (fn) => replyHooks.push(fn),
+  onMessage: (type, fn) => { (msgHooks[type] = msgHooks[type] || []).push(fn); },
+  onRender: (fn) => renderHooks.push(fn),
+};
 
 const charts = new StripCharts($('plotarea'), (t) => {
   const r = t === null ? null : charts.valuesAt(t);
@@ -103,6 +117,7 @@ function onMessage(m) {
     case 'text': log(m.line, 'info'); break;
     case 'gone': onGone(m.reason); break;
   }
+  for (const fn of msgHooks[m.type] || []) fn(m);
   render();
 }
 
@@ -114,7 +129,7 @@ function onGone(reason) {
 
 function onMeta(m) {
   S.meta = m;
-  charts.setSeries(new Series(m.signals, m.units, KEEP_S));
+  charts.setSeries(new Series(m.signals, m.units, KEEP_S, m.scales));
 }
 
 function maybeAutostart() {
@@ -131,17 +146,16 @@ function listLines(m) { return m.lines.slice(1).map((l) => l.replace(/^ {2}/, ''
 function onReply(m) {
   const first = m.lines[0] || '';
   const mine = m.origin === 'page' + S.page;
-  if (m.origin !== 'poll' && mine && !(m.line === 'tel list' || m.line === 'ctrl list' ||
-      m.line === 'param list')) {
+  if (m.origin !== 'poll' && mine && !QUIET.has(m.line) && !/^param get /.test(m.line)) {
     for (const l of m.lines) log(l, m.ok ? '' : 'err');
   } else if (m.origin !== 'poll' && !mine && m.origin !== 'page-loss') {
     log('[' + m.origin + '] > ' + m.line + '  → ' + first, m.ok ? 'info' : 'err');
   }
   S.replies.push({ line: m.line, ok: m.ok, lines: m.lines, origin: m.origin });
   if (S.replies.length > 200) S.replies.shift();
-  const w = m.line.split(/\s+/);
-  if (w[0] === 'param' && w[1] === 'set') markParam(w[2], m.ok, first);
+  for (const fn of replyHooks) fn(m);
   if (!m.ok) return;
+  const w = m.line.split(/\s+/);
   if (m.line === 'tel list') {
     S.signals = listLines(m).map((l) => {
       const p = l.trim().split(/\s+/);
@@ -151,13 +165,8 @@ function onReply(m) {
   } else if (m.line === 'ctrl list') {
     S.ctrls = listLines(m).map((l) => { const p = l.trim().split(/\s+/); return { sel: p[0] === '*', name: p[1] }; });
     buildCtrls();
-  } else if (m.line === 'param list') {
-    S.params = listLines(m).map(parseParam).filter((p) => p);
-    buildParams();
-  } else if (w[0] === 'param' && w[1] === 'set') {
-    command('param list', { quiet: true });
   } else if ((w[0] === 'ctrl' && w[1] === 'select') || m.line === 'ident apply') {
-    command('param list', { quiet: true }); command('ctrl list', { quiet: true });
+    command('ctrl list', { quiet: true });
   } else if (m.line === 'ident status' || m.line === 'bringup status') {
     onCmStatus(m.line, first);
   } else if (m.line === 'ident result') {
@@ -165,15 +174,8 @@ function onReply(m) {
   }
 }
 
-function parseParam(l) {
-  const w = l.trim().split(/\s+/);
-  if (w.length < 3) return null;
-  const p = { name: w[0], value: w[1], unit: w[2] === '-' ? '' : w[2], range: '', ro: false };
-  const rest = l.trim().split(/\s+/).slice(3).join(' ');
-  const mr = rest.match(/^\[([^\]]*)\]\s*(ro\b)?\s*(.*)$/);
-  if (mr) { p.range = '[' + mr[1] + ']'; p.ro = !!mr[2]; p.help = mr[3]; } else p.help = rest;
-  return p;
-}
+// Replies the page asks for itself: not echoed in the command log.
+const QUIET = new Set(['tel list', 'ctrl list', 'param list']);
 
 // ---------------------------------------------------------------- building the panels
 function buildSignals() {
@@ -198,40 +200,6 @@ function buildCtrls() {
     o.value = o.textContent = c.name; o.selected = c.sel;
     sel.appendChild(o);
   }
-}
-
-function buildParams() {
-  const tb = $('params').tBodies[0];
-  tb.textContent = '';
-  for (const p of S.params) {
-    const tr = document.createElement('tr');
-    tr.dataset.param = p.name;
-    const cells = [p.name, null, p.unit, p.range + (p.ro ? ' ro' : ''), ''];
-    cells.forEach((c, i) => {
-      const td = document.createElement('td');
-      if (i === 1) {
-        const inp = document.createElement('input');
-        inp.value = p.value; inp.disabled = p.ro; inp.title = p.help || '';
-        inp.addEventListener('keydown', (e) => {
-          if (e.key === 'Enter') command('param set ' + p.name + ' ' + inp.value.trim());
-        });
-        td.appendChild(inp);
-      } else td.textContent = c;
-      if (i === 4) td.className = 'msg';
-      tr.appendChild(td);
-    });
-    tb.appendChild(tr);
-    const msg = S.paramMsg[p.name];
-    if (msg) markParam(p.name, msg.ok, msg.text);
-  }
-}
-
-function markParam(name, ok, text) {
-  S.paramMsg[name] = { ok, text };
-  const tr = document.querySelector('tr[data-param="' + CSS.escape(name) + '"]');
-  if (!tr) return;
-  const td = tr.querySelector('td.msg');
-  td.textContent = text; td.classList.toggle('err', !ok); td.classList.toggle('ok', ok);
 }
 
 function onCmStatus(which, first) {
@@ -296,6 +264,7 @@ function render() {
   role.className = 'chip ' + (S.role === 'control' ? 'ok' : '');
   $('take').classList.toggle('hidden', S.role !== 'watch');
   $('rec-info').textContent = S.recording ? S.recording.rows.length + ' samples' : '';
+  for (const fn of renderHooks) fn();
 }
 
 function frame() {
@@ -344,7 +313,6 @@ function wire() {
   $('win').onchange = () => { const v = +$('win').value; if (v > 0) charts.windowS = v; };
   $('pause').onclick = () => charts.pause();
   $('live').onclick = () => charts.goLive();
-  $('params-load').onclick = () => command('param list', { quiet: true });
   $('rec').onclick = () => {
     if (S.recording) { S.recording.stopped = true; S.lastRecording = S.recording; S.recording = null; $('rec').textContent = 'record'; } else if (S.meta) {
       S.recording = { names: S.meta.signals, units: S.meta.units, rows: [] };
@@ -381,6 +349,9 @@ function wire() {
   });
 }
 
-wire();
-connect();
-requestAnimationFrame(frame);
+// After every script of the page has registered its hooks (they are deferred).
+document.addEventListener('DOMContentLoaded', () => {
+  wire();
+  connect();
+  requestAnimationFrame(frame);
+});

@@ -6,8 +6,10 @@
 'use strict';
 
 class Series {
-  constructor(names, units, keepS) {
+  // scales: SI per raw count of each signal (the META frame), for the axes' least span.
+  constructor(names, units, keepS, scales) {
     this.names = names; this.units = units; this.keepS = keepS;
+    this.scales = scales || names.map(() => 1);
     this.t = []; this.v = names.map(() => []);
   }
   push(rows) {
@@ -43,6 +45,7 @@ class StripCharts {
     this.frames = 0; this.fps = 0; this.fpsT0 = performance.now(); this.drag = null;
     this.drawn = 0;  // frames rendered since the page opened
     this.drawMs = 0; // milliseconds spent drawing them
+    this.axes = [];  // the y axis each chart was last drawn with ({lo, hi, step}; tests read it)
   }
   setSeries(series) {
     this.series = series;
@@ -142,23 +145,23 @@ class StripCharts {
     g.clearRect(0, 0, w, h);
     const s = this.series, t = s.t;
     const L = 52, R = 6, T = 16, B = 14, pw = w - L - R, ph = h - T - B;
-    // y range over the visible samples, with a margin; at least a tiny span.
+    // y range over the visible samples, widened to at least the group's least span.
     let lo = Infinity, hi = -Infinity;
     for (const k of group) {
       const v = s.v[k];
       for (let i = i0; i <= i1; i++) { const y = v[i]; if (y < lo) lo = y; if (y > hi) hi = y; }
     }
-    if (!(lo <= hi)) { lo = -1; hi = 1; }
-    const span = Math.max(hi - lo, Math.abs(hi) * 1e-3, 1e-9);
-    lo -= span * 0.08; hi += span * 0.08;
+    const ax = niceAxis(lo, hi, Math.max(...group.map((k) => leastSpan(s.scales[k]))));
+    this.axes[this.canvases.indexOf(c)] = ax;
+    lo = ax.lo; hi = ax.hi;
     const X = (x) => L + (x - t0) / (t1 - t0) * pw;
     const Y = (y) => T + (hi - y) / (hi - lo) * ph;
     g.strokeStyle = '#e3e6ea'; g.fillStyle = '#666'; g.font = '10px sans-serif';
     g.lineWidth = 1;
-    for (let j = 0; j <= 4; j++) {
-      const yv = lo + (hi - lo) * j / 4, yy = Y(yv);
+    for (let yv = lo; yv <= hi + ax.step * 1e-6; yv += ax.step) {
+      const yy = Y(yv);
       g.beginPath(); g.moveTo(L, yy); g.lineTo(L + pw, yy); g.stroke();
-      g.fillText(fmt(yv), 2, yy + 3);
+      g.fillText(fmt(Math.abs(yv) < ax.step * 1e-6 ? 0 : yv), 2, yy + 3);
     }
     g.fillText(fmt(t0) + ' s', L, h - 2);
     const tr = fmt(t1) + ' s';
@@ -206,6 +209,30 @@ class StripCharts {
 
 const COLORS = ['#1565c0', '#c62828', '#2e7d32', '#6a1b9a', '#ef6c00', '#00838f', '#4e342e',
   '#ad1457'];
+
+// The least span a chart shows: 2 % of one per-unit step of a signal sent in
+// Q24 per unit (2^24 counts), one count of an integer-coded one (scale 1: the
+// vector, the state, ...). A flat or quiet signal then gets an axis of its
+// own size, not one that magnifies its last bit (or +-1e-9 around zero).
+function leastSpan(scale) {
+  const s = Math.abs(scale);
+  if (!(s > 0) || s === 1) return 1;
+  return 0.02 * s * 16777216;
+}
+
+// An axis over [lo, hi] at least minSpan wide, centred on the data when it is
+// narrower, with a 5 % margin, at round ticks (1, 2, 2.5 or 5 x 10^n) and
+// about four steps: {lo, hi, step}. No data (lo > hi): around 0.
+function niceAxis(lo, hi, minSpan) {
+  if (!(lo <= hi)) { lo = 0; hi = 0; }
+  if (hi - lo < minSpan) { const mid = (lo + hi) / 2; lo = mid - minSpan / 2; hi = mid + minSpan / 2; }
+  const margin = (hi - lo) * 0.05;
+  lo -= margin; hi += margin;
+  const raw = (hi - lo) / 4;
+  const mag = Math.pow(10, Math.floor(Math.log10(raw)));
+  const step = [1, 2, 2.5, 5, 10].map((m) => m * mag).find((x) => x >= raw * (1 - 1e-9));
+  return { lo: Math.floor(lo / step) * step, hi: Math.ceil(hi / step) * step, step };
+}
 
 function fmt(x) {
   if (!isFinite(x)) return String(x);
