@@ -143,7 +143,11 @@ static int op_select_controller(void *ctx, const char *name)
 
 static int op_arm(void *ctx)
 {
-    fw_t *fw = fw_link_of(ctx)->fw;
+    const fw_link_t *l = fw_link_of(ctx);
+    fw_t *fw = l->fw;
+    if (l->hold != NULL) {
+        return CMD_E_STATE; /* op_state_detail names why */
+    }
     if (fw_state(fw) == FW_STATE_FAULT) {
         return CMD_E_FAULT;
     }
@@ -373,6 +377,10 @@ static int op_cm_start(void *ctx, const char *what, const char **detail)
 {
     fw_link_t *l = fw_link_of(ctx);
     fw_t *fw = l->fw;
+    if (l->hold != NULL) {
+        *detail = l->hold;
+        return CMD_E_STATE;
+    }
     uint8_t steps[CM_STEP_COUNT];
     uint8_t n = 0;
     const bool run = strcmp(what, "run") == 0;
@@ -461,6 +469,9 @@ static bool op_config_item_at(void *ctx, size_t index, cmd_config_item_t *it)
 static const char *op_state_detail(void *ctx)
 {
     fw_link_t *l = fw_link_of(ctx);
+    if (l->hold != NULL) {
+        return l->hold; /* held off for good: that is the state */
+    }
     fw_state_id_t s;
     const char *req = fw_gates_request_pending(l->fw, &s);
     if (req != NULL) {

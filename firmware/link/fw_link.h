@@ -58,6 +58,11 @@ typedef struct {
     fw_settings_t *settings;
     int (*settings_cmd)(fw_settings_t *st, fw_t *fw, const char *what, const char **detail);
     bool (*settings_item)(const fw_settings_t *st, size_t index, cmd_config_item_t *it);
+    /* Why the board holds its gates off for good (a failed start-up: its
+     * gate driver did not answer, the clock fell back), NULL: not held.
+     * "arm", "ident ..." and "bringup ..." are then refused with it as the
+     * detail of "err 8 state" (fw_link_set_hold). */
+    const char *hold;
 } fw_link_t;
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
@@ -67,6 +72,12 @@ void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, v
  * fw_link_init; it must outlive the link; NULL detaches it). In
  * fw_settings.c, so that an image without settings does not link them. */
 void fw_link_set_settings(fw_link_t *l, fw_settings_t *st);
+/* The board holds its gates off for good, for the reason `why` (a sentence
+ * that outlives the link), or no longer (NULL). */
+static inline void fw_link_set_hold(fw_link_t *l, const char *why)
+{
+    l->hold = why;
+}
 /* For an application parameter's set (main loop) that fails because the core
  * refused the configuration: the reason (fw_t.why before the application
  * restores its previous data), sent as the detail of "err 10 failed". */

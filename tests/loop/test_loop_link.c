@@ -146,6 +146,35 @@ static void test_fault_over_link(void)
     TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
 }
 
+/* A board that holds its gates off for good (fw_link_set_hold: its gate
+ * driver did not answer at start-up): arm, identification and bring-up are
+ * refused with the board's reason as the detail of "err 8 state", the
+ * drive stays disarmed; released, arm works again. */
+static void test_board_hold_refuses_by_name(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 0.0, 0.3, 0.0);
+    loop_start(&run, &c);
+    fw_link_init(&link, &run.fw, link_text_capture, &lt);
+    periods(2);
+    send("disarm");
+    periods(1);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
+    static const char why[] = "gates held off: DRV8301 no answer on SPI";
+    fw_link_set_hold(&link, why);
+    send("arm");
+    TEST_ASSERT_EQUAL_STRING("err 8 state gates held off: DRV8301 no answer on SPI\r\n", lt.out);
+    send("ident run");
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "err 8 state gates held off: DRV8301 no answer on SPI"));
+    send("bringup gates");
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "err 8 state gates held off"));
+    periods(2);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&run.fw));
+    fw_link_set_hold(&link, NULL);
+    send("arm");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok armed", 8));
+}
+
 /* Application parameters (fw_link_set_params, e.g. a board's machine data):
  * listed after the controller's tunables, read and written by name, the
  * interpreter's range check applies, a read-only one answers err 11, the
@@ -314,6 +343,7 @@ int main(void)
     RUN_TEST(test_application_parameters);
     RUN_TEST(test_telemetry_frames);
     RUN_TEST(test_fault_over_link);
+    RUN_TEST(test_board_hold_refuses_by_name);
     RUN_TEST(test_max_speed_refusal_is_named);
     RUN_TEST(test_overspeed_refusal_is_named);
     RUN_TEST(test_tiny_inertia_encoder_limits);
