@@ -41,7 +41,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-import fw_studies as fws  # noqa: E402  (write_ini: one home for machine-file variants)
+import fieldweak_studies as fws  # noqa: E402  (write_ini: one home for machine-file variants)
 
 ROOT = os.path.dirname(HERE)
 MDIR = os.path.join(ROOT, "sim_host", "machines")

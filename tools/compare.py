@@ -960,7 +960,7 @@ def main():
       "(`tools/filters.py`).\n")
     w("Field weakening (torque-speed envelope of every controller), the voltage-replacement "
       "angle σ, the flux-ripple gap and the robustness to parameter errors: "
-      "[fieldweak.md](fieldweak.md) (`tools/fw_studies.py`).\n")
+      "[fieldweak.md](fieldweak.md) (`tools/fieldweak_studies.py`).\n")
     w("## Findings\n")
     w("### The sources' claims beside the measurements\n")
     w("Verdicts: *reproduced* — same direction and a size within ±50 % of the claim (for "

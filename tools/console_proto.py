@@ -26,7 +26,7 @@ SIGNALS = [
     ("vector", ""), ("duty", ""), ("vdc", "V"), ("theta", "rad"),
     ("sector", ""), ("state", ""), ("fault", ""), ("cycles", ""),
     ("cm_step", ""), ("cm_progress", ""),
-    ("torque_max", "N*m"), ("fw_limit", ""),
+    ("torque_max", "N*m"), ("fieldweak_limit", ""),
 ]
 
 

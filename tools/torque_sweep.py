@@ -71,7 +71,7 @@ LIMIT_WORDS = ("was limited to", "outside the drive's torque limit",
 # FW_TORQUE_FLUX_MARGIN): the load angle's ripple must stay below the peak.
 FLUX_MARGIN = 0.95
 # The same in regenerative braking (control/regulators/field_weak_config.h,
-# CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT): there the zero vector carries the load
+# CTRL_FIELDWEAK_TORQUE_MARGIN_BRAKE_DEFAULT): there the zero vector carries the load
 # angle toward the pull-out.
 FLUX_MARGIN_BRAKE = 0.88
 HALVES = ("motoring", "braking")

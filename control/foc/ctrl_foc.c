@@ -76,7 +76,7 @@ void ctrl_foc_reset(void *state)
     s->pi_q.integ = 0;
     s->v_d = 0;
     s->v_q = 0;
-    ctrl_fieldweak_reset(&s->fw);
+    ctrl_fieldweak_reset(&s->fieldweak);
 }
 
 /* foc: PI current loops + SVPWM. */
@@ -148,8 +148,8 @@ void ctrl_foc_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
     if (ctx->ref->psi > 0) {
         /* d-axis current from the voltage limit: the flux circle the voltage
          * allows (MTPA currents when their flux is inside it). */
-        ctrl_fieldweak_currents(&s->fw, ctx->params, ctx->ref->torque, ctx->ref->psi, &id_ref,
-                                &iq_ref);
+        ctrl_fieldweak_currents(&s->fieldweak, ctx->params, ctx->ref->torque, ctx->ref->psi,
+                                &id_ref, &iq_ref);
     } else {
         ctrl_foc_iref(ctx->params, &s->iref, ctx->ref->torque, &id_ref, &iq_ref);
     }

@@ -53,7 +53,7 @@ typedef struct {
     ctrl_foc_iref_t iref;
     /* Field weakening (ref->psi > 0 below the MTPA flux): the currents of the
      * torque on that flux circle (ctrl_fieldweak_currents, MTPV at most). */
-    ctrl_fieldweak_t fw;
+    ctrl_fieldweak_t fieldweak;
     ctrl_foc_pi_t pi_d, pi_q;
     q24_t v_d, v_q; /* last commanded voltage before the limit (telemetry/tests), Q24 pu */
 } ctrl_foc_state_t;

@@ -125,9 +125,10 @@ static int foc_init_common(void *state, const void *cfg, const ctrl_setup_t *su,
     if (rc == CTRL_OK) {
         /* The flux-circle constants of the machine (current and voltage
          * limits unused here: the pipeline limits the torque). */
-        ctrl_fieldweak_cfg_t fwc;
-        ctrl_fieldweak_cfg_default(&fwc);
-        rc = ctrl_fieldweak_init(&s->fw, &fwc, su->machine, su->bases, p, NULL, 0u);
+        ctrl_fieldweak_cfg_t fieldweak_cfg;
+        ctrl_fieldweak_cfg_default(&fieldweak_cfg);
+        rc =
+            ctrl_fieldweak_init(&s->fieldweak, &fieldweak_cfg, su->machine, su->bases, p, NULL, 0u);
         if (rc != CTRL_OK && !(su->machine->lq_h >= su->machine->ld_h)) {
             rc = ctrl_setup_refuse(su, rc, "lq_h (reverse saliency Lq < Ld, field weakening)", "H",
                                    su->machine->lq_h, su->machine->ld_h, INFINITY);

@@ -71,12 +71,12 @@
 
 /* What bounds the torque at this speed and DC link. */
 typedef enum {
-    CTRL_FW_LIMIT_CURRENT = 0, /* current circle (MTPA at I_max): below base speed */
-    CTRL_FW_LIMIT_VOLTAGE = 1, /* current circle and voltage ellipse: field weakening */
-    CTRL_FW_LIMIT_MTPV = 2,    /* voltage alone (MTPV, IPMSM with psi_pm/Ld < I_max) */
-    CTRL_FW_LIMIT_FLUX = 3,    /* a fixed flux reference below the voltage's limit */
-    CTRL_FW_LIMIT_COUNT = 4
-} ctrl_fw_limit_t;
+    CTRL_FIELDWEAK_LIMIT_CURRENT = 0, /* current circle (MTPA at I_max): below base speed */
+    CTRL_FIELDWEAK_LIMIT_VOLTAGE = 1, /* current circle and voltage ellipse: field weakening */
+    CTRL_FIELDWEAK_LIMIT_MTPV = 2,    /* voltage alone (MTPV, IPMSM with psi_pm/Ld < I_max) */
+    CTRL_FIELDWEAK_LIMIT_FLUX = 3,    /* a fixed flux reference below the voltage's limit */
+    CTRL_FIELDWEAK_LIMIT_COUNT = 4
+} ctrl_fieldweak_limit_t;
 
 typedef struct {
     /* configuration (field_weak_config.c) */
@@ -125,7 +125,7 @@ typedef struct {
     q24_t torque_max;  /* |torque| limit (> = 0) */
     q24_t torque;      /* request clamped to +-torque_max */
     q24_t psi_ref;     /* stator-flux amplitude reference for torque */
-    uint8_t limit;     /* ctrl_fw_limit_t: what bounds torque_max */
+    uint8_t limit;     /* ctrl_fieldweak_limit_t: what bounds torque_max */
     uint8_t clipped;   /* 1 when the request was larger than torque_max */
     uint8_t weakening; /* 1 when psi_ref is below the controller's own reference */
 } ctrl_fieldweak_out_t;
@@ -143,7 +143,7 @@ void ctrl_fieldweak_step(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24_t vdc,
 
 /* ctrl_fieldweak_out_t.psi_max of ctrl_fieldweak_step_lazy where it was not
  * computed. */
-#define CTRL_FW_PSI_MAX_NOT_BINDING ((q24_t)-1)
+#define CTRL_FIELDWEAK_PSI_MAX_NOT_BINDING ((q24_t)-1)
 
 /* The DC link's first-order low pass of a period (the ADC's noise, not its
  * dips: vdc_k is set for ~1 kHz); returns it, >= 0. */
@@ -161,7 +161,7 @@ static inline q24_t ctrl_fieldweak_vdc_filter(ctrl_fieldweak_t *s, q24_t vdc)
 }
 
 /* Inside the lazy step's region (lz_*; speed w = |omega| > 0): there
- * psi_max >= psi_mtpa (field_weak.c, fw_lazy_region). */
+ * psi_max >= psi_mtpa (field_weak.c, fieldweak_lazy_region). */
 static inline int ctrl_fieldweak_in_region(const ctrl_fieldweak_t *s, q24_t vdc_f, q24_t w)
 {
     return w <= s->lz_w_max && vdc_f >= s->lz_vdc_min && fx_abs(s->t_prev) <= s->t_mtpa;
@@ -193,11 +193,11 @@ static inline void ctrl_fieldweak_t_prev(ctrl_fieldweak_t *s, q24_t t)
 static inline void ctrl_fieldweak_current_limit(ctrl_fieldweak_t *s, q24_t t, q24_t t_req,
                                                 q24_t psi_own, ctrl_fieldweak_out_t *out)
 {
-    out->psi_max = CTRL_FW_PSI_MAX_NOT_BINDING;
+    out->psi_max = CTRL_FIELDWEAK_PSI_MAX_NOT_BINDING;
     out->torque_max = s->t_mtpa;
     out->torque = t;
     out->psi_ref = psi_own;
-    out->limit = CTRL_FW_LIMIT_CURRENT;
+    out->limit = CTRL_FIELDWEAK_LIMIT_CURRENT;
     out->clipped = t != t_req ? 1u : 0u;
     out->weakening = 0u;
     ctrl_fieldweak_t_prev(s, t);
@@ -209,7 +209,7 @@ void ctrl_fieldweak_limits_lazy(ctrl_fieldweak_t *s, const ctrl_params_t *p, q24
 
 /*
  * ctrl_fieldweak_step for the interrupt, with psi_cmd = 0: the same outputs,
- * except that psi_max is CTRL_FW_PSI_MAX_NOT_BINDING where the comparison of
+ * except that psi_max is CTRL_FIELDWEAK_PSI_MAX_NOT_BINDING where the comparison of
  * squares shows it at least the MTPA flux at the current limit and the flux
  * reference of the clamped torque (below base speed: then neither the
  * torque limit nor the flux reference depends on its value), which saves

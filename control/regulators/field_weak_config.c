@@ -14,16 +14,16 @@
 void ctrl_fieldweak_cfg_default(ctrl_fieldweak_cfg_t *c)
 {
     if (c != NULL) {
-        c->v_frac = CTRL_FW_VFRAC_DEFAULT;
+        c->v_frac = CTRL_FIELDWEAK_VFRAC_DEFAULT;
         c->current_max_a = 0.0;
-        c->torque_margin = CTRL_FW_TORQUE_MARGIN_DEFAULT;
-        c->torque_margin_brake = CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT;
-        c->vdc_lpf_hz = CTRL_FW_VDC_LPF_HZ_DEFAULT;
+        c->torque_margin = CTRL_FIELDWEAK_TORQUE_MARGIN_DEFAULT;
+        c->torque_margin_brake = CTRL_FIELDWEAK_TORQUE_MARGIN_BRAKE_DEFAULT;
+        c->vdc_lpf_hz = CTRL_FIELDWEAK_VDC_LPF_HZ_DEFAULT;
     }
 }
 
-static int fw_refuse(char *why, size_t n, int code, const char *what, double v, double lo,
-                     double hi, const char *unit)
+static int fieldweak_refuse(char *why, size_t n, int code, const char *what, double v, double lo,
+                            double hi, const char *unit)
 {
     if (why != NULL && n > 0u) {
         snprintf(why, n, "field weakening: %s = %g %s is outside [%g, %g] %s", what, v, unit, lo,
@@ -33,10 +33,10 @@ static int fw_refuse(char *why, size_t n, int code, const char *what, double v, 
 }
 
 /* x (pu) -> Q24 when |x| <= 100 pu, else CTRL_ERANGE with the quantity named. */
-static int fw_q24(double x, const char *what, q24_t *out, char *why, size_t n)
+static int fieldweak_q24(double x, const char *what, q24_t *out, char *why, size_t n)
 {
     if (!isfinite(x) || fabs(x) > 100.0) {
-        return fw_refuse(why, n, CTRL_ERANGE, what, x, -100.0, 100.0, "pu");
+        return fieldweak_refuse(why, n, CTRL_ERANGE, what, x, -100.0, 100.0, "pu");
     }
     *out = ctrl_q24_from_double(x);
     return CTRL_OK;
@@ -56,30 +56,30 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     }
     memset(s, 0, sizeof *s);
     const double fs = (double)p->fs_hz;
-    if (!(c->v_frac > 0.0 && c->v_frac <= CTRL_FW_VFRAC_MAX)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "v_frac", c->v_frac, 0.0, CTRL_FW_VFRAC_MAX,
-                         "x Vdc/sqrt(3)");
+    if (!(c->v_frac > 0.0 && c->v_frac <= CTRL_FIELDWEAK_VFRAC_MAX)) {
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "v_frac", c->v_frac, 0.0,
+                                CTRL_FIELDWEAK_VFRAC_MAX, "x Vdc/sqrt(3)");
     }
     if (!(c->torque_margin > 0.0 && c->torque_margin <= 1.0)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "torque_margin", c->torque_margin, 0.0, 1.0,
-                         "");
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "torque_margin", c->torque_margin, 0.0,
+                                1.0, "");
     }
     if (!(c->torque_margin_brake > 0.0 && c->torque_margin_brake <= 1.0)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "torque_margin_brake", c->torque_margin_brake,
-                         0.0, 1.0, "");
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "torque_margin_brake",
+                                c->torque_margin_brake, 0.0, 1.0, "");
     }
     if (!(c->vdc_lpf_hz > 0.0 && c->vdc_lpf_hz < 0.5 * fs)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "vdc_lpf_hz", c->vdc_lpf_hz, 0.0, 0.5 * fs,
-                         "Hz");
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "vdc_lpf_hz", c->vdc_lpf_hz, 0.0,
+                                0.5 * fs, "Hz");
     }
     const double i_si = c->current_max_a == 0.0 ? m->current_rated_a : c->current_max_a;
     if (!(i_si > 0.0 && i_si <= m->current_max_a)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "current limit", i_si, 0.0, m->current_max_a,
-                         "A (up to the over-current trip, current_max_a)");
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "current limit", i_si, 0.0,
+                                m->current_max_a, "A (up to the over-current trip, current_max_a)");
     }
     if (!(m->lq_h >= m->ld_h)) {
-        return fw_refuse(why, why_len, CTRL_EINVAL, "lq_h (reverse saliency Lq < Ld)", m->lq_h,
-                         m->ld_h, INFINITY, "H");
+        return fieldweak_refuse(why, why_len, CTRL_EINVAL, "lq_h (reverse saliency Lq < Ld)",
+                                m->lq_h, m->ld_h, INFINITY, "H");
     }
     /* Per unit, from the SI data and the bases (no base value assumed). */
     const double psi = m->psi_pm_wb / b->psi_wb;
@@ -97,32 +97,36 @@ int ctrl_fieldweak_init(ctrl_fieldweak_t *s, const ctrl_fieldweak_cfg_t *c, cons
     const double vf = c->v_frac / sqrt(3.0);
     s->v_frac = (int32_t)ctrl_cfg_llround(vf * (double)(1L << 30));
     int rc = CTRL_OK;
-    rc = rc ? rc : fw_q24(i, "current limit", &s->i_max, why, why_len);
-    rc = rc ? rc : fw_q24(2.0 * rs, "2 Rs", &s->two_rs, why, why_len);
-    rc = rc ? rc : fw_q24(rs * i, "Rs I_max", &s->rs_imax, why, why_len);
-    rc = rc ? rc : fw_q24(rs / psi, "Rs / psi_pm", &s->rs_ipsi, why, why_len);
-    rc = rc ? rc : fw_q24(psi, "psi_pm", &s->psi_pm, why, why_len);
-    rc = rc ? rc : fw_q24(ld, "Ld", &s->ld, why, why_len);
-    rc = rc ? rc : fw_q24(ld - lq, "Ld - Lq", &s->ld_m_lq, why, why_len);
-    rc = rc ? rc : fw_q24(1.0 / (lq * lq), "1/Lq^2", &s->inv_lq2, why, why_len);
-    rc = rc ? rc : fw_q24(1.0 / ld, "1/Ld", &s->inv_ld, why, why_len);
-    rc = rc ? rc : fw_q24(psi_mtpa, "MTPA flux at the current limit", &s->psi_mtpa, why, why_len);
-    rc = rc ? rc : fw_q24(t_mtpa, "MTPA torque at the current limit", &s->t_mtpa, why, why_len);
-    rc = rc ? rc : fw_q24(psi + lq * i, "psi_pm + Lq I", &s->psi_ceil, why, why_len);
-    rc = rc ? rc : fw_q24(2.0 * ld * psi, "2 Ld psi_pm", &s->b, why, why_len);
-    rc = rc ? rc : fw_q24(lq * lq - ld * ld, "Lq^2 - Ld^2", &s->dl2, why, why_len);
-    rc = rc ? rc : fw_q24(psi * psi + lq * lq * i * i, "psi_pm^2 + Lq^2 I^2", &s->c0, why, why_len);
-    rc = rc ? rc : fw_q24(c1, "psi_pm/Ld", &s->c1, why, why_len);
-    rc = rc ? rc : fw_q24(c2, "1/Ld - 1/Lq", &s->c2, why, why_len);
-    rc = rc ? rc : fw_q24(c1 * c1, "(psi_pm/Ld)^2", &s->c1_sq, why, why_len);
-    rc = rc ? rc : fw_q24(8.0 * c2 * c2, "8 (1/Ld - 1/Lq)^2", &s->c2_sq8, why, why_len);
-    rc = rc ? rc : fw_q24(c->torque_margin, "torque_margin", &s->t_margin, why, why_len);
+    rc = rc ? rc : fieldweak_q24(i, "current limit", &s->i_max, why, why_len);
+    rc = rc ? rc : fieldweak_q24(2.0 * rs, "2 Rs", &s->two_rs, why, why_len);
+    rc = rc ? rc : fieldweak_q24(rs * i, "Rs I_max", &s->rs_imax, why, why_len);
+    rc = rc ? rc : fieldweak_q24(rs / psi, "Rs / psi_pm", &s->rs_ipsi, why, why_len);
+    rc = rc ? rc : fieldweak_q24(psi, "psi_pm", &s->psi_pm, why, why_len);
+    rc = rc ? rc : fieldweak_q24(ld, "Ld", &s->ld, why, why_len);
+    rc = rc ? rc : fieldweak_q24(ld - lq, "Ld - Lq", &s->ld_m_lq, why, why_len);
+    rc = rc ? rc : fieldweak_q24(1.0 / (lq * lq), "1/Lq^2", &s->inv_lq2, why, why_len);
+    rc = rc ? rc : fieldweak_q24(1.0 / ld, "1/Ld", &s->inv_ld, why, why_len);
     rc = rc ? rc
-            : fw_q24(c->torque_margin_brake, "torque_margin_brake", &s->t_margin_brake, why,
-                     why_len);
+            : fieldweak_q24(psi_mtpa, "MTPA flux at the current limit", &s->psi_mtpa, why, why_len);
     rc = rc ? rc
-            : fw_q24(1.0 - ctrl_cfg_exp(-2.0 * CTRL_PI * c->vdc_lpf_hz / fs),
-                     "DC-link filter coefficient", &s->vdc_k, why, why_len);
+            : fieldweak_q24(t_mtpa, "MTPA torque at the current limit", &s->t_mtpa, why, why_len);
+    rc = rc ? rc : fieldweak_q24(psi + lq * i, "psi_pm + Lq I", &s->psi_ceil, why, why_len);
+    rc = rc ? rc : fieldweak_q24(2.0 * ld * psi, "2 Ld psi_pm", &s->b, why, why_len);
+    rc = rc ? rc : fieldweak_q24(lq * lq - ld * ld, "Lq^2 - Ld^2", &s->dl2, why, why_len);
+    rc = rc ? rc
+            : fieldweak_q24(psi * psi + lq * lq * i * i, "psi_pm^2 + Lq^2 I^2", &s->c0, why,
+                            why_len);
+    rc = rc ? rc : fieldweak_q24(c1, "psi_pm/Ld", &s->c1, why, why_len);
+    rc = rc ? rc : fieldweak_q24(c2, "1/Ld - 1/Lq", &s->c2, why, why_len);
+    rc = rc ? rc : fieldweak_q24(c1 * c1, "(psi_pm/Ld)^2", &s->c1_sq, why, why_len);
+    rc = rc ? rc : fieldweak_q24(8.0 * c2 * c2, "8 (1/Ld - 1/Lq)^2", &s->c2_sq8, why, why_len);
+    rc = rc ? rc : fieldweak_q24(c->torque_margin, "torque_margin", &s->t_margin, why, why_len);
+    rc = rc ? rc
+            : fieldweak_q24(c->torque_margin_brake, "torque_margin_brake", &s->t_margin_brake, why,
+                            why_len);
+    rc = rc ? rc
+            : fieldweak_q24(1.0 - ctrl_cfg_exp(-2.0 * CTRL_PI * c->vdc_lpf_hz / fs),
+                            "DC-link filter coefficient", &s->vdc_k, why, why_len);
     s->id_star = FX_MAX;
     if (lq > ld && rc == CTRL_OK) {
         const double id_star = ld * psi / (lq * lq - ld * ld);

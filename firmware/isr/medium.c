@@ -76,7 +76,7 @@ void fw_medium(fw_t *fw)
     }
     if (in->reset != 0u) {
         ctrl_speed_pi_reset(&fw->speed_pi, 0);
-        ctrl_fieldweak_reset(&fw->fwk);
+        ctrl_fieldweak_reset(&fw->fieldweak);
         fw->torque_max = fw->torque_ref_max;
         fw->mid_mode = in->ref_mode;
     }
@@ -99,8 +99,9 @@ void fw_medium(fw_t *fw)
     /* ctrl_fieldweak_step_lazy without its inline shortcut (the same outputs,
      * field_weak.h; flash matters more than time here) */
     ctrl_fieldweak_out_t lim;
-    ctrl_fieldweak_limits_lazy(&fw->fwk, &fw->params, ctrl_fieldweak_vdc_filter(&fw->fwk, vdc),
-                               in->omega_e, t_req, &lim);
+    ctrl_fieldweak_limits_lazy(&fw->fieldweak, &fw->params,
+                               ctrl_fieldweak_vdc_filter(&fw->fieldweak, vdc), in->omega_e, t_req,
+                               &lim);
     fw->torque_max = lim.torque_max;
     out->torque_max = lim.torque_max;
     out->psi_ref = lim.psi_ref;

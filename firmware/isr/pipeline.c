@@ -43,7 +43,7 @@ static void fw_tm_no_estimate(fw_telemetry_t *tm)
     tm->i_d = tm->i_q = 0;
     tm->psi_d = tm->psi_q = 0;
     tm->torque = tm->omega_e = tm->torque_ref = tm->torque_max = 0;
-    tm->fw_limit = 0u;
+    tm->fieldweak_limit = 0u;
 }
 
 /* Q8 counts -> Q24 pu with a Q30 gain: round(d gain / 2^14), saturated. raw
@@ -523,7 +523,7 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
         tm->duty = 0;
         tm->torque_ref = 0;
         tm->torque_max = 0;
-        tm->fw_limit = 0u;
+        tm->fieldweak_limit = 0u;
         fw_pwm_off(fw, tm);
         return false;
     }
@@ -551,7 +551,8 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
     fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
     fw->torque_ref_now = tref;
     tm->torque_max = torque_max;
-    tm->fw_limit = (uint8_t)(mo->limit + 4u * (tref != *t_req) + 8u * weak + 16u * fw->tqf.warn);
+    tm->fieldweak_limit =
+        (uint8_t)(mo->limit + 4u * (tref != *t_req) + 8u * weak + 16u * fw->tqf.warn);
 
     const ctrl_ctx_t ctx = {&fw->params, est, &fw->refs};
     /* The descriptor and its state were validated when it was installed

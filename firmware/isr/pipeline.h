@@ -110,20 +110,20 @@ typedef struct {
             fx_angle_t theta_e; /* electrical angle from the encoder */
         };
     };
-    q24_t i_d, i_q;       /* rotor-frame current at k, Q24 pu */
-    q24_t psi_d, psi_q;   /* rotor-frame stator flux at k, Q24 pu (|psi_s|, sector: main loop) */
-    q24_t torque;         /* torque estimate at k, Q24 pu */
-    q24_t omega_e;        /* electrical speed estimate, Q24 pu */
-    q24_t torque_ref;     /* torque reference used at k (after the limits), Q24 pu */
-    q24_t torque_max;     /* |torque| limit of this period (field_weak.h), Q24 pu */
-    uint8_t fw_limit;     /* what bounds it: ctrl_fw_limit_t, + 4 when the request was
-                             clipped, + 8 when the flux reference is weakened, + 16 while
-                             the torque misses its reference (torque_follow.h) */
-    q24_t duty;           /* on-time of segment 0, Q24 fraction */
-    q24_t legs[3];        /* leg duties written at k, Q24 fraction */
-    uint32_t cycles;      /* ISR duration measured with hal_cycles */
-    uint8_t cm_step;      /* commissioning step running (cm_step_id_t), 0 = none */
-    uint16_t cm_progress; /* its progress, per mille */
+    q24_t i_d, i_q;          /* rotor-frame current at k, Q24 pu */
+    q24_t psi_d, psi_q;      /* rotor-frame stator flux at k, Q24 pu (|psi_s|, sector: main loop) */
+    q24_t torque;            /* torque estimate at k, Q24 pu */
+    q24_t omega_e;           /* electrical speed estimate, Q24 pu */
+    q24_t torque_ref;        /* torque reference used at k (after the limits), Q24 pu */
+    q24_t torque_max;        /* |torque| limit of this period (field_weak.h), Q24 pu */
+    uint8_t fieldweak_limit; /* what bounds it: ctrl_fieldweak_limit_t, + 4 when the request was
+                         clipped, + 8 when the flux reference is weakened, + 16 while
+                         the torque misses its reference (torque_follow.h) */
+    q24_t duty;              /* on-time of segment 0, Q24 fraction */
+    q24_t legs[3];           /* leg duties written at k, Q24 fraction */
+    uint32_t cycles;         /* ISR duration measured with hal_cycles */
+    uint8_t cm_step;         /* commissioning step running (cm_step_id_t), 0 = none */
+    uint16_t cm_progress;    /* its progress, per mille */
 } fw_telemetry_t;
 
 /* Records kept for the main loop (power of 2): at one record in `every`
@@ -168,7 +168,7 @@ typedef struct {
                           torque mode the limited torque reference: a bumpless switch), Q24 */
     q24_t torque_max;  /* |torque| limit (field_weak.h), Q24 pu */
     q24_t psi_ref;     /* stator-flux reference while weakening, Q24 pu */
-    uint8_t limit;     /* ctrl_fw_limit_t: what bounds torque_max */
+    uint8_t limit;     /* ctrl_fieldweak_limit_t: what bounds torque_max */
     uint8_t weakening; /* 1: psi_ref is below the controller's own reference */
     uint8_t fault;     /* a slow protection's fault (FW_FAULT_*), latched by the interrupt */
     /* A tracker run's (in.track): the flux's step, which the interrupt adds at
@@ -302,7 +302,7 @@ typedef struct {
      * torque limit (regulators/field_weak.h: the flux the voltage allows,
      * torque limit from the current circle, the voltage ellipse and MTPV). */
     ctrl_speed_pi_t speed_pi;
-    ctrl_fieldweak_t fwk;
+    ctrl_fieldweak_t fieldweak;
     q24_t torque_max; /* the last run's torque limit, Q24 pu (speed PI's anti-windup) */
     uint8_t mid_mode; /* the last run's fw_ref_mode_t */
     fw_speed_info_t speed_info;

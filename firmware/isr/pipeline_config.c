@@ -107,10 +107,10 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     }
     /* Field weakening and the torque limit: rated current, 92 % of Vdc/sqrt(3)
      * (field_weak_config.h defaults). */
-    ctrl_fieldweak_cfg_t fwc;
-    ctrl_fieldweak_cfg_default(&fwc);
-    const int fwrc =
-        ctrl_fieldweak_init(&fw->fwk, &fwc, fw->machine, &fw->bases, &fw->params, NULL, 0u);
+    ctrl_fieldweak_cfg_t fieldweak_cfg;
+    ctrl_fieldweak_cfg_default(&fieldweak_cfg);
+    const int fwrc = ctrl_fieldweak_init(&fw->fieldweak, &fieldweak_cfg, fw->machine, &fw->bases,
+                                         &fw->params, NULL, 0u);
     if (fwrc != CTRL_OK) {
         const ctrl_diag_t d = {
             fwrc, "field-weakening constants (Lq < Ld, or beyond 100 pu)", "", 0.0, 0.0,
@@ -258,8 +258,8 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     /* Field weakening runs in the medium task on the DC link's mean over a
      * run: its filter's coefficient per run, for the same corner. Its first
      * run starts its state anew. */
-    fw->fwk.vdc_k =
-        ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * fwc.vdc_lpf_hz *
+    fw->fieldweak.vdc_k =
+        ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * fieldweak_cfg.vdc_lpf_hz *
                                                 (double)fw->mid_div / (double)in->pwm_freq_hz));
     fw->mid_reset = 1u;
     fw->mid_fresh = 0u;

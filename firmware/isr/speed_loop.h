@@ -67,7 +67,7 @@ double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, doub
 
 /*
  * The same limit in regenerative braking (w T < 0), with the braking margin
- * CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT (field_weak_config.h) in place of
+ * CTRL_FIELDWEAK_TORQUE_MARGIN_BRAKE_DEFAULT (field_weak_config.h) in place of
  * FW_TORQUE_FLUX_MARGIN; the field weakening's period limit applies it
  * (field_weak.h). 80 kW IPMSM at 0.1837 Wb: 0.88 x 383.7 = 337.7 N*m.
  */

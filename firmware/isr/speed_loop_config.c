@@ -147,5 +147,5 @@ double fw_torque_limit_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl, doub
 double fw_torque_limit_brake_nm(const ctrl_machine_t *m, const ctrl_desc_t *ctrl,
                                 double *t_flux_max)
 {
-    return fw_torque_limit_at(m, ctrl, t_flux_max, CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT);
+    return fw_torque_limit_at(m, ctrl, t_flux_max, CTRL_FIELDWEAK_TORQUE_MARGIN_BRAKE_DEFAULT);
 }

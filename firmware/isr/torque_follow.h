@@ -10,7 +10,7 @@
  * (5 % of the reference, with a floor of 2 % of the rated torque for small
  * references whose mean the ripple resolves no better); compared on the sums
  * (|sum e| 20 > sum |T_ref| and |sum e| > n tol_rated): no division.
- * A missed window sets the warning (fw_telemetry_t.fw_limit + 16) until a
+ * A missed window sets the warning (fw_telemetry_t.fieldweak_limit + 16) until a
  * window meets the reference; with fault_windows > 0, that many consecutive
  * misses are a fault (FW_FAULT_TORQUE_FOLLOW: gates off). Periods without a
  * trustworthy estimate (the sensorless start's forced angle) restart the

@@ -575,7 +575,7 @@ static void fw_link_sample(const fw_t *fw, const fw_telemetry_t *r, tel_sample_t
     s->cm_step = (int32_t)r->cm_step;
     s->cm_progress = (int32_t)r->cm_progress;
     s->torque_max = r->torque_max;
-    s->fw_limit = (int32_t)r->fw_limit;
+    s->fieldweak_limit = (int32_t)r->fieldweak_limit;
 }
 
 void fw_link_poll(fw_link_t *l)

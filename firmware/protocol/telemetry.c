@@ -36,10 +36,10 @@ static const tel_signal_t tel_signals[TEL_SIG_COUNT] = {
     TEL_SIG("cm_progress", "", "its progress, per mille", TEL_KIND_INTEGER, cm_progress),
     TEL_SIG("torque_max", "N*m", "torque limit (current circle, voltage ellipse, MTPV)",
             TEL_KIND_TORQUE, torque_max),
-    TEL_SIG("fw_limit", "",
+    TEL_SIG("fieldweak_limit", "",
             "limit: 0 current, 1 voltage, 2 MTPV, 3 flux; +4 clipped, +8 weakened, +16 torque "
             "not followed",
-            TEL_KIND_INTEGER, fw_limit),
+            TEL_KIND_INTEGER, fieldweak_limit),
 };
 
 const tel_signal_t *tel_signal_at(size_t index)

@@ -43,7 +43,7 @@ typedef enum {
     TEL_SIG_CM_STEP,     /* commissioning step running (cm_step_id_t, 0 none) */
     TEL_SIG_CM_PROGRESS, /* its progress, per mille */
     TEL_SIG_TORQUE_MAX,  /* |torque| limit of the period (current, voltage, MTPV) */
-    TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fw_limit_t) + 4 clipped + 8 flux weakened */
+    TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fieldweak_limit_t) + 4 clipped + 8 flux weakened */
     TEL_SIG_COUNT
 } tel_sig_t;
 
@@ -58,7 +58,7 @@ typedef enum {
  *   vdc                  Q24 pu of the voltage base (V)
  *   duty                 Q24 fraction of the period (FX_ONE = 100 %)
  *   theta                theta_e >> 8: Q24 fraction of a turn, [0, 2^24)
- *   vector sector state fault cycles cm_step cm_progress fw_limit   plain integers
+ *   vector sector state fault cycles cm_step cm_progress fieldweak_limit   plain integers
  */
 typedef struct {
     uint32_t tick; /* control period index k (wraps), sent in every frame */
@@ -69,7 +69,7 @@ typedef struct {
     int32_t vector, duty, vdc, theta, sector;
     int32_t state, fault, cycles;
     int32_t cm_step, cm_progress;
-    int32_t torque_max, fw_limit;
+    int32_t torque_max, fieldweak_limit;
 } tel_sample_t;
 
 /* How a raw value turns into SI. */

@@ -130,11 +130,11 @@ struct Ref {
         const double i_min =
             std::sqrt(std::max(id_m * id_m + (p * p - pdm * pdm) / (lq * lq), 0.0));
         double t = tv;
-        kind = CTRL_FW_LIMIT_MTPV;
+        kind = CTRL_FIELDWEAK_LIMIT_MTPV;
         margin_dist = std::min(std::fabs(i_min - i), std::fabs(std::fabs(id_l) - i));
         if (i_min > i) {
             t = 0.0;
-            kind = CTRL_FW_LIMIT_VOLTAGE;
+            kind = CTRL_FIELDWEAK_LIMIT_VOLTAGE;
         } else if (std::fabs(id_l) > i) {
             const double c = psi * psi + lq * lq * i * i - p * p;
             const double b = 2.0 * ld * psi;
@@ -142,7 +142,7 @@ struct Ref {
             margin_dist = std::min(margin_dist, std::fabs(idv - idx));
             if (idv < idx) {
                 t = torque(idx, std::sqrt(std::max(i * i - idx * idx, 0.0)));
-                kind = CTRL_FW_LIMIT_VOLTAGE;
+                kind = CTRL_FIELDWEAK_LIMIT_VOLTAGE;
             }
         }
         return std::min(std::max(t, 0.0), marg * tv);
@@ -241,7 +241,7 @@ void run(const ctrl_machine_t &m, bool mtpa_mode, uint32_t fs, int n, std::mt199
         const q24_t fix = pc > 0 ? q(pc) : p.psi_ref;
         if (fix <= 0 && o.psi_max >= s.psi_mtpa) {
             TEST_ASSERT_EQUAL_INT32(s.t_mtpa, o.torque_max);
-            TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_CURRENT, o.limit);
+            TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_CURRENT, o.limit);
             TEST_ASSERT_DOUBLE_WITHIN(0.5 * L, r.t_mtpa, d(o.torque_max));
         } else {
             const double pl = d(fix > 0 ? std::min(fix, o.psi_max) : o.psi_max);
@@ -252,7 +252,7 @@ void run(const ctrl_machine_t &m, bool mtpa_mode, uint32_t fs, int n, std::mt199
             const double tl = r.t_at_flux(pl, brake ? r.margin_brake : r.margin, kind, dist);
             w_t.add(std::fabs(d(o.torque_max) - tl), r.t_bound(pl));
             if (fix > 0 && q(pl) < o.psi_max) {
-                kind = CTRL_FW_LIMIT_FLUX;
+                kind = CTRL_FIELDWEAK_LIMIT_FLUX;
             }
             if (dist > kKindGuard) {
                 kind_checked++;

@@ -219,7 +219,7 @@ static void test_below_base(void)
     const double t_i = 1.5 * M.pole_pairs * M.psi_pm_wb * M.current_rated_a; /* i_d = 0 */
     TEST_ASSERT_DOUBLE_WITHIN(4 * LSB, t_i / B.torque_nm, d(o.torque_max));
     TEST_ASSERT_EQUAL_INT32(o.torque_max, o.torque);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_CURRENT, o.limit);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_CURRENT, o.limit);
     TEST_ASSERT_EQUAL_UINT8(1u, o.clipped);
     TEST_ASSERT_EQUAL_UINT8(0u, o.weakening);
     TEST_ASSERT_EQUAL_INT32(ctrl_mtpa_psi(&P, o.torque), o.psi_ref);
@@ -239,7 +239,7 @@ static void test_below_base(void)
     ctrl_fieldweak_out_t o4;
     ctrl_fieldweak_step(&S, &pm, vdc_pu(), omega_pu(500.0), q(1e4 / B.torque_nm), 0, &o4);
     TEST_ASSERT_DOUBLE_WITHIN(8 * LSB, t_m / B.torque_nm, d(o4.torque_max));
-    TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_CURRENT, o4.limit);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_CURRENT, o4.limit);
 }
 
 /* SPMSM, Rs = 0, between base and maximum speed: the circle meets the circle at
@@ -263,7 +263,7 @@ static void test_spmsm_field_weakening(void)
         /* psi_max within 8 LSB (above) moves i_d by 8 LSB psi/L (pu: psi/Ld) and
          * T by that times i_d/i_q psi; 64 LSB covers it with the roundings. */
         TEST_ASSERT_DOUBLE_WITHIN(64 * LSB + 1e-6 * want, want, d(o.torque_max));
-        TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_VOLTAGE, o.limit);
+        TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_VOLTAGE, o.limit);
         TEST_ASSERT_EQUAL_UINT8(1u, o.weakening);
         TEST_ASSERT_EQUAL_INT32(o.psi_max, o.psi_ref);
     }
@@ -282,7 +282,7 @@ static void test_ipmsm_mtpv(void)
     P.psi_ref = 0; /* MTPA (the file's fixed reference is tested below) */
     const double rpm = 4.0 * 1538.0;
     const ctrl_fieldweak_out_t o = step_at(rpm, 1e4, 0);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_MTPV, o.limit);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_MTPV, o.limit);
     /* MTPV closed form (SI): psi_d = (c1 - sqrt(c1^2 + 8 c2^2 psi^2)) / (4 c2). */
     const double ps = d(o.psi_max) * B.psi_wb;
     const double c1 = M.psi_pm_wb / M.ld_h;
@@ -305,7 +305,7 @@ static void test_ipmsm_mtpv(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-5 * best, best, t_v);
     /* At 1.5x base the current circle and the voltage ellipse. */
     const ctrl_fieldweak_out_t o2 = step_at(1.5 * 1538.0, 1e4, 0);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_VOLTAGE, o2.limit);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_VOLTAGE, o2.limit);
 }
 
 /* Smooth entry and exit: the limits are continuous in speed. From standstill
@@ -434,7 +434,7 @@ static void check_lazy(const ctrl_machine_t *m, double psi_ref_wb)
         TEST_ASSERT_EQUAL_UINT8(oe.limit, ol.limit);
         TEST_ASSERT_EQUAL_UINT8(oe.clipped, ol.clipped);
         TEST_ASSERT_EQUAL_UINT8(oe.weakening, ol.weakening);
-        if (ol.psi_max == CTRL_FW_PSI_MAX_NOT_BINDING) {
+        if (ol.psi_max == CTRL_FIELDWEAK_PSI_MAX_NOT_BINDING) {
             n_lazy++;
             TEST_ASSERT_TRUE(oe.psi_max >= S.psi_mtpa && oe.psi_max >= oe.psi_ref);
         } else {
@@ -464,7 +464,7 @@ static void test_fixed_flux(void)
 {
     setup(&ini_thesis_ipmsm80, -1.0);
     const ctrl_fieldweak_out_t o = step_at(1000.0, 1e4, 0);
-    TEST_ASSERT_EQUAL_UINT8(CTRL_FW_LIMIT_FLUX, o.limit);
+    TEST_ASSERT_EQUAL_UINT8(CTRL_FIELDWEAK_LIMIT_FLUX, o.limit);
     TEST_ASSERT_EQUAL_INT32(P.psi_ref, o.psi_ref);
     /* Scan the flux circle 0.1837 Wb inside 400 A for the largest torque. */
     const double ps = M.psi_ref_wb;

@@ -85,7 +85,7 @@ static double sim_torque_ref_nm(const sim_run_t *r)
 }
 
 /* One period of the window: the field-weakening limit and whether it clipped
- * the request (fw_telemetry_t.fw_limit bit 2), and the reference applied. */
+ * the request (fw_telemetry_t.fieldweak_limit bit 2), and the reference applied. */
 static void sim_limit_add(sim_run_t *r)
 {
     const fw_telemetry_t *tm = fw_telemetry(&r->fw);
@@ -93,11 +93,11 @@ static void sim_limit_add(sim_run_t *r)
     if (r->lim_n == 0u || tmax < r->lim_min_nm) {
         r->lim_min_nm = tmax;
     }
-    if ((tm->fw_limit & 4u) != 0u) {
+    if ((tm->fieldweak_limit & 4u) != 0u) {
         r->lim_clipped_n++;
-        r->lim_last = tm->fw_limit;
+        r->lim_last = tm->fieldweak_limit;
     }
-    if ((tm->fw_limit & 8u) != 0u) {
+    if ((tm->fieldweak_limit & 8u) != 0u) {
         r->lim_weak_n++;
     }
     r->tref_sum_nm += sim_torque_ref_nm(r);
@@ -878,7 +878,7 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
                  "braking, the zero vector carries the load angle toward the pull-out): the "
                  "firmware limits it to %g N*m",
                  c->torque_ref_nm, t_brake, c->speed_rpm,
-                 100.0 * CTRL_FW_TORQUE_MARGIN_BRAKE_DEFAULT, t_flux, c->ctrl_machine.name,
+                 100.0 * CTRL_FIELDWEAK_TORQUE_MARGIN_BRAKE_DEFAULT, t_flux, c->ctrl_machine.name,
                  c->ctrl_machine.psi_ref_wb, copysign(t_brake, c->torque_ref_nm));
     }
 
@@ -1055,7 +1055,7 @@ int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctr
     if (!r->cfg.speed_mode && r->lim_clipped_n > 0u && !r->lim_warned) {
         /* Not a silent clamp: T_sse is against the reference the drive could
          * apply, so say that it differs from the one asked for. */
-        static const char *const lim_names[CTRL_FW_LIMIT_COUNT] = {
+        static const char *const lim_names[CTRL_FIELDWEAK_LIMIT_COUNT] = {
             "the current limit", "the voltage limit", "MTPV", "the flux reference's torque"};
         sim_warn(r->cfg.warnings,
                  "torque reference %g N*m was limited to %.4g N*m (mean; down to %.4g N*m) by %s "
@@ -1143,16 +1143,16 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     {
         /* Field weakening at the end of the run (pipeline.h fw_telemetry_t):
          * the torque limit of the last period and what set it. */
-        static const char *const lim_names[CTRL_FW_LIMIT_COUNT] = {"current", "voltage", "mtpv",
-                                                                   "flux"};
+        static const char *const lim_names[CTRL_FIELDWEAK_LIMIT_COUNT] = {"current", "voltage",
+                                                                          "mtpv", "flux"};
         const fw_telemetry_t *tm = fw_telemetry(&r->fw);
         sim_json_num(f, "torque_max_nm",
                      ctrl_q24_to_double(tm->torque_max) * r->fw.bases.torque_nm);
-        fprintf(f, "  \"fw_limit\": \"%s\",\n", lim_names[tm->fw_limit & 3u]);
-        fprintf(f, "  \"fw_clipped\": %u,\n  \"fw_weakening\": %u,\n", (tm->fw_limit >> 2) & 1u,
-                (tm->fw_limit >> 3) & 1u);
+        fprintf(f, "  \"fieldweak_limit\": \"%s\",\n", lim_names[tm->fieldweak_limit & 3u]);
+        fprintf(f, "  \"fieldweak_clipped\": %u,\n  \"fieldweak_active\": %u,\n",
+                (tm->fieldweak_limit >> 2) & 1u, (tm->fieldweak_limit >> 3) & 1u);
         /* the firmware's torque supervision (torque_follow.h) at the end */
-        fprintf(f, "  \"torque_follow_warning\": %u,\n", (tm->fw_limit >> 4) & 1u);
+        fprintf(f, "  \"torque_follow_warning\": %u,\n", (tm->fieldweak_limit >> 4) & 1u);
     }
     sim_json_num(f, "speed_ref_rpm", sim_run_speed_ref_now(r));
     sim_json_num(f, "speed_imposed_rpm", c->free_mech ? NAN : sim_run_speed_rpm(r));

@@ -184,10 +184,10 @@ struct sim_run {
      * the sum of the reference the controller got (before the trim). */
     uint64_t lim_n, lim_clipped_n;
     double lim_min_nm, tref_sum_nm;
-    uint8_t lim_last; /* fw_telemetry_t.fw_limit of the last clipped period */
+    uint8_t lim_last; /* fw_telemetry_t.fieldweak_limit of the last clipped period */
     bool lim_warned;
     bool link_failed;    /* the PIL link reported a fault (cfg.link->error) */
-    uint64_t lim_weak_n; /* periods of the window with the flux weakened (fw_limit bit 3) */
+    uint64_t lim_weak_n; /* periods of the window with the flux weakened (fieldweak_limit bit 3) */
 };
 
 /* The pipeline configuration of a run (the controller's aside). */

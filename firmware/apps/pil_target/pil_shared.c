@@ -63,7 +63,7 @@ uint16_t pil_tm_digest(const fw_telemetry_t *tm)
         td_u32(b, &n, (uint32_t)v[k]);
     }
     td_u32(b, &n, tm->theta_e);
-    td_u8(b, &n, tm->fw_limit);
+    td_u8(b, &n, tm->fieldweak_limit);
     td_u8(b, &n, tm->cm_step);
     td_u32(b, &n, tm->cm_progress);
     return tel_crc16(b, n);

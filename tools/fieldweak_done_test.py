@@ -20,7 +20,7 @@
             weakening on both sides, through standstill): no fault, the speed reaches
             -3200 r/min.
 
-usage: tools/fw_done_test.py SIM [--only envelope,robust,reversal] [--machines ipmsm,spmsm]
+usage: tools/fieldweak_done_test.py SIM [--only envelope,robust,reversal] [--machines ipmsm,spmsm]
                              [--ctrls m2ptfc,drr,fst,foc]
 Exit 0 when every point holds; prints one line per point.
 """
@@ -98,7 +98,7 @@ def main():
                         print(f"{tag} {m.name} {rpm} r/min {c}: "
                               f"request {want:.4g} N*m, mean {got if got is None else round(got, 4)}"
                               f" N*m ({'n/a' if got is None else f'{100 * (got / want - 1):+.1f} %'}),"
-                              f" limit {r.get('torque_max_nm')} N*m ({r.get('fw_limit')}), fault {r.get('fault', r.get('err'))}")
+                              f" limit {r.get('torque_max_nm')} N*m ({r.get('fieldweak_limit')}), fault {r.get('fault', r.get('err'))}")
         if "robust" in a.only:
             mfile = CASES["spmsm"][0]
             off = os.path.join(tmp, "spmsm_psi120.ini")
@@ -132,7 +132,7 @@ def main():
                 bad += not good
                 print(f"{'ok  ' if good else 'FAIL'} reversal {c}: +3400 -> -3400 r/min, mean speed "
                       f"{end} r/min over 0.1-0.12 s, fault {r.get('fault', r.get('err'))}")
-    print(f"fw_done_test: {bad} point(s) failed")
+    print(f"fieldweak_done_test: {bad} point(s) failed")
     return 1 if bad else 0
 
 

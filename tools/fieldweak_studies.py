@@ -21,7 +21,7 @@ OUT/fieldweak.md with its plots (linked from OUT/report.md).
             torque ripple and T_sse against nominal.
 Indices from the plant's true signals on a Ts/10 grid unless stated.
 
-usage: tools/fw_studies.py [--only envelope,sigma,flux,robust] [--out DIR] [--jobs N]
+usage: tools/fieldweak_studies.py [--only envelope,sigma,flux,robust] [--out DIR] [--jobs N]
 """
 import argparse
 import concurrent.futures as cf
@@ -62,7 +62,7 @@ def sim_binary():
     r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
                        capture_output=True, text=True)
     if r.returncode != 0:
-        sys.exit(f"fw_studies: tools/sim failed:\n{r.stderr}")
+        sys.exit(f"fieldweak_studies: tools/sim failed:\n{r.stderr}")
     bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
     names = [ln.split("\t")[0] for ln in r.stdout.splitlines() if "\t" in ln]
     fs = {ln.split("\t")[0]: int(ln.split("\t")[1]) for ln in r.stdout.splitlines() if "\t" in ln}
@@ -149,7 +149,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
     jobs, meta = {}, {}
     for mname, mfile, base, top, checks, dur, ws in cases:
         # MTPA below base speed (the IPMSM file's fixed flux reference, Table 3.1,
-        # allows at most 375 N*m at the rated current), as tools/fw_done_test.py.
+        # allows at most 375 N*m at the rated current), as tools/fieldweak_done_test.py.
         ctl = write_ini(mfile, os.path.join(tmp, f"{mname}_mtpa.ini"),
                         {("rated", "psi_ref_wb"): 0.0})
         m, lim, rpms = envelope_points(mfile, base, top)
@@ -212,7 +212,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
         for g, members in groups:
             if not members:
                 continue
-            fn = f"fw_envelope_{mname}_{g}.png"
+            fn = f"fieldweak_envelope_{mname}_{g}.png"
             env.plot(m, lim, os.path.join(out, fn), rpm_max=max(rpms) * 1.05,
                      extra={c: extra[c] for c in members})
             figs.append(fn)
@@ -248,7 +248,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
 
 # ----------------------------------------------------------------------------- sigma
 SIGMAS_DEG = (0.0, 3.75, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0)
-SIGMA_MAX_DEG = float(os.environ.get("FW_SIGMA_MAX_DEG", "30"))
+SIGMA_MAX_DEG = float(os.environ.get("FIELDWEAK_SIGMA_MAX_DEG", "30"))
 
 
 def study_sigma(names, fsd, tmp, n_jobs, out):
@@ -292,7 +292,7 @@ def study_sigma(names, fsd, tmp, n_jobs, out):
                 ax[i][j].axvline(15.0, color="grey", lw=0.6, ls=":")
     ax[0][0].legend(fontsize=8)
     fig.tight_layout()
-    fn = "fw_sigma.png"
+    fn = "fieldweak_sigma.png"
     fig.savefig(os.path.join(out, fn), dpi=DPI)
     plt.close(fig)
     lines += ["", f"![sigma]({fn})", ""]
@@ -561,7 +561,7 @@ def study_robust(names, fsd, tmp, n_jobs, out):
         ax[k].grid(True, axis="y", lw=0.3)
     ax[-1].legend(fontsize=7, ncol=2)
     fig.tight_layout()
-    fn = "fw_robust.png"
+    fn = "fieldweak_robust.png"
     fig.savefig(os.path.join(out, fn), dpi=DPI)
     plt.close(fig)
     lines += [f"![robustness]({fn})", ""]
@@ -612,19 +612,19 @@ def main():
     os.makedirs(a.out, exist_ok=True)
     t0 = time.time()
     lines = ["# Field weakening, σ, flux ripple and robustness", "",
-             "Written by `tools/fw_studies.py` (called by `./tools/demo`). Thesis SPMSM and 80 kW "
+             "Written by `tools/fieldweak_studies.py` (called by `./tools/demo`). Thesis SPMSM and 80 kW "
              "IPMSM of the machine files; every index from the plant's true signals on a Ts/10 "
              "grid unless marked \"ctrl\" (the estimate at the control instants).", ""]
     dump = {}
     with tempfile.TemporaryDirectory() as tmp:
         for s in a.only.split(","):
             if s not in STUDIES:
-                sys.exit(f"fw_studies: unknown study {s} (known: {', '.join(STUDIES)})")
+                sys.exit(f"fieldweak_studies: unknown study {s} (known: {', '.join(STUDIES)})")
             t1 = time.time()
             r = STUDIES[s](names, fsd, tmp, a.jobs, a.out)
             lines += r[0]
             dump[s] = {"|".join(map(str, k)): v for k, v in r[1].items()}
-            print(f"fw_studies: {s} in {time.time() - t1:.0f} s", flush=True)
+            print(f"fieldweak_studies: {s} in {time.time() - t1:.0f} s", flush=True)
     lines.append(f"Total wall time {time.time() - t0:.0f} s on {a.jobs} processes.")
     k = lines.index("") + 3
     lines[k:k] = ["## Findings", ""] + [f"- {f}" for f in FINDINGS] + [""]
@@ -633,7 +633,7 @@ def main():
     if a.json:
         with open(a.json, "w") as f:
             json.dump(dump, f, indent=0, default=str)
-    print(f"fw_studies: wrote {os.path.relpath(os.path.join(a.out, 'fieldweak.md'))}")
+    print(f"fieldweak_studies: wrote {os.path.relpath(os.path.join(a.out, 'fieldweak.md'))}")
 
 
 if __name__ == "__main__":
