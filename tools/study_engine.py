@@ -2,7 +2,7 @@
 stored as it arrives, keyed by the run's full description.
 
 Every tool that runs many simulations (tools/compare.py, analyses.py, filters.py,
-fieldweak studies, torque_sweep.py, the declarative studies of tools/study) goes
+fieldweak_studies.py, torque_sweep.py, the declarative studies of tools/study) goes
 through it:
 
     with study_engine.Engine.from_args(args, out_dir, "compare") as eng:
