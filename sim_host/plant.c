@@ -23,6 +23,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "plant_mech.h"
+
 #define PLANT_SQRT3 1.73205080756887729353
 #define PLANT_RK4_STEP_DEFAULT 0.5e-6
 /* Time comparisons: instants closer than this are the same instant. */
@@ -535,6 +537,60 @@ static int electrical_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, 
     return rk4_interval(p, l, w, dt);
 }
 
+/* Free mechanics with friction, stiction, cogging or a load profile
+ * (plant_mech.h): the electrical part at the sub-interval's mean speed
+ * predicted with Te held at its start value (stick and slip included), then
+ * the mechanics against the quadratic through Te at 0, dt/2, dt. theta_e
+ * follows theta_m. */
+static int mech_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, double dt)
+{
+    const double pp = (double)p->cfg.pole_pairs;
+    mech_in_t in;
+    mech_setup(p, &in);
+    in.prof_x0 = p->t - p->profile_t0;
+    const double te0 = plant_torque(p);
+    in.te[0] = te0;
+    mech_out_t mo;
+    int rc = mech_solve(&in, dt, p->omega_m, p->mech_dir, &mo);
+    if (rc != PLANT_OK) {
+        return rc;
+    }
+    const double wh = mo.dtheta / dt;
+    const double th0 = p->theta_e;
+    rc = electrical_piece(p, l, sine, wh * pp, 0.0, 0.5 * dt);
+    if (rc != PLANT_OK) {
+        return rc;
+    }
+    p->theta_e = th0 + wh * pp * 0.5 * dt;
+    const double tem = plant_torque(p);
+    rc = electrical_piece(p, l, sine, wh * pp, 0.5 * dt, 0.5 * dt);
+    if (rc != PLANT_OK) {
+        return rc;
+    }
+    const double te1 = plant_torque(p);
+    in.te[1] = (-3.0 * te0 + 4.0 * tem - te1) / dt;
+    in.te[2] = (2.0 * te0 - 4.0 * tem + 2.0 * te1) / (dt * dt);
+    rc = mech_solve(&in, dt, p->omega_m, p->mech_dir, &mo);
+    if (rc != PLANT_OK) {
+        return rc;
+    }
+    p->omega_m = mo.omega;
+    p->mech_dir = mo.dir;
+    p->theta_m += mo.dtheta;
+    p->theta_e = wrap_pi(th0 + pp * mo.dtheta);
+    plant_mech_stats_t *s = &p->ms;
+    s->stuck_s += mo.d.stuck_s;
+    s->moving_s += mo.d.moving_s;
+    s->breakaways += mo.d.breakaways;
+    s->stops += mo.d.stops;
+    s->reversals += mo.d.reversals;
+    s->e_drive_j += mo.d.e_drive_j;
+    s->e_friction_j += mo.d.e_friction_j;
+    s->e_load_j += mo.d.e_load_j;
+    s->abs_angle_rad += mo.d.abs_angle_rad;
+    return PLANT_OK;
+}
+
 /* Advance dt with fixed effective leg states: electrical + mechanical. */
 static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, double dt)
 {
@@ -546,7 +602,12 @@ static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, dou
     }
     const double pp = (double)p->cfg.pole_pairs;
     int rc;
-    if (p->cfg.mech == PLANT_MECH_FREE) {
+    if (p->cfg.mech == PLANT_MECH_FREE && p->mech_events) {
+        rc = mech_piece(p, l, sine, dt);
+        if (rc != PLANT_OK) {
+            return rc;
+        }
+    } else if (p->cfg.mech == PLANT_MECH_FREE) {
         /* omega held at the midpoint prediction; Te averaged by Simpson. */
         const double J = p->cfg.inertia_kgm2, B = p->cfg.friction_nms;
         const double te0 = plant_torque(p);
@@ -607,6 +668,35 @@ static int advance_piece(plant_t *p, const legs_t *l, const sine_in_t *sine, dou
 
 /* ------------------------------------------------------------------ API */
 
+/* The non-ideal mechanics' part of a configuration: clears *ok if a value is
+ * out of range; returns 1 if any term is present (the event path). */
+static int mech_config_ok(const plant_config_t *c, int *ok)
+{
+    int good = finite_nonneg(c->coulomb_nm) && isfinite(c->stiction_nm) &&
+               c->stiction_nm >= c->coulomb_nm && c->cog_n >= 0 && c->cog_n <= PLANT_COG_MAX;
+    int any_cog = 0;
+    for (int k = 0; good && k < c->cog_n; ++k) {
+        good = finite_nonneg(c->cog_amp_nm[k]) && isfinite(c->cog_phase_rad[k]);
+        any_cog |= c->cog_amp_nm[k] > 0.0;
+    }
+    if (good && c->cog_n > 0) {
+        good = c->cog_per_rev >= 1;
+    }
+    const plant_profile_t *pr = &c->load_profile;
+    if (good && pr->kind != PLANT_PROFILE_NONE) {
+        good = (pr->kind == PLANT_PROFILE_TIME || pr->kind == PLANT_PROFILE_SPEED) && pr->n >= 2 &&
+               pr->n <= PLANT_PROFILE_MAX;
+        for (int i = 0; good && i < pr->n; ++i) {
+            good = isfinite(pr->x[i]) && isfinite(pr->y[i]) && (i == 0 || pr->x[i] > pr->x[i - 1]);
+        }
+    }
+    if (!good) {
+        *ok = 0;
+        return 0;
+    }
+    return c->coulomb_nm > 0.0 || c->stiction_nm > 0.0 || any_cog || pr->kind != PLANT_PROFILE_NONE;
+}
+
 int plant_init(plant_t *p, const plant_config_t *cfg)
 {
     if (p == NULL) {
@@ -639,6 +729,11 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
         /* the filter path integrates the linear model exactly (plant_filter.h) */
         ok = c->fluxmap == NULL && c->dc_cap_f == 0.0 && c->dead_time_s == 0.0 && c->v_fwd_v == 0.0;
     }
+    const int events = mech_config_ok(c, &ok);
+    if (ok && events && c->filter.type != PLANT_FILTER_NONE) {
+        /* the filter path holds the speed over a whole PWM period */
+        ok = 0;
+    }
     if (!ok) {
         return PLANT_EINVAL;
     }
@@ -653,6 +748,10 @@ int plant_init(plant_t *p, const plant_config_t *cfg)
     p->vdc = c->vdc_v;
     p->load_torque_nm = c->load_torque_nm;
     p->load_passive_nm = c->load_passive_nm;
+    p->mech_events = events;
+    p->mech_dir = (p->omega_m > 0.0) - (p->omega_m < 0.0);
+    p->profile_on = 1;
+    p->profile_t0 = 0.0;
     p->id = c->id0_a;
     p->iq = c->iq0_a;
     flux_from_current(p, p->id, p->iq, &p->psi_d, &p->psi_q);
@@ -699,12 +798,34 @@ void plant_set_load_passive(plant_t *p, double t_passive_nm)
     }
 }
 
+/* The mechanics' inputs now (sub-interval time 0, the torque now). */
+static void mech_now(const plant_t *p, mech_in_t *in)
+{
+    mech_setup(p, in);
+    in->prof_x0 = p->t - p->profile_t0;
+    in->te[0] = plant_torque(p);
+}
+
 double plant_load_torque(const plant_t *p)
 {
     if (p == NULL) {
         return NAN;
     }
     const double tp = p->load_passive_nm;
+    if (p->mech_events) {
+        mech_in_t in;
+        mech_now(p, &in);
+        const double tla = mech_load(&in, 0.0, p->omega_m);
+        if (p->mech_dir != 0) {
+            return tla + tp * (double)p->mech_dir;
+        }
+        /* At rest the bearings hold up to T_s of the net torque, the passive
+         * load the rest (at most T_p). */
+        const double net = in.te[0] + plant_cogging_torque(p) - tla;
+        const double ts = p->cfg.stiction_nm;
+        const double bearing = net > ts ? ts : (net < -ts ? -ts : net);
+        return tla + (net - bearing);
+    }
     if (p->omega_m != 0.0) {
         return p->load_torque_nm + (p->omega_m > 0.0 ? tp : -tp);
     }
@@ -717,7 +838,63 @@ void plant_set_speed_rpm(plant_t *p, double rpm)
 {
     if (p != NULL && isfinite(rpm)) {
         p->omega_m = rpm * 2.0 * PLANT_PI / 60.0;
+        p->mech_dir = (p->omega_m > 0.0) - (p->omega_m < 0.0);
     }
+}
+
+void plant_load_profile_enable(plant_t *p, int on)
+{
+    if (p != NULL) {
+        p->profile_on = on != 0;
+        p->profile_t0 = p->t;
+    }
+}
+
+double plant_cogging_torque(const plant_t *p)
+{
+    if (p == NULL || p->cfg.cog_n == 0) {
+        return 0.0;
+    }
+    mech_in_t in;
+    mech_setup(p, &in);
+    return mech_cogging(&in, in.cog_phase0);
+}
+
+double plant_cogging_energy(const plant_t *p)
+{
+    if (p == NULL || p->cfg.cog_n == 0) {
+        return 0.0;
+    }
+    mech_in_t in;
+    mech_setup(p, &in);
+    return mech_cogging_energy(&in, in.cog_phase0);
+}
+
+double plant_friction_torque(const plant_t *p)
+{
+    if (p == NULL) {
+        return NAN;
+    }
+    if (!p->mech_events || p->mech_dir != 0) {
+        const double d = p->mech_events ? (double)p->mech_dir
+                                        : (double)((p->omega_m > 0.0) - (p->omega_m < 0.0));
+        return p->cfg.friction_nms * p->omega_m + p->cfg.coulomb_nm * d;
+    }
+    mech_in_t in;
+    mech_now(p, &in);
+    const double net = in.te[0] + mech_cogging(&in, in.cog_phase0) - mech_load(&in, 0.0, 0.0);
+    const double ts = p->cfg.stiction_nm;
+    return net > ts ? ts : (net < -ts ? -ts : net);
+}
+
+int plant_stuck(const plant_t *p)
+{
+    return p != NULL && p->mech_events && p->mech_dir == 0;
+}
+
+void plant_mech_stats(const plant_t *p, plant_mech_stats_t *st)
+{
+    *st = p->ms;
 }
 
 /* Effective leg states at the current time (dead time). */

@@ -19,9 +19,17 @@
  *    drop, gates off): fixed-sub-step RK4 in flux coordinates (psi_d, psi_q,
  *    vdc), sub-step cfg.rk4_step_s (default 0.5 us), still split at every
  *    switching instant.
- *  - free mechanics: omega is held in each sub-interval at the midpoint
- *    prediction omega_k + dt/2 * (Te_k - T_L - B omega_k)/J, then updated
- *    exactly for the interval's mean torque (Simpson on Te at 0, dt/2, dt).
+ *  - free mechanics, smooth (viscous friction, constant and passive load
+ *    only): omega is held in each sub-interval at the midpoint prediction
+ *    omega_k + dt/2 * (Te_k - T_L - B omega_k)/J, then updated exactly for
+ *    the interval's mean torque (Simpson on Te at 0, dt/2, dt).
+ *  - free mechanics with Coulomb friction, stiction, cogging or a load
+ *    profile (plant_mech.c): the electrical part holds omega at the
+ *    sub-interval's predicted mean speed; the mechanics are integrated
+ *    against the sub-interval's torque Te(t) (the quadratic through Te at 0,
+ *    dt/2, dt) by RK4 with steps bounded by the cogging phase, the stick and
+ *    slip instants (speed zero crossings, break-away) located inside the
+ *    sub-interval, not stepped over (sim_host/README.md, "Mechanics").
  *
  * The observer (plant_set_observer) sees the state at every instant of its
  * grid n * obs_dt (global time), so metrics see the true continuous signals,
@@ -70,8 +78,29 @@ typedef struct {
 
 typedef enum {
     PLANT_MECH_IMPOSED = 0, /* dynamometer: omega follows plant_set_speed */
-    PLANT_MECH_FREE = 1     /* (3.15): J dw_m/dt + B w_m = Te - T_L */
+    PLANT_MECH_FREE = 1     /* (3.15): J dw_m/dt + B w_m = Te - T_L, with the
+                               friction, cogging and load terms below */
 } plant_mech_mode_t;
+
+/* Cogging harmonics (fundamental included) and load-profile points. */
+#define PLANT_COG_MAX 8
+#define PLANT_PROFILE_MAX 32
+
+typedef enum {
+    PLANT_PROFILE_NONE = 0,
+    PLANT_PROFILE_TIME = 1, /* x: time since the profile's origin, s */
+    PLANT_PROFILE_SPEED = 2 /* x: signed mechanical speed, rad/s */
+} plant_profile_kind_t;
+
+/* Active load profile T(x), piecewise linear through the points, held at the
+ * first and last value outside them; x strictly increasing; positive values
+ * oppose positive rotation (like load_torque_nm, to which it adds). */
+typedef struct {
+    plant_profile_kind_t kind;
+    int n; /* points, 2..PLANT_PROFILE_MAX (kind != NONE) */
+    double x[PLANT_PROFILE_MAX];
+    double y[PLANT_PROFILE_MAX]; /* N*m */
+} plant_profile_t;
 
 typedef struct {
     /* Machine, (3.8)-(3.10). */
@@ -101,6 +130,21 @@ typedef struct {
     double load_passive_nm; /* >= 0: passive load T_p sign(w_m) (Coulomb friction of a
                                load): opposes the rotation, holds the rotor at rest
                                while |Te - T_L| <= T_p, never drives it */
+    /* Non-ideal mechanics (all 0: the smooth model above, integrated as
+     * before, bit for bit). Free mechanics:
+     *   J dw/dt = Te + T_cog(theta_m) - T_L - T_prof - B w - (T_c + T_p) sign(w)
+     * and at rest (w = 0) the rotor stays stuck while
+     *   |Te + T_cog - T_L - T_prof| <= T_s + T_p. */
+    double coulomb_nm;  /* T_c >= 0: running (Coulomb) friction of the bearings */
+    double stiction_nm; /* T_s >= T_c: break-away friction (T_s = T_c: none extra) */
+    /* Cogging, the torque of the magnets on the stator teeth acting on the
+     * rotor: T_cog = sum_k cog_amp_nm[k] sin((k+1) N theta_m + cog_phase_rad[k]),
+     * N = cog_per_rev periods per revolution (lcm(slots, 2 p)). */
+    int cog_per_rev;                     /* N >= 1 when cog_n > 0 */
+    int cog_n;                           /* harmonics given, 0..PLANT_COG_MAX */
+    double cog_amp_nm[PLANT_COG_MAX];    /* >= 0 */
+    double cog_phase_rad[PLANT_COG_MAX]; /* finite */
+    plant_profile_t load_profile;        /* active, on from init (plant_load_profile_enable) */
 
     /* Initial state. */
     double theta0_e_rad; /* electrical rotor angle */
@@ -122,6 +166,21 @@ typedef struct {
 } plant_config_t;
 
 typedef struct plant plant_t;
+
+/* Mechanical accounting since init (free mechanics with non-ideal
+ * mechanics; zero otherwise). Energy balance, exact up to the integration:
+ *   e_drive = dKE + e_friction + e_load + dW_cog   (plant_cogging_energy). */
+typedef struct {
+    double stuck_s;       /* time at rest held by friction (stiction + passive load) */
+    uint64_t breakaways;  /* stuck -> turning */
+    uint64_t stops;       /* turning -> stuck */
+    uint64_t reversals;   /* speed through zero without sticking */
+    double e_drive_j;     /* integral Te w_m dt (Te: the sub-interval's quadratic) */
+    double e_friction_j;  /* integral (B w + T_c sign w) w dt, >= 0: the bearings */
+    double e_load_j;      /* integral (T_L + T_prof + T_p sign w) w dt: into the load */
+    double moving_s;      /* time turning */
+    double abs_angle_rad; /* integral |w_m| dt */
+} plant_mech_stats_t;
 
 /* Observer: called at every grid instant n * obs_dt (n integer, global time)
  * reached during an advance, with the true state at that instant. */
@@ -163,6 +222,15 @@ struct plant {
      * observer instant (plant_v_motor_mean_abc) */
     double v_int[2];
     double v_int_t0;
+    /* non-ideal mechanics (plant_mech.c): on when the configuration has
+     * Coulomb friction, stiction, cogging or a load profile */
+    int mech_events;
+    int mech_dir;          /* -1, +1: turning that way (w may be 0 at a break-away
+                              or a reversal); 0: stuck, held by friction */
+    int profile_on;        /* the load profile acts */
+    double profile_t0;     /* its time origin (PLANT_PROFILE_TIME) */
+    double cog_phase0;     /* N theta_m mod 2 pi, kept with theta_m */
+    plant_mech_stats_t ms; /* since init */
     /* output filter (cfg.filter.type != PLANT_FILTER_NONE) and its step */
     plant_filter_t flt;
     int step_on;
@@ -199,6 +267,18 @@ void plant_set_load_passive(plant_t *p, double t_passive_nm); /* magnitude >= 0 
  * present value (T_p sign(w_m); at rest the part of Te - T_L it holds). */
 double plant_load_torque(const plant_t *p);
 void plant_set_speed_rpm(plant_t *p, double rpm); /* imposed speed (and free: sets the state) */
+/* The active load profile on (its time origin: now) or off. */
+void plant_load_profile_enable(plant_t *p, int on);
+/* Cogging torque on the rotor now, T_cog(theta_m), N*m; and its potential
+ * W_cog(theta_m) = sum A_k/(k N) cos(k N theta_m + phi_k), J (T_cog = -dW/dtheta). */
+double plant_cogging_torque(const plant_t *p);
+double plant_cogging_energy(const plant_t *p);
+/* Bearing friction torque now (opposing the motion, signed like the speed;
+ * at rest the part of the net torque it holds), N*m. */
+double plant_friction_torque(const plant_t *p);
+/* 1: the rotor is at rest held by friction (non-ideal mechanics). */
+int plant_stuck(const plant_t *p);
+void plant_mech_stats(const plant_t *p, plant_mech_stats_t *st);
 
 /* True state getters. */
 double plant_time(const plant_t *p);

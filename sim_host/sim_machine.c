@@ -12,13 +12,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum { K_TEXT, K_INT, K_REAL, K_PATH } key_kind_t;
+/* K_LIST: reals (each in the range) separated by blanks or commas, their
+ * count in k_lists; K_PROFILE: points x:y (load_profile). */
+typedef enum { K_TEXT, K_INT, K_REAL, K_PATH, K_LIST, K_PROFILE } key_kind_t;
 
 typedef struct {
     const char *section, *name;
     key_kind_t kind;
     int required;
-    double lo, hi; /* accepted closed range (REAL / INT) */
+    double lo, hi; /* accepted closed range (REAL / INT / LIST items) */
     int lo_open;   /* 1: lo excluded (strictly positive quantities) */
     double scale;  /* stored value = parsed * scale */
     size_t offset; /* into sim_machine_t */
@@ -45,6 +47,16 @@ static const key_t_ k_keys[] = {
     {"inverter", "dc_src_r_ohm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(dc_src_r_ohm)},
     {"mechanics", "inertia_kgm2", K_REAL, 1, 0, 1e6, 1, 1.0, OFF(inertia_kgm2)},
     {"mechanics", "friction_nms", K_REAL, 0, 0, 1e6, 0, 1.0, OFF(friction_nms)},
+    {"mechanics", "coulomb_nm", K_REAL, 0, 0, 1e5, 0, 1.0, OFF(coulomb_nm)},
+    {"mechanics", "stiction_nm", K_REAL, 0, 0, 1e5, 0, 1.0, OFF(stiction_nm)},
+    {"mechanics", "slots", K_INT, 0, 1, 1000, 0, 1.0, OFF(slots)},
+    {"mechanics", "cogging_nm", K_REAL, 0, 0, 1e5, 0, 1.0, OFF(cogging_nm)},
+    {"mechanics", "cogging_phase_deg", K_REAL, 0, -360, 360, 0, 1.0, OFF(cogging_phase_deg)},
+    {"mechanics", "cogging_harmonics_nm", K_LIST, 0, 0, 1e5, 0, 1.0, OFF(cog_harm_nm)},
+    {"mechanics", "cogging_harmonics_deg", K_LIST, 0, -360, 360, 0, 1.0, OFF(cog_harm_deg)},
+    {"mechanics", "load_kind", K_TEXT, 0, 0, 0, 0, 1.0, OFF(load_kind_text)},
+    {"mechanics", "load_nm", K_REAL, 0, -1e5, 1e5, 0, 1.0, OFF(load_nm)},
+    {"mechanics", "load_profile", K_PROFILE, 0, -1e6, 1e6, 0, 1.0, OFF(load_profile)},
     {"fluxmap", "file", K_PATH, 0, 0, 0, 0, 1.0, OFF(fluxmap_path)},
     {"rated", "overspeed_rpm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(overspeed_rpm)},
     {"rated", "speed_max_rpm", K_REAL, 0, 0, 1e6, 1, 1.0, OFF(speed_max_rpm)},
@@ -85,6 +97,16 @@ static const key_t_ k_keys[] = {
 };
 #define N_KEYS (sizeof(k_keys) / sizeof(k_keys[0]))
 
+/* K_LIST keys: where their count goes and how many values they take. */
+static const struct {
+    const char *name;
+    size_t offset_n;
+    int max_n;
+} k_lists[] = {
+    {"cogging_harmonics_nm", OFF(cog_harm_n), PLANT_COG_MAX - 1},
+    {"cogging_harmonics_deg", OFF(cog_harm_deg_n), PLANT_COG_MAX - 1},
+};
+
 typedef struct {
     sim_machine_t *m;
     unsigned char seen[N_KEYS];
@@ -92,6 +114,131 @@ typedef struct {
     const char *dir; /* folder of the INI file, for relative paths */
     size_t dirlen;
 } ctx_t;
+
+/* One number of a list at *p (blanks and commas before it skipped);
+ * returns 1 and advances *p, 0 at the end, -1 if malformed (the token in tok). */
+static int next_number(const char **p, double *v, char *tok, size_t toklen)
+{
+    const char *q = *p;
+    while (*q == ' ' || *q == '\t' || *q == ',') {
+        q++;
+    }
+    if (*q == '\0') {
+        return 0;
+    }
+    size_t n = strcspn(q, " \t,:");
+    snprintf(tok, toklen, "%.*s", (int)(n < 40 ? n : 40), q);
+    char *end;
+    errno = 0;
+    *v = strtod(q, &end);
+    if (end != q + n || n == 0 || errno != 0 || !isfinite(*v)) {
+        return -1;
+    }
+    *p = q + n;
+    return 1;
+}
+
+static int parse_list(ctx_t *c, const key_t_ *K, const char *value, char *dst)
+{
+    double *out = (double *)(void *)dst;
+    size_t li = 0;
+    while (li + 1 < sizeof k_lists / sizeof k_lists[0] && strcmp(k_lists[li].name, K->name) != 0) {
+        li++; /* every K_LIST key has its row */
+    }
+    int *count = (int *)(void *)((char *)c->m + k_lists[li].offset_n);
+    const int max_n = k_lists[li].max_n;
+    const char *p = value;
+    int n = 0;
+    char tok[48];
+    for (;;) {
+        double v;
+        const int r = next_number(&p, &v, tok, sizeof tok);
+        if (r == 0) {
+            break;
+        }
+        if (r < 0) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s value %d '%s' is not a number", K->section,
+                     K->name, n + 1, tok);
+            return 0;
+        }
+        if (n == max_n) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s has more than %d values", K->section, K->name,
+                     max_n);
+            return 0;
+        }
+        if (!(v >= K->lo && v <= K->hi)) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s value %d = %g out of range [%g, %g]",
+                     K->section, K->name, n + 1, v, K->lo, K->hi);
+            return 0;
+        }
+        out[n++] = v * K->scale;
+    }
+    if (n == 0) {
+        snprintf(c->msg, sizeof c->msg, "[%s] %s is empty", K->section, K->name);
+        return 0;
+    }
+    *count = n;
+    return 1;
+}
+
+/* x:y points; the kind (time or speed) and the x range are checked after the
+ * file is read (load_kind may come later), x increasing here. */
+static int parse_profile(ctx_t *c, const key_t_ *K, const char *value, plant_profile_t *pr)
+{
+    const char *p = value;
+    int n = 0;
+    char tok[48];
+    for (;;) {
+        while (*p == ' ' || *p == '\t' || *p == ',') {
+            p++;
+        }
+        if (*p == '\0') {
+            break;
+        }
+        double x, y;
+        const char *start = p;
+        int r = next_number(&p, &x, tok, sizeof tok);
+        if (r > 0 && *p == ':') {
+            p++;
+            r = next_number(&p, &y, tok, sizeof tok);
+        } else if (r > 0) {
+            r = -1;
+        }
+        if (r <= 0) {
+            size_t k = strcspn(start, " \t,");
+            snprintf(c->msg, sizeof c->msg, "[%s] %s point %d '%.*s' is not x:T (two numbers)",
+                     K->section, K->name, n + 1, (int)(k < 40 ? k : 40), start);
+            return 0;
+        }
+        if (n == PLANT_PROFILE_MAX) {
+            snprintf(c->msg, sizeof c->msg, "[%s] %s has more than %d points", K->section, K->name,
+                     PLANT_PROFILE_MAX);
+            return 0;
+        }
+        if (!(x >= K->lo && x <= K->hi) || !(y >= -1e5 && y <= 1e5)) {
+            snprintf(c->msg, sizeof c->msg,
+                     "[%s] %s point %d = %g:%g out of range (x in [%g, %g], T in [-1e5, 1e5] N*m)",
+                     K->section, K->name, n + 1, x, y, K->lo, K->hi);
+            return 0;
+        }
+        if (n > 0 && !(x > pr->x[n - 1])) {
+            snprintf(c->msg, sizeof c->msg,
+                     "[%s] %s point %d: x = %g not after the previous point's %g (x must increase)",
+                     K->section, K->name, n + 1, x, pr->x[n - 1]);
+            return 0;
+        }
+        pr->x[n] = x;
+        pr->y[n] = y;
+        n++;
+    }
+    if (n < 2) {
+        snprintf(c->msg, sizeof c->msg, "[%s] %s needs at least 2 points x:T (got %d)", K->section,
+                 K->name, n);
+        return 0;
+    }
+    pr->n = n;
+    return 1;
+}
 
 static int handler(void *user, const char *section, const char *name, const char *value)
 {
@@ -129,6 +276,12 @@ static int handler(void *user, const char *section, const char *name, const char
                 return 0;
             }
             return 1;
+        }
+        if (K->kind == K_LIST) {
+            return parse_list(c, K, value, dst);
+        }
+        if (K->kind == K_PROFILE) {
+            return parse_profile(c, K, value, (plant_profile_t *)(void *)dst);
         }
         char *end;
         errno = 0;
@@ -259,6 +412,162 @@ static int filter_check(sim_machine_t *m, const unsigned char *seen, char *err, 
     return 0;
 }
 
+/* Line of `key` in [section] of the file (0: not found), for the messages of
+ * the rules that involve several keys (libinih reports no line to them). */
+static int key_line(const char *path, const char *section, const char *key)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL) {
+        return 0;
+    }
+    char line[512], sec[64] = "";
+    int n = 0, found = 0;
+    while (found == 0 && fgets(line, sizeof line, f) != NULL) {
+        n++;
+        const char *p = line;
+        while (*p == ' ' || *p == '\t') {
+            p++;
+        }
+        if (*p == '[') {
+            const size_t k = strcspn(p + 1, "]");
+            snprintf(sec, sizeof sec, "%.*s", (int)k, p + 1);
+            continue;
+        }
+        const size_t k = strcspn(p, " \t=:");
+        if (strcmp(sec, section) == 0 && k == strlen(key) && strncmp(p, key, k) == 0) {
+            found = n;
+        }
+    }
+    fclose(f);
+    return found;
+}
+
+static int key_index(const char *section, const char *name)
+{
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        if (strcmp(k_keys[k].section, section) == 0 && strcmp(k_keys[k].name, name) == 0) {
+            return (int)k;
+        }
+    }
+    return -1;
+}
+
+/* [mechanics]' rules between keys; err gets "file:line: message". */
+static int mech_check(const char *path, sim_machine_t *m, const unsigned char *seen, char *err,
+                      size_t errlen)
+{
+#define SEEN(name) seen[key_index("mechanics", name)]
+    char bad[256] = "";
+    const char *at = NULL; /* the key whose line is reported */
+    if (!SEEN("stiction_nm")) {
+        m->stiction_nm = m->coulomb_nm; /* no break-away above the running friction */
+    }
+    static const struct {
+        const char *text;
+        sim_load_kind_t kind;
+    } kinds[] = {{"none", SIM_LOAD_NONE},
+                 {"constant", SIM_LOAD_CONSTANT},
+                 {"passive", SIM_LOAD_PASSIVE},
+                 {"time", SIM_LOAD_TIME},
+                 {"speed", SIM_LOAD_SPEED}};
+    int kind = -1;
+    if (!SEEN("load_kind")) {
+        kind = SIM_LOAD_NONE;
+    }
+    for (size_t i = 0; kind < 0 && i < sizeof kinds / sizeof kinds[0]; ++i) {
+        if (strcmp(m->load_kind_text, kinds[i].text) == 0) {
+            kind = (int)kinds[i].kind;
+        }
+    }
+    m->load_kind = kind < 0 ? SIM_LOAD_NONE : (sim_load_kind_t)kind;
+    const int profile = kind == SIM_LOAD_TIME || kind == SIM_LOAD_SPEED;
+    if (!(m->stiction_nm >= m->coulomb_nm)) {
+        at = "stiction_nm";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] stiction_nm = %g below coulomb_nm = %g: allowed range [%g, 1e5] "
+                 "(the break-away torque is at least the running friction)",
+                 m->stiction_nm, m->coulomb_nm, m->coulomb_nm);
+    } else if ((m->cogging_nm > 0.0 || SEEN("cogging_harmonics_nm")) && m->slots == 0) {
+        at = m->cogging_nm > 0.0 ? "cogging_nm" : "cogging_harmonics_nm";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] %s needs slots (the cogging repeats lcm(slots, 2 pole_pairs) times "
+                 "per revolution)",
+                 at);
+    } else if (SEEN("cogging_harmonics_deg") && m->cog_harm_deg_n != m->cog_harm_n) {
+        at = "cogging_harmonics_deg";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] cogging_harmonics_deg has %d values, cogging_harmonics_nm %d: one "
+                 "phase per harmonic",
+                 m->cog_harm_deg_n, m->cog_harm_n);
+    } else if (kind < 0) {
+        at = "load_kind";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] load_kind = '%s': expected none, constant, passive, time or speed",
+                 m->load_kind_text);
+    } else if ((kind == SIM_LOAD_CONSTANT || kind == SIM_LOAD_PASSIVE) && !SEEN("load_nm")) {
+        at = "load_kind";
+        snprintf(bad, sizeof bad, "[mechanics] load_kind = %s needs load_nm", m->load_kind_text);
+    } else if (kind == SIM_LOAD_PASSIVE && !(m->load_nm >= 0.0)) {
+        at = "load_nm";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] load_nm = %g out of range [0, 1e5] for load_kind = passive (a "
+                 "magnitude: it opposes the motion either way)",
+                 m->load_nm);
+    } else if (SEEN("load_nm") && kind != SIM_LOAD_CONSTANT && kind != SIM_LOAD_PASSIVE) {
+        at = "load_nm";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] load_nm belongs to load_kind = constant or passive (load_kind = %s)",
+                 SEEN("load_kind") ? m->load_kind_text : "none");
+    } else if (profile && !SEEN("load_profile")) {
+        at = "load_kind";
+        snprintf(bad, sizeof bad, "[mechanics] load_kind = %s needs load_profile = x:T x:T ...",
+                 m->load_kind_text);
+    } else if (SEEN("load_profile") && !profile) {
+        at = "load_profile";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] load_profile belongs to load_kind = time or speed (load_kind = %s)",
+                 SEEN("load_kind") ? m->load_kind_text : "none");
+    } else if (kind == SIM_LOAD_TIME && !(m->load_profile.x[0] >= 0.0)) {
+        at = "load_profile";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] load_profile point 1 at t = %g s: allowed range [0, 1e6] s (time "
+                 "from the arm instant)",
+                 m->load_profile.x[0]);
+    } else if (m->filter.type != PLANT_FILTER_NONE &&
+               (m->coulomb_nm > 0.0 || m->stiction_nm > 0.0 || m->cogging_nm > 0.0 ||
+                m->cog_harm_n > 0 || profile)) {
+        at = m->coulomb_nm > 0.0    ? "coulomb_nm"
+             : m->stiction_nm > 0.0 ? "stiction_nm"
+             : profile              ? "load_profile"
+                                    : "cogging_nm";
+        snprintf(bad, sizeof bad,
+                 "[mechanics] Coulomb friction, stiction, cogging and load profiles need a "
+                 "machine without [filter] (the filter path holds the speed over a PWM period)");
+    }
+    if (bad[0] != '\0') {
+        const int line = key_line(path, "mechanics", at);
+        if (line > 0) {
+            snprintf(err, errlen, "%s:%d: %s", path, line, bad);
+        } else {
+            snprintf(err, errlen, "%s: %s", path, bad);
+        }
+        return -1;
+    }
+    if (kind == SIM_LOAD_SPEED) {
+        for (int i = 0; i < m->load_profile.n; ++i) {
+            m->load_profile.x[i] *= 2.0 * PLANT_PI / 60.0; /* r/min -> rad/s */
+        }
+    }
+    m->load_profile.kind = kind == SIM_LOAD_TIME    ? PLANT_PROFILE_TIME
+                           : kind == SIM_LOAD_SPEED ? PLANT_PROFILE_SPEED
+                                                    : PLANT_PROFILE_NONE;
+    if (!profile) {
+        m->load_profile.n = 0;
+    }
+    return 0;
+#undef SEEN
+}
+
 int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen)
 {
     char dummy[8];
@@ -369,6 +678,10 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
         char tmp[256];
         snprintf(tmp, sizeof tmp, "%s", err);
         snprintf(err, errlen, "%s: %s", path, tmp);
+        memset(out, 0, sizeof(*out));
+        return -1;
+    }
+    if (mech_check(path, out, c.seen, err, errlen) != 0) {
         memset(out, 0, sizeof(*out));
         return -1;
     }

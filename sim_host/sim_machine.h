@@ -13,7 +13,21 @@
  *               default, where the back-EMF meets the DC link: fw_speed_max_rpm),
  *               overspeed_rpm (optional, 0 = 1.05 x the maximum speed: the
  *               firmware's overspeed trip level)
- *   [mechanics] inertia_kgm2, friction_nms (optional, 0)
+ *   [mechanics] inertia_kgm2, friction_nms (optional, 0: viscous B, N*m*s/rad);
+ *               the optional non-ideal terms (0 = absent; sim_host/README.md):
+ *               coulomb_nm (running friction), stiction_nm (break-away,
+ *               >= coulomb_nm; default coulomb_nm), slots (stator slots),
+ *               cogging_nm (peak of the cogging fundamental, lcm(slots,
+ *               2 pole_pairs) periods per revolution; needs slots),
+ *               cogging_phase_deg (its phase, degrees of the cogging period),
+ *               cogging_harmonics_nm = a2 a3 ... (peaks of harmonics 2, 3, ...
+ *               of the fundamental, up to PLANT_COG_MAX - 1 values),
+ *               cogging_harmonics_deg = p2 p3 ... (their phases, same count;
+ *               default 0), load_kind = none | constant | passive | time |
+ *               speed, load_nm (constant: signed; passive: magnitude >= 0),
+ *               load_profile = x:T x:T ... (time: x in s from the arm instant;
+ *               speed: x in r/min, signed; linear between points, held
+ *               outside; 2..PLANT_PROFILE_MAX points, x increasing)
  *   [fluxmap]   file (optional, CSV path relative to the INI file's folder)
  *   [speed_loop] (optional, firmware/isr/speed_loop.h) bandwidth_hz,
  *               phase_margin_deg (the sizing from the inertia; 0 = defaults),
@@ -58,6 +72,15 @@ typedef enum {
     SIM_SENSE_MOTOR = 1     /* motor terminals */
 } sim_current_sense_t;
 
+/* [mechanics] load_kind. */
+typedef enum {
+    SIM_LOAD_NONE = 0,
+    SIM_LOAD_CONSTANT = 1, /* active, load_nm (from the arm instant in sim_run) */
+    SIM_LOAD_PASSIVE = 2,  /* opposes the motion, holds at rest up to load_nm */
+    SIM_LOAD_TIME = 3,     /* active profile in time (from the arm instant) */
+    SIM_LOAD_SPEED = 4     /* active profile in speed */
+} sim_load_kind_t;
+
 typedef struct {
     char name[SIM_MACHINE_NAME_MAX];
     int pole_pairs;
@@ -74,9 +97,19 @@ typedef struct {
     double speed_kp, speed_ki;               /* explicit gains; 0 = sized */
     plant_filter_cfg_t filter;               /* type NONE without [filter] */
     sim_current_sense_t current_sense;
+    /* [mechanics] non-ideal terms (plant_config_t for their meaning) */
+    double coulomb_nm, stiction_nm;
+    int slots;
+    double cogging_nm, cogging_phase_deg;
+    int cog_harm_n, cog_harm_deg_n; /* values given */
+    double cog_harm_nm[PLANT_COG_MAX - 1], cog_harm_deg[PLANT_COG_MAX - 1];
+    sim_load_kind_t load_kind;
+    double load_nm;
+    plant_profile_t load_profile; /* plant units (s or rad/s, N*m) */
+    char load_kind_text[SIM_MACHINE_NAME_MAX];
     char filter_type[SIM_MACHINE_NAME_MAX];        /* [filter] type as written */
     char current_sense_text[SIM_MACHINE_NAME_MAX]; /* [filter] current_sense as written */
-    int encoder_lines;                       /* [sensors] */
+    int encoder_lines;                             /* [sensors] */
     double encoder_offset_deg;
     int encoder_direction;
 } sim_machine_t;
@@ -85,9 +118,18 @@ typedef struct {
  * line for malformed values) in err. */
 int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t errlen);
 
+/* Cogging periods per mechanical revolution, lcm(slots, 2 pole_pairs); 0
+ * without slots. */
+int sim_machine_cog_per_rev(const sim_machine_t *m);
+
+/* 1 if the machine has Coulomb friction, stiction, cogging or a load. */
+int sim_machine_nonideal(const sim_machine_t *m);
+
 /* Fill a plant configuration from a machine (mechanics imposed, zero initial
  * state, no flux map: the caller loads m->fluxmap_path into cfg.fluxmap with
- * plant_fluxmap_load; sim_run and the CLI's replay do). */
+ * plant_fluxmap_load; sim_run and the CLI's replay do). The friction and
+ * cogging are copied; so is the load: constant into load_torque_nm, passive
+ * into load_passive_nm, a profile into load_profile. */
 void sim_machine_to_plant(const sim_machine_t *m, plant_config_t *cfg);
 
 #ifdef __cplusplus

@@ -212,6 +212,96 @@ static void test_ini_bad_input(void)
     TEST_ASSERT_EQUAL_INT(-1, sim_machine_load(NULL, &m, err, sizeof err));
 }
 
+/* [mechanics]' non-ideal terms: every key read into the machine and the
+ * plant's configuration; bad values named with the file, the line, the key,
+ * the value and the allowed range (line 17 is the first after inertia_kgm2). */
+static void test_ini_mechanics(void)
+{
+    char err[256];
+    const char *all = "inertia_kgm2 = 1e-4\ncoulomb_nm = 0.02\nstiction_nm = 0.03\nslots = 12\n"
+                      "cogging_nm = 0.01\ncogging_phase_deg = 90\n"
+                      "cogging_harmonics_nm = 0.004, 0.002\ncogging_harmonics_deg = 10 -20\n"
+                      "load_kind = speed\nload_profile = -3000:-0.4 0:0, 3000:0.4\n";
+    char text[1400];
+    const char *at = strstr(k_good_ini, "inertia_kgm2 = 1e-4\n");
+    snprintf(text, sizeof text, "%.*s%s", (int)(at - k_good_ini), k_good_ini, all);
+    const char *path = tmp_path("mech.ini");
+    write_file(path, text);
+    sim_machine_t m;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+    remove(path);
+    TEST_ASSERT_EQUAL_INT(24, sim_machine_cog_per_rev(&m)); /* lcm(12, 8) */
+    TEST_ASSERT_EQUAL_INT(2, m.cog_harm_n);
+    TEST_ASSERT_EQUAL_INT(SIM_LOAD_SPEED, m.load_kind);
+    plant_config_t pc;
+    sim_machine_to_plant(&m, &pc);
+    TEST_ASSERT_EQUAL_DOUBLE(0.02, pc.coulomb_nm);
+    TEST_ASSERT_EQUAL_DOUBLE(0.03, pc.stiction_nm);
+    TEST_ASSERT_EQUAL_INT(24, pc.cog_per_rev);
+    TEST_ASSERT_EQUAL_INT(3, pc.cog_n);
+    TEST_ASSERT_EQUAL_DOUBLE(0.01, pc.cog_amp_nm[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 0.5 * PLANT_PI, pc.cog_phase_rad[0]);
+    TEST_ASSERT_EQUAL_DOUBLE(0.002, pc.cog_amp_nm[2]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -20.0 * PLANT_PI / 180.0, pc.cog_phase_rad[2]);
+    TEST_ASSERT_EQUAL_INT(PLANT_PROFILE_SPEED, pc.load_profile.kind);
+    TEST_ASSERT_EQUAL_INT(3, pc.load_profile.n);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, -100.0 * PLANT_PI, pc.load_profile.x[0]); /* r/min -> rad/s */
+    pc.mech = PLANT_MECH_FREE;
+    plant_t p;
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &pc));
+
+    /* defaults: stiction = coulomb; a passive and a constant load */
+    const char *base = "inertia_kgm2 = 1e-4\n";
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        0, load_variant(base, "inertia_kgm2 = 1e-4\ncoulomb_nm = 0.02\n", err, sizeof err), err);
+
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\ncoulomb_nm = 0.02\nstiction_nm = 0.01\n",
+                     ":19: [mechanics] stiction_nm = 0.01 below coulomb_nm = 0.02: allowed range "
+                     "[0.02, 1e5]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\ncoulomb_nm = -1\n",
+                     ":18: [mechanics] coulomb_nm = -1 out of range [0, 100000]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\ncogging_nm = 0.01\n",
+                     ":18: [mechanics] cogging_nm needs slots");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nslots = 0\n",
+                     ":18: [mechanics] slots = 0 out of range [1, 1000]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nslots = 9.5\n", "slots = 9.5 is not an integer");
+    expect_ini_error(
+        base, "inertia_kgm2 = 1e-4\nslots = 12\ncogging_harmonics_nm = 0.1 -0.2\n",
+        ":19: [mechanics] cogging_harmonics_nm value 2 = -0.2 out of range [0, 100000]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nslots = 12\ncogging_harmonics_nm = 0.1 x\n",
+                     ":19: [mechanics] cogging_harmonics_nm value 2 'x' is not a number");
+    expect_ini_error(base,
+                     "inertia_kgm2 = 1e-4\nslots = 12\ncogging_harmonics_nm = 1 1 1 1 1 1 1 1\n",
+                     "cogging_harmonics_nm has more than 7 values");
+    expect_ini_error(base,
+                     "inertia_kgm2 = 1e-4\nslots = 12\ncogging_harmonics_nm = 0.1\n"
+                     "cogging_harmonics_deg = 1 2\n",
+                     ":20: [mechanics] cogging_harmonics_deg has 2 values, cogging_harmonics_nm 1");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = heavy\n",
+                     ":18: [mechanics] load_kind = 'heavy': expected none, constant, passive");
+    expect_ini_error(
+        base, "inertia_kgm2 = 1e-4\nload_kind = passive\nload_nm = -0.3\n",
+        ":19: [mechanics] load_nm = -0.3 out of range [0, 1e5] for load_kind = passive");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = passive\n",
+                     ":18: [mechanics] load_kind = passive needs load_nm");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_nm = 0.3\n",
+                     ":18: [mechanics] load_nm belongs to load_kind = constant or passive");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = time\nload_profile = 0:0 1:1 1:2\n",
+                     ":19: [mechanics] load_profile point 3: x = 1 not after the previous");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = time\nload_profile = 0:0 1\n",
+                     ":19: [mechanics] load_profile point 2 '1' is not x:T");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = time\nload_profile = 0:0\n",
+                     "load_profile needs at least 2 points");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = time\nload_profile = -1:0 1:1\n",
+                     ":19: [mechanics] load_profile point 1 at t = -1 s: allowed range [0, 1e6]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nload_kind = speed\n",
+                     ":18: [mechanics] load_kind = speed needs load_profile");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nfriction_nms = -1e-5\n",
+                     ":18: [mechanics] friction_nms = -1e-05 out of range [0, 1e+06]");
+    expect_ini_error(base, "inertia_kgm2 = 1e-4\nstiction = 0.1\n",
+                     "unknown key stiction in [mechanics]");
+}
+
 /* --------------------------------------------------------------- replay */
 
 static plant_config_t spmsm_cfg(void)
@@ -505,6 +595,7 @@ int main(void)
     RUN_TEST(test_ini_shipped_machines);
     RUN_TEST(test_ini_mirror_header);
     RUN_TEST(test_ini_bad_input);
+    RUN_TEST(test_ini_mechanics);
     RUN_TEST(test_replay_round_trip);
     RUN_TEST(test_replay_malformed_rows);
     RUN_TEST(test_fluxmap_shipped_and_inverse);

@@ -72,6 +72,9 @@ void sim_run_config_default(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl
     c->speed_kp = m->speed_kp;
     c->speed_ki = m->speed_ki;
     c->overspeed_rpm = m->overspeed_rpm;
+    /* The load's one home is the machine file; the run may replace it. */
+    c->load_nm = m->load_kind == SIM_LOAD_CONSTANT ? m->load_nm : 0.0;
+    c->load_passive_nm = m->load_kind == SIM_LOAD_PASSIVE ? m->load_nm : 0.0;
     c->auto_arm = true;
     c->kick_watchdog = true;
     engine_hal_config_default(&c->hal, c->fs_hz, m->current_max_a, m->vdc_v);
@@ -270,6 +273,7 @@ static void sim_arm(sim_run_t *r)
     if (c->free_mech) {
         plant_set_load_torque(&r->plant, c->load_nm);
         plant_set_load_passive(&r->plant, c->load_passive_nm);
+        plant_load_profile_enable(&r->plant, 1); /* its time from the arm instant */
     }
     r->t_arm = plant_time(&r->plant);
     r->armed = true;
@@ -749,7 +753,12 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (!(c->load_passive_nm >= 0.0) || !isfinite(c->load_passive_nm)) {
         return sim_err(err, errlen, "passive load must be a finite magnitude >= 0 N*m");
     }
-    if (!c->free_mech && (c->load_nm != 0.0 || c->load_passive_nm != 0.0)) {
+    /* On the dynamometer the machine file's own load is the dynamometer's
+     * to hold; a load the run asks for is refused. */
+    const sim_machine_t *pm = &c->plant_machine;
+    if (!c->free_mech &&
+        (c->load_nm != (pm->load_kind == SIM_LOAD_CONSTANT ? pm->load_nm : 0.0) ||
+         c->load_passive_nm != (pm->load_kind == SIM_LOAD_PASSIVE ? pm->load_nm : 0.0))) {
         return sim_err(err, errlen,
                        "a load torque needs free mechanics (a dynamometer imposes "
                        "the speed)");
@@ -786,6 +795,8 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (plant_init(&r->plant, &pc) != PLANT_OK) {
         return sim_err(err, errlen, "plant rejected the machine configuration");
     }
+    /* The active load profile starts with the constant load, at arm. */
+    plant_load_profile_enable(&r->plant, 0);
     c->hal.pwm_freq_hz = c->fs_hz;
     c->hal.seed = c->seed;
     /* The plant's encoder: the simulated machine's [sensors]. */

@@ -92,8 +92,10 @@ typedef struct {
     uint32_t fs_hz;
     bool free_mech;         /* false: dynamometer at speed_rpm */
     double speed_rpm;       /* imposed speed, or initial speed (free) */
-    double load_nm;         /* free mechanics: constant (active) load torque */
-    double load_passive_nm; /* free mechanics: passive load magnitude (opposes motion) */
+    double load_nm;         /* free mechanics: constant (active) load torque, from arm on
+                               (default: the machine file's [mechanics] constant load) */
+    double load_passive_nm; /* free mechanics: passive load magnitude (opposes motion;
+                               default: the machine file's [mechanics] passive load) */
     bool speed_mode;        /* speed reference (outer PI) instead of torque */
     double torque_ref_nm, speed_ref_rpm;
     double duration_s;             /* after arm */

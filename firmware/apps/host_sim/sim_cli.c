@@ -95,9 +95,11 @@ static const cli_opt_t k_opts[] = {
     {"--free", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(free_mech),
      "free mechanics (3.15) instead of the dynamometer"},
     {"--load-nm", "T", K_REAL, -1e5, 1e5, "N*m", M_LOOP, "--free", NULL, F(load_nm),
-     "constant (active) load torque from arm on (default 0)"},
+     "constant (active) load torque from arm on, instead of the machine file's (default: its "
+     "[mechanics] load_kind = constant, else 0)"},
     {"--load-passive-nm", "T", K_REAL, 0, 1e5, "N*m", M_LOOP, "--free", NULL, F(load_passive_nm),
-     "passive load of this magnitude: opposes the rotation, never drives it (default 0)"},
+     "passive load of this magnitude: opposes the rotation, never drives it (default: the "
+     "machine file's [mechanics] load_kind = passive, else 0)"},
     {"--torque-ref", "NM", K_REAL, -1e5, 1e5, "N*m", M_LOOP, NULL, "--speed-ref-rpm", F(torque_ref),
      "torque reference, torque mode (default 0)"},
     {"--speed-ref-rpm", "R", K_REAL, -1e5, 1e5, "r/min", M_LOOP, "--free", "--torque-ref",
@@ -803,8 +805,12 @@ int main(int argc, char **argv)
     cfg.fs_hz = is_given(given, "--fs") ? (uint32_t)c.fs : d->fs_default_hz;
     cfg.free_mech = c.free_mech != 0;
     cfg.speed_rpm = c.speed_rpm;
-    cfg.load_nm = c.load_nm;
-    cfg.load_passive_nm = c.load_passive_nm;
+    if (is_given(given, "--load-nm")) { /* else the machine file's */
+        cfg.load_nm = c.load_nm;
+    }
+    if (is_given(given, "--load-passive-nm")) {
+        cfg.load_passive_nm = c.load_passive_nm;
+    }
     cfg.speed_mode = is_given(given, "--speed-ref-rpm");
     cfg.torque_ref_nm = c.torque_ref;
     cfg.speed_ref_rpm = c.speed_ref;
