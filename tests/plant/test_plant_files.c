@@ -302,6 +302,38 @@ static void test_ini_mechanics(void)
                      "unknown key stiction in [mechanics]");
 }
 
+/* The identification's stress cases (sim_host/machines/nonideal/*_stress.ini,
+ * made by gen_nonideal.py): stiction 15 %, Coulomb friction 10 %, viscous
+ * friction 5 % at rated speed, cogging 10 % peak (one harmonic), passive load
+ * 20 % of each file's rated torque; they load and the plant takes them. */
+static void test_ini_nonideal_stress(void)
+{
+    static const char *const files[] = {"thesis_spmsm", "mj5208_drone", "gbm5208_gimbal",
+                                        "outrunner_24v"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; ++i) {
+        char path[512], err[256];
+        snprintf(path, sizeof path, "%s/nonideal/%s_stress.ini", PLANT_MACHINES_DIR, files[i]);
+        sim_machine_t m;
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+        const double t = m.torque_rated_nm, w = m.speed_rated_rpm * 2.0 * PLANT_PI / 60.0;
+        TEST_MESSAGE(path);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, 0.15, m.stiction_nm / t);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, 0.10, m.coulomb_nm / t);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, 0.05, m.friction_nms * w / t);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, 0.10, m.cogging_nm / t);
+        TEST_ASSERT_EQUAL_INT(0, m.cog_harm_n);
+        TEST_ASSERT_TRUE(sim_machine_cog_per_rev(&m) > 0);
+        TEST_ASSERT_EQUAL_INT(SIM_LOAD_PASSIVE, m.load_kind);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-5, 0.20, m.load_nm / t);
+        plant_config_t pc;
+        sim_machine_to_plant(&m, &pc);
+        pc.mech = PLANT_MECH_FREE;
+        plant_t p;
+        TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &pc));
+        TEST_ASSERT_TRUE(plant_stuck(&p));
+    }
+}
+
 /* --------------------------------------------------------------- replay */
 
 static plant_config_t spmsm_cfg(void)
@@ -596,6 +628,7 @@ int main(void)
     RUN_TEST(test_ini_mirror_header);
     RUN_TEST(test_ini_bad_input);
     RUN_TEST(test_ini_mechanics);
+    RUN_TEST(test_ini_nonideal_stress);
     RUN_TEST(test_replay_round_trip);
     RUN_TEST(test_replay_malformed_rows);
     RUN_TEST(test_fluxmap_shipped_and_inverse);
