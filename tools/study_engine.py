@@ -187,6 +187,24 @@ class Run:
         return self.tag if self.tag is not None else " ".join(self.argv)[:160]
 
 
+def run_of_command(build, args, tag=None):
+    """A Run from arguments written for the simulator itself: the paths of its
+    --metrics and --trace become the engine's outputs. Returns (run, {output: path});
+    Result.save_all(paths) writes them there."""
+    rest, paths = [], {}
+    args = [str(a) for a in args]
+    i = 0
+    while i < len(args):
+        name = next((o for o, (opt, _) in OUTPUT_OPTS.items() if opt == args[i]), None)
+        if name is not None and i + 1 < len(args):
+            paths[name] = args[i + 1]
+            i += 2
+            continue
+        rest.append(args[i])
+        i += 1
+    return Run(build, rest, outputs=tuple(paths), tag=tag), paths
+
+
 # ---------------------------------------------------------------- results
 
 def _last_error(stderr):
@@ -256,6 +274,11 @@ class Result:
         with open(path, "w") as f:
             f.write(txt)
         return True
+
+    def save_all(self, paths):
+        """Each output to its path ({output: path}, run_of_command's)."""
+        for name, path in paths.items():
+            self.save(name, path)
 
     def table_row(self):
         """What the store keeps of the run itself (no timing): the comparable part."""
@@ -446,9 +469,13 @@ class Engine:
                              "distributed.worker.memory.monitor-interval": "1s",
                              "distributed.admin.system-monitor.interval": "2s",
                              "distributed.admin.tick.interval": "200ms"})
+            # No dashboard (no bokeh here); the scheduler's HTTP server on a free
+            # loopback port, not on 8787 (where another cluster may be).
             self.cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1,
                                         processes=False, dashboard_address=None,
-                                        silence_logs=logging.ERROR)
+                                        silence_logs=logging.ERROR,
+                                        scheduler_kwargs={"dashboard": False,
+                                                          "dashboard_address": "127.0.0.1:0"})
             self.client = Client(self.cluster, set_as_default=False)
 
     def workers(self):
