@@ -37,25 +37,25 @@ place in meets / warned / silent (a miss against it needs a warning of its own).
 
 usage: tools/torque_sweep.py [--machines A.ini,B.ini] [--controllers a,b]
                              [--speeds 0.1,0.5] [--fracs 0.5,0.9]
-                             [--halves motoring,braking] [--jobs N]
-                             [--json OUT.json] [--check]
+                             [--halves motoring,braking] [--json OUT.json] [--check]
+                             [--jobs N | --scheduler tcp://HOST:PORT] [--store FILE]
 --check: exit status 1 when a run is silent, bites, or the simulator fails.
 The full sweep (8 machine files x 4 controllers x up to 4 speeds x 2 halves x
 2 requests) takes a few minutes on two cores; CI runs a subset (tests/loop/CMakeLists.txt).
+Runs through the study engine (tools/study_engine.py, docs/studies.md): results
+stored in out/runs.sqlite (--store), a rerun computes only what is missing.
 """
 import argparse
-import concurrent.futures as cf
 import configparser
 import glob
 import json
 import math
 import os
-import subprocess
 import sys
-import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import envelope as env  # noqa: E402
+import study_engine as se  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MDIR = os.path.join(ROOT, "sim_host", "machines")
@@ -113,11 +113,6 @@ def stated_limit(mfile, ctrl, brake=False, rpm=0.0, tref=0.0):
     return (lim, why) if math.isfinite(lim) and lim > 0 else (float("inf"), None)
 
 
-def sim_cmd(args):
-    exe = os.environ.get("PMSM_SIM_EXE")
-    return [exe] if exe else [os.path.join(ROOT, "tools", "sim")]
-
-
 def points(mfile, speeds, fracs, halves=HALVES):
     """(speed, fraction, request, rated torque) of each run; the speed is
     positive, a braking request negative."""
@@ -138,26 +133,25 @@ def points(mfile, speeds, fracs, halves=HALVES):
     return out
 
 
-def run_one(args, job):
+def run_of(build, job):
+    """The simulator run of a job (study engine)."""
     mfile, ctrl, rpm, frac, tref, t_rated = job
-    fd, path = tempfile.mkstemp(suffix=".json")
-    os.close(fd)
-    cmd = sim_cmd(args) + ["--machine", mfile, "--controller", ctrl, "--speed-rpm",
-                           f"{rpm:.6g}", "--torque-ref", f"{tref:.6g}", "--duration", "0.3",
-                           "--window", "0.15:0.3", "--metrics", path]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    return se.Run(build, ["--machine", mfile, "--controller", ctrl, "--speed-rpm", f"{rpm:.6g}",
+                          "--torque-ref", f"{tref:.6g}", "--duration", "0.3",
+                          "--window", "0.15:0.3"],
+                  tag=f"{os.path.basename(mfile)} {ctrl} {rpm:.1f} r/min {tref:.4g} N*m")
+
+
+def judge(job, r):
+    """The verdict of a job from its run's result (study_engine.Result)."""
+    mfile, ctrl, rpm, frac, tref, t_rated = job
     res = {"machine": os.path.basename(mfile), "controller": ctrl, "rpm": rpm, "frac": frac,
-           "request_nm": tref, "rated_nm": t_rated, "exit": r.returncode,
+           "request_nm": tref, "rated_nm": t_rated, "exit": r.rc,
            "half": "braking" if tref * rpm < 0.0 else "motoring"}
     brake = res["half"] == "braking"
-    try:
-        with open(path) as f:
-            mj = json.load(f)
-    except (OSError, ValueError):
-        mj = None
-    os.unlink(path)
-    if mj is None or r.returncode not in (0, 3):
-        res.update(verdict="error", stderr=r.stderr[-500:])
+    mj = r.metrics
+    if mj is None or r.rc not in (0, 3):
+        res.update(verdict="error", stderr=(r.stderr[-500:] if r.stored else r.reason))
         return res
     t = mj.get("torque_mean_nm")
     warns = mj.get("warnings", [])
@@ -205,9 +199,9 @@ def main():
     ap.add_argument("--speeds", default=",".join(str(s) for s in SPEEDS))
     ap.add_argument("--fracs", default=",".join(str(f) for f in FRACS))
     ap.add_argument("--halves", default=",".join(HALVES))
-    ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", default="")
     ap.add_argument("--check", action="store_true")
+    se.add_arguments(ap)
     args = ap.parse_args()
     mfiles = ([os.path.join(MDIR, m) if os.sep not in m else m for m in args.machines.split(",")]
               if args.machines else sorted(glob.glob(os.path.join(MDIR, "*.ini"))))
@@ -220,8 +214,15 @@ def main():
         ap.error(f"--halves {','.join(bad)}: allowed {', '.join(HALVES)}")
     jobs = [(mf, c) + p for mf in mfiles for p in points(mf, speeds, fracs, halves)
             for c in ctrls]
-    with cf.ThreadPoolExecutor(max_workers=max(args.jobs, 1)) as ex:
-        results = list(ex.map(lambda j: run_one(args, j), jobs))
+    try:
+        build = se.Build(os.environ["PMSM_SIM_EXE"]) if os.environ.get("PMSM_SIM_EXE") \
+            else se.default_build()
+        runs = [run_of(build, j) for j in jobs]
+    except se.StudyInputError as e:
+        print(f"torque sweep: error: {e}", file=sys.stderr)
+        return 2
+    with se.engine_or_exit(args, os.path.join(ROOT, "out"), "torque sweep") as eng:
+        results = [judge(j, r) for j, r in zip(jobs, eng.run(runs))]
     counts = {}
     for h in halves:
         rs = [r for r in results if r["half"] == h]
