@@ -17,11 +17,12 @@ true signals on the Ts/10 grid:
   * current sensors at the inverter output instead of the motor terminals;
   * the active filter's storage capacitors over 6 s, without and with a storage
     regulation, and their pre-charge.
-usage: tools/filters.py [--out DIR] [--jobs N] [--seed N] [--duration S]
+usage: tools/filters.py [--out DIR] [--seed N] [--duration S]
+                        [--jobs N | --scheduler tcp://HOST:PORT] [--store FILE]
+Runs through the study engine (tools/study_engine.py, docs/studies.md): results
+stored in OUT/runs.sqlite, a rerun computes only what is missing.
 """
 import argparse
-import concurrent.futures as cf
-import json
 import os
 import subprocess
 import sys
@@ -32,6 +33,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import study_engine as se  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MDIR = os.path.join(ROOT, "sim_host", "machines")
@@ -64,25 +68,21 @@ def sim_binary():
     return os.path.join(bdir, "firmware", "sim")
 
 
-def job(sim, runs, ctrl, filt, duration, settle, sense=None, machine=None, tag="",
+def job(build, ctrl, filt, duration, settle, sense=None, machine=None, tag="",
         trace=False, window=None, seed=1):
+    """(name, the run of the study engine)."""
     name = f"{ctrl}_{filt}{tag}" + (f"_s{seed}" if seed != SEEDS[0] else "")
-    base = os.path.join(runs, name)
     mpath = machine or os.path.join(MDIR, MACHINES[filt])
     w0, w1 = window or (settle, duration)
-    cmd = [sim, "--machine", mpath, "--controller", ctrl, "--fs", "10000", "--free",
-           "--speed-rpm", f"{W_RPM:.6f}", "--load-nm", "2", "--speed-ref-rpm", f"{W_RPM:.6f}",
-           "--duration", str(duration), "--window", f"{w0}:{w1}", "--metrics", base + ".json",
-           "--seed", str(seed)]
+    args = ["--machine", mpath, "--controller", ctrl, "--fs", "10000", "--free",
+            "--speed-rpm", f"{W_RPM:.6f}", "--load-nm", "2", "--speed-ref-rpm", f"{W_RPM:.6f}",
+            "--duration", str(duration), "--window", f"{w0}:{w1}", "--seed", str(seed)]
     if sense:
-        cmd += ["--current-sense", sense]
+        args += ["--current-sense", sense]
     if trace:
-        cmd += ["--trace", base + ".csv", "--trace-window", f"{settle}:{duration}"]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode != 0:
-        return name, None, r.stderr.strip()
-    with open(base + ".json") as f:
-        return name, json.load(f), None
+        args += ["--trace-window", f"{settle}:{duration}"]
+    return name, se.Run(build, args, outputs=("metrics", "trace") if trace else ("metrics",),
+                        tag=name)
 
 
 def spectrum(x, dt):
@@ -183,14 +183,14 @@ def spectra_plot(traces, path, ctrl):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "out"))
-    ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--duration", type=float, default=0.25)
     ap.add_argument("--settle", type=float, default=0.1)
     ap.add_argument("--seed", type=int, default=1, help="first of the four ADC-noise seeds")
+    se.add_arguments(ap)
     # tools/demo passes its options to both reports: ignore compare.py's own
     a, _ = ap.parse_known_args()
     SEEDS[:] = [a.seed + k for k in range(4)]
-    sim = sim_binary()
+    build = se.Build(sim_binary())
     fdir = os.path.join(a.out, "filters")
     runs = os.path.join(fdir, "runs")
     os.makedirs(runs, exist_ok=True)
@@ -222,16 +222,19 @@ def main():
             f.write(ini.replace("af_cf_initial_v = 264", f"af_cf_initial_v = {v}"))
         jobs.append(dict(ctrl="hdtc", filt="active", tag=f"_cf{v}", machine=p))
     res, failed = {}, []
-    with cf.ThreadPoolExecutor(max_workers=max(1, a.jobs)) as ex:
-        futs = [ex.submit(job, sim, runs, j["ctrl"], j["filt"], j.get("dur", D), S,
-                          j.get("sense"), j.get("machine"), j.get("tag", ""), j.get("trace", False),
-                          j.get("window"), j.get("seed", SEEDS[0])) for j in jobs]
-        for fu in futs:
-            name, m, err = fu.result()
-            if m is None:
-                failed.append((name, err))
-            else:
-                res[name] = m
+    named = [job(build, j["ctrl"], j["filt"], j.get("dur", D), S, j.get("sense"), j.get("machine"),
+                 j.get("tag", ""), j.get("trace", False), j.get("window"), j.get("seed", SEEDS[0]))
+             for j in jobs]
+    with se.engine_or_exit(a, a.out, "filters") as eng:
+        out = eng.run([r for _, r in named])
+    for (name, _), r in zip(named, out):
+        base = os.path.join(runs, name)
+        r.save("metrics", base + ".json")
+        r.save("trace", base + ".csv")
+        if r.rc != 0:
+            failed.append((name, r.stderr.strip() if r.stored else r.reason))
+        else:
+            res[name] = r.metrics
     wall = time.time() - t0
 
     def g(name, key):
