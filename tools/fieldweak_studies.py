@@ -21,10 +21,12 @@ OUT/fieldweak.md with its plots (linked from OUT/report.md).
             torque ripple and T_sse against nominal.
 Indices from the plant's true signals on a Ts/10 grid unless stated.
 
-usage: tools/fieldweak_studies.py [--only envelope,sigma,flux,robust] [--out DIR] [--jobs N]
+usage: tools/fieldweak_studies.py [--only envelope,sigma,flux,robust] [--out DIR]
+                                  [--jobs N | --scheduler tcp://HOST:PORT] [--store FILE]
+Runs through the study engine (tools/study_engine.py, docs/studies.md): results
+stored in OUT/runs.sqlite, a rerun computes only what is missing.
 """
 import argparse
-import concurrent.futures as cf
 import json
 import math
 import os
@@ -40,6 +42,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import envelope as env  # noqa: E402
+import study_engine as se  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MDIR = os.path.join(ROOT, "sim_host", "machines")
@@ -74,31 +77,20 @@ SEED = 1
 FINDINGS = []  # one bullet per study, written at the top of the report
 
 
-def run(args, tmpdir):
-    """One simulation; returns the metrics dict (with 'rc', 'err') or a stub."""
-    fd, path = tempfile.mkstemp(suffix=".json", dir=tmpdir)
-    os.close(fd)
-    r = subprocess.run([SIM] + [str(a) for a in args] + ["--metrics", path, "--seed", str(SEED)],
-                       capture_output=True, text=True)
-    m = {}
-    if r.returncode in (0, 3) and os.path.exists(path) and os.path.getsize(path) > 0:
-        with open(path) as f:
-            m = json.load(f)
-    if os.path.exists(path):
-        os.unlink(path)
-    m["rc"] = r.returncode
-    m["err"] = r.stderr.strip().splitlines()[-1] if r.returncode not in (0, 3) and r.stderr else ""
+def metrics_of(r):
+    """A run's metrics dict (with 'rc', 'err'), or a stub with them."""
+    m = dict(r.metrics or {}) if r.rc in (0, 3) else {}
+    m["rc"] = r.rc
+    m["err"] = ("" if r.rc in (0, 3) else
+                (r.stderr.strip().splitlines() or [""])[-1] if r.stored else r.reason)
     return m
 
 
-def run_all(jobs, tmpdir, n_jobs):
-    """jobs: {key: args}; returns {key: metrics}."""
-    out = {}
-    with cf.ThreadPoolExecutor(max_workers=n_jobs) as ex:
-        futs = {ex.submit(run, a, tmpdir): k for k, a in jobs.items()}
-        for f in cf.as_completed(futs):
-            out[futs[f]] = f.result()
-    return out
+def run_all(jobs, tmpdir, eng):
+    """jobs: {key: args}; returns {key: metrics} (the study engine eng)."""
+    runs = {k: se.Run(SIM, list(a) + ["--seed", str(SEED)], tag=" ".join(map(str, k)))
+            for k, a in jobs.items()}
+    return {k: metrics_of(r) for k, r in eng.run(runs).items()}
 
 
 def ok(m):
@@ -143,7 +135,7 @@ def envelope_points(mfile, base_rpm, top):
     return m, lim, rpms
 
 
-def study_envelope(names, fsd, tmp, n_jobs, out):
+def study_envelope(names, fsd, tmp, eng, out):
     cases = (("thesis_ipmsm_80kw", IPMSM, 3000.0, 2.0, (3000, 4500, 6000), 0.12, 0.06),
              ("thesis_spmsm", SPMSM, 3000.0, 1.25, (3000, 3400, 3750), 0.12, 0.06))
     jobs, meta = {}, {}
@@ -163,7 +155,7 @@ def study_envelope(names, fsd, tmp, n_jobs, out):
                                          "--torque-ref", f"{0.9 * op.torque:.6g}", "--duration", dur,
                                          "--window", f"{ws}:{dur}", "--continue-on-fault"]
     t0 = time.time()
-    res = run_all(jobs, tmp, n_jobs)
+    res = run_all(jobs, tmp, eng)
     wall = time.time() - t0
     lines = ["## Torque-speed envelope", "",
              "Dynamometer speed, torque request 90 % of the theoretical envelope "
@@ -251,7 +243,7 @@ SIGMAS_DEG = (0.0, 3.75, 7.5, 10.0, 15.0, 20.0, 25.0, 30.0)
 SIGMA_MAX_DEG = float(os.environ.get("FIELDWEAK_SIGMA_MAX_DEG", "30"))
 
 
-def study_sigma(names, fsd, tmp, n_jobs, out):
+def study_sigma(names, fsd, tmp, eng, out):
     SIG = [x for x in SIGMAS_DEG if x <= SIGMA_MAX_DEG]
     jobs = {}
     for c in ("fst", "drr"):
@@ -260,7 +252,7 @@ def study_sigma(names, fsd, tmp, n_jobs, out):
                 jobs[(c, rpm, sd)] = ["--machine", SPMSM, "--controller", c, "--speed-rpm", rpm,
                                       "--torque-ref", LOAD_NM, "--duration", 0.3,
                                       "--set", f"sigma={math.radians(sd):.12g}"]
-    res = run_all(jobs, tmp, n_jobs)
+    res = run_all(jobs, tmp, eng)
     lines = ["## The voltage-replacement angle σ (thesis (4.19), §7.2)", "",
              "Thesis SPMSM, 1.8 N·m, dynamometer, FST at 20 kHz, DRR at 10 kHz; σ = 0 turns the "
              "replacement off; σ = 30° (π/6) replaces over the whole half sector. The thesis "
@@ -328,7 +320,7 @@ def study_sigma(names, fsd, tmp, n_jobs, out):
 
 
 # ----------------------------------------------------------------------------- flux-ripple gap
-def study_flux(names, fsd, tmp, n_jobs, out):
+def study_flux(names, fsd, tmp, eng, out):
     real = os.path.join(tmp, "spmsm_real_inverter.ini")
     write_ini(SPMSM, real, {("inverter", "dead_time_ns"): REAL_INV["dead_time_ns"],
                             ("inverter", "v_fwd_v"): REAL_INV["v_fwd_v"]})
@@ -376,7 +368,7 @@ def study_flux(names, fsd, tmp, n_jobs, out):
             jobs[(f"m1 zeta {zeta:g}", "m1", rpm)] = [
                 "--machine", SPMSM, "--controller", "m1", "--speed-rpm", rpm, "--torque-ref",
                 LOAD_NM, "--duration", 0.3, "--set", f"zeta={zeta}"]
-    res = run_all(jobs, tmp, n_jobs)
+    res = run_all(jobs, tmp, eng)
 
     def ratio(a, b, key):
         if not (ok(a) and ok(b)) or not b.get(key):
@@ -482,7 +474,7 @@ def robust_ctrls(names):
     return out
 
 
-def study_robust(names, fsd, tmp, n_jobs, out):
+def study_robust(names, fsd, tmp, eng, out):
     files = {}
     for case, ch in ROBUST_CASES:
         if ch is None:
@@ -514,7 +506,7 @@ def study_robust(names, fsd, tmp, n_jobs, out):
                 else:
                     a += ["--machine", SPMSM, "--control-machine", files[case]]
                 jobs[(case, c, rpm)] = a
-    res = run_all(jobs, tmp, n_jobs)
+    res = run_all(jobs, tmp, eng)
     lines = ["## Robustness to parameter errors", "",
              "Thesis SPMSM, 1.8 N·m, dynamometer; each controller configured with one machine "
              "parameter 20 % off (`--control-machine`: the estimator, MTPA and the "
@@ -602,13 +594,14 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("--only", default=",".join(STUDIES))
     ap.add_argument("--out", default=os.path.join(ROOT, "out"))
-    ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", help="also dump every run's metrics to this file")
     ap.add_argument("--seed", type=int, default=1, help="ADC-noise seed of every run")
+    se.add_arguments(ap)
     a, _unused = ap.parse_known_args()  # ./tools/demo passes its options to every script
     global SEED
     SEED = a.seed
-    SIM, names, fsd = sim_binary()
+    sim, names, fsd = sim_binary()
+    SIM = se.Build(sim)
     os.makedirs(a.out, exist_ok=True)
     t0 = time.time()
     lines = ["# Field weakening, σ, flux ripple and robustness", "",
@@ -616,16 +609,17 @@ def main():
              "IPMSM of the machine files; every index from the plant's true signals on a Ts/10 "
              "grid unless marked \"ctrl\" (the estimate at the control instants).", ""]
     dump = {}
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, se.engine_or_exit(a, a.out, "fieldweak") as eng:
         for s in a.only.split(","):
             if s not in STUDIES:
                 sys.exit(f"fieldweak_studies: unknown study {s} (known: {', '.join(STUDIES)})")
             t1 = time.time()
-            r = STUDIES[s](names, fsd, tmp, a.jobs, a.out)
+            r = STUDIES[s](names, fsd, tmp, eng, a.out)
             lines += r[0]
             dump[s] = {"|".join(map(str, k)): v for k, v in r[1].items()}
             print(f"fieldweak_studies: {s} in {time.time() - t1:.0f} s", flush=True)
-    lines.append(f"Total wall time {time.time() - t0:.0f} s on {a.jobs} processes.")
+        how = eng.describe()
+    lines.append(f"Total wall time {time.time() - t0:.0f} s ({how}).")
     k = lines.index("") + 3
     lines[k:k] = ["## Findings", ""] + [f"- {f}" for f in FINDINGS] + [""]
     with open(os.path.join(a.out, "fieldweak.md"), "w") as f:
