@@ -24,12 +24,13 @@ them, and this script alone writes OUT/analyses.md.
          10 levels, 20/100/200 points (build/hpdtc-pP-lL, a minute each).
 
 usage: tools/analyses.py [--only drr,zeta,hpdtc] [--partitions] [--short] [--out DIR]
-                         [--jobs N] [--seed N] [--sim SIM]
-Indices from the plant's true signals on a Ts/10 grid (docs: tools/compare.py).
+                         [--seed N] [--sim SIM]
+                         [--jobs N | --scheduler tcp://HOST:PORT] [--store FILE]
+Indices from the plant's true signals on a Ts/10 grid (docs: tools/compare.py). Runs
+through the study engine (tools/study_engine.py, docs/studies.md).
 """
 import argparse
-import concurrent.futures as cf
-import json
+import io
 import math
 import os
 import subprocess
@@ -42,6 +43,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import fieldweak_studies as fws  # noqa: E402  (write_ini: one home for machine-file variants)
+import study_engine as se  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
 MDIR = os.path.join(ROOT, "sim_host", "machines")
@@ -66,44 +68,50 @@ PARTITIONS = ((20, 10), (100, 10), (200, 10), (100, 5))  # (points, levels); S1:
 # ---------------------------------------------------------------- running
 
 class Runner:
-    """Simulations in parallel; a run's metrics, and its trace where asked for."""
+    """Simulations through the study engine; a run's metrics, and its trace where
+    asked for."""
 
-    def __init__(self, sim, jobs, seed, tmp):
-        self.sim, self.jobs, self.seed, self.tmp = sim, jobs, seed, tmp
+    def __init__(self, sim, eng, seed, tmp):
+        self.eng, self.seed, self.tmp = eng, seed, tmp
+        self.builds = {}
+        self.sim = self.build(sim)
         self.count = 0
 
-    def one(self, args, trace, sim):
-        fd, mpath = tempfile.mkstemp(suffix=".json", dir=self.tmp)
-        os.close(fd)
-        cmd = [sim or self.sim] + [str(a) for a in args] + ["--metrics", mpath]
-        if "--seed" not in cmd:
-            cmd += ["--seed", str(self.seed)]
-        tpath = None
+    def build(self, sim):
+        if sim is None:
+            return self.sim
+        if isinstance(sim, se.Build):
+            return sim
+        if sim not in self.builds:
+            self.builds[sim] = se.Build(sim)
+        return self.builds[sim]
+
+    def run_of(self, args, trace, sim):
+        args = [str(a) for a in args]
+        if "--seed" not in args:
+            args += ["--seed", str(self.seed)]
         if trace:
-            tpath = mpath[:-5] + ".csv"
-            cmd += ["--trace", tpath, "--trace-window", f"{trace[0]}:{trace[1]}"]
-        r = subprocess.run(cmd, capture_output=True, text=True)
-        m = {}
-        if r.returncode in (0, 3) and os.path.getsize(mpath) > 0:
-            with open(mpath) as f:
-                m = json.load(f)
-        os.unlink(mpath)
-        if tpath and os.path.exists(tpath):
-            if m.get("fault") == "none":
-                m["trace"] = np.atleast_1d(np.genfromtxt(tpath, delimiter=",", names=True))
-            os.unlink(tpath)
-        m["rc"] = r.returncode
-        if r.returncode not in (0, 3):
-            m["err"] = (r.stderr.strip().splitlines() or ["?"])[-1]
+            args += ["--trace-window", f"{trace[0]}:{trace[1]}"]
+        return se.Run(self.build(sim), args, outputs=("metrics", "trace") if trace else
+                      ("metrics",), tag=" ".join(args[:8]))
+
+    @staticmethod
+    def metrics_of(r, trace):
+        m = dict(r.metrics or {}) if r.rc in (0, 3) else {}
+        if trace and m.get("fault") == "none" and r.text("trace"):
+            m["trace"] = np.atleast_1d(np.genfromtxt(io.StringIO(r.text("trace")), delimiter=",",
+                                                     names=True))
+        m["rc"] = r.rc
+        if r.rc not in (0, 3):
+            m["err"] = (r.stderr.strip().splitlines() or ["?"])[-1] if r.stored else r.reason
         return m
 
     def all(self, jobs):
         """jobs: {key: args or (args, trace_window, sim)} -> {key: metrics}."""
         norm = {k: (v if isinstance(v, tuple) else (v, None, None)) for k, v in jobs.items()}
         self.count += len(norm)
-        with cf.ThreadPoolExecutor(max_workers=self.jobs) as ex:
-            futs = {k: ex.submit(self.one, *v) for k, v in norm.items()}
-            return {k: f.result() for k, f in futs.items()}
+        res = self.eng.run({k: self.run_of(*v) for k, v in norm.items()})
+        return {k: self.metrics_of(res[k], norm[k][1]) for k in norm}
 
 
 def ok(m):
@@ -561,12 +569,17 @@ def hpdtc_partitions(run, tmp, seeds=(1, 2, 3)):
 ANALYSES = {"drr": drr_flux, "zeta": m1_zeta, "hpdtc": hpdtc_bound}
 
 
-def run_analyses(sim, jobs, seed, only=("drr", "zeta", "hpdtc"), short=False,
+def run_analyses(sim, eng, seed, only=("drr", "zeta", "hpdtc"), short=False,
                  partitions=False):
-    """{name: result} of the analyses; the simulations' count in result['_runs']."""
+    """{name: result} of the analyses; the simulations' count in result['_runs'].
+    eng: a study engine (study_engine.Engine), or a number of local workers for an
+    engine of this call alone (no store)."""
+    if not isinstance(eng, se.Engine):
+        with se.Engine(jobs=eng, store=":memory:", name="analyses") as e:
+            return run_analyses(sim, e, seed, only, short, partitions)
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
-        run = Runner(sim, jobs, seed, tmp)
+        run = Runner(sim, eng, seed, tmp)
         for name in only:
             out[name] = ANALYSES[name](run, tmp, short)
         if partitions:
@@ -582,9 +595,9 @@ def main():
                     help="also the finer HP-DTC tables (builds build/hpdtc-p*-l*)")
     ap.add_argument("--short", action="store_true", help="a reduced set of short runs (tests)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out"))
-    ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--sim", default="", help="simulator binary (default: tools/sim's)")
+    se.add_arguments(ap)
     a, _unused = ap.parse_known_args()  # ./tools/demo passes its options to every script
     only = [x for x in a.only.split(",") if x]
     bad = [x for x in only if x not in ANALYSES]
@@ -592,10 +605,12 @@ def main():
         sys.exit(f"analyses: unknown analysis {', '.join(bad)} (known: {', '.join(ANALYSES)})")
     sim = a.sim or fws_sim()
     t0 = time.time()
-    res = run_analyses(sim, a.jobs, a.seed, only, a.short, a.partitions)
+    with se.engine_or_exit(a, a.out, "analyses") as eng:
+        res = run_analyses(sim, eng, a.seed, only, a.short, a.partitions)
+        how = eng.describe()
     L = ["# Analyses of three findings of the comparison report", "",
          f"Written by `tools/analyses.py`{' --short' if a.short else ''}: {res['_runs']} "
-         f"simulations in {time.time() - t0:.0f} s on {a.jobs} processes. The report "
+         f"simulations in {time.time() - t0:.0f} s ({how}). The report "
          "(`tools/compare.py`) embeds the same analyses.", ""]
     for k in only + (["partitions"] if a.partitions else []):
         L += res[k]["lines"]
