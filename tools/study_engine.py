@@ -105,7 +105,8 @@ class Text:
 
 
 def _ini_deps(data, base_dir):
-    """Relative files a machine file names ([fluxmap] file), with their content."""
+    """Files a machine file names ([fluxmap] file): (path as written, content or None
+    when it cannot be read: the simulator then says so)."""
     deps, sec = [], None
     for ln in data.decode("utf-8", "replace").splitlines():
         s = ln.split(";")[0].split("#")[0].strip()
@@ -113,10 +114,11 @@ def _ini_deps(data, base_dir):
             sec = s.strip("[]").strip()
         elif sec == "fluxmap" and "=" in s and s.split("=")[0].strip() == "file":
             rel = s.split("=", 1)[1].strip()
-            p = os.path.join(base_dir or "", rel)
-            if not os.path.isabs(rel) and ".." not in rel.split("/") and os.path.isfile(p):
-                with open(p, "rb") as f:
+            try:
+                with open(os.path.join(base_dir or "", rel), "rb") as f:
                     deps.append((rel, f.read()))
+            except OSError:
+                deps.append((rel, None))
     return deps
 
 
@@ -144,18 +146,27 @@ class Run:
                     except OSError as e:
                         raise StudyInputError(f"{args[i - 1]} {a}: {e.strerror}") from None
                     name, base = os.path.basename(path), os.path.dirname(path)
-                slot = f"in{len(self.inputs)}"
-                rel = f"{slot}/{name}"
-                self.inputs[rel] = data
-                entry = {"file": rel, "sha256": hashlib.sha256(data).hexdigest()}
+                slot = f"in{len(desc_args)}"
                 deps = _ini_deps(data, base) if str(args[i - 1]) in ("--machine",
                                                                       "--control-machine") else []
+                # A dependency reached through "..": the file one folder deeper per "..",
+                # so that the path as written resolves inside the run's folder.
+                up = max([os.path.normpath(d).split(os.sep).count("..") for d, _ in deps
+                          if not os.path.isabs(d)] + [0])
+                rel = "/".join([slot] + ["d"] * up + [name])
+                self.inputs[rel] = data
+                entry = {"file": rel, "sha256": hashlib.sha256(data).hexdigest()}
                 if deps:
                     entry["deps"] = []
-                    for drel, ddata in deps:
-                        self.inputs[f"{slot}/{drel}"] = ddata
-                        entry["deps"].append({"file": f"{slot}/{drel}",
-                                              "sha256": hashlib.sha256(ddata).hexdigest()})
+                    for d, ddata in deps:
+                        h = hashlib.sha256(ddata).hexdigest() if ddata is not None else None
+                        if os.path.isabs(d):  # not shipped: the worker's own file at that path
+                            entry["deps"].append({"path": d, "sha256": h})
+                            continue
+                        drel = os.path.normpath(os.path.join(os.path.dirname(rel), d))
+                        if ddata is not None:
+                            self.inputs[drel] = ddata
+                        entry["deps"].append({"file": drel, "sha256": h})
                 desc_args.append(entry)
                 argv.append(rel)
             else:
@@ -617,7 +628,8 @@ class Engine:
                 more = f" and {len(labs) - 3} more" if len(labs) > 3 else ""
                 L.append(f"  {len(labs)} {st}: {why} [{'; '.join(labs[:3])}{more}]")
         line = (f"{self.name}: wall {wall:.1f} s; simulator {s['sim_wall']:.1f} s wall, "
-                f"{s['sim_cpu']:.1f} s CPU; this process {time.process_time() - self.cpu0:.1f} s "
+                f"{s['sim_cpu']:.1f} s CPU; this process (engine and tool) "
+                f"{time.process_time() - self.cpu0:.1f} s "
                 "CPU")
         n = s["computed"]
         if n and s["sim_wall"] > 0:
