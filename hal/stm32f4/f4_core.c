@@ -23,7 +23,7 @@ const char *f4_strerror(int rc)
     case F4_E_ADC:
         return "ADC conversion timed out";
     case F4_E_LSI:
-        return "IWDG registers not updated (LSI)";
+        return "LSI not running (IWDG_SR, RCC_CSR.LSIRDY): no watchdog";
     case F4_E_TIM:
         return "TIM1 update not at the counter peak";
     case F4_E_RANGE:

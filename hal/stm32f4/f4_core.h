@@ -34,7 +34,7 @@ typedef enum {
     F4_E_PWR = -6,     /* voltage scaling not in scale 1 */
     F4_E_SPI = -7,     /* SPI transfer did not complete */
     F4_E_ADC = -8,     /* ADC conversion did not complete */
-    F4_E_LSI = -9,     /* IWDG registers not updated (LSI not running) */
+    F4_E_LSI = -9,     /* LSI not running: IWDG not updated, LSIRDY low */
     F4_E_TIM = -10,    /* TIM1 update phase wrong (see f4_tim1_start) */
     F4_E_RANGE = -11,  /* a measured value outside its plausible range */
     F4_E_DRIVER = -12, /* the gate driver refused or did not answer (f4_hal.h) */

@@ -132,6 +132,13 @@ int f4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)
     if (!f4_wait_bits(F4_IWDG + F4_IWDG_SR, 0x3u, 0u, 10u * (f_cpu_hz / 1000u))) {
         return F4_E_LSI;
     }
+    /* The start key forces the LSI on (sec. 21.3.2); it is ready within
+     * t_SU(LSI) = 40 us at most (DS8626, LSI oscillator characteristics):
+     * without LSIRDY the watchdog does not count. 1 ms. */
+    if (!f4_wait_bits(F4_RCC + F4_RCC_CSR, F4_RCC_CSR_LSIRDY, F4_RCC_CSR_LSIRDY,
+                      f_cpu_hz / 1000u)) {
+        return F4_E_LSI;
+    }
     f4_wr(F4_IWDG + F4_IWDG_KR, F4_IWDG_KR_REFRESH);
     /* Debugger halts freeze the watchdog (else a breakpoint resets). */
     f4_set(F4_DBGMCU + F4_DBGMCU_APB1_FZ, F4_DBGMCU_APB1_FZ_IWDG_STOP);

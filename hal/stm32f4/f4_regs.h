@@ -189,6 +189,7 @@ static inline void f4_clr(uintptr_t reg, uint32_t bits)
 #define F4_RCC_APB2ENR_SPI1EN F4_BIT(12)
 #define F4_RCC_APB2ENR_SYSCFGEN F4_BIT(14)
 #define F4_RCC_CSR 0x74u
+#define F4_RCC_CSR_LSIRDY F4_BIT(1)
 #define F4_RCC_CSR_RMVF F4_BIT(24)
 #define F4_RCC_CSR_BORRSTF F4_BIT(25)
 #define F4_RCC_CSR_PINRSTF F4_BIT(26)
@@ -395,8 +396,15 @@ static inline void f4_clr(uintptr_t reg, uint32_t bits)
 #define F4_DWT_CYCCNT 0x04u
 #define F4_SCB_ICSR 0x04u                /* B3.2.4 */
 #define F4_SCB_ICSR_PENDSVSET F4_BIT(28) /* write 1: PendSV pending; 0s: no effect */
-#define F4_SCB_SHPR3 0x20u               /* B3.2.12: PendSV priority in bits 23:16 */
-#define F4_SCB_SHPR3_PENDSV_SHIFT 20u    /* 4 priority bits implemented: 23:20 */
+#define F4_SCB_AIRCR 0x0Cu               /* B3.2.6 */
+#define F4_SCB_AIRCR_VECTKEY 0x05FA0000u /* bits 31:16, written with every write */
+#define F4_SCB_AIRCR_SYSRESETREQ F4_BIT(2)
+#define F4_SCB_CFSR 0x28u             /* B3.2.15 (MMFSR 7:0, BFSR 15:8, UFSR 31:16) */
+#define F4_SCB_HFSR 0x2Cu             /* B3.2.16 */
+#define F4_SCB_MMFAR 0x34u            /* B3.2.17 */
+#define F4_SCB_BFAR 0x38u             /* B3.2.18 */
+#define F4_SCB_SHPR3 0x20u            /* B3.2.12: PendSV priority in bits 23:16 */
+#define F4_SCB_SHPR3_PENDSV_SHIFT 20u /* 4 priority bits implemented: 23:20 */
 #define F4_SCB_DEMCR 0xFCu
 #define F4_SCB_DEMCR_TRCENA F4_BIT(24)
 #define F4_NVIC_ISER(n) (0x000u + 4u * (n))

@@ -381,6 +381,11 @@ void f4_trace_write(uintptr_t reg, uint32_t value)
             f4_model.rcr_before_cen = f4_model.rcr_written;
         }
     }
-    /* USART: DR written is the byte sent (SR keeps TXE). IWDG: SR stays 0. */
+    /* IWDG: the start key forces the LSI on, which is ready at once here
+     * (RM0090 sec. 21.3.2; RCC_CSR LSION, LSIRDY); SR stays 0. */
+    if (reg == F4_IWDG + F4_IWDG_KR && value == F4_IWDG_KR_START && !f4_model.lsi_dead) {
+        *f4_reg(F4_RCC, F4_RCC_CSR) |= F4_RCC_CSR_LSIRDY | 1u;
+    }
+    /* USART: DR written is the byte sent (SR keeps TXE). */
     *c = value;
 }

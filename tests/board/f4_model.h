@@ -40,6 +40,7 @@ typedef struct {
     uint16_t gpio_in[4];  /* levels of the input pins of ports A..D */
     bool flash_wrp[12];   /* write-protected sectors */
     bool flash_bsy_stuck; /* BSY never clears */
+    bool lsi_dead;        /* LSIRDY never rises (as in QEMU, which has no RCC) */
     /* SPI peer: frames written to SPIn's DR go to it, its answer is read
      * back; NULL: the bus reads 0 (nothing connected). */
     uint16_t (*spi_peer)(uint32_t spi, uint16_t out);

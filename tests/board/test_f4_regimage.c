@@ -536,6 +536,30 @@ static void test_gate_pins_safe(void)
     }
 }
 
+/* The watchdog: started with the start key (which forces the LSI on),
+ * unlocked, PR and RLR written, refreshed, frozen under a debugger halt
+ * (RM0090 sec. 21.3.2-21.3.4, DBGMCU_APB1_FZ); without LSIRDY (QEMU, a dead
+ * LSI) it is refused by name. */
+static void test_iwdg_start_and_lsi(void)
+{
+    uint32_t pr, rlr;
+    TEST_ASSERT_EQUAL_INT(STM32_OK, stm32_iwdg_config(100u, F4_LSI_TYP_HZ, &pr, &rlr));
+    TEST_ASSERT_EQUAL_INT(F4_OK, f4_iwdg_start(pr, rlr, 16000000u));
+    const int start = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_START, 0);
+    const int unlock = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_UNLOCK, 0);
+    const int refresh = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_REFRESH, 0);
+    assert_before(start, unlock, "IWDG: started (LSI on) before the unlock");
+    assert_before(unlock, f4_model_find(F4_IWDG + F4_IWDG_PR, 0u, 0u, 0), "PR after the unlock");
+    assert_before(f4_model_find(F4_IWDG + F4_IWDG_RLR, 0u, 0u, 0), refresh, "RLR, then refresh");
+    TEST_ASSERT_EQUAL_UINT32(pr, reg(F4_IWDG + F4_IWDG_PR));
+    TEST_ASSERT_EQUAL_UINT32(rlr, reg(F4_IWDG + F4_IWDG_RLR));
+    ASSERT_BITS_SET(F4_DBGMCU_APB1_FZ_IWDG_STOP, reg(F4_DBGMCU + F4_DBGMCU_APB1_FZ));
+    f4_model_reset();
+    f4_model.lsi_dead = true;
+    TEST_ASSERT_EQUAL_INT(F4_E_LSI, f4_iwdg_start(pr, rlr, 16000000u));
+    TEST_ASSERT_NOT_NULL(strstr(f4_strerror(F4_E_LSI), "LSI"));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -554,5 +578,6 @@ int main(void)
     RUN_TEST(test_pwm_limit_ack_and_encoder);
     RUN_TEST(test_servo_capture);
     RUN_TEST(test_gate_pins_safe);
+    RUN_TEST(test_iwdg_start_and_lsi);
     return UNITY_END();
 }
