@@ -101,6 +101,9 @@ typedef struct {
     uint8_t throttle_tim, throttle_ch;
     f4_pin_t throttle;
     uint8_t throttle_filter;
+    /* a 32-bit timer (2 or 5) free for the main loop's microsecond clock
+     * (f4_ticks_init) */
+    uint8_t tick_tim;
     /* status LEDs (F4_PORT_NONE: none) */
     f4_pin_t led, led_fault;
     /* Outputs held at a fixed level from start-up on, before anything else,

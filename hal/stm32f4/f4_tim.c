@@ -98,6 +98,22 @@ void f4_gptim_enable(uint32_t n)
     f4_set(F4_RCC + F4_RCC_APB1ENR, F4_RCC_APB1ENR_TIM2EN << (n - 2u));
 }
 
+void f4_ticks_init(uint32_t n, uint32_t f_tim_hz)
+{
+    const uintptr_t t = f4_gptim_base(n);
+    f4_gptim_enable(n);
+    f4_wr(t + F4_TIM_CR1, 0u);
+    f4_wr(t + F4_TIM_PSC, f_tim_hz / 1000000u - 1u);
+    f4_wr(t + F4_TIM_ARR, 0xFFFFFFFFu);
+    f4_wr(t + F4_TIM_EGR, F4_TIM_EGR_UG); /* the prescaler loaded */
+    f4_wr(t + F4_TIM_CR1, F4_TIM_CR1_CEN);
+}
+
+uint32_t f4_ticks(uint32_t n)
+{
+    return f4_rd(f4_gptim_base(n) + F4_TIM_CNT);
+}
+
 /* CCMRx of channel ch, and its place (0, 1) in that register. */
 static uintptr_t f4_ccmr(uintptr_t t, uint32_t ch)
 {

@@ -56,6 +56,14 @@ uintptr_t f4_gptim_base(uint32_t n);
 /* Its clock on (RCC_APB1ENR.TIMxEN). */
 void f4_gptim_enable(uint32_t n);
 
+/* TIMn (2 or 5, the 32-bit ones) free-running at 1 MHz (PSC = f_tim / 1 MHz
+ * - 1, ARR = 0xFFFF_FFFF): the main loop's microsecond clock. The DWT cycle
+ * counter times the short waits; this one the main loop's periods, and it
+ * also runs in QEMU's STM32F405 model, which has no DWT. */
+void f4_ticks_init(uint32_t n, uint32_t f_tim_hz);
+/* Its count, microseconds modulo 2^32. */
+uint32_t f4_ticks(uint32_t n);
+
 /* TIMn (2..5) as quadrature counter (encoder mode 3: x4, counts on both edges
  * of both channels, CH1/CH2 inputs), free-running over its 16 low bits
  * (ARR = 0xFFFF), input filter `icf`; channel `index_ch` (3 or 4; 0: none)

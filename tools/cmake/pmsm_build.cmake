@@ -1,6 +1,6 @@
 # Build-wide settings. PMSM_TARGET: host | cm4 | cm0 (set by the presets).
-set(PMSM_TARGET "host" CACHE STRING "host, cm4, cm0 or stm32g4")
-set_property(CACHE PMSM_TARGET PROPERTY STRINGS host cm4 cm0 stm32g4)
+set(PMSM_TARGET "host" CACHE STRING "host, cm4, cm0, stm32g4 or stm32f4")
+set_property(CACHE PMSM_TARGET PROPERTY STRINGS host cm4 cm0 stm32g4 stm32f4)
 # Board of a stm32g4 build (a folder of hal/boards/ and its app in firmware/apps/).
 set(PMSM_BOARD "b_g431b_esc1" CACHE STRING "board of the stm32g4 build")
 option(PMSM_SANITIZE "Build host code with ASan and UBSan" OFF)

@@ -144,6 +144,9 @@ const f4_board_t f4_board_odrive_v36 = {
     .throttle = {A, 3u, 2u},
     .throttle_filter = 15u,
 
+    /* TIM2 drives the brake resistor in ODrive's firmware; here that switch
+     * is held off and TIM2 counts microseconds. */
+    .tick_tim = 2u,
     .led = NONE, /* no LED on a microcontroller pin */
     .led_fault = NONE,
     /* Axis M1 is not driven: its DRV8301 is enabled with M0's (shared
@@ -161,8 +164,6 @@ const f4_board_t f4_board_odrive_v36 = {
                  {B, 11u, 0u}},
     .hold_high = {{C, 14u, 0u}, NONE},
 
-    /* The current range of the sense at gain 40: 1.35 V / (40 x 0.5 mOhm)
-     * = 67.5 A; ODrive's default range 60 A. */
-    .current_peak_a = 60.0,
-    .vbus_max_v = 56.0, /* the 56 V board */
+    .current_peak_a = ODRIVE_V36_CURRENT_PEAK_A,
+    .vbus_max_v = ODRIVE_V36_VBUS_MAX_V,
 };

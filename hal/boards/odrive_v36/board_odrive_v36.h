@@ -11,6 +11,13 @@
 
 #include "f4_board.h"
 
+/* Ratings of the power stage (the description's vbus_max_v and
+ * current_peak_a, and the ranges of the machine parameters). */
+#define ODRIVE_V36_VBUS_MAX_V 56.0 /* the 56 V board */
+/* The current range of the sense at gain 40: 1.35 V / (40 x 0.5 mOhm) =
+ * 67.5 A; ODrive's default range 60 A. */
+#define ODRIVE_V36_CURRENT_PEAK_A 60.0
+
 extern const f4_board_t f4_board_odrive_v36;
 
 #endif /* HAL_BOARDS_ODRIVE_V36_BOARD_ODRIVE_V36_H */

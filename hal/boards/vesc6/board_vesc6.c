@@ -133,12 +133,13 @@ const f4_board_t f4_board_vesc6 = {
     .throttle = {B, 6u, 2u},
     .throttle_filter = 15u, /* ICF 1111: f_DTS/32, N = 8: 256 / 84 MHz = 3 us */
 
+    .tick_tim = 2u,           /* TIM2 is free on this board */
     .led = {B, 0u, 0u},       /* green [HW60] LED_GREEN */
     .led_fault = {B, 1u, 0u}, /* red [HW60] LED_RED */
     /* PD2 low: the current filter off, as hw_init_gpio leaves it [HW60]. */
     .hold_low = {{D, 2u, 0u}, NONE, NONE, NONE, NONE, NONE, NONE, NONE},
     .hold_high = {NONE, NONE},
 
-    .current_peak_a = 160.0, /* [HW60] HW_LIM_CURRENT_ABS (the phase current range 165 A) */
-    .vbus_max_v = 57.0,      /* [HW60] HW_LIM_VIN */
+    .current_peak_a = VESC6_CURRENT_PEAK_A,
+    .vbus_max_v = VESC6_VBUS_MAX_V,
 };

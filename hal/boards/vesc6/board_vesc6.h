@@ -12,6 +12,11 @@
 
 #include "f4_board.h"
 
+/* Ratings of the power stage (the description's vbus_max_v and
+ * current_peak_a, and the ranges of the machine parameters). */
+#define VESC6_VBUS_MAX_V 57.0      /* [HW60] HW_LIM_VIN */
+#define VESC6_CURRENT_PEAK_A 160.0 /* [HW60] HW_LIM_CURRENT_ABS (phase current range 165 A) */
+
 extern const f4_board_t f4_board_vesc6;
 
 #endif /* HAL_BOARDS_VESC6_BOARD_VESC6_H */

@@ -1,0 +1,119 @@
+/* Console byte rings (board_uart.h). */
+#include "board_uart.h"
+
+#include <string.h>
+
+void board_uart_init(board_uart_t *u, const board_uart_port_t *port, uint32_t ticks_hz,
+                     uint32_t f_cpu_hz, uint32_t baud)
+{
+    memset(u, 0, sizeof *u);
+    u->port = port;
+    /* A full ring drains in TX_SIZE x 10 bits / baud; wait at most that. */
+    u->tx_wait_ticks = (uint32_t)((uint64_t)ticks_hz * 10u * BOARD_UART_TX_SIZE / baud);
+    u->byte_ticks = (uint32_t)((uint64_t)ticks_hz * 10u / baud) + 1u;
+    u->poll_cycles = (uint32_t)((uint64_t)f_cpu_hz * 10u / baud);
+}
+
+int board_uart_getc(board_uart_t *u)
+{
+    const uint32_t t = u->rx_tail;
+    if (t == u->rx_head) {
+        return -1;
+    }
+    const int c = u->rx[t & (BOARD_UART_RX_SIZE - 1u)];
+    u->rx_tail = t + 1u;
+    return c;
+}
+
+/* A byte by polling, calling idle between the characters (the writer's
+ * wait, as with the ring). */
+static void board_uart_put_direct(board_uart_t *u, uint8_t c)
+{
+    if (u->idle != NULL) {
+        u->idle(u->idle_ctx);
+    }
+    if (!u->port->put_polled(c, 4u * u->poll_cycles)) {
+        u->tx_dropped++;
+    }
+}
+
+bool board_uart_check_tx(board_uart_t *u, const char *probe)
+{
+    board_uart_puts(u, probe);
+    const uint32_t t0 = u->port->ticks();
+    while (u->tx_tail == 0u && u->port->ticks() - t0 <= 8u * u->byte_ticks) {
+    }
+    if (u->tx_tail != 0u) {
+        return true;
+    }
+    u->polled = true;
+    /* the interrupt never sent: its enable off, the queued bytes by polling */
+    u->port->tx_irq_off();
+    while (u->tx_tail != u->tx_head) {
+        board_uart_put_direct(u, u->tx[u->tx_tail & (BOARD_UART_TX_SIZE - 1u)]);
+        u->tx_tail++;
+    }
+    return false;
+}
+
+void board_uart_write(board_uart_t *u, const uint8_t *bytes, size_t len)
+{
+    if (u->polled) {
+        for (size_t i = 0; i < len; i++) {
+            board_uart_put_direct(u, bytes[i]);
+        }
+        return;
+    }
+    for (size_t i = 0; i < len; i++) {
+        if (u->tx_head - u->tx_tail >= BOARD_UART_TX_SIZE) {
+            const uint32_t t0 = u->port->ticks();
+            while (u->tx_head - u->tx_tail >= BOARD_UART_TX_SIZE) {
+                if (u->idle != NULL) {
+                    u->idle(u->idle_ctx);
+                }
+                if (u->port->ticks() - t0 > u->tx_wait_ticks) {
+                    u->tx_dropped += (uint32_t)(len - i);
+                    return;
+                }
+            }
+        }
+        u->tx[u->tx_head & (BOARD_UART_TX_SIZE - 1u)] = bytes[i];
+        u->tx_head++;
+        u->port->tx_irq_on();
+    }
+}
+
+void board_uart_puts(board_uart_t *u, const char *s)
+{
+    board_uart_write(u, (const uint8_t *)s, strlen(s));
+}
+
+void board_uart_puts_polled(board_uart_t *u, const char *s)
+{
+    for (; *s != '\0'; s++) {
+        if (!u->port->put_polled((uint8_t)*s, 4u * u->poll_cycles)) {
+            u->tx_dropped++;
+            return;
+        }
+    }
+}
+
+void board_uart_rx(board_uart_t *u, uint8_t c)
+{
+    if (u->rx_head - u->rx_tail < BOARD_UART_RX_SIZE) {
+        u->rx[u->rx_head & (BOARD_UART_RX_SIZE - 1u)] = c;
+        u->rx_head++;
+    } else {
+        u->rx_dropped++;
+    }
+}
+
+bool board_uart_tx_next(board_uart_t *u, uint8_t *c)
+{
+    if (u->tx_tail == u->tx_head) {
+        return false;
+    }
+    *c = u->tx[u->tx_tail & (BOARD_UART_TX_SIZE - 1u)];
+    u->tx_tail++;
+    return true;
+}

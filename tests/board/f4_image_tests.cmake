@@ -1,0 +1,37 @@
+# Image checks of a stm32f4 build (included from the top-level CMakeLists.txt;
+# ctest --preset vesc6 / odrive-v36): the ELF as the chip boots it, its
+# messages' formats, tools/flash for the board, and the image booted in
+# QEMU's emulated STM32F405 (netduinoplus2).
+set(PMSM_F405_ELF ${CMAKE_BINARY_DIR}/firmware/apps/f405/pmsm-${PMSM_BOARD}.elf)
+# Per board: the console's USART as QEMU numbers its serial ports (USART1,
+# USART2, USART3, UART4, ...: -serial options in that order) and its IRQ
+# (RM0090 table 61), nFAULT's EXTI IRQ; the board's tools/flash name.
+if(PMSM_BOARD STREQUAL "vesc6")
+  set(f405_qemu_serial 2)  # USART3 (PB10/PB11, the COMM port)
+  set(f405_console_irq 39) # USART3
+  set(f405_nfault_irq 23)  # PB7: EXTI9_5
+  set(f405_flash_board vesc6)
+elseif(PMSM_BOARD STREQUAL "odrive_v36")
+  set(f405_qemu_serial 3)  # UART4 (PA0/PA1, GPIO 1/2)
+  set(f405_console_irq 52) # UART4
+  set(f405_nfault_irq 8)   # PD2: EXTI2
+  set(f405_flash_board odrive-v36)
+else()
+  message(FATAL_ERROR "f4_image_tests.cmake: no checks for board '${PMSM_BOARD}'")
+endif()
+set(f405_tests ${PMSM_BOARD}_image ${PMSM_BOARD}_image_printf ${PMSM_BOARD}_flash
+    ${PMSM_BOARD}_qemu_boot)
+add_test(NAME ${PMSM_BOARD}_image
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_f4_image.py ${PMSM_F405_ELF}
+                 ${f405_console_irq} ${f405_nfault_irq} ${PMSM_CONTROLLERS_ALL})
+# Its messages print their numbers: every conversion one its formatter has.
+add_test(NAME ${PMSM_BOARD}_image_printf
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_printf.py ${PMSM_F405_ELF})
+add_test(NAME ${PMSM_BOARD}_flash
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/test_flash.py ${PROJECT_SOURCE_DIR}
+                 ${PMSM_F405_ELF} ${f405_flash_board})
+add_test(NAME ${PMSM_BOARD}_qemu_boot
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_boot.py ${PMSM_F405_ELF}
+                 ${PMSM_BOARD} ${f405_qemu_serial} ${f405_console_irq})
+set_tests_properties(${f405_tests} PROPERTIES LABELS "board")
+set_tests_properties(${PMSM_BOARD}_qemu_boot PROPERTIES LABELS "board;qemu" TIMEOUT 150)
