@@ -429,7 +429,8 @@ class Engine:
     the store. Use as a context manager; close() prints the summary."""
 
     def __init__(self, jobs=None, scheduler=None, store=":memory:", progress=None, serial=False,
-                 connect_timeout_s=10.0, name="study", stream=sys.stderr, callback=None):
+                 connect_timeout_s=10.0, name="study", stream=sys.stderr, callback=None,
+                 chunk_s=1.0):
         self.jobs = int(jobs) if jobs else (os.cpu_count() or 1)
         if self.jobs < 1:
             raise StudyInputError(f"--jobs {jobs}: at least 1 worker")
@@ -439,6 +440,7 @@ class Engine:
         if progress is not None:
             Progress(progress, name, 0)  # refuse a bad mode now
         self.connect_timeout_s = connect_timeout_s
+        self.chunk_s = chunk_s  # seconds of simulation per dask task (0: one run per task)
         self.store = Store(store or ":memory:")
         self.client = self.cluster = None
         self.stats = {"runs": 0, "cached": 0, "computed": 0, "sim_wall": 0.0, "sim_cpu": 0.0,
@@ -551,41 +553,61 @@ class Engine:
         self.stats["slot_s"] = self.stats.get("slot_s", 0.0) + n * (now - self._t_slot)
         self._t_slot = now
 
+    def _chunk_size(self, left, slots):
+        """Runs per dask task: about chunk_s seconds of simulation (the mean run's
+        time so far), so that the scheduler's own work per task is a small part of
+        it; one run per task until a few have been timed; never so many that the
+        workers would wait for each other at the end (left / (3 slots))."""
+        n, t = self._timed
+        if self.chunk_s <= 0 or n < 2 * slots:
+            return 1
+        per_run = max(t / n, 1e-3)
+        return max(1, min(int(self.chunk_s / per_run), left // (3 * slots), 256))
+
     def _compute_dask(self, todo, got, prog, slots):
+        from collections import deque
+
         from distributed import as_completed
-        pending = iter(todo)
+        pending = deque(todo)
         runs_of = {}
         ac = as_completed(loop=self.client.loop)
-        window = max(16, 4 * slots)  # tasks in flight: memory bounded for 10^5 runs
+        self._timed = (0, 0.0)
 
         def submit_next():
-            r = next(pending, None)
-            if r is not None:
-                f = self.client.submit(study_worker.execute, r.task(), key=f"pmsm-run-{r.key}",
-                                       pure=False)
-                runs_of[f.key] = r
-                ac.add(f)
+            if not pending:
+                return
+            k = self._chunk_size(len(pending), slots)
+            chunk = [pending.popleft() for _ in range(min(k, len(pending)))]
+            # The key names the chunk's first run (tests find a run by it).
+            f = self.client.submit(study_worker.execute_many, [r.task() for r in chunk],
+                                   key=f"pmsm-runs-{chunk[0].key}-{len(chunk)}", pure=False)
+            runs_of[f.key] = chunk
+            ac.add(f)
 
-        for _ in range(window):
+        for _ in range(2 * slots):  # tasks in flight: each worker has the next one at hand
             submit_next()
         for f in ac:
-            r = runs_of.pop(f.key)
+            chunk = runs_of.pop(f.key)
             if f.status == "finished":
-                got[r.key] = self._arrived(r, f.result(), prog)
+                for r, raw in zip(chunk, f.result()):
+                    got[r.key] = self._arrived(r, raw, prog)
+                    n, t = self._timed
+                    self._timed = (n + 1, t + raw["wall_s"])
             else:
                 exc = f.exception()
                 name = type(exc).__name__
-                if name == "KilledWorker":
-                    res = Result(r.key, None, "", {}, status="lost",
-                                 reason=f"the workers running it died ({exc})")
-                elif isinstance(exc, study_worker.MissingBuild) or name == "MissingBuild":
-                    res = Result(r.key, None, "", {}, status="no-build", reason=str(exc))
-                else:
-                    res = Result(r.key, None, "", {}, status="engine-error",
-                                 reason=f"{name}: {exc}")
-                got[r.key] = res
-                self._tick()
-                prog.step(failed=True)
+                for r in chunk:
+                    if name == "KilledWorker":
+                        res = Result(r.key, None, "", {}, status="lost",
+                                     reason=f"the workers running it died ({exc})")
+                    elif name == "MissingBuild":
+                        res = Result(r.key, None, "", {}, status="no-build", reason=str(exc))
+                    else:
+                        res = Result(r.key, None, "", {}, status="engine-error",
+                                     reason=f"{name}: {exc}")
+                    got[r.key] = res
+                    self._tick()
+                    prog.step(failed=True)
             f.release()
             submit_next()
 

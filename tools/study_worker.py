@@ -126,3 +126,9 @@ def execute(task):
             "outputs": zlib.compress(json.dumps(outs, sort_keys=True).encode(), 6),
             "wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
             "worker": worker_name()}
+
+
+def execute_many(tasks):
+    """execute() of each task in turn: one dask task for several short runs, so
+    that the scheduler's work per task is spread over them."""
+    return [execute(t) for t in tasks]
