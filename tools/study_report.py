@@ -39,7 +39,16 @@ def describe_dist(p, d):
             f"{d['lo'] * sc:g} … {d['hi'] * sc:g}{unit}")
 
 
-def describe_unit(spec, params):
+def col_name(col):
+    """A table column's short name (current_gain_b: gain b)."""
+    if col.startswith("current_gain_"):
+        return f"gain {col[-1]}"
+    return SHORT[col][0] if col in SHORT else col
+
+
+def describe_unit(spec, params, unit=None):
+    if unit == 0:
+        return "nominal (every distribution at its centre)"
     parts = []
     for p in spec.spread:
         v = params.get(p)
@@ -81,6 +90,41 @@ def worst_of(metric, rows):
     if not cand:
         return None
     return max(cand, key=lambda t: abs(t[0]) if how == "abs" else t[0])
+
+
+def spread_of(spec, p):
+    """(column, range of the parameter's spread) per table column."""
+    d = spec.spread[p]
+    rng = 0.0 if d["dist"] == "fixed" else d["hi"] - d["lo"]
+    cols = [f"current_gain_{x}" for x in "abc"] if p == "current_gain" else [p]
+    return [(c, rng) for c in cols]
+
+
+def sensitivities(spec, rows, metric):
+    """Per group (controller, machine, point): a linear least-squares fit of the
+    metric on the drawn units' parameters; each parameter's effect is its slope
+    times the width of its spread (the change from one end of the spread to the
+    other, the others held), with R^2 of the fit. None where there are too few
+    units or no spread."""
+    cols = [c for p in spec.spread for c in spread_of(spec, p) if c[1] > 0]
+    out = {}
+    for key, g in groups(spec, rows).items():
+        pts = [(r[0], r[2][metric]) for r in g if r[0].unit > 0 and r[2].get(metric) is not None]
+        if len(pts) < len(cols) + 3 or not cols:
+            continue
+        X = np.array([[float(v) for v in ss.param_values(spec, c)] for c, _ in pts], dtype=float)
+        names = ss.param_columns(spec)
+        idx = [names.index(c) for c, _ in cols]
+        X = X[:, idx]
+        y = np.array([v for _, v in pts], dtype=float)
+        A = np.c_[X, np.ones(len(y))]
+        coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+        sst = float(((y - y.mean()) ** 2).sum())
+        r2 = 1.0 - float(((y - A @ coef) ** 2).sum()) / sst if sst > 0 else None
+        eff = sorted(((c, float(b) * w) for (c, w), b in zip(cols, coef[:-1])),
+                     key=lambda t: -abs(t[1]))
+        out[key] = (r2, eff)
+    return out
 
 
 def plot(spec, rows, out):
@@ -234,6 +278,27 @@ def write(spec, rows, info, out):
                   f"{fmt(st['median'])} | {fmt(st['p95'])} | **{fmt(wv[0])}** (unit "
                   f"{wv[1][0].unit}) | {st['n']} |")
         w("")
+    # ---- sensitivities
+    sens_mets = [m for m in spec.metrics if ss.METRICS[m][4] == "abs" or m == "torque_ripple_pct"]
+    if spec.spread and sens_mets:
+        w("## What moves them\n")
+        w("A linear fit of each metric on the drawn units' parameters, per controller, machine "
+          "and point: each parameter's effect is the change of the metric from one end of its "
+          "spread to the other (the fit's slope times the spread's width), the three largest "
+          "shown; R² tells how much of the spread the linear fit explains.\n")
+        for met in sens_mets:
+            sens = sensitivities(spec, rows, met)
+            if not sens:
+                continue
+            w(f"**{ss.METRICS[met][3]}** (`{met}`, {ss.METRICS[met][2]}):\n")
+            w("| controller | machine | point | R² | largest effects across the spread |")
+            w("|---|---|---|---|---|")
+            for (c, m, pi), (r2, eff) in sens.items():
+                g = groups(spec, rows)[(c, m, pi)]
+                w(f"| {c} | {g[0][0].machine.name} | {g[0][0].label} | "
+                  f"{'n/a' if r2 is None else f'{r2:.2f}'} | "
+                  + ", ".join(f"{col_name(n)} {fmt(e)}" for n, e in eff[:3]) + " |")
+            w("")
     # ---- worst cases
     w("## Worst cases\n")
     w("| controller | metric | value | machine | point | unit | its parameters |")
@@ -245,7 +310,7 @@ def write(spec, rows, info, out):
                 continue
             v, (case, _, _) = wv
             w(f"| {c} | `{met}` | {fmt(v)} {ss.METRICS[met][2]} | {case.machine.name} | "
-              f"{case.label} | {case.unit} | {describe_unit(spec, case.params) or 'nominal'} |")
+              f"{case.label} | {case.unit} | {describe_unit(spec, case.params, case.unit) or 'nominal'} |")
     w("")
     # ---- failures
     w("## Runs without indices\n")
@@ -258,7 +323,7 @@ def write(spec, rows, info, out):
         w("|---|---|---|---|---|---|---|")
         for case, res, _ in bad[:200]:
             w(f"| {case.ctrl} | {case.machine.name} | {case.label} | {case.unit} | {res.status} "
-              f"| {res.reason} | {describe_unit(spec, case.params) or 'nominal'} |")
+              f"| {res.reason} | {describe_unit(spec, case.params, case.unit) or 'nominal'} |")
         if len(bad) > 200:
             w(f"\n… and {len(bad) - 200} more ({spec.name}.csv).")
         w("")
