@@ -317,9 +317,22 @@ static int handler(void *user, const char *section, const char *name, const char
     return 0;
 }
 
+/* A section some key of k_keys belongs to. */
+static int section_known(const char *name, size_t len)
+{
+    for (size_t k = 0; k < N_KEYS; ++k) {
+        if (strlen(k_keys[k].section) == len && strncmp(k_keys[k].section, name, len) == 0) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
 /* Section headers libinih would skip silently (it reports the line but then
  * files the keys under the previous section): "[name]" with nothing but a
- * comment after it. Returns the first bad line (0: none) and its text. */
+ * comment after it; and unknown sections, on their header's line (libinih
+ * reports the line of their first key, and nothing for an empty one).
+ * Returns the first bad line (0: none) and its message. */
 static int header_check(FILE *f, char *bad, size_t badlen)
 {
     char line[512];
@@ -340,7 +353,25 @@ static int header_check(FILE *f, char *bad, size_t badlen)
         }
         if (close == NULL || close == p + 1 || (*q != '\0' && *q != ';' && *q != '#')) {
             size_t k = strcspn(p, "\r\n");
-            snprintf(bad, badlen, "%.*s", (int)(k < 60 ? k : 60), p);
+            snprintf(bad, badlen, "malformed section header '%.*s' (expected [name])",
+                     (int)(k < 60 ? k : 60), p);
+            return n;
+        }
+        if (!section_known(p + 1, (size_t)(close - p - 1))) {
+            char known[128] = "";
+            for (size_t k = 0; k < N_KEYS; ++k) {
+                const char *sec = k_keys[k].section;
+                size_t j = 0;
+                while (j < k && strcmp(k_keys[j].section, sec) != 0) {
+                    j++;
+                }
+                if (j == k) { /* its first key */
+                    const size_t used = strlen(known);
+                    snprintf(known + used, sizeof known - used, "%s%s", used ? ", " : "", sec);
+                }
+            }
+            snprintf(bad, badlen, "unknown section [%.*s] (known: %s)",
+                     (int)((size_t)(close - p - 1) < 40 ? close - p - 1 : 40), p + 1, known);
             return n;
         }
     }
@@ -596,12 +627,11 @@ int sim_machine_load(const char *path, sim_machine_t *out, char *err, size_t err
         snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
         return -1;
     }
-    char hdr[64];
+    char hdr[256];
     const int hdr_line = header_check(f, hdr, sizeof hdr);
     if (hdr_line != 0) {
         fclose(f);
-        snprintf(err, errlen, "%s:%d: malformed section header '%s' (expected [name])", path,
-                 hdr_line, hdr);
+        snprintf(err, errlen, "%s:%d: %s", path, hdr_line, hdr);
         memset(out, 0, sizeof(*out));
         return -1;
     }

@@ -53,7 +53,7 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
         ++lineno;
         if (!sim_csv_line_complete(line, in)) {
             snprintf(err, errlen, "%s:%ld: line too long", in_name, lineno);
-            return -1;
+            return SIM_REPLAY_EINPUT;
         }
         const char *s = sim_csv_content(line);
         if (s == NULL) {
@@ -62,7 +62,7 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
         if (!header_seen) {
             if (!sim_csv_is_header(s, k_header)) {
                 snprintf(err, errlen, "%s:%ld: expected header %s", in_name, lineno, k_header);
-                return -1;
+                return SIM_REPLAY_EINPUT;
             }
             header_seen = 1;
             continue;
@@ -71,26 +71,26 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
         if (sim_csv_numbers(s, v, 5) != 0) {
             snprintf(err, errlen, "%s:%ld: expected 5 numeric fields %s", in_name, lineno,
                      k_header);
-            return -1;
+            return SIM_REPLAY_EINPUT;
         }
         if (!(v[1] >= 0.0) || v[1] > 1e3) {
             snprintf(err, errlen, "%s:%ld: duration_s = %g must be in [0, 1000] s", in_name, lineno,
                      v[1]);
-            return -1;
+            return SIM_REPLAY_EINPUT;
         }
         const double dns = v[1] * 1e9;
         const int64_t ns = (int64_t)llround(dns);
         if (fabs(dns - (double)ns) > 1e-3 + 1e-12 * dns) {
             snprintf(err, errlen, "%s:%ld: duration_s = %.12g is not a whole number of ns", in_name,
                      lineno, v[1]);
-            return -1;
+            return SIM_REPLAY_EINPUT;
         }
         uint8_t sw[3];
         for (int x = 0; x < 3; ++x) {
             if (v[2 + x] != 0.0 && v[2 + x] != 1.0) {
                 snprintf(err, errlen, "%s:%ld: S%d = %g must be 0 or 1", in_name, lineno, x + 1,
                          v[2 + x]);
-                return -1;
+                return SIM_REPLAY_EINPUT;
             }
             sw[x] = (uint8_t)(v[2 + x] != 0.0);
         }
@@ -103,7 +103,7 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
                 snprintf(err, errlen,
                          "%s:%ld: t_start_s = %.12g, expected %.12g (end of previous interval)",
                          in_name, lineno, v[0], expect);
-                return -1;
+                return SIM_REPLAY_EINPUT;
             }
         }
         elapsed_ns += ns;
@@ -126,7 +126,7 @@ int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FI
     }
     if (!header_seen) {
         snprintf(err, errlen, "%s: empty file (expected header %s)", in_name, k_header);
-        return -1;
+        return SIM_REPLAY_EINPUT;
     }
     return 0;
 }
@@ -146,13 +146,13 @@ int sim_replay_files(const plant_config_t *base, const sim_replay_opts_t *opts, 
     FILE *in = fopen(in_path, "r");
     if (in == NULL) {
         snprintf(err, errlen, "%s: cannot open: %s", in_path, strerror(errno));
-        return -1;
+        return SIM_REPLAY_EINPUT;
     }
     FILE *out = fopen(trace_path, "w");
     if (out == NULL) {
         snprintf(err, errlen, "%s: cannot create: %s", trace_path, strerror(errno));
         fclose(in);
-        return -1;
+        return SIM_REPLAY_EINPUT;
     }
     int rc = sim_replay_run(base, opts, in, in_path, out, err, errlen);
     if (fclose(out) != 0 && rc == 0) {

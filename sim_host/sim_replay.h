@@ -28,8 +28,13 @@ typedef struct {
     double id0_a, iq0_a; /* initial currents */
 } sim_replay_opts_t;
 
+/* A malformed replay file (or one that cannot be opened, or a trace that
+ * cannot be created): the input's fault, not the run's. */
+#define SIM_REPLAY_EINPUT (-2)
+
 /* base: plant configuration of the machine (its mech/initial fields are
- * overridden by opts). Returns 0, or -1 with "file:line: message" in err. */
+ * overridden by opts). Returns 0; SIM_REPLAY_EINPUT with "file:line: message"
+ * in err for a malformed input; -1 for a plant or I/O failure. */
 int sim_replay_run(const plant_config_t *base, const sim_replay_opts_t *opts, FILE *in,
                    const char *in_name, FILE *trace, char *err, size_t errlen);
 

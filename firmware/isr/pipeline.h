@@ -396,7 +396,7 @@ void fw_set_torque_ref(fw_t *fw, q24_t torque_pu); /* selects torque mode */
 void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu); /* selects speed mode */
 /* SI helpers (pipeline_config.c; not for the ISR). */
 void fw_set_torque_ref_nm(fw_t *fw, double nm);
-void fw_set_speed_ref_rpm(fw_t *fw, double rpm);
+void fw_set_speed_ref_rpm(fw_t *fw, double rpm); /* clamped to +-speed_info.speed_ref_max_rpm */
 
 fw_state_id_t fw_state(const fw_t *fw);
 /* Main loop: the request the interrupt has not taken yet that turns the

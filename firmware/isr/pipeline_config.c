@@ -558,7 +558,10 @@ void fw_set_torque_ref_nm(fw_t *fw, double nm)
 void fw_set_speed_ref_rpm(fw_t *fw, double rpm)
 {
     if (fw != NULL && isfinite(rpm)) {
-        const double we = ctrl_rpm_to_elec(rpm, fw->params.pole_pairs);
+        /* the speed limit, as fw_set_torque_ref clamps the torque (the link
+         * refuses a value outside it; the simulator warns) */
+        const double lim = fw->speed_info.speed_ref_max_rpm;
+        const double we = ctrl_rpm_to_elec(fmin(fmax(rpm, -lim), lim), fw->params.pole_pairs);
         fw_set_speed_ref(fw, ctrl_q24_from_double(we / fw->bases.w_rad_s));
     }
 }

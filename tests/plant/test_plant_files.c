@@ -193,8 +193,10 @@ static void test_ini_bad_input(void)
     expect_ini_error("lq_mh = 6.5", "lq_mh = 0", "lq_mh = 0 out of range");
     /* non-integer pole pairs */
     expect_ini_error("pole_pairs = 4", "pole_pairs = 4.5", "pole_pairs = 4.5 is not an integer");
-    /* unknown section: rejected */
-    expect_ini_error("[mechanics]", "[mechanic]", "unknown section [mechanic]");
+    /* unknown section: rejected on its header's line (16), not its first key's */
+    expect_ini_error("[mechanics]", "[mechanic]", ":16: unknown section [mechanic] (known: ");
+    /* an unknown section without keys (libinih calls no handler for it) */
+    expect_ini_error("[inverter]", "[inverterr]\n[inverter]", ":13: unknown section [inverterr]");
     /* unknown key: rejected */
     expect_ini_error("fs_hz = 20000", "fs_khz = 20", "unknown key fs_khz in [inverter]");
     /* duplicate key */
@@ -412,7 +414,9 @@ static void expect_replay_error(const char *text, const char *must_contain)
     TEST_ASSERT_NOT_NULL(in);
     TEST_ASSERT_NOT_NULL(out);
     char err[256] = "";
-    TEST_ASSERT_EQUAL_INT(-1, sim_replay_run(&base, &o, in, "bad.csv", out, err, sizeof err));
+    /* a malformed file is the input's fault (the simulator exits 2 on it) */
+    TEST_ASSERT_EQUAL_INT(SIM_REPLAY_EINPUT,
+                          sim_replay_run(&base, &o, in, "bad.csv", out, err, sizeof err));
     fclose(in);
     fclose(out);
     remove(ip);

@@ -107,8 +107,7 @@ static void sim_limit_add(sim_run_t *r)
     r->lim_n++;
 }
 
-/* The speed reference in force (r/min), NaN in torque mode. */
-static double sim_run_speed_ref_now(const sim_run_t *r)
+double sim_run_speed_ref_now(const sim_run_t *r)
 {
     if (r->fw.ref_mode != FW_REF_SPEED) {
         return NAN;
@@ -695,8 +694,9 @@ static int sim_scenario_check(sim_run_t *r, char *err, size_t errlen)
         if ((e->set & SIM_SET_SPEED_REF) && fabs(e->speed_ref_rpm) > si->speed_ref_max_rpm) {
             sim_warn(c->warnings,
                      "scenario line %d (%s): speed_ref=%g r/min is outside the drive's speed "
-                     "limit [-%g, %g] r/min",
-                     e->line, trig, e->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm);
+                     "limit [-%g, %g] r/min: the firmware clamps it to %g r/min",
+                     e->line, trig, e->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm,
+                     copysign(si->speed_ref_max_rpm, e->speed_ref_rpm));
         }
         if ((e->set & SIM_SET_SPEED) && fabs(e->speed_rpm) > si->overspeed_rpm) {
             sim_warn(c->warnings,
@@ -848,8 +848,10 @@ int sim_run_init(sim_run_t *r, const sim_run_cfg_t *cfg, char *err, size_t errle
     if (c->speed_mode && fabs(c->speed_ref_rpm) > si->speed_ref_max_rpm) {
         sim_warn(c->warnings,
                  "speed reference %g r/min is outside the drive's speed limit [-%g, %g] r/min "
-                 "(the overspeed trip is at %g r/min)",
-                 c->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm, si->overspeed_rpm);
+                 "(the maximum speed; the overspeed trip is at %g r/min): the firmware clamps "
+                 "it to %g r/min",
+                 c->speed_ref_rpm, si->speed_ref_max_rpm, si->speed_ref_max_rpm, si->overspeed_rpm,
+                 copysign(si->speed_ref_max_rpm, c->speed_ref_rpm));
     }
     if (!c->free_mech && fabs(c->speed_rpm) > si->overspeed_rpm) {
         sim_warn(c->warnings,

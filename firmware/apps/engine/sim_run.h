@@ -239,5 +239,7 @@ bool sim_run_faulted(const sim_run_t *r);
 
 /* The speed reference, N*m limit and mode in SI for reports. */
 double sim_run_speed_rpm(const sim_run_t *r);
+/* The speed reference in force (r/min, after the drive's clamp), NaN in torque mode. */
+double sim_run_speed_ref_now(const sim_run_t *r);
 
 #endif /* FIRMWARE_HOST_SIM_RUN_H */

@@ -436,6 +436,29 @@ static int cli_check(cli_t *c, const int *given)
             return die("%s belongs to --replay", o->name);
         }
     }
+    /* Where the firmware runs, and the options of that place only. */
+    const char *t = c->target != NULL ? c->target : "host";
+    const int qemu = strcmp(t, "qemu") == 0;
+    const int board = strncmp(t, "board:", 6) == 0;
+    if (!qemu && !board && strcmp(t, "host") != 0) {
+        return die("--target '%s': allowed values host, qemu or board:DEVICE", t);
+    }
+    if (board && t[6] == '\0') {
+        return die("--target '%s': board:DEVICE needs the serial device, e.g. "
+                   "board:/dev/ttyACM0",
+                   t);
+    }
+    if (c->pil_transport != NULL && strcmp(c->pil_transport, "semihosting") != 0 &&
+        strcmp(c->pil_transport, "socket") != 0) {
+        return die("--pil-transport '%s': allowed values semihosting or socket", c->pil_transport);
+    }
+    if (!qemu && (c->pil_transport != NULL || c->pil_image != NULL)) {
+        return die("%s applies to --target qemu only (--target %s)",
+                   c->pil_image != NULL ? "--pil-image" : "--pil-transport", t);
+    }
+    if (!board && is_given(given, "--baud")) {
+        return die("--baud applies to --target board:DEVICE only (--target %s)", t);
+    }
     if (replay) {
         if (!is_given(given, "--speed-rpm")) {
             return die("--replay needs --speed-rpm");
@@ -554,7 +577,7 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
     const double mean_rpm = r->speed_n > 0u ? r->speed_sum_rpm / (double)r->speed_n : NAN;
     if (r->cfg.speed_mode) {
         fprintf(f, "  speed mode: reference %.1f r/min, window mean %s, at the end %s\n",
-                r->cfg.speed_ref_rpm, fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
+                sim_run_speed_ref_now(r), fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
                 fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
     } else if (r->lim_n > 0u) {
         /* the mean torque against the request and the reference applied */
@@ -601,7 +624,7 @@ static int replay_main(const cli_t *c, const sim_machine_t *pm)
     plant_fluxmap_free(&map);
     if (rc != 0) {
         fprintf(stderr, "sim: error: replay: %s\n", err);
-        return SIM_EXIT_RUN;
+        return rc == SIM_REPLAY_EINPUT ? SIM_EXIT_USAGE : SIM_EXIT_RUN;
     }
     printf("replay: %s -> %s\n", c->replay, c->trace);
     return SIM_EXIT_OK;
