@@ -225,12 +225,13 @@ struct plant {
     /* non-ideal mechanics (plant_mech.c): on when the configuration has
      * Coulomb friction, stiction, cogging or a load profile */
     int mech_events;
-    int mech_dir;          /* -1, +1: turning that way (w may be 0 at a break-away
-                              or a reversal); 0: stuck, held by friction */
-    int profile_on;        /* the load profile acts */
-    double profile_t0;     /* its time origin (PLANT_PROFILE_TIME) */
-    double cog_phase0;     /* N theta_m mod 2 pi, kept with theta_m */
-    plant_mech_stats_t ms; /* since init */
+    int mech_dir; /* -1, +1: turning that way (w may be 0 at a break-away
+                     or a reversal); 0: stuck, held by friction */
+    double cog_c[PLANT_COG_MAX], cog_s[PLANT_COG_MAX]; /* cos, sin of the cogging phases */
+    int profile_on;                                    /* the load profile acts */
+    double profile_t0;                                 /* its time origin (PLANT_PROFILE_TIME) */
+    double cog_phase0;                                 /* N theta_m mod 2 pi, kept with theta_m */
+    plant_mech_stats_t ms;                             /* since init */
     /* output filter (cfg.filter.type != PLANT_FILTER_NONE) and its step */
     plant_filter_t flt;
     int step_on;

@@ -41,22 +41,91 @@ void mech_setup(const plant_t *p, mech_in_t *in)
     in->cog_per_rev = (double)c->cog_per_rev;
     in->cog_amp = c->cog_amp_nm;
     for (int k = 0; k < c->cog_n; ++k) {
-        in->cog_c[k] = cos(c->cog_phase_rad[k]);
-        in->cog_s[k] = sin(c->cog_phase_rad[k]);
+        in->cog_c[k] = p->cog_c[k];
+        in->cog_s[k] = p->cog_s[k];
+    }
+    /* the speed-independent parts of step_max: the bound of |dw/dt| but Te
+     * and B w, and the steps of the linear parts (cogging detent
+     * J theta'' = -N sum k A_k theta linearised, J/B, the speed profile's
+     * slope) */
+    double prof_max = 0.0, prof_slope = 0.0, cog_sum = 0.0, cog_k = 0.0;
+    if (in->prof != NULL) {
+        for (int i = 0; i < in->prof->n; ++i) {
+            prof_max = fmax(prof_max, fabs(in->prof->y[i]));
+            if (i + 1 < in->prof->n && in->prof->kind == PLANT_PROFILE_SPEED) {
+                prof_slope = fmax(prof_slope, fabs((in->prof->y[i + 1] - in->prof->y[i]) /
+                                                   (in->prof->x[i + 1] - in->prof->x[i])));
+            }
+        }
+    }
+    for (int k = 0; k < c->cog_n; ++k) {
+        cog_sum += c->cog_amp_nm[k];
+        cog_k += (double)(k + 1) * c->cog_amp_nm[k];
+    }
+    in->acc_rest = (fabs(in->tl) + prof_max + in->tc + in->tp + cog_sum) / in->j;
+    in->h_lin = INFINITY;
+    if (cog_k > 0.0) {
+        in->h_lin = MECH_DPHI_MAX / sqrt(in->cog_per_rev * cog_k / in->j);
+    }
+    if (in->b > 0.0) {
+        in->h_lin = fmin(in->h_lin, MECH_DPHI_MAX * in->j / in->b);
+    }
+    if (prof_slope > 0.0) {
+        in->h_lin = fmin(in->h_lin, MECH_DPHI_MAX * in->j / prof_slope);
     }
     if (c->cog_n > 0) {
         double ph = fmod(in->cog_per_rev * p->theta_m, TWO_PI);
         in->cog_phase0 = ph < 0.0 ? ph + TWO_PI : ph;
+        in->cog_s0 = sin(in->cog_phase0);
+        in->cog_c0 = cos(in->cog_phase0);
     }
 }
 
-/* sin(k phi + phi_k) for k = 1..n by the angle-addition recurrence. */
-double mech_cogging(const mech_in_t *in, double phi)
+/* sin and cos of the cogging phase phase0 + d: for |d| <= 0.5 (a sub-interval
+ * rarely travels more) the rotation of the start's sin and cos by d, with d's
+ * own sin and cos from their Taylor series to degree 15 and 16 (remainder
+ * < 0.5^17/17! = 2e-20), a fraction of the cost of sin() and cos(). */
+static void cog_sincos(const mech_in_t *in, double d, double *s, double *c)
+{
+    if (fabs(d) > 0.5) {
+        *s = sin(in->cog_phase0 + d);
+        *c = cos(in->cog_phase0 + d);
+        return;
+    }
+    const double d2 = d * d;
+    const double sd =
+        d * (1.0 -
+             d2 / 6.0 *
+                 (1.0 -
+                  d2 / 20.0 *
+                      (1.0 - d2 / 42.0 *
+                                 (1.0 - d2 / 72.0 *
+                                            (1.0 - d2 / 110.0 *
+                                                       (1.0 - d2 / 156.0 * (1.0 - d2 / 210.0)))))));
+    const double cd =
+        1.0 -
+        d2 / 2.0 *
+            (1.0 -
+             d2 / 12.0 *
+                 (1.0 -
+                  d2 / 30.0 *
+                      (1.0 - d2 / 56.0 *
+                                 (1.0 - d2 / 90.0 *
+                                            (1.0 - d2 / 132.0 *
+                                                       (1.0 - d2 / 182.0 * (1.0 - d2 / 240.0)))))));
+    *s = in->cog_s0 * cd + in->cog_c0 * sd;
+    *c = in->cog_c0 * cd - in->cog_s0 * sd;
+}
+
+/* sum_k A_k sin(k phi + phi_k), phi = phase0 + N dth, by the angle-addition
+ * recurrence over k. */
+double mech_cogging(const mech_in_t *in, double dth)
 {
     if (in->cog_n == 0) {
         return 0.0;
     }
-    const double s1 = sin(phi), c1 = cos(phi);
+    double s1, c1;
+    cog_sincos(in, in->cog_per_rev * dth, &s1, &c1);
     double sk = s1, ck = c1, t = 0.0;
     for (int k = 0; k < in->cog_n; ++k) {
         t += in->cog_amp[k] * (sk * in->cog_c[k] + ck * in->cog_s[k]);
@@ -67,8 +136,9 @@ double mech_cogging(const mech_in_t *in, double phi)
     return t;
 }
 
-double mech_cogging_energy(const mech_in_t *in, double phi)
+double mech_cogging_energy(const mech_in_t *in, double dth)
 {
+    const double phi = in->cog_phase0 + in->cog_per_rev * dth;
     double w = 0.0;
     for (int k = 0; k < in->cog_n; ++k) {
         const double a = (double)(k + 1) * phi;
@@ -122,12 +192,12 @@ static double te_at(const mech_in_t *in, double t)
     return in->te[0] + t * (in->te[1] + t * in->te[2]);
 }
 
-/* Net driving torque Te + T_cog - T_La at time t, cogging phase phi, speed w.
+/* Net driving torque Te + T_cog - T_La at time t, angle dth from the start, speed w.
  * The stuck test and the acceleration at rest use this same expression, so
  * a break-away found by it starts with an acceleration of the right sign. */
-static double net_torque(const mech_in_t *in, double t, double phi, double w)
+static double net_torque(const mech_in_t *in, double t, double dth, double w)
 {
-    return (te_at(in, t) + mech_cogging(in, phi)) - mech_load(in, t, w);
+    return (te_at(in, t) + mech_cogging(in, dth)) - mech_load(in, t, w);
 }
 
 /* ----------------------------------------------------------- turning */
@@ -139,9 +209,8 @@ static double net_torque(const mech_in_t *in, double t, double phi, double w)
 static void deriv(const mech_in_t *in, int dir, double t, const double y[NY], double dy[NY])
 {
     const double w = y[1];
-    const double phi = in->cog_phase0 + in->cog_per_rev * y[0];
     const double tla = mech_load(in, t, w);
-    const double net = (te_at(in, t) + mech_cogging(in, phi)) - tla;
+    const double net = (te_at(in, t) + mech_cogging(in, y[0])) - tla;
     const double d = (double)dir;
     dy[0] = w;
     dy[1] = ((net - in->b * w) - (in->tc + in->tp) * d) / in->j;
@@ -173,42 +242,19 @@ static void rk4(const mech_in_t *in, int dir, double t, const double y[NY], cons
     }
 }
 
-/* Largest RK4 step for this sub-interval (see MECH_DPHI_MAX). */
-static double step_max(const mech_in_t *in, double h, double w0)
+/* Largest RK4 step for this sub-interval (see MECH_DPHI_MAX); *a_bound: a
+ * bound of |dw/dt| over it. */
+static double step_max(const mech_in_t *in, double h, double w0, double *a_bound)
 {
-    double hmax = h;
     const double te_max = fabs(in->te[0]) + fabs(in->te[1]) * h + fabs(in->te[2]) * h * h;
-    double prof_max = 0.0, prof_slope = 0.0;
-    if (in->prof != NULL) {
-        for (int i = 0; i < in->prof->n; ++i) {
-            prof_max = fmax(prof_max, fabs(in->prof->y[i]));
-            if (i + 1 < in->prof->n && in->prof->kind == PLANT_PROFILE_SPEED) {
-                prof_slope = fmax(prof_slope, fabs((in->prof->y[i + 1] - in->prof->y[i]) /
-                                                   (in->prof->x[i + 1] - in->prof->x[i])));
-            }
-        }
-    }
-    double cog_sum = 0.0, cog_k = 0.0;
-    for (int k = 0; k < in->cog_n; ++k) {
-        cog_sum += in->cog_amp[k];
-        cog_k += (double)(k + 1) * in->cog_amp[k];
-    }
-    const double a_max =
-        (te_max + fabs(in->tl) + prof_max + in->tc + in->tp + cog_sum + in->b * fabs(w0)) / in->j;
-    const double w_max = fabs(w0) + a_max * h;
+    const double a_max = (te_max + in->b * fabs(w0)) / in->j + in->acc_rest;
+    *a_bound = a_max;
+    double hmax = fmin(h, in->h_lin);
     if (in->cog_n > 0) {
-        const double rate = w_max * in->cog_per_rev * (double)in->cog_n; /* highest harmonic */
-        if (rate > 0.0) {
-            hmax = fmin(hmax, MECH_DPHI_MAX / rate);
+        const double rate = (fabs(w0) + a_max * h) * in->cog_per_rev * (double)in->cog_n;
+        if (rate * hmax > MECH_DPHI_MAX) { /* the highest harmonic's phase per step */
+            hmax = MECH_DPHI_MAX / rate;
         }
-        /* detent: J theta'' = -N sum k A_k theta linearised */
-        hmax = fmin(hmax, MECH_DPHI_MAX / sqrt(in->cog_per_rev * cog_k / in->j + 1e-300));
-    }
-    if (in->b > 0.0) {
-        hmax = fmin(hmax, MECH_DPHI_MAX * in->j / in->b);
-    }
-    if (prof_slope > 0.0) {
-        hmax = fmin(hmax, MECH_DPHI_MAX * in->j / prof_slope);
     }
     return hmax;
 }
@@ -346,12 +392,12 @@ static int quad_roots(double a, double b, double c, double r[2])
     return 2;
 }
 
-/* First instant in [t0, t1] at which the rotor at rest (cogging phase phi)
+/* First instant in [t0, t1] at which the rotor at rest (at dth)
  * breaks away, |net| > tbrk; +inf if none. Between t0 and t1 the active load
  * is linear in t (t1 is at most the next time-profile point). */
-static double breakaway(const mech_in_t *in, double t0, double t1, double phi)
+static double breakaway(const mech_in_t *in, double t0, double t1, double dth)
 {
-    if (fabs(net_torque(in, t0, phi, 0.0)) > in->tbrk) {
+    if (fabs(net_torque(in, t0, dth, 0.0)) > in->tbrk) {
         return t0;
     }
     /* net(t) = A + B t + C t^2 on [t0, t1]: from three evaluations of the load
@@ -360,7 +406,7 @@ static double breakaway(const mech_in_t *in, double t0, double t1, double phi)
     const double l0 = mech_load(in, t0, 0.0), l1 = mech_load(in, t1, 0.0);
     const double ls = t1 > t0 ? (l1 - l0) / (t1 - t0) : 0.0;
     (void)tm;
-    const double cog = mech_cogging(in, phi);
+    const double cog = mech_cogging(in, dth);
     const double C = in->te[2];
     const double B = in->te[1] - ls;
     const double A = in->te[0] + cog - (l0 - ls * t0);
@@ -391,7 +437,7 @@ static double breakaway(const mech_in_t *in, double t0, double t1, double phi)
          * where the evaluated torque exceeds (a tangency never does) */
         double t = cand[i], step = fmax(fabs(t), 1e-300) * 2.2e-16;
         while (t <= t1 && t - cand[i] <= reach) {
-            if (fabs(net_torque(in, t, phi, 0.0)) > in->tbrk) {
+            if (fabs(net_torque(in, t, dth, 0.0)) > in->tbrk) {
                 return t;
             }
             t = cand[i] + step;
@@ -399,11 +445,11 @@ static double breakaway(const mech_in_t *in, double t0, double t1, double phi)
         }
     }
     /* Rounding hid a crossing that the end value shows: bisect for it. */
-    if (fabs(net_torque(in, t1, phi, 0.0)) > in->tbrk) {
+    if (fabs(net_torque(in, t1, dth, 0.0)) > in->tbrk) {
         double lo = t0, hi = t1;
         for (int it = 0; it < 200 && hi - lo > MECH_LOC_TOL * (t1 - t0); ++it) {
             const double m = 0.5 * (lo + hi);
-            if (fabs(net_torque(in, m, phi, 0.0)) > in->tbrk) {
+            if (fabs(net_torque(in, m, dth, 0.0)) > in->tbrk) {
                 hi = m;
             } else {
                 lo = m;
@@ -431,22 +477,44 @@ static double next_break(const mech_in_t *in, double t, double h)
     return h;
 }
 
+int mech_mean_speed(const mech_in_t *in, double h, double w0, int dir, double *wh)
+{
+    double a_max;
+    (void)step_max(in, h, w0, &a_max);
+    if (dir != 0 && fabs(w0) > a_max * h) {
+        /* no stop and no break-away possible: the midpoint prediction */
+        const double y[NY] = {0.0, w0, 0.0, 0.0, 0.0, 0.0};
+        double dy[NY];
+        deriv(in, dir, 0.0, y, dy);
+        *wh = w0 + 0.5 * h * dy[1];
+        return PLANT_OK;
+    }
+    mech_out_t o;
+    const int rc = mech_solve(in, h, w0, dir, &o);
+    *wh = o.dtheta / h;
+    return rc;
+}
+
 int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *out)
 {
     memset(out, 0, sizeof *out);
+    out->t_event = INFINITY;
     double y[NY] = {0.0, w0, 0.0, 0.0, 0.0, 0.0};
     int dir = dir0;
     if (w0 != 0.0) {
         dir = w0 > 0.0 ? 1 : -1;
     }
-    const double hmax = step_max(in, h, w0);
+    double a_max;
+    double hmax = step_max(in, h, w0, &a_max);
+    if (in->coarse) {
+        hmax = h;
+    }
     double t = 0.0;
     long events = 0;
     while (t < h) {
         const double t_end = next_break(in, t, h);
         if (dir == 0) {
-            const double phi = in->cog_phase0 + in->cog_per_rev * y[0];
-            const double tb = breakaway(in, t, t_end, phi);
+            const double tb = breakaway(in, t, t_end, y[0]);
             if (!(tb <= t_end)) {
                 out->d.stuck_s += t_end - t;
                 t = t_end;
@@ -454,7 +522,8 @@ int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *o
             }
             out->d.stuck_s += tb - t;
             t = tb;
-            dir = net_torque(in, t, phi, 0.0) > 0.0 ? 1 : -1;
+            out->t_event = fmin(out->t_event, t);
+            dir = net_torque(in, t, y[0], 0.0) > 0.0 ? 1 : -1;
             out->d.breakaways++;
             if (++events > MECH_EVENTS_MAX) {
                 return PLANT_ERANGE;
@@ -480,8 +549,13 @@ int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *o
             const double g0 = (double)dir * y[1], g1 = (double)dir * y1[1];
             double s_dip = 0.0;
             int cross = !(g1 > 0.0) && !(g0 == 0.0 && g1 == 0.0 && k1[1] == 0.0);
-            if (!cross) {
+            /* a dip below zero inside the step needs the speed to fall by
+             * min(g0, g1) within it */
+            const int dip_possible = fmin(g0, g1) <= a_max * len;
+            if (!cross && (dip_possible || i + 1 < n)) {
                 deriv(in, dir, ts + len, y1, k1n);
+            }
+            if (!cross && dip_possible) {
                 s_dip = hermite_dip(g0, g1, (double)dir * k1[1] * len, (double)dir * k1n[1] * len);
                 cross = s_dip > 0.0;
             }
@@ -491,8 +565,8 @@ int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *o
                 y[1] = 0.0;
                 out->d.moving_s += ts + tau - t;
                 t = ts + tau;
-                const double phi = in->cog_phase0 + in->cog_per_rev * y[0];
-                const double net = net_torque(in, t, phi, 0.0);
+                out->t_event = fmin(out->t_event, t);
+                const double net = net_torque(in, t, y[0], 0.0);
                 if (fabs(net) <= in->tbrk) {
                     dir = 0;
                     out->d.stops++;
@@ -506,11 +580,10 @@ int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *o
                 event = 1;
                 break;
             }
-            if (cross) {
-                deriv(in, dir, ts + len, y1, k1n); /* a dip only: go on */
+            memcpy(y, y1, sizeof y); /* (a dip of the interpolant only: go on) */
+            if (i + 1 < n) {
+                memcpy(k1, k1n, sizeof k1);
             }
-            memcpy(y, y1, sizeof y);
-            memcpy(k1, k1n, sizeof k1);
         }
         if (!event) {
             out->d.moving_s += t_end - t;

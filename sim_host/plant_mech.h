@@ -37,11 +37,17 @@ typedef struct {
     double cog_per_rev; /* N */
     const double *cog_amp;
     double cog_c[PLANT_COG_MAX], cog_s[PLANT_COG_MAX]; /* cos, sin of the phases */
-    double cog_phase0; /* N theta at the sub-interval's start, in [0, 2 pi) */
-    double te[3];      /* Te(t) = te[0] + t (te[1] + t te[2]), t from the start */
+    double cog_phase0;     /* N theta at the sub-interval's start, in [0, 2 pi) */
+    double cog_s0, cog_c0; /* its sin and cos */
+    double te[3];          /* Te(t) = te[0] + t (te[1] + t te[2]), t from the start */
+    double acc_rest;       /* bound of |dw/dt| from all but Te and B w */
+    double h_lin;          /* step bound of the linear parts (step_max) */
+    int coarse;            /* 1: one RK4 step per event-free stretch (a mean speed to
+                              hold, an event to split at), not the bounded steps */
 } mech_in_t;
 
 typedef struct {
+    double t_event;       /* first stick or slip event (s from the start), +inf: none */
     double dtheta, omega; /* end: angle travelled, speed */
     int dir;              /* end direction (0: stuck) */
     plant_mech_stats_t d; /* increments over the sub-interval */
@@ -56,9 +62,14 @@ void mech_setup(const plant_t *p, mech_in_t *in);
  * end (more than 10^5 in one sub-interval) or the state is not finite. */
 int mech_solve(const mech_in_t *in, double h, double w0, int dir0, mech_out_t *out);
 
-/* Cogging torque and potential at cogging phase phi = N theta. */
-double mech_cogging(const mech_in_t *in, double phi);
-double mech_cogging_energy(const mech_in_t *in, double phi);
+/* The mean speed over h (for the electrical part's held speed): the midpoint
+ * prediction when the speed cannot reach zero in h, else mech_solve's. */
+int mech_mean_speed(const mech_in_t *in, double h, double w0, int dir, double *wh);
+
+/* Cogging torque and potential at dth (mechanical angle travelled since
+ * the sub-interval's start). */
+double mech_cogging(const mech_in_t *in, double dth);
+double mech_cogging_energy(const mech_in_t *in, double dth);
 
 /* Active load T_La at sub-interval time t and speed w. */
 double mech_load(const mech_in_t *in, double t, double w);

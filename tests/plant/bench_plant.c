@@ -2,8 +2,13 @@
  * Plant speed: simulated seconds per wall-clock second for the thesis SPMSM at
  * 3000 r/min (imposed) with a 20 kHz centre-aligned sinusoidal PWM pattern
  * (modulation index 0.9 of the linear range, rotating with the rotor), with
- * and without an observer at 10 samples per PWM period.
- * Usage: plant_bench [simulated_seconds (default 2)]
+ * and without an observer at 10 samples per PWM period; then free mechanics
+ * from 3000 r/min with viscous friction and a constant load (the smooth
+ * path), and with the stress case's non-ideal mechanics (Coulomb friction,
+ * stiction, cogging at 24 and 48 per revolution, a passive load: the
+ * event path, sim_host/README.md "Mechanics").
+ * Usage: plant_bench [simulated_seconds (default 2) [case 1..5 (default all)]]
+ * (one case: for an instruction count, valgrind --tool=callgrind).
  */
 #include <math.h>
 #include <stdio.h>
@@ -27,7 +32,7 @@ static void obs_sum(void *ctx, const plant_t *p)
 
 /* Returns simulated seconds per CPU second (process time: the machine is
  * shared, wall time would measure the other users); *wall_ratio per wall s. */
-static double run(double sim_s, int with_obs, int track_energy, double *torque_mean,
+static double run(double sim_s, int with_obs, int track_energy, int mech, double *torque_mean,
                   double *wall_ratio)
 {
     plant_config_t c = {0};
@@ -38,6 +43,22 @@ static double run(double sim_s, int with_obs, int track_energy, double *torque_m
     c.vdc_v = 220.0;
     c.speed0_rpm = 3000.0;
     c.track_energy = track_energy;
+    if (mech > 0) {
+        c.mech = PLANT_MECH_FREE;
+        c.inertia_kgm2 = 1.2e-4;
+        c.friction_nms = 3.82e-4;
+        c.load_torque_nm = 1.0;
+    }
+    if (mech > 1) {
+        c.load_torque_nm = 0.0;
+        c.coulomb_nm = 0.24;
+        c.stiction_nm = 0.36;
+        c.load_passive_nm = 0.48;
+        c.cog_per_rev = 24;
+        c.cog_n = 2;
+        c.cog_amp_nm[0] = 0.24;
+        c.cog_amp_nm[1] = 0.07;
+    }
     plant_t p;
     if (plant_init(&p, &c) != PLANT_OK) {
         return NAN;
@@ -65,6 +86,9 @@ static double run(double sim_s, int with_obs, int track_energy, double *torque_m
     const double cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
     const double wall = now_s() - t0;
     *torque_mean = tq / (double)n + 0.0 * acc;
+    if (mech > 0) {
+        printf("    (end speed %.0f r/min)\n", plant_omega_m(&p) * 60.0 / (2.0 * PLANT_PI));
+    }
     *wall_ratio = sim_s / wall;
     return sim_s / cpu;
 }
@@ -72,15 +96,24 @@ static double run(double sim_s, int with_obs, int track_energy, double *torque_m
 int main(int argc, char **argv)
 {
     const double sim_s = (argc > 1) ? atof(argv[1]) : 2.0;
-    double tq, wall;
+    const int only = (argc > 2) ? atoi(argv[2]) : 0;
+    static const struct {
+        const char *name;
+        int obs, energy, mech;
+    } cases[] = {{"plain:                     ", 0, 0, 0},
+                 {"observer 10/period:        ", 1, 0, 0},
+                 {"observer + energy tracking:", 1, 1, 0},
+                 {"free, viscous + load:      ", 0, 0, 1},
+                 {"free, non-ideal mechanics: ", 0, 0, 2}};
+    double tq = 0.0, wall;
     printf("SPMSM 3000 r/min, 20 kHz centre-aligned PWM, %.2f s simulated\n", sim_s);
     printf("simulated s per CPU s (per wall s)\n");
-    double r = run(sim_s, 0, 0, &tq, &wall);
-    printf("  plain:                      %8.1f (%.1f)\n", r, wall);
-    r = run(sim_s, 1, 0, &tq, &wall);
-    printf("  observer 10/period:         %8.1f (%.1f)\n", r, wall);
-    r = run(sim_s, 1, 1, &tq, &wall);
-    printf("  observer + energy tracking: %8.1f (%.1f)\n", r, wall);
+    for (int i = 0; i < 5; ++i) {
+        if (only == 0 || only == i + 1) {
+            const double r = run(sim_s, cases[i].obs, cases[i].energy, cases[i].mech, &tq, &wall);
+            printf("  %s %8.1f (%.1f)\n", cases[i].name, r, wall);
+        }
+    }
     printf("  (mean torque %.4g N m)\n", tq);
     return 0;
 }
