@@ -446,6 +446,7 @@ class Engine:
         self.stats = {"runs": 0, "cached": 0, "computed": 0, "sim_wall": 0.0, "sim_cpu": 0.0,
                       "compute_wall": 0.0, "slots": 0}
         self.failures = []  # (status, reason, label)
+        self._slots, self._slots_at = 0, -1e9
         self.t0, self.cpu0 = time.monotonic(), time.process_time()
         if self.scheduler:
             self._connect()  # an unreachable scheduler is refused before any work
@@ -481,7 +482,9 @@ class Engine:
             dask.config.set({"distributed.worker.profile.enabled": False,
                              "distributed.worker.memory.monitor-interval": "1s",
                              "distributed.admin.system-monitor.interval": "2s",
-                             "distributed.admin.tick.interval": "200ms"})
+                             "distributed.admin.tick.interval": "200ms",
+                             # every worker is in this process: nothing to steal
+                             "distributed.scheduler.work-stealing": False})
             # No dashboard (no bokeh here); the scheduler's HTTP server on a free
             # loopback port, not on 8787 (where another cluster may be).
             self.cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1,
@@ -538,11 +541,16 @@ class Engine:
         return got
 
     def _slots_now(self):
-        """Worker threads the cluster has now (the scheduler's cached view)."""
+        """Worker threads the cluster has now, asked of the scheduler at most every
+        2 s (each question is a round trip through the scheduler)."""
         if self.serial:
             return 1
-        info = self.client.scheduler_info().get("workers", {})
-        return sum(w.get("nthreads", 1) for w in info.values())
+        now = time.monotonic()
+        if now - self._slots_at >= 2.0:
+            info = self.client.scheduler_info().get("workers", {})
+            self._slots = sum(w.get("nthreads", 1) for w in info.values())
+            self._slots_at = now
+        return self._slots
 
     def _tick(self):
         """Slot-seconds (worker threads x time) since the last result: the time the

@@ -14,6 +14,8 @@ the simulator's messages: the same task gives the same bytes on every worker.
 import hashlib
 import json
 import os
+import select
+import shutil
 import signal
 import socket
 import subprocess
@@ -79,38 +81,81 @@ def worker_name():
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def execute(task):
+class Scratch:
+    """The folder the runs of one dask task share: an input is written only when
+    its content changes, a run's outputs and stderr are removed before it starts
+    (the simulator sees exactly its own files; creating and removing a folder per
+    run cost more than a short run's margin)."""
+
+    def __init__(self):
+        self.dir = tempfile.mkdtemp(prefix="pmsm-study-")
+        self.have = {}  # relative path -> bytes written there
+
+    def prepare(self, task):
+        for rel, data in task["inputs"].items():
+            if self.have.get(rel) != data:
+                p = os.path.join(self.dir, rel)
+                os.makedirs(os.path.dirname(p), exist_ok=True)
+                with open(p, "wb") as f:
+                    f.write(data)
+                self.have[rel] = data
+        for rel in list(task["outputs"].values()) + ["stderr.txt"]:
+            p = os.path.join(self.dir, rel)
+            os.makedirs(os.path.dirname(p), exist_ok=True)
+            if os.path.lexists(p):
+                os.unlink(p)
+
+    def close(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def wait_child(p, timeout_s):
+    """Wait for the simulator; kill it after timeout_s. Returns (status, usage,
+    timed out): os.wait4 gives the child's own CPU time (several runs share this
+    process). A pidfd bounds the wait without a timer thread per run."""
+    timed_out = False
+    try:
+        fd = os.pidfd_open(p.pid)
+    except (AttributeError, OSError):
+        fd = None
+    if fd is not None:
+        try:
+            ready, _, _ = select.select([fd], [], [], timeout_s)
+        finally:
+            os.close(fd)
+        if not ready:
+            timed_out = True
+            p.send_signal(signal.SIGKILL)
+        _, status, usage = os.wait4(p.pid, 0)
+    else:
+        flag = []
+        timer = threading.Timer(timeout_s, lambda: (flag.append(1), p.send_signal(signal.SIGKILL)))
+        timer.start()
+        try:
+            _, status, usage = os.wait4(p.pid, 0)
+        finally:
+            timer.cancel()
+        timed_out = bool(flag)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return status, usage, timed_out
+
+
+def execute(task, scratch=None):
     """Run task (study_engine.Run.task()); returns the raw result: exit status,
     stderr, the outputs (zlib-compressed JSON {name: text or null}), the run's
     wall and CPU time (the simulator process's own) and the worker's name."""
     sim = find_sim(task["sim"], task["build"])
-    with tempfile.TemporaryDirectory(prefix="pmsm-study-") as d:
-        for rel, data in task["inputs"].items():
-            p = os.path.join(d, rel)
-            os.makedirs(os.path.dirname(p), exist_ok=True)
-            with open(p, "wb") as f:
-                f.write(data)
-        for rel in task["outputs"].values():
-            os.makedirs(os.path.join(d, os.path.dirname(rel)), exist_ok=True)
+    own = scratch is None
+    scratch = scratch or Scratch()
+    try:
+        scratch.prepare(task)
+        d = scratch.dir
         err_path = os.path.join(d, "stderr.txt")
-        timed_out = []
         t0 = time.perf_counter()
         with open(err_path, "wb") as err:
             p = subprocess.Popen([sim] + task["args"], cwd=d, stdin=subprocess.DEVNULL,
                                  stdout=subprocess.DEVNULL, stderr=err)
-
-            def stop():
-                timed_out.append(True)
-                p.send_signal(signal.SIGKILL)
-
-            timer = threading.Timer(task["timeout_s"], stop)
-            timer.start()
-            try:
-                # wait4: the child's own CPU time (several runs share a process).
-                _, status, usage = os.wait4(p.pid, 0)
-            finally:
-                timer.cancel()
-            p.returncode = os.waitstatus_to_exitcode(status)
+            _, usage, timed_out = wait_child(p, task["timeout_s"])
         wall = time.perf_counter() - t0
         with open(err_path, "rb") as f:
             stderr = f.read()[-STDERR_MAX:].decode("utf-8", "replace")
@@ -121,14 +166,20 @@ def execute(task):
                     outs[name] = f.read().decode("utf-8", "replace")
             except OSError:
                 outs[name] = None
-    return {"key": task["key"], "rc": p.returncode, "stderr": stderr,
-            "timeout": bool(timed_out),
+    finally:
+        if own:
+            scratch.close()
+    return {"key": task["key"], "rc": p.returncode, "stderr": stderr, "timeout": timed_out,
             "outputs": zlib.compress(json.dumps(outs, sort_keys=True).encode(), 6),
             "wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
             "worker": worker_name()}
 
 
 def execute_many(tasks):
-    """execute() of each task in turn: one dask task for several short runs, so
-    that the scheduler's work per task is spread over them."""
-    return [execute(t) for t in tasks]
+    """execute() of each task in turn in one scratch folder: one dask task for
+    several short runs, so that the scheduler's work per task is spread over them."""
+    scratch = Scratch()
+    try:
+        return [execute(t, scratch) for t in tasks]
+    finally:
+        scratch.close()
