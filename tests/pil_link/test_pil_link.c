@@ -9,8 +9,8 @@
 #include <string.h>
 
 #include "../plant/ini_machines.h"
-#include "pil_shared.h"
 #include "pil_frame.h"
+#include "pil_shared.h"
 #include "pil_target.h"
 #include "unity.h"
 
@@ -357,6 +357,50 @@ static void test_target_refuses_setup(void)
     assert_fault(period(1u, PIL_CMD_KICK), PIL_E_FORMAT);
 }
 
+/* A port that returns STOP and the next SETUP in one read (a serial port
+ * whose bytes arrived together): the run ends at the STOP, the next run
+ * starts with the SETUP's bytes and answers READY; nothing is lost. */
+static const uint8_t *chunk;
+static size_t chunk_n;
+static int chunk_read(void *ctx, uint8_t *buf, size_t cap)
+{
+    (void)ctx;
+    if (chunk_n == 0u) {
+        return -1;
+    }
+    const size_t n = chunk_n < cap ? chunk_n : cap;
+    memcpy(buf, chunk, n);
+    chunk += n;
+    chunk_n -= n;
+    return (int)n;
+}
+
+static void test_run_keeps_bytes_after_stop(void)
+{
+    static const pil_port_t cport = {&fp, chunk_read, fake_write, NULL, 1000u, fake_cycles, 0u, 0u};
+    static pil_setup_t s;
+    setup_thesis(&s);
+    static uint8_t p[PIL_BODY_MAX];
+    static uint8_t w[2u * PIL_WIRE_MAX];
+    size_t n = wire_of(PIL_T_STOP, 0u, NULL, 0u, w);
+    /* STOP, then the first bytes of SETUP in the same read of 64 bytes */
+    TEST_ASSERT_TRUE(n < 32u);
+    n += wire_of(PIL_T_SETUP, 0u, p, pil_setup_pack(&s, p, sizeof p), w + n);
+    chunk = w;
+    chunk_n = n;
+    fp.n = 0u;
+    memset(&tgt, 0, sizeof tgt);
+    TEST_ASSERT_EQUAL_INT(PIL_OK, pil_target_run(&tgt, &cport));
+    TEST_ASSERT_TRUE(tgt.carry_n > 0u);
+    TEST_ASSERT_EQUAL_INT(PIL_E_CLOSED, pil_target_run(&tgt, &cport));
+    static pil_frame_t f[4];
+    TEST_ASSERT_EQUAL_UINT(1u, take_frames(f, 4u));
+    TEST_ASSERT_EQUAL_UINT(PIL_T_READY, f[0].type);
+    pil_ready_t rd;
+    TEST_ASSERT_EQUAL_INT(PIL_OK, pil_ready_unpack(f[0].payload, f[0].len, &rd));
+    TEST_ASSERT_EQUAL_INT(0, rd.rc);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -368,5 +412,6 @@ int main(void)
     RUN_TEST(test_target_format_fault);
     RUN_TEST(test_target_timeout_fault);
     RUN_TEST(test_target_refuses_setup);
+    RUN_TEST(test_run_keeps_bytes_after_stop);
     return UNITY_END();
 }

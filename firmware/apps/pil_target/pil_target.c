@@ -179,6 +179,10 @@ void pil_target_poll_timeout(pil_target_t *t)
 
 int pil_target_run(pil_target_t *t, const pil_port_t *port)
 {
+    uint8_t buf[sizeof t->carry];
+    /* what the last run read after its STOP (a new SETUP, typically) */
+    const size_t carried = t->port == port && t->carry_n <= sizeof buf ? t->carry_n : 0u;
+    memcpy(buf, t->carry, carried);
     memset(t, 0, sizeof *t);
     t->port = port;
     pil_dec_init(&t->dec);
@@ -186,20 +190,25 @@ int pil_target_run(pil_target_t *t, const pil_port_t *port)
     if (port->now != NULL) {
         t->t_last = port->now(port->ctx);
     }
-    uint8_t buf[64];
+    int n = (int)carried;
     for (;;) {
-        const int n = port->read(port->ctx, buf, sizeof buf);
-        if (n < 0) {
-            return t->fault != PIL_OK ? t->fault : PIL_E_CLOSED;
-        }
         if (n == 0) {
-            pil_target_poll_timeout(t);
-            continue;
+            n = port->read(port->ctx, buf, sizeof buf);
+            if (n < 0) {
+                return t->fault != PIL_OK ? t->fault : PIL_E_CLOSED;
+            }
+            if (n == 0) {
+                pil_target_poll_timeout(t);
+                continue;
+            }
         }
         for (int i = 0; i < n; i++) {
             if (pil_target_byte(t, buf[i]) != 0) {
+                t->carry_n = (uint8_t)(n - i - 1);
+                memcpy(t->carry, &buf[i + 1], t->carry_n);
                 return t->fault;
             }
         }
+        n = 0;
     }
 }

@@ -52,10 +52,16 @@ typedef struct {
     int fault;         /* pil_err_t latched, PIL_OK while fine */
     uint32_t t_last;   /* port->now at the last good frame */
     uint32_t periods;
+    /* Bytes read with a STOP but after it: the next run's first (a port may
+     * return STOP and the next SETUP in one read). */
+    uint8_t carry[64];
+    uint8_t carry_n;
 } pil_target_t;
 
 /* Serve the link until STOP (returns PIL_OK) or until it closes (PIL_E_CLOSED,
- * or the fault latched before it closed). */
+ * or the fault latched before it closed). The bytes read after a STOP are
+ * the next call's first (same t and port; t zeroed before the first call,
+ * as a static object is). */
 int pil_target_run(pil_target_t *t, const pil_port_t *port);
 
 /* One received byte (the run loop's step; exposed for the tests). Returns
