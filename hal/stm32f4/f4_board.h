@@ -117,4 +117,10 @@ typedef struct {
     double vbus_max_v;
 } f4_board_t;
 
+/* EN_GATE low (the DRV8301 holds every gate low), the six gate pins as GPIO
+ * outputs at their inactive level, the board's hold_low / hold_high pins at
+ * their levels: f4_hal_init's first step, the fault handlers' last, the PIL
+ * image's first (f4_gates.c: GPIO only). */
+void f4_hal_gate_pins_safe(const f4_board_t *b);
+
 #endif /* HAL_STM32F4_F4_BOARD_H */

@@ -118,11 +118,6 @@ int f4_hal_cmp_max(const f4_board_t *b, const stm32_pwm_timing_t *t, uint32_t f_
  * and its tolerance (the sense's zero_tol_v), counts. */
 void f4_hal_current_zero(const f4_board_t *b, uint16_t *zero, uint16_t *tol);
 
-/* EN_GATE low (the DRV8301 holds every gate low), the six gate pins as GPIO
- * outputs at their inactive level, the board's hold_low / hold_high pins at
- * their levels: init's first step and the fault handlers' last. */
-void f4_hal_gate_pins_safe(const f4_board_t *b);
-
 /* From the interrupts (board application). */
 void f4_hal_adc_irq_ack(hal_t *h); /* clears JEOC of every sampling ADC */
 /* nFAULT's EXTI interrupt: gates off (MOE cleared), counted, pending bit

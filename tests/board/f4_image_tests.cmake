@@ -1,7 +1,8 @@
 # Image checks of a stm32f4 build (included from the top-level CMakeLists.txt;
 # ctest --preset vesc6 / odrive-v36): the ELF as the chip boots it, its
-# messages' formats, tools/flash for the board, and the image booted in
-# QEMU's emulated STM32F405 (netduinoplus2).
+# messages' formats, tools/flash for the board, the image booted in QEMU's
+# emulated STM32F405 (netduinoplus2), and the board's PIL image there under
+# ./tools/sim --target board:DEV.
 set(PMSM_F405_ELF ${CMAKE_BINARY_DIR}/firmware/apps/f405/pmsm-${PMSM_BOARD}.elf)
 # Per board: the console's USART as QEMU numbers its serial ports (USART1,
 # USART2, USART3, UART4, ...: -serial options in that order) and its IRQ
@@ -33,5 +34,13 @@ add_test(NAME ${PMSM_BOARD}_flash
 add_test(NAME ${PMSM_BOARD}_qemu_boot
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_boot.py ${PMSM_F405_ELF}
                  ${PMSM_BOARD} ${f405_qemu_serial} ${f405_console_irq})
+# The board's PIL image in QEMU, its console on a pseudo-terminal:
+# ./tools/sim --target board:/dev/pts/N against it (the simulator from
+# build/host-release, which tools/sim builds when missing).
+set(PMSM_F405_PIL_ELF ${CMAKE_BINARY_DIR}/firmware/apps/f405_pil/pmsm-${PMSM_BOARD}-pil.elf)
+add_test(NAME ${PMSM_BOARD}_qemu_pil
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_pil.py ${PROJECT_SOURCE_DIR}
+                 ${PMSM_F405_PIL_ELF} ${f405_qemu_serial})
 set_tests_properties(${f405_tests} PROPERTIES LABELS "board")
 set_tests_properties(${PMSM_BOARD}_qemu_boot PROPERTIES LABELS "board;qemu" TIMEOUT 150)
+set_tests_properties(${PMSM_BOARD}_qemu_pil PROPERTIES LABELS "board;qemu;pil" TIMEOUT 300)

@@ -37,9 +37,9 @@ static void board_uart_put_direct(board_uart_t *u, uint8_t c)
     }
 }
 
-bool board_uart_check_tx(board_uart_t *u, const char *probe)
+bool board_uart_check_tx(board_uart_t *u, const uint8_t *probe, size_t n)
 {
-    board_uart_puts(u, probe);
+    board_uart_write(u, probe, n);
     const uint32_t t0 = u->port->ticks();
     while (u->tx_tail == 0u && u->port->ticks() - t0 <= 8u * u->byte_ticks) {
     }

@@ -49,12 +49,13 @@ typedef struct {
  * ticks_hz and the core at f_cpu_hz. */
 void board_uart_init(board_uart_t *u, const board_uart_port_t *port, uint32_t ticks_hz,
                      uint32_t f_cpu_hz, uint32_t baud);
-/* After the USART's interrupt is enabled: queues `probe` and waits up to
- * eight character times for the transmit interrupt to take its first byte.
+/* After the USART's interrupt is enabled: queues the n >= 1 bytes of
+ * `probe` and waits up to eight character times for the transmit interrupt
+ * to take the first.
  * When it does not (QEMU 7.2's STM32F405 USART models no transmit
  * interrupt), every later byte is sent by polling (u->polled) and the
  * probe's bytes too. Returns true when the interrupt works. */
-bool board_uart_check_tx(board_uart_t *u, const char *probe);
+bool board_uart_check_tx(board_uart_t *u, const uint8_t *probe, size_t n);
 /* Next received byte, or -1. */
 int board_uart_getc(board_uart_t *u);
 /* Queues bytes; when the ring is full it waits for the interrupt to drain

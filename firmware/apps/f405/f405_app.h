@@ -19,6 +19,7 @@
 #include <stdint.h>
 
 #include "board_app.h"
+#include "f405_uart.h"
 #include "f4_board.h"
 #include "f4_clock.h"
 #include "f4_hal.h"
@@ -69,11 +70,6 @@ extern const char f405_tag[];
  * medium-rate task is due), the interrupt counted. f405_isr.c, also built
  * into the QEMU image that counts its instructions. */
 void f405_control_isr(f405_t *s);
-
-/* The console: pins, BRR from its bus clock, the rings (f405_uart.c);
- * F4_OK or F4_E_CONFIG. Its interrupt's body. */
-int f405_uart_init(f405_t *s, uint32_t baud);
-void f405_uart_irq(f405_t *s);
 
 /* The board image's parameters after the shared ones (f405_params.c). */
 int f405_get_trip(void *ctx, const fw_link_param_t *p, double *v);

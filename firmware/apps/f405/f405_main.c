@@ -132,23 +132,23 @@ void EXTI15_10_IRQHandler(void)
  * enabled). */
 void USART1_IRQHandler(void)
 {
-    f405_uart_irq(&f405);
+    f405_uart_irq(&f405.app.uart, &f405.usart);
 }
 void USART2_IRQHandler(void)
 {
-    f405_uart_irq(&f405);
+    f405_uart_irq(&f405.app.uart, &f405.usart);
 }
 void USART3_IRQHandler(void)
 {
-    f405_uart_irq(&f405);
+    f405_uart_irq(&f405.app.uart, &f405.usart);
 }
 void UART4_IRQHandler(void)
 {
-    f405_uart_irq(&f405);
+    f405_uart_irq(&f405.app.uart, &f405.usart);
 }
 void USART6_IRQHandler(void)
 {
-    f405_uart_irq(&f405);
+    f405_uart_irq(&f405.app.uart, &f405.usart);
 }
 
 /* After the gates are off in a fault handler: EN_GATE low, the gate pins as
@@ -300,7 +300,7 @@ int main(void)
     s->clock_rc = f4_clock_init(b->hse_hz, b->sysclk_hz, &s->clk);
     f4_ticks_init(b->tick_tim, s->clk.tim_apb1_hz);
     /* 3. */
-    (void)f405_uart_init(s, b->baud);
+    (void)f405_uart_init(&a->uart, &s->usart, b, &s->clk, b->baud);
     f405_report_startup(s, csr);
     /* 4. */
     const f4_hal_cfg_t hc = {F405_FS_HZ, F405_ENCODER_CPR};
@@ -335,7 +335,7 @@ int main(void)
     f4_nvic_set_priority(s->usart.irq, 2u);
     f4_pendsv_set_priority(3u);
     f4_nvic_enable(s->usart.irq);
-    if (!board_uart_check_tx(&a->uart, "\r\n")) {
+    if (!board_uart_check_tx(&a->uart, (const uint8_t *)"\r\n", 2u)) {
         f405_report_line(s,
                          "console: transmit interrupt silent (an emulator without one); "
                          "polled output",
