@@ -285,6 +285,31 @@ static void sim_filter_window_end(sim_run_t *r, double t)
         r->flt_t1 = t;
         r->flt_w1_set = true;
     }
+    plant_mech_stats(&r->plant, &r->mech_w1);
+    r->mech_t1 = t;
+}
+
+void sim_run_mech_summary(const sim_run_t *r, sim_mech_summary_t *m)
+{
+    memset(m, 0, sizeof *m);
+    m->present = r->cfg.free_mech && sim_machine_nonideal(&r->cfg.plant_machine) && r->win_started;
+    m->stuck_frac = m->friction_nm = m->load_nm = m->friction_w = NAN;
+    if (!m->present) {
+        return;
+    }
+    const plant_mech_stats_t *a = &r->mech_w0, *b = &r->mech_w1;
+    const double span = r->mech_t1 - r->mech_t0;
+    const double angle = b->abs_angle_rad - a->abs_angle_rad;
+    m->stuck_s = b->stuck_s - a->stuck_s;
+    m->stuck_frac = span > 0.0 ? m->stuck_s / span : NAN;
+    m->breakaways = b->breakaways - a->breakaways;
+    m->stops = b->stops - a->stops;
+    m->reversals = b->reversals - a->reversals;
+    if (angle > 0.0) {
+        m->friction_nm = (b->e_friction_j - a->e_friction_j) / angle;
+        m->load_nm = (b->e_load_j - a->e_load_j) / angle;
+    }
+    m->friction_w = span > 0.0 ? (b->e_friction_j - a->e_friction_j) / span : NAN;
 }
 
 static void sim_count_transitions(sim_run_t *r, double t)
@@ -375,6 +400,8 @@ int sim_run_period(sim_run_t *r)
             (void)plant_filter_reset_peaks(&r->plant);
             r->flt_t0 = t;
         }
+        plant_mech_stats(&r->plant, &r->mech_w0);
+        r->mech_t0 = t;
     }
     if (t >= r->cfg.win_end_s && r->win_started && !r->win_done) {
         r->win_done = true;
@@ -1199,6 +1226,19 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     sim_json_num(f, "thd_v_pct", mp->thd_v_pct);
     sim_json_num(f, "v1_amp_v", mp->v1_amp_v);
     sim_write_filter_json(f, r);
+    sim_mech_summary_t ms;
+    sim_run_mech_summary(r, &ms);
+    if (ms.present) {
+        /* only for a machine with non-ideal mechanics on a free rotor */
+        sim_json_num(f, "mech_stuck_s", ms.stuck_s);
+        sim_json_num(f, "mech_stuck_frac", ms.stuck_frac);
+        sim_json_num(f, "mech_breakaways", (double)ms.breakaways);
+        sim_json_num(f, "mech_stops", (double)ms.stops);
+        sim_json_num(f, "mech_reversals", (double)ms.reversals);
+        sim_json_num(f, "mech_friction_torque_nm", ms.friction_nm);
+        sim_json_num(f, "mech_load_torque_nm", ms.load_nm);
+        sim_json_num(f, "mech_friction_power_w", ms.friction_w);
+    }
     sim_json_num(f, "torque_mean_ctrl_nm", mc->torque_mean_nm);
     sim_json_num(f, "torque_ripple_ctrl_nm", mc->torque_ripple_nm);
     sim_json_num(f, "flux_mean_ctrl_wb", mc->flux_mean_wb);

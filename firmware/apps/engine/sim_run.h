@@ -181,6 +181,9 @@ struct sim_run {
     plant_filter_stats_t flt_w0, flt_w1;
     double flt_t0, flt_t1;
     bool flt_w1_set;
+    /* non-ideal mechanics (plant_mech_stats) at the window's start and end */
+    plant_mech_stats_t mech_w0, mech_w1;
+    double mech_t0, mech_t1;
     /* The torque limit of field weakening over the metrics window (torque
      * mode): periods, periods the request was clipped, the smallest limit and
      * the sum of the reference the controller got (before the trim). */
@@ -222,6 +225,19 @@ double sim_run_time(const sim_run_t *r);
 int sim_run_all(sim_run_t *r, char *err, size_t errlen);
 /* Metrics of the window (plant and control sampling). */
 int sim_run_metrics(sim_run_t *r, metrics_result_t *plant, metrics_result_t *ctrl);
+
+/* The non-ideal mechanics over the metrics window (free mechanics on a machine
+ * with Coulomb friction, stiction, cogging or a load; else 0 and NaN): time at
+ * rest held by friction, its fraction of the window, break-aways, stops,
+ * reversals, the mean bearing friction and load torque against the motion
+ * (their work over the angle turned) and the friction's power. */
+typedef struct {
+    int present;
+    double stuck_s, stuck_frac;
+    uint64_t breakaways, stops, reversals;
+    double friction_nm, load_nm, friction_w;
+} sim_mech_summary_t;
+void sim_run_mech_summary(const sim_run_t *r, sim_mech_summary_t *m);
 /* {...} with the keys of the CLI's --metrics. */
 void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_result_t *mp,
                                 const metrics_result_t *mc);

@@ -594,6 +594,19 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
                 fmt_num(b[10], 32, "%.1f r/min", mean_rpm),
                 fmt_num(b[11], 32, "%.1f r/min", sim_run_speed_rpm(r)));
     }
+    sim_mech_summary_t ms;
+    sim_run_mech_summary(r, &ms);
+    if (ms.present) {
+        fprintf(f,
+                "  mechanics: at rest (held by friction) %.4f s (%.1f %%), %llu break-aways, %llu "
+                "stops, %llu reversals; friction %s (%s), load %s (means over the angle "
+                "turned)\n",
+                ms.stuck_s, 100.0 * ms.stuck_frac, (unsigned long long)ms.breakaways,
+                (unsigned long long)ms.stops, (unsigned long long)ms.reversals,
+                fmt_num(b[0], 32, "%.4f N*m", ms.friction_nm),
+                fmt_num(b[1], 32, "%.3f W", ms.friction_w),
+                fmt_num(b[2], 32, "%.4f N*m", ms.load_nm));
+    }
     double ea;
     double em;
     double es;
