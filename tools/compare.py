@@ -77,8 +77,11 @@ FAMILIES = (
     ("book chapter", ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc", "hdtc_pred")),
 )
 FAST_CTRLS = ("bst", "m2ptfc")
-LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)))
-MARKERS = ("o", "s", "^", "v", "D")
+# Every controller its own look: the family's colour map at its own shade, and its own
+# line style and marker within the family (the largest family has six members).
+FAMILY_CMAPS = ("Blues", "Oranges", "Greens", "Purples", "Greys")
+LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1, 1, 1)))
+MARKERS = ("o", "s", "^", "v", "D", "X")
 
 
 def family_of(name):
@@ -89,9 +92,13 @@ def family_of(name):
 
 
 def style_of(name):
+    """Colour, line style and marker of a controller in every plot: no two alike."""
     f, i = family_of(name)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    return dict(color=colors[f % len(colors)], ls=LINESTYLES[i % 5], marker=MARKERS[i % 5])
+    n = len(FAMILIES[f][1]) if f < len(FAMILIES) else 1
+    shade = 0.95 - 0.5 * i / max(n - 1, 1)  # darkest first
+    color = matplotlib.colors.to_hex(plt.get_cmap(FAMILY_CMAPS[f % len(FAMILY_CMAPS)])(shade))
+    return dict(color=color, ls=LINESTYLES[i % len(LINESTYLES)],
+                marker=MARKERS[i % len(MARKERS)])
 
 
 # ---------------------------------------------------------------- running
@@ -300,7 +307,7 @@ def plot_indices(results, names, rpm, out):
         axx.set_ylabel(lab, fontsize=9)
         axx.grid(True, axis="y", lw=0.3)
     fig.suptitle(f"Steady-state indices, thesis SPMSM, {rpm} r/min, {LOAD_NM} N·m "
-                 "(colours: controller families)")
+                 "(colours: controller families, a shade per controller)")
     fig.tight_layout()
     fn = f"indices_{rpm}.png"
     fig.savefig(os.path.join(out, fn), dpi=DPI[0])

@@ -85,6 +85,24 @@ class ReportTest(unittest.TestCase):
                 self.assertIn(r[7], ("yes", "**no**"), r)
 
 
+class PlotStyles(unittest.TestCase):
+    """Every controller is told apart in every plot: no two share colour, line style and
+    marker (the plots drew 21 series in four family colours; foc and hdtc_pred both
+    solid red), and within a family no two share a colour, a line style or a marker."""
+
+    def test_unique(self):
+        sys.path.insert(0, HERE)
+        import compare
+        names = [n for _f, members in compare.FAMILIES for n in members]
+        looks = {n: compare.style_of(n) for n in names}
+        triples = {(s["color"], str(s["ls"]), s["marker"]) for s in looks.values()}
+        self.assertEqual(len(triples), len(names))
+        for _f, members in compare.FAMILIES:
+            for key in ("color", "ls", "marker"):
+                vals = [str(looks[n][key]) for n in members]
+                self.assertEqual(len(set(vals)), len(vals), (key, members))
+
+
 class HdtcPredCause(unittest.TestCase):
     """hdtc_pred (thesis SPMSM, 1.8 N*m, 10 kHz): one period's torque steps
     dwarf S1's band, so the three-level regulator goes from +1 straight to -1 and
