@@ -1,4 +1,4 @@
-"""Live console in the browser: `tools/console --web` (see README, "Live console").
+"""Live console in the browser: `tools/console --web` (see docs/console.md).
 
 A local web server (python3-aiohttp) between one target (board, QEMU, any
 program speaking firmware/PROTOCOL.md) and any number of pages. The page

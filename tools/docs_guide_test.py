@@ -1,11 +1,12 @@
 #!/usr/bin/python3
-"""README.md's user guide against the tools it documents.
+"""The user guides (docs/simulator.md, docs/console.md) against the tools they document.
 
-usage: readme_test.py SIM_BINARY
-Checks that the scenario example of README.md parses and runs in the simulator
-(and fires its events), that its tools/plot_trace usage line is the script's
-own, that every tools/console option its session uses exists, and that every
-./tools/sim option it names is one the simulator accepts.
+usage: docs_guide_test.py SIM_BINARY
+Checks that the scenario example of docs/simulator.md parses and runs in the
+simulator (and fires its events), that its tools/plot_trace usage line is the
+script's own, that every tools/console option docs/console.md's terminal section
+uses exists, and that every ./tools/sim option docs/simulator.md names is one the
+simulator accepts. (The example outputs themselves: tools/doc_examples.py.)
 """
 import os
 import re
@@ -16,19 +17,22 @@ import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SIM = None
-README = open(os.path.join(ROOT, "README.md")).read()
+def page(name):
+    with open(os.path.join(ROOT, "docs", name)) as f:
+        return f.read()
 
 
-def section(title):
-    """From the heading to the next heading of level 2 or 3."""
-    i = README.index(title)
-    m = re.compile(r"\n#{2,3} ").search(README, i + len(title))
-    return README[i:m.start() if m else None]
+def section(name, title):
+    """From the heading to the next heading of level 1 or 2 of docs/name."""
+    text = page(name)
+    i = text.index(title)
+    m = re.compile(r"\n#{1,2} ").search(text, i + len(title))
+    return text[i:m.start() if m else None]
 
 
 class ReadmeTest(unittest.TestCase):
     def test_scenario_example_runs(self):
-        sec = section("### Scenario files")
+        sec = section("simulator.md", "## Scenario files")
         lines = [ln.strip() for ln in sec.splitlines()
                  if re.match(r"^    (#|at |when )", ln) and "<" not in ln]
         self.assertGreaterEqual(len(lines), 3, sec)
@@ -44,7 +48,7 @@ class ReadmeTest(unittest.TestCase):
                                capture_output=True, text=True)
             self.assertEqual(r.returncode, 0, r.stderr)
             # FST's one-vector-per-period mean-torque offset is reported
-            # (README.md, "No wrong torque without a word"); nothing else.
+            # (docs/simulator.md, "No wrong torque without a word"); nothing else.
             other = [ln for ln in r.stderr.splitlines()
                      if "warning" in ln and "torque not followed: controller fst" not in ln]
             self.assertEqual(other, [], r.stderr)
@@ -54,24 +58,24 @@ class ReadmeTest(unittest.TestCase):
     def test_plot_trace_usage(self):
         src = open(os.path.join(ROOT, "tools", "plot_trace")).read()
         usage = re.search(r"^usage: (tools/plot_trace .+)$", src, re.M).group(1)
-        self.assertIn("    " + usage, section("### Plotting a trace"))
+        self.assertIn("    " + usage, section("simulator.md", "## Plotting a trace"))
 
     def test_console_options_exist(self):
         h = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "console"), "--help"],
                            capture_output=True, text=True).stdout
-        sec = section("### Console against the emulated target")
+        sec = section("console.md", "## The command-line console")
         for opt in set(re.findall(r"(--[a-z][a-z-]+)", sec)):
             self.assertIn(opt, h, opt)
 
     def test_sim_options_exist(self):
         h = subprocess.run([SIM, "--help"], capture_output=True, text=True).stdout
-        sec = section("### `./tools/sim`")
+        sec = page("simulator.md").replace(section("simulator.md", "## Plotting a trace"), "")
         for opt in set(re.findall(r"(--[a-z][a-z-]+)", sec)):
             self.assertIn(opt, h, opt)
 
 
 if __name__ == "__main__":
     if len(sys.argv) < 2:
-        sys.exit("usage: readme_test.py SIM_BINARY")
+        sys.exit("usage: docs_guide_test.py SIM_BINARY")
     SIM = sys.argv.pop(1)
     unittest.main(verbosity=2)

@@ -4,7 +4,7 @@
  * scaling by powers of two): host and target round them identically, so the
  * Q values they lead to are bit-identical (libm's sin, cos, exp and hypot
  * are not the same code on the host's C library and the target's newlib, and
- * newlib's pulled 6.8 KB into the board image: README, "Flash budget").
+ * newlib's pulled 6.8 KB into the board image: docs/board-b-g431b-esc1.md, "Flash budget").
  * Accuracy: a few ulp (Taylor series on a reduced argument, Horner's rule).
  */
 #ifndef CTRL_CFG_MATH_H

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Interrupt-cost benchmark and memory footprint of every registered controller.
 
-Called by ./tools/bench (see README.md, "Interrupt cost and memory footprint"). Steps:
+Called by ./tools/bench (see docs/bench.md). Steps:
   1. build (host-release: bench_rec, bench_host; cm4: bench_cm4 and the
      footprint images) and the QEMU counting plugin (cc, no sanitizers);
   2. record a host closed loop per controller at 750 and 2250 r/min, 1.8 N*m;

@@ -5,7 +5,7 @@
                        [--out FILE]
     tools/bench --board vesc6|odrive-v36 [the same options]
 
-The bench's method (tools/bench, README "Interrupt cost"): a host closed loop
+The bench's method (tools/bench, docs/bench.md): a host closed loop
 (thesis SPMSM on a dynamometer, 750 r/min, 1.8 N*m) is recorded and replayed
 on the emulated Cortex-M4 with the counting plugin. Here the replayed code is
 the board image's control interrupt (esc1_control_isr with the G4 back-end

@@ -24,7 +24,7 @@
 #include "sim_replay.h"
 #include "sim_run.h"
 
-/* Exit status (documented in --help and README.md). */
+/* Exit status (documented in --help and docs/simulator.md). */
 enum {
     SIM_EXIT_OK = 0,    /* the run completed, the drive did not fault */
     SIM_EXIT_RUN = 1,   /* the run could not complete (plant failure, I/O error) */
@@ -124,7 +124,7 @@ static const cli_opt_t k_opts[] = {
     {"--window", "START:END", K_SPAN, 0, 0, "s", M_LOOP, NULL, NULL, F(window),
      "metrics window (default duration/3 : duration)"},
     {"--scenario", "FILE", K_TEXT, 0, 0, "", M_LOOP, NULL, NULL, F(scenario),
-     "time/speed-triggered steps (format: README.md, sim_scenario.h)"},
+     "time/speed-triggered steps (format: docs/simulator.md, sim_scenario.h)"},
     {"--seed", "N", K_UINT, 0, 9007199254740992.0, "", M_LOOP, NULL, NULL, F(seed),
      "ADC noise seed, integer (default 1)"},
     {"--trace", "FILE.csv", K_TEXT, 0, 0, "", M_ANY, NULL, NULL, F(trace),
