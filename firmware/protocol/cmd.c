@@ -100,7 +100,8 @@ static void cmd_out_flush(cmd_t *c)
 }
 
 /* "err <code> <reason>[ <detail>]" */
-static void cmd_err(cmd_t *c, int code, const char *detail)
+/* "err <code> <reason>", the line left open for a detail. */
+static void cmd_err_begin(cmd_t *c, int code)
 {
     if (code <= 0 || code >= (int)CMD_E_COUNT) {
         code = CMD_E_FAILED;
@@ -110,6 +111,11 @@ static void cmd_err(cmd_t *c, int code, const char *detail)
     cmd_out_u32(c, (uint32_t)code);
     cmd_out_char(c, ' ');
     cmd_out_str(c, cmd_reasons[code]);
+}
+
+static void cmd_err(cmd_t *c, int code, const char *detail)
+{
+    cmd_err_begin(c, code);
     if (detail != NULL) {
         cmd_out_char(c, ' ');
         cmd_out_str(c, detail);
@@ -380,7 +386,13 @@ static void cmd_ctrl(cmd_t *c, const cmd_tok_t *tok, size_t n)
             }
         }
         if (!found) {
-            cmd_err(c, CMD_E_NAME, "see ctrl list");
+            /* by name: an image holds the controllers its preset lists
+             * (PMSM_CONTROLLERS), not every one of the core */
+            cmd_err_begin(c, CMD_E_NAME);
+            cmd_out_char(c, ' ');
+            cmd_out_tok(c, tok[2]);
+            cmd_out_str(c, ": not in this image");
+            cmd_out_flush(c);
             return;
         }
         cmd_status_t st;

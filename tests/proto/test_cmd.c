@@ -153,6 +153,7 @@ static void test_unknown_and_argument_errors(void)
     assert_rejected("ctrl select", CMD_E_ARGS);
     assert_rejected("ctrl select bst fst", CMD_E_ARGS);
     assert_rejected("ctrl select nope", CMD_E_NAME);
+    assert_ok("ctrl select nope", "err 5 name nope: not in this image\r\n");
     assert_rejected("ctrl select BST", CMD_E_NAME);
     assert_rejected("ref", CMD_E_ARGS);
     assert_rejected("ref torque", CMD_E_ARGS);
