@@ -386,6 +386,97 @@ static void test_passive_load_stop_located(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, -(0.8 - 0.5 - 1e-3) / J * 0.01, plant_omega_m(&p));
 }
 
+/* Time profile: an active load ramping 0 -> 0.5 N*m over 0.1 s from the
+ * instant the profile is switched on (here 0.02 s after init), then held; no
+ * electromagnetic torque (psi_pm = 0). The rotor at rest breaks away when the
+ * load reaches T_s (0.2 N*m: at 0.04 s after the origin, a root of the
+ * linear load), then turns backward:
+ *   J w(t) = -(2.5 (t^2 - t_b^2) - T_c (t - t_b))   (t from the origin, up to 0.1 s)
+ * and after 0.1 s at (0.5 - T_c)/J. A step boundary falls inside the ramp's
+ * end (the profile's point splits the RK4 steps there). */
+static void test_load_profile_time(void)
+{
+    plant_config_t c = cfg_spmsm();
+    c.psi_pm_wb = 0.0;
+    c.coulomb_nm = 0.1;
+    c.stiction_nm = 0.2;
+    c.load_profile.kind = PLANT_PROFILE_TIME;
+    c.load_profile.n = 2;
+    c.load_profile.x[0] = 0.0;
+    c.load_profile.y[0] = 0.0;
+    c.load_profile.x[1] = 0.1;
+    c.load_profile.y[1] = 0.5;
+    plant_t p;
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
+    plant_load_profile_enable(&p, 0);
+    const uint8_t low[3] = {0, 0, 0};
+    const double h = 0.7e-4, J = c.inertia_kgm2, tc = c.coulomb_nm;
+    while (plant_time(&p) < 0.02 - 1e-12) {
+        TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, fmin(h, 0.02 - plant_time(&p)), low));
+    }
+    plant_load_profile_enable(&p, 1); /* origin: 0.02 s */
+    const double t0 = plant_time(&p), tb = 0.2 / 5.0;
+    double worst = 0.0;
+    for (int i = 1; i * h < 0.15; ++i) {
+        TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, h, low));
+        const double t = plant_time(&p) - t0;
+        double w = 0.0;
+        if (t > tb && t <= 0.1) {
+            w = -(2.5 * (t * t - tb * tb) - tc * (t - tb)) / J;
+        } else if (t > 0.1) {
+            w = -(2.5 * (0.01 - tb * tb) - tc * (0.1 - tb) + (0.5 - tc) * (t - 0.1)) / J;
+        }
+        worst = fmax(worst, fabs(plant_omega_m(&p) - w));
+    }
+    plant_mech_stats_t st;
+    plant_mech_stats(&p, &st);
+    char msg[160];
+    snprintf(msg, sizeof msg,
+             "time profile: break-away %.12f s after the origin (%.12f), speed err %.3g rad/s",
+             st.stuck_s - t0, tb, worst);
+    TEST_MESSAGE(msg);
+    TEST_ASSERT_EQUAL_UINT64(1u, st.breakaways);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, tb, st.stuck_s - t0);
+    /* RK4 is exact for a load linear in time (w quadratic): rounding only */
+    TEST_ASSERT_TRUE_MESSAGE(worst < 1e-9 * (0.5 / J) * 0.15, msg);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.5, plant_load_torque(&p)); /* the profile's end value */
+}
+
+/* Speed profile: T(w) = 0.001 N*m*s/rad x w between -200 and 200 rad/s, held at
+ * +-0.2 N*m outside; from 300 rad/s (no electromagnetic torque, no friction)
+ * the rotor decelerates at 0.2/J until 200 rad/s (t1 = 100 J/0.2), then
+ * exponentially: w = 200 e^{-0.001 (t - t1)/J}. The table's corner at 200 rad/s
+ * is not located: the step that holds it sees the slope's jump, an error of
+ * about (slope/J) |a| h^2/2 = 8.3 x 1667 x (1.37e-4)^2/2 = 1.3e-4 rad/s at most. */
+static void test_load_profile_speed(void)
+{
+    plant_config_t c = cfg_spmsm();
+    c.psi_pm_wb = 0.0;
+    c.load_profile.kind = PLANT_PROFILE_SPEED;
+    c.load_profile.n = 2;
+    c.load_profile.x[0] = -200.0;
+    c.load_profile.y[0] = -0.2;
+    c.load_profile.x[1] = 200.0;
+    c.load_profile.y[1] = 0.2;
+    c.speed0_rpm = 300.0 * 60.0 / (2.0 * PLANT_PI);
+    plant_t p;
+    TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_init(&p, &c));
+    const uint8_t low[3] = {0, 0, 0};
+    const double J = c.inertia_kgm2, t1 = 100.0 * J / 0.2, h = 1.37e-4; /* t1 inside a step */
+    double worst = 0.0;
+    for (int i = 1; i * h < 0.3; ++i) {
+        TEST_ASSERT_EQUAL_INT(PLANT_OK, plant_advance(&p, h, low));
+        const double t = plant_time(&p);
+        const double w = t < t1 ? 300.0 - 0.2 / J * t : 200.0 * exp(-0.001 * (t - t1) / J);
+        worst = fmax(worst, fabs(plant_omega_m(&p) - w));
+    }
+    char msg[120];
+    snprintf(msg, sizeof msg, "speed profile: speed err %.3g rad/s", worst);
+    TEST_MESSAGE(msg);
+    TEST_ASSERT_TRUE_MESSAGE(worst < 1.3e-4, msg);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.001 * plant_omega_m(&p), plant_load_torque(&p));
+}
+
 static void test_bad_config(void)
 {
     plant_t p;
@@ -438,6 +529,8 @@ int main(void)
     RUN_TEST(test_cogging_period_from_file);
     RUN_TEST(test_energy_balance_all_terms);
     RUN_TEST(test_passive_load_stop_located);
+    RUN_TEST(test_load_profile_time);
+    RUN_TEST(test_load_profile_speed);
     RUN_TEST(test_bad_config);
     return UNITY_END();
 }
