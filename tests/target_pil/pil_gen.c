@@ -58,7 +58,17 @@ static void put_machine(FILE *f, const ctrl_machine_t *m)
             m->current_max_a, m->psi_ref_wb);
 }
 
-/* A sim_machine_t initializer (designated, so new fields default to 0). */
+static void put_array(FILE *f, const char *name, const double *v, int n)
+{
+    fprintf(f, ", .%s = {", name);
+    for (int i = 0; i < n; i++) {
+        fprintf(f, "%s%.17g", i ? ", " : "", v[i]);
+    }
+    fprintf(f, "}");
+}
+
+/* A sim_machine_t initializer (designated, so new fields default to 0),
+ * [mechanics]' non-ideal terms included (plant_config_t takes them from it). */
 static void put_sim_machine(FILE *f, const sim_machine_t *m)
 {
     fprintf(f,
@@ -68,12 +78,24 @@ static void put_sim_machine(FILE *f, const sim_machine_t *m)
             ".vdc_v = %.17g, .fs_hz = %.17g, .dead_time_s = %.17g, .v_fwd_v = %.17g, "
             ".dc_cap_f = %.17g, .dc_src_r_ohm = %.17g, .inertia_kgm2 = %.17g, "
             ".friction_nms = %.17g, .overspeed_rpm = %.17g, .speed_bw_hz = %.17g, "
-            ".speed_pm_deg = %.17g, .speed_kp = %.17g, .speed_ki = %.17g}",
+            ".speed_pm_deg = %.17g, .speed_kp = %.17g, .speed_ki = %.17g",
             m->name, m->pole_pairs, m->rs_ohm, m->ld_h, m->lq_h, m->psi_pm_wb, m->torque_rated_nm,
             m->speed_rated_rpm, m->current_rated_a, m->current_max_a, m->psi_ref_wb, m->vdc_v,
             m->fs_hz, m->dead_time_s, m->v_fwd_v, m->dc_cap_f, m->dc_src_r_ohm, m->inertia_kgm2,
             m->friction_nms, m->overspeed_rpm, m->speed_bw_hz, m->speed_pm_deg, m->speed_kp,
             m->speed_ki);
+    fprintf(f,
+            ", .coulomb_nm = %.17g, .stiction_nm = %.17g, .slots = %d, .cogging_nm = %.17g, "
+            ".cogging_phase_deg = %.17g, .cog_harm_n = %d, .cog_harm_deg_n = %d",
+            m->coulomb_nm, m->stiction_nm, m->slots, m->cogging_nm, m->cogging_phase_deg,
+            m->cog_harm_n, m->cog_harm_deg_n);
+    put_array(f, "cog_harm_nm", m->cog_harm_nm, PLANT_COG_MAX - 1);
+    put_array(f, "cog_harm_deg", m->cog_harm_deg, PLANT_COG_MAX - 1);
+    fprintf(f, ", .load_kind = %d, .load_nm = %.17g, .load_profile = {.kind = %d, .n = %d",
+            (int)m->load_kind, m->load_nm, (int)m->load_profile.kind, m->load_profile.n);
+    put_array(f, "x", m->load_profile.x, PLANT_PROFILE_MAX);
+    put_array(f, "y", m->load_profile.y, PLANT_PROFILE_MAX);
+    fprintf(f, "}}");
 }
 
 static uint32_t fs_of(const ctrl_desc_t *d, const sim_machine_t *m)

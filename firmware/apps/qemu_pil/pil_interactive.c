@@ -5,10 +5,12 @@
  * script and no end: it runs until QEMU is stopped.
  *
  * Plant: free rotor (J of the machine file) with a passive load of
- * PIL_APP_LOAD_NM (it opposes the rotation and never drives it), at rest at
- * power-up. The closed-loop engine (firmware/apps/engine) runs one PWM period
- * per Timer0 interrupt (pil_common.h) from boot on: calibration (256 periods,
- * gates off), then ready; "arm" is the user's. Default controller
+ * PIL_APP_LOAD_NM on the shaft (it opposes the rotation and never drives it),
+ * at rest at power-up: the demo rig's, given to the plant as the machine's
+ * [mechanics] load (load_kind = passive), the one way a load reaches the
+ * plant and the run (sim_machine_to_plant, sim_run_config_default). The closed-loop engine
+ * (firmware/apps/engine) runs one PWM period per Timer0 interrupt (pil_common.h) from boot on:
+ * calibration (256 periods, gates off), then ready; "arm" is the user's. Default controller
  * PIL_APP_CTRL at its default fs; "ctrl select" changes it while disarmed.
  * Wall time: a running period costs 50-110 k emulated instructions, so plant
  * time runs at about 1/20 of real time (-icount shift=3).
@@ -95,7 +97,11 @@ int main(void)
         return 2;
     }
     static sim_run_cfg_t c;
-    sim_run_config_default(&c, &pil_machine, desc);
+    static sim_machine_t rig;
+    rig = pil_machine;
+    rig.load_kind = SIM_LOAD_PASSIVE;
+    rig.load_nm = PIL_APP_LOAD_NM;
+    sim_run_config_default(&c, &rig, desc);
     c.fs_hz = desc->fs_default_hz;
     c.free_mech = true;
     c.duration_s = 100.0; /* never reached: the engine is not armed by itself */
@@ -110,7 +116,6 @@ int main(void)
         printf("interactive: %s\n", err);
         return 2;
     }
-    plant_set_load_passive(&app.run.plant, PIL_APP_LOAD_NM);
     app.machine = app.run.fw.machine_own;
     sfm_init(&app.flash, 1u);
     sfm_flash(&app.flash, &app.settings.flash);
@@ -122,7 +127,7 @@ int main(void)
     hal_qemu_uart_rx_enable();
     printf("pmsm-dtc on QEMU mps2-an386: %s, free rotor, passive load %.2f N*m; controller %s "
            "at %u Hz; calibrating (256 periods), then 'arm' (PROTOCOL.md, 'help')\n",
-           pil_machine.name, PIL_APP_LOAD_NM, desc->name, (unsigned)c.fs_hz);
+           rig.name, c.load_passive_nm, desc->name, (unsigned)c.fs_hz);
     printf("%s (flash: RAM model)\n", app.settings.msg);
     pil_timer_start(&app.timer, app_isr);
     for (;;) {
