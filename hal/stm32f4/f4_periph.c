@@ -123,6 +123,11 @@ void f4_iwdg_window(uint32_t pr, uint32_t rlr, uint32_t *min_ms, uint32_t *max_m
 
 int f4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)
 {
+    /* LSION as well: the start key forces the LSI on (sec. 21.3.2), LSION
+     * makes LSIRDY below the oscillator's own flag whoever started it
+     * (RCC_CSR's reset flags are read-only: the read-modify-write keeps
+     * them, RMVF reads 0). */
+    f4_set(F4_RCC + F4_RCC_CSR, F4_RCC_CSR_LSION);
     f4_wr(F4_IWDG + F4_IWDG_KR, F4_IWDG_KR_START);
     f4_wr(F4_IWDG + F4_IWDG_KR, F4_IWDG_KR_UNLOCK);
     f4_wr(F4_IWDG + F4_IWDG_PR, pr);

@@ -189,6 +189,7 @@ static inline void f4_clr(uintptr_t reg, uint32_t bits)
 #define F4_RCC_APB2ENR_SPI1EN F4_BIT(12)
 #define F4_RCC_APB2ENR_SYSCFGEN F4_BIT(14)
 #define F4_RCC_CSR 0x74u
+#define F4_RCC_CSR_LSION F4_BIT(0)
 #define F4_RCC_CSR_LSIRDY F4_BIT(1)
 #define F4_RCC_CSR_RMVF F4_BIT(24)
 #define F4_RCC_CSR_BORRSTF F4_BIT(25)

@@ -384,7 +384,15 @@ void f4_trace_write(uintptr_t reg, uint32_t value)
     /* IWDG: the start key forces the LSI on, which is ready at once here
      * (RM0090 sec. 21.3.2; RCC_CSR LSION, LSIRDY); SR stays 0. */
     if (reg == F4_IWDG + F4_IWDG_KR && value == F4_IWDG_KR_START && !f4_model.lsi_dead) {
-        *f4_reg(F4_RCC, F4_RCC_CSR) |= F4_RCC_CSR_LSIRDY | 1u;
+        *f4_reg(F4_RCC, F4_RCC_CSR) |= F4_RCC_CSR_LSIRDY | F4_RCC_CSR_LSION;
+    }
+    if (reg == F4_RCC + F4_RCC_CSR) {
+        /* LSION on: LSIRDY (at once here); the reset flags read-only, RMVF
+         * clears them */
+        const uint32_t keep = *c & 0xFE000000u;
+        *c = (value & F4_RCC_CSR_LSION) | ((value & F4_RCC_CSR_RMVF) != 0u ? 0u : keep) |
+             ((value & F4_RCC_CSR_LSION) != 0u && !f4_model.lsi_dead ? F4_RCC_CSR_LSIRDY : 0u);
+        return;
     }
     /* USART: DR written is the byte sent (SR keeps TXE). */
     *c = value;

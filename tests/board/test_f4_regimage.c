@@ -545,7 +545,11 @@ static void test_iwdg_start_and_lsi(void)
     uint32_t pr, rlr;
     TEST_ASSERT_EQUAL_INT(STM32_OK, stm32_iwdg_config(100u, F4_LSI_TYP_HZ, &pr, &rlr));
     TEST_ASSERT_EQUAL_INT(F4_OK, f4_iwdg_start(pr, rlr, 16000000u));
+    const uint32_t flags = reg(F4_RCC + F4_RCC_CSR) & 0xFE000000u;
+    TEST_ASSERT_TRUE(flags != 0u); /* the reset's flags (model: power-on) */
     const int start = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_START, 0);
+    /* LSION, and the reset flags kept for the start-up report */
+    ASSERT_BITS_SET(F4_RCC_CSR_LSION | F4_RCC_CSR_LSIRDY, reg(F4_RCC + F4_RCC_CSR));
     const int unlock = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_UNLOCK, 0);
     const int refresh = f4_model_find(F4_IWDG + F4_IWDG_KR, 0xFFFFu, F4_IWDG_KR_REFRESH, 0);
     assert_before(start, unlock, "IWDG: started (LSI on) before the unlock");
