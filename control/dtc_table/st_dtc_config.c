@@ -147,9 +147,37 @@ static int st_fst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return CTRL_OK;
 }
 
+#if PMSM_LIVE_PARAMS
+/* Both bands while running: the comparators keep their last outputs, the
+ * flux reference's memo is cleared so that the next step forms the flux
+ * limits with the new band (ctrl_hyst2_sq_limits). */
+static void st_hyst_retune(void *state, const void *fresh)
+{
+    st_hyst_state_t *s = state;
+    const st_hyst_state_t *f = fresh;
+    s->flux.h.band = f->flux.h.band;
+    s->torque3.band = f->torque3.band;
+    s->torque2.band = f->torque2.band;
+    s->flux_ref.valid = 0u;
+}
+
+/* sigma, dT_step and f_i while running: the voltage replacement's table, the
+ * step threshold and the integrator's gain; the logic, the last vector and
+ * the integrator's torque g stay (a new gain changes g's rate, not g). */
+static void st_fst_retune(void *state, const void *fresh)
+{
+    st_fst_state_t *s = state;
+    const st_fst_state_t *f = fresh;
+    s->vr = f->vr;
+    s->logic.dt_step = f->logic.dt_step;
+    s->ki = f->ki;
+}
+#endif
+
 #define ST_HYST_DESC(id, label, initfn, est)                                                       \
-    CTRL_DESC_DEFINE(id, label, ST_FS_HZ, st_hyst_state_t, st_hyst_cfg_t, hyst_tunables,           \
-                     st_hyst_cfg_default, initfn, st_hyst_reset, st_hyst_step, est)
+    CTRL_DESC_DEFINE_LIVE(id, label, ST_FS_HZ, st_hyst_state_t, st_hyst_cfg_t, hyst_tunables,      \
+                          st_hyst_cfg_default, initfn, st_hyst_reset, st_hyst_step, est, 0u,       \
+                          CTRL_RETUNE(st_hyst_retune), 0x3u)
 
 ST_HYST_DESC(bst, "ST-DTC, basic switching table (thesis Table 4.1, S1 Table 3)", st_bst_init,
              CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
@@ -161,7 +189,8 @@ ST_HYST_DESC(ast, "ST-DTC, active vectors only, two-level torque (thesis Table 4
 ST_HYST_DESC(zst, "ST-DTC, zero vector at decrease/decrease, two-level torque (Table 4.5)",
              st_zst_init, CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
 
-CTRL_DESC_DEFINE(
+CTRL_DESC_DEFINE_LIVE(
     fst, "ST-DTC, flexible switching table + voltage replacement (thesis sec. 4.5, Table 4.6)",
     ST_FS_HZ, st_fst_state_t, st_fst_cfg_t, fst_tunables, st_fst_cfg_default, st_fst_init,
-    st_fst_reset, st_fst_step, CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT);
+    st_fst_reset, st_fst_step, CTRL_EST_AMP_SQ_NEXT | CTRL_EST_SECTOR_NEXT, 0u,
+    CTRL_RETUNE(st_fst_retune), 0x7u);

@@ -303,3 +303,10 @@ void fx_rot_q30(int32_t step, int32_t *cos_q30, int32_t *sin_q30)
 {
     fx_rot_q30_inline(step, cos_q30, sin_q30);
 }
+
+#if PMSM_LIVE_PARAMS
+FX_NOINLINE int64_t fx_rshift64_round_call(int64_t x, unsigned n)
+{
+    return fx_rshift64_round(x, n);
+}
+#endif

@@ -28,6 +28,8 @@
 #include "field_weak.h"
 #include "fx.h"
 
+#define FOC_KP_QBITS 20u /* fractional bits of ctrl_foc_pi_t.kp */
+
 /* One current PI (Q formats at the fields). */
 typedef struct {
     int32_t kp;    /* V pu per A pu, Q20 (up to 2047: Kp ~ L wc / w_base grows with fs) */
@@ -56,6 +58,7 @@ typedef struct {
     ctrl_fieldweak_t fieldweak;
     ctrl_foc_pi_t pi_d, pi_q;
     q24_t v_d, v_q; /* last commanded voltage before the limit (telemetry/tests), Q24 pu */
+    q24_t e_d, e_q; /* last current errors, Q24 pu (a gain changed while running) */
 } ctrl_foc_state_t;
 
 /* Current references for torque t (Q24 pu): i_d <= 0, i_q with the sign of t. */

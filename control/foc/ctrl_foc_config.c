@@ -89,7 +89,7 @@ static int foc_pi_config(ctrl_foc_pi_t *pi, double kp_si, double ki_si, double l
     while (ki_shift > 17u && ki_ts * ctrl_cfg_ldexp(1.0, (int)ki_shift) >= 2147483000.0) {
         ki_shift--;
     }
-    pi->kp = (int32_t)ctrl_cfg_llround(kp * 1048576.0); /* Q20 */
+    pi->kp = (int32_t)ctrl_cfg_llround(kp * 1048576.0); /* Q20: FOC_KP_QBITS */
     /* Q(24 + ki_shift): vdc_nom <= 32 pu (2^29), so lim <= 2^59 */
     pi->lim = (int64_t)p->vdc_nom * ((int64_t)1 << ki_shift);
     pi->ki_ts = (int32_t)ctrl_cfg_llround(ctrl_cfg_ldexp(ki_ts, (int)ki_shift));
@@ -159,16 +159,49 @@ static int foc_hyst_init(void *state, const void *cfg, const ctrl_setup_t *su)
     return foc_init_common(state, cfg, su, 1);
 }
 
+#if PMSM_LIVE_PARAMS
+/* One axis' PI takes new gains while running (integer-only: the interrupt
+ * calls it): the integrator holds the output for the last step's error e
+ * under the old gains less the new proportional part, Kp_new e + I_new =
+ * Kp_old e + I_old (within +-lim), in the new Q(24 + ki_shift). */
+static void foc_pi_retune(ctrl_foc_pi_t *pi, const ctrl_foc_pi_t *to, q24_t e)
+{
+    /* Q24: the integrator (ki_shift >= 17), (Kp_old - Kp_new) e from Q44
+     * (|e| < 2^31, |kp| < 2^31); |sum| < 2^43 */
+    int64_t v = fx_rshift64_round_call(pi->integ, pi->ki_shift) +
+                fx_rshift64_round_call((int64_t)e * ((int64_t)pi->kp - to->kp), FOC_KP_QBITS);
+    const int64_t lim = to->lim >> to->ki_shift; /* lim >= 0 */
+    v = v > lim ? lim : (v < -lim ? -lim : v);
+    *pi = *to;
+    pi->integ = v * ((int64_t)1 << to->ki_shift); /* |v| 2^ki_shift <= lim <= 2^59 */
+}
+
+/* The tunables changed while running: foc the current PIs' gains (wc and the
+ * four gains, bumpless by foc_pi_retune), foc_hyst its band; mtpa changes the
+ * current references: with the controller stopped only. */
+static void foc_retune(void *state, const void *fresh)
+{
+    ctrl_foc_state_t *s = state;
+    const ctrl_foc_state_t *f = fresh;
+    if (s->hyst != 0u) {
+        s->h_i = f->h_i;
+        return;
+    }
+    foc_pi_retune(&s->pi_d, &f->pi_d, s->e_d);
+    foc_pi_retune(&s->pi_q, &f->pi_q, s->e_q);
+}
+#endif
+
 /* FOC reads no optional estimator output: rotor-frame currents and fluxes
  * only. Its currents come from the torque (ctrl_foc_iref, or the flux circle
  * of field weakening): no fixed flux reference (flux_free). */
-CTRL_DESC_DEFINE_FLUX(
+CTRL_DESC_DEFINE_LIVE(
     foc, "FOC, rotor-field oriented, dq current PI + SVPWM, MTPA/i_d=0 (S1 sec. 2, Algorithm 1)",
     FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_tunables, foc_cfg_default, foc_init,
-    ctrl_foc_reset, ctrl_foc_step, 0u, 1u);
+    ctrl_foc_reset, ctrl_foc_step, 0u, 1u, CTRL_RETUNE(foc_retune), 0x1Fu);
 
 /* The hysteresis variant reads the angle at k+1. */
-CTRL_DESC_DEFINE_FLUX(
+CTRL_DESC_DEFINE_LIVE(
     foc_hyst, "FOC with per-phase hysteresis current control, one vector per period (S1 sec. 2)",
     FOC_FS_HZ, ctrl_foc_state_t, ctrl_foc_cfg_t, foc_hyst_tunables, foc_cfg_default, foc_hyst_init,
-    ctrl_foc_reset, ctrl_foc_step, CTRL_EST_SC_NEXT, 1u);
+    ctrl_foc_reset, ctrl_foc_step, CTRL_EST_SC_NEXT, 1u, CTRL_RETUNE(foc_retune), 0x1u);

@@ -76,6 +76,19 @@ typedef struct ctrl_desc {
      * the flux circle of field weakening) and holds no fixed flux reference
      * (ctrl_params_t.psi_ref): the drive's limits then use MTPA for it. */
     uint8_t flux_free;
+    /* Optional (NULL: none; absent without PMSM_LIVE_PARAMS, fx.h): a tunable
+     * changed while the controller runs.
+     * fresh is a state that init made from the changed configuration (same
+     * machine, same fs); retune takes from it what that configuration sets -
+     * gains, bands, weights - and keeps the dynamic state, adjusted where the
+     * output would otherwise step (a PI integrator takes the change of the
+     * proportional part). Called between two steps, integer-only. live: bit i
+     * set when tunables[i] may change this way (the others only with the
+     * controller stopped: init and reset anew). */
+#if PMSM_LIVE_PARAMS
+    void (*retune)(void *state, const void *fresh);
+    uint32_t live;
+#endif
 } ctrl_desc_t;
 
 /* Size of the caller's state and configuration blocks (the firmware's fw_t):
@@ -110,6 +123,25 @@ typedef struct ctrl_desc {
 /* CTRL_DESC_DEFINE with ctrl_desc_t.flux_free. */
 #define CTRL_DESC_DEFINE_FLUX(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_,    \
                               init_, reset_, step_, est_read, flux_free_)                          \
+    CTRL_DESC_DEFINE_LIVE(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_, init_, \
+                          reset_, step_, est_read, flux_free_, NULL, 0u)
+
+/* A descriptor's retune, or none in an image built without live changes
+ * (PMSM_LIVE_PARAMS 0, fx.h: the retune functions are not compiled, #if
+ * PMSM_LIVE_PARAMS around them). */
+#if PMSM_LIVE_PARAMS
+#define CTRL_RETUNE(fn) fn
+#define CTRL_DESC_TAIL(flux_free_, retune_, live_)                                                 \
+    .flux_free = flux_free_, .retune = retune_, .live = live_
+#else
+#define CTRL_RETUNE(fn) NULL
+#define CTRL_DESC_TAIL(flux_free_, retune_, live_) .flux_free = flux_free_
+#endif
+
+/* CTRL_DESC_DEFINE_FLUX with ctrl_desc_t.retune (as CTRL_RETUNE(fn)) and
+ * .live (tunables changed while running). */
+#define CTRL_DESC_DEFINE_LIVE(id, title_, fs_hz, state_type, cfg_type, tunables_, cfg_default_,    \
+                              init_, reset_, step_, est_read, flux_free_, retune_, live_)          \
     const ctrl_desc_t ctrl_desc_##id = {                                                           \
         .name = #id,                                                                               \
         .title = title_,                                                                           \
@@ -122,7 +154,7 @@ typedef struct ctrl_desc {
         .reset = reset_,                                                                           \
         .step = step_,                                                                             \
         .est_unused = CTRL_EST_ONLY(est_read),                                                     \
-        .flux_free = flux_free_,                                                                   \
+        CTRL_DESC_TAIL(flux_free_, retune_, live_),                                                \
     }
 
 /* Registry (controller_registry.c; the entries are chosen at build time by

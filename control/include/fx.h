@@ -88,6 +88,24 @@ static inline int64_t fx_rshift64_round(int64_t x, unsigned n)
     return (int64_t)(u >> n) - (int64_t)((uint64_t)1 << (63u - n));
 }
 
+/* Parameters changed while the drive runs (retune, control/CMakeLists.txt's
+ * PMSM_LIVE_PARAMS): 0 leaves that code out of a flash-tight image. */
+#ifndef PMSM_LIVE_PARAMS
+#define PMSM_LIVE_PARAMS 1
+#endif
+
+/* Keeps a function out of line (gcc/clang): code that runs once per change,
+ * not per period, in one copy (link-time optimisation would inline it). */
+#if defined(__GNUC__)
+#define FX_NOINLINE __attribute__((noinline))
+#else
+#define FX_NOINLINE
+#endif
+
+/* fx_rshift64_round out of line (fx.c): one copy of the variable 64-bit
+ * shift for the code that runs once per change. */
+FX_NOINLINE int64_t fx_rshift64_round_call(int64_t x, unsigned n);
+
 /* x / 2^n rounded to nearest for int32_t, 1 <= n <= 31, same technique. */
 static inline int32_t fx_rshift32_round(int32_t x, unsigned n)
 {

@@ -56,7 +56,19 @@ static int m2ptfc_init(void *state, const void *cfg, const ctrl_setup_t *setup)
     return CTRL_OK;
 }
 
-CTRL_DESC_DEFINE(m2ptfc, "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
-                 10000u, ctrl_m2ptfc_t, ctrl_m2ptfc_cfg_t, m2ptfc_tunables, m2ptfc_cfg_default,
-                 m2ptfc_init, ctrl_m2ptfc_reset, ctrl_m2ptfc_step,
-                 CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT);
+#if PMSM_LIVE_PARAMS
+/* lambda while running: the EMA's coefficient; sigma_T (6.8) keeps its value
+ * and follows at the new rate. centre and the model's overrides change the
+ * torque the equations use: with the controller stopped only. */
+static void m2ptfc_retune(void *state, const void *fresh)
+{
+    ((ctrl_m2ptfc_t *)state)->lambda = ((const ctrl_m2ptfc_t *)fresh)->lambda;
+}
+#endif
+
+CTRL_DESC_DEFINE_LIVE(m2ptfc,
+                      "Two-candidate M2PTFC without weighting factor (thesis 6.3, (6.5)-(6.12))",
+                      10000u, ctrl_m2ptfc_t, ctrl_m2ptfc_cfg_t, m2ptfc_tunables, m2ptfc_cfg_default,
+                      m2ptfc_init, ctrl_m2ptfc_reset, ctrl_m2ptfc_step,
+                      CTRL_EST_SC_NEXT | CTRL_EST_SECTOR_NEXT, 0u, CTRL_RETUNE(m2ptfc_retune),
+                      0x1u);

@@ -33,3 +33,26 @@ q24_t ctrl_speed_pi_step(ctrl_speed_pi_t *pi, q24_t omega_ref, q24_t omega)
     const int64_t u = prop + pi_shift(pi->integ, pi->ki_shift);
     return u > pi->out_max ? pi->out_max : (u < -(int64_t)pi->out_max ? -pi->out_max : (q24_t)u);
 }
+
+#if PMSM_LIVE_PARAMS
+/* pi_shift for the retune: the shift out of line (fx_rshift64_round_call). */
+static int64_t pi_shift_call(int64_t x, uint8_t n)
+{
+    return n > 0u ? fx_rshift64_round_call(x, n) : x;
+}
+
+FX_NOINLINE void ctrl_speed_pi_retune(ctrl_speed_pi_t *pi, const ctrl_speed_pi_t *to, q24_t e)
+{
+    /* The output for e under the old gains less the new gains' proportional
+     * part: the new integrator's torque (Q24; |e kp| < 2^62; the read-out
+     * rounds by half an LSB at most). */
+    const int64_t u = pi_shift_call((int64_t)e * pi->kp, pi->kp_shift) +
+                      pi_shift_call(pi->integ, pi->ki_shift) -
+                      pi_shift_call((int64_t)e * to->kp, to->kp_shift);
+    pi->kp = to->kp;
+    pi->kp_shift = to->kp_shift;
+    pi->ki_ts = to->ki_ts;
+    pi->ki_shift = to->ki_shift;
+    ctrl_speed_pi_reset(pi, fx_sat32(u)); /* within the output limit */
+}
+#endif

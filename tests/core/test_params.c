@@ -541,6 +541,67 @@ static void test_speed_pi(void)
         CTRL_ERANGE, ctrl_speed_pi_config(&pi, &b, 4, 0.1, 0.7, CTRL_SPEED_UNIT_RPM, 1e6, 100u));
 }
 
+/* New gains while running (ctrl_speed_pi_retune): the first step after the
+ * change differs from the same step under the old gains only by
+ * (Ki_new - Ki_old) Ts e' + (Kp_new - Kp_old)(e' - e), e the error the change
+ * was made with, e' the step's (speed_pi.h), and 2 LSB of rounding (the
+ * proportional parts and the integrator's read-out); the integrator's torque
+ * survives a change of its format (ki_shift); a change that needs more than
+ * the limit leaves the integrator at the limit. */
+static void test_speed_pi_retune(void)
+{
+    const ctrl_machine_t spm = machine_thesis_spmsm();
+    ctrl_params_t p;
+    ctrl_bases_t b;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_params_init(&p, &b, &spm, 10000u));
+    /* old: the thesis gains (Ki Ts = 0.11 Kp at 1 kHz); new: Kp x 0.3 and Ki x 2
+     * (ki_shift moves by 1), Kp x 3 and Ki / 8 (by 3), the same */
+    const double kp = 0.006843, ki = 0.78046;
+    const double scale[][2] = {{0.3, 2.0}, {3.0, 0.125}, {1.0, 1.0}};
+    for (size_t c = 0; c < sizeof scale / sizeof scale[0]; c++) {
+        ctrl_speed_pi_t pi, to;
+        TEST_ASSERT_EQUAL_INT(
+            CTRL_OK,
+            ctrl_speed_pi_config(&pi, &b, 4, kp, ki, CTRL_SPEED_UNIT_RAD_S_MECH, 2.4, 1000u));
+        TEST_ASSERT_EQUAL_INT(CTRL_OK,
+                              ctrl_speed_pi_config(&to, &b, 4, kp * scale[c][0], ki * scale[c][1],
+                                                   CTRL_SPEED_UNIT_RAD_S_MECH, 2.4, 1000u));
+        if (scale[c][1] != 1.0) {
+            TEST_ASSERT_NOT_EQUAL(pi.ki_shift, to.ki_shift);
+        }
+        /* an integrator away from zero and the limit */
+        ctrl_speed_pi_reset(&pi, ctrl_q24_from_double(0.1)); /* the limit: 0.295 pu */
+        const q24_t e = ctrl_q24_from_double(0.05);          /* the error of the change */
+        const q24_t e1 = ctrl_q24_from_double(0.051);        /* the next step's */
+        ctrl_speed_pi_t old = pi;
+        const q24_t u_old = ctrl_speed_pi_step(&old, e1, 0);
+        ctrl_speed_pi_retune(&pi, &to, e);
+        const q24_t u_new = ctrl_speed_pi_step(&pi, e1, 0);
+        const double kp_o = ldexp((double)old.kp, -(int)old.kp_shift);
+        const double kp_n = ldexp((double)to.kp, -(int)to.kp_shift);
+        const double ki_o = ldexp((double)old.ki_ts, -(int)old.ki_shift);
+        const double ki_n = ldexp((double)to.ki_ts, -(int)to.ki_shift);
+        const double bound =
+            fabs((ki_n - ki_o) * d(e1)) + fabs((kp_n - kp_o) * (d(e1) - d(e))) + 2.0 * LSB;
+        TEST_ASSERT_TRUE(u_old < pi.out_max && u_new < pi.out_max); /* not at the limit */
+        TEST_ASSERT_TRUE_MESSAGE(fabs(d(u_new) - d(u_old)) <= bound, "bumpless within the bound");
+        /* without the integrator's share it would have stepped by (Kp_new - Kp_old) e */
+        if (scale[c][0] != 1.0) {
+            TEST_ASSERT_TRUE(fabs((kp_n - kp_o) * d(e)) > 4.0 * bound);
+        }
+    }
+    /* a change that needs more than the limit: the integrator stops there */
+    ctrl_speed_pi_t pi, to;
+    TEST_ASSERT_EQUAL_INT(CTRL_OK, ctrl_speed_pi_config(&pi, &b, 4, kp * 100.0, ki,
+                                                        CTRL_SPEED_UNIT_RAD_S_MECH, 2.4, 1000u));
+    TEST_ASSERT_EQUAL_INT(
+        CTRL_OK, ctrl_speed_pi_config(&to, &b, 4, kp, ki, CTRL_SPEED_UNIT_RAD_S_MECH, 2.4, 1000u));
+    ctrl_speed_pi_reset(&pi, pi.out_max / 2);
+    ctrl_speed_pi_retune(&pi, &to, FX_ONE);
+    TEST_ASSERT_TRUE(pi.integ == (int64_t)pi.out_max * ((int64_t)1 << pi.ki_shift));
+    ctrl_speed_pi_retune(&pi, &to, FX_MIN); /* extreme error: no overflow (UBSan) */
+}
+
 typedef struct {
     double alpha;
     double beta;
@@ -596,6 +657,7 @@ int main(void)
     RUN_TEST(test_mtpa_ipmsm_table);
     RUN_TEST(test_speed_lpf_setter);
     RUN_TEST(test_speed_pi);
+    RUN_TEST(test_speed_pi_retune);
     RUN_TEST(test_tunables);
     return UNITY_END();
 }
