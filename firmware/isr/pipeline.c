@@ -205,8 +205,35 @@ static void fw_mid_restart(fw_t *fw)
     fw->mid_n = 0u;
 }
 
+#if PMSM_LIVE_PARAMS
+/* A live change the main loop published (pipeline.h): the speed PI's new
+ * gains with the latest speed error (the next run's will be close to it), the
+ * controller's retune from the state made for its new configuration. Out of
+ * line: once per change. */
+static FW_NOINLINE void fw_apply_tune(fw_t *fw)
+{
+#if defined(__GNUC__)
+    __asm__ volatile("" ::: "memory"); /* the change is read after its request */
+#endif
+    if (fw->req_speed_tune != 0u) {
+        const q24_t e = fx_sat32((int64_t)fw->speed_ref - fw->estimate.omega_e);
+        ctrl_speed_pi_retune(&fw->speed_pi, &fw->speed_pi_next, e);
+        fw->req_speed_tune = 0u;
+    }
+    if (fw->req_ctrl_tune != 0u) {
+        fw->ctrl->retune(fw->ctrl_state.bytes, fw->ctrl_next.bytes);
+        fw->req_ctrl_tune = 0u;
+    }
+}
+#endif
+
 static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
 {
+#if PMSM_LIVE_PARAMS
+    if ((fw->req_speed_tune | fw->req_ctrl_tune) != 0u) {
+        fw_apply_tune(fw);
+    }
+#endif
     if (fw->req_clear != 0u) {
         fw->req_clear = 0u;
         if (fw_state_event(&fw->sm, FW_EV_CLEAR, 0u)) {

@@ -357,6 +357,20 @@ typedef struct {
     /* PM-flux tracking (fw_config_t.psi_adapt, estimation/psi_track.h); last,
      * so that its size moves no other field's offset (code size). */
     ctrl_psi_track_t psi_track;
+    /* Live changes (fw_speed_retune, fw_tunable_set while running), after it
+     * for the same reason: the main loop fills the speed PI's new gains or
+     * the controller's state for its new configuration, then sets the
+     * request; the interrupt takes the change at its next period's start
+     * (fw_apply_commands) and clears the request. The main loop writes
+     * neither while its request is set. */
+    volatile uint8_t req_speed_tune, req_ctrl_tune;
+#if PMSM_LIVE_PARAMS
+    ctrl_speed_pi_t speed_pi_next;
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_STATE_MAX];
+    } ctrl_next;
+#endif
 } fw_t;
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),
@@ -429,6 +443,33 @@ void fw_tm_release(fw_t *fw);
 int fw_select_controller(fw_t *fw, const ctrl_desc_t *desc, const void *cfg);
 int fw_tunable_set(fw_t *fw, const char *name, double value);
 int fw_tunable_get(const fw_t *fw, const char *name, double *value);
+/*
+ * Live changes (main loop; taken by the interrupt at its next period, in any
+ * state; docs/console.md "Live changes"):
+ * - fw_tunable_set with the gates on (or about to go on) changes a tunable
+ *   the controller marks live (ctrl_desc_t.live, retune: bumpless where its
+ *   state would step), else FW_EBUSY;
+ * - fw_speed_retune: the speed loop's bandwidth, phase margin and gains
+ *   (fw_config_t.speed_bw_hz, speed_pm_deg, speed_kp, speed_ki), with the
+ *   gates on or off: the speed PI's new gains, its integrator carried over
+ *   bumplessly (ctrl_speed_pi_retune); FW_EINVAL when the design refuses the
+ *   bandwidth or the margin (speed_loop.h), FW_ERANGE (fw->why) when the
+ *   gains do not fit; the configuration in force stays then.
+ * Both: FW_EBUSY while the previous change waits for the interrupt, and
+ * always in an image built without live changes (PMSM_LIVE_PARAMS 0).
+ * fw_tunable_is_live: tunables[index] of the selected controller is live.
+ */
+int fw_speed_retune(fw_t *fw, double bw_hz, double pm_deg, double kp, double ki);
+#if PMSM_LIVE_PARAMS
+bool fw_tunable_is_live(const fw_t *fw, size_t index);
+#else
+static inline bool fw_tunable_is_live(const fw_t *fw, size_t index)
+{
+    (void)fw;
+    (void)index;
+    return false;
+}
+#endif
 
 /*
  * Commissioning (main loop; cm.h, docs/identification.md).

@@ -18,6 +18,15 @@
 
 #define FW_CALIB_DEFAULT 256u
 
+/* Orders the main loop's writes of a live change before its request: the
+ * interrupt takes the change when it sees the request. */
+static inline void fw_publish_barrier(void)
+{
+#if defined(__GNUC__)
+    __asm__ volatile("" ::: "memory");
+#endif
+}
+
 void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl)
 {
     if (c == NULL) {
@@ -88,6 +97,62 @@ static int32_t fw_q30(double x)
     return (int32_t)floor(x * 1073741824.0 + 0.5);
 }
 
+/* The speed PI's gains for cfg into *pi (integrator cleared) and what they
+ * are into *si's gain and design fields: cfg's explicit gains (speed_kp or
+ * speed_ki > 0, in speed_unit), else designed from the machine's inertia with
+ * cfg's bandwidth and phase margin for the medium task's rate (speed_loop.h).
+ * FW_OK, or FW_EINVAL (the design refused: bandwidth or phase margin) /
+ * FW_ERANGE (fw->why). fw_init and a live change (fw_speed_retune) share it. */
+#if PMSM_LIVE_PARAMS
+#define FW_SPEED_GAINS_INLINE /* two callers: one copy */
+#elif defined(__GNUC__)
+/* one caller: in it, as before it had a name (measured: 300 B less on the
+ * B-G431B-ESC1 than a call) */
+#define FW_SPEED_GAINS_INLINE __attribute__((always_inline)) inline
+#else
+#define FW_SPEED_GAINS_INLINE inline
+#endif
+static FW_SPEED_GAINS_INLINE int fw_speed_gains(fw_t *fw, const fw_config_t *cfg,
+                                                ctrl_speed_pi_t *pi, fw_speed_info_t *si)
+{
+    const hal_info_t *in = &fw->info;
+    double kp = cfg->speed_kp;
+    double ki = cfg->speed_ki;
+    ctrl_speed_unit_t unit = cfg->speed_unit;
+    si->bandwidth_hz = 0.0;
+    si->phase_margin_deg = 0.0;
+    si->zero_hz = 0.0;
+    if (!(kp > 0.0) && !(ki > 0.0)) {
+        fw_speed_design_t d = {cfg->speed_bw_hz, cfg->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
+        const double loop_rate = (double)in->pwm_freq_hz / (double)fw->mid_div;
+        const double lpf_hz = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)in->pwm_freq_hz
+                                  ? CTRL_SPEED_LPF_HZ_DEFAULT
+                                  : 0.45 * (double)in->pwm_freq_hz;
+        if (fw_speed_loop_design(&d, fw->machine, loop_rate, lpf_hz, NULL, 0u) != CTRL_OK) {
+            return FW_EINVAL;
+        }
+        kp = d.kp_nm_s_rad;
+        ki = d.ki_nm_rad;
+        unit = CTRL_SPEED_UNIT_RAD_S_MECH;
+        si->bandwidth_hz = d.bandwidth_hz;
+        si->phase_margin_deg = d.phase_margin_deg;
+        si->zero_hz = d.zero_hz;
+    }
+    /* The gains in SI per mechanical rad/s for reports. */
+    const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / CTRL_TWO_PI
+                           : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)fw->machine->pole_pairs
+                                                                : 1.0;
+    si->kp_nm_s_rad = kp * per_rad;
+    si->ki_nm_rad = ki * per_rad;
+    if (!(cfg->speed_out_max_nm > 0.0) ||
+        ctrl_speed_pi_config_diag(pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
+                                  cfg->speed_out_max_nm, in->pwm_freq_hz / fw->mid_div,
+                                  &fw->why) != CTRL_OK) {
+        return FW_ERANGE;
+    }
+    return FW_OK;
+}
+
 /* Everything that follows from the machine: per-unit parameters, estimator,
  * controller, conversion gains, encoder scaling, protections, speed loop and
  * the commissioning limits. fw_init (with the caller's controller
@@ -96,6 +161,8 @@ static int32_t fw_q30(double x)
 static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t *ctrl,
                             const void *ctrl_cfg)
 {
+    fw->req_speed_tune = 0u; /* superseded by the gains set here */
+    fw_publish_barrier();
     const hal_info_t *in = &fw->info;
     if (ctrl_params_init_diag(&fw->params, &fw->bases, fw->machine, in->pwm_freq_hz, &fw->why) !=
         CTRL_OK) {
@@ -274,37 +341,9 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     fw_torque_follow_init(&fw->tqf, &tfc);
 
     /* Speed loop: one update per run of the medium task. */
-    fw_speed_info_t *si = &fw->speed_info;
-    double kp = cfg->speed_kp;
-    double ki = cfg->speed_ki;
-    ctrl_speed_unit_t unit = cfg->speed_unit;
-    if (!(kp > 0.0) && !(ki > 0.0)) {
-        fw_speed_design_t d = {cfg->speed_bw_hz, cfg->speed_pm_deg, 0.0, 0.0, 0.0, 0.0};
-        const double loop_rate = (double)in->pwm_freq_hz / (double)fw->mid_div;
-        const double lpf_hz = CTRL_SPEED_LPF_HZ_DEFAULT < 0.45 * (double)in->pwm_freq_hz
-                                  ? CTRL_SPEED_LPF_HZ_DEFAULT
-                                  : 0.45 * (double)in->pwm_freq_hz;
-        if (fw_speed_loop_design(&d, fw->machine, loop_rate, lpf_hz, NULL, 0u) != CTRL_OK) {
-            return FW_EINVAL;
-        }
-        kp = d.kp_nm_s_rad;
-        ki = d.ki_nm_rad;
-        unit = CTRL_SPEED_UNIT_RAD_S_MECH;
-        si->bandwidth_hz = d.bandwidth_hz;
-        si->phase_margin_deg = d.phase_margin_deg;
-        si->zero_hz = d.zero_hz;
-    }
-    /* The gains in SI per mechanical rad/s for reports. */
-    const double per_rad = unit == CTRL_SPEED_UNIT_RPM          ? 60.0 / CTRL_TWO_PI
-                           : unit == CTRL_SPEED_UNIT_RAD_S_ELEC ? (double)fw->machine->pole_pairs
-                                                                : 1.0;
-    si->kp_nm_s_rad = kp * per_rad;
-    si->ki_nm_rad = ki * per_rad;
-    if (!(cfg->speed_out_max_nm > 0.0) ||
-        ctrl_speed_pi_config_diag(&fw->speed_pi, &fw->bases, fw->machine->pole_pairs, kp, ki, unit,
-                                  cfg->speed_out_max_nm, in->pwm_freq_hz / fw->mid_div,
-                                  &fw->why) != CTRL_OK) {
-        return FW_ERANGE;
+    const int src = fw_speed_gains(fw, cfg, &fw->speed_pi, &fw->speed_info);
+    if (src != FW_OK) {
+        return src;
     }
 
     fw->torque_ref_max = ctrl_q24_from_double(cfg->speed_out_max_nm / fw->bases.torque_nm);
@@ -464,6 +503,11 @@ bool fw_commission_poll(fw_t *fw)
 /* Initialise desc with cfg into the state block; keep both on success. */
 static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *cfg)
 {
+    /* A live change the interrupt has not taken yet is superseded (cfg holds
+     * it): withdrawn before the state is written, so that the interrupt no
+     * longer touches the state. */
+    fw->req_ctrl_tune = 0u;
+    fw_publish_barrier();
     union {
         max_align_t align;
         unsigned char bytes[CTRL_STATE_MAX];
@@ -516,27 +560,109 @@ int fw_select_controller(fw_t *fw, const ctrl_desc_t *d, const void *cfg)
     return fw_ctrl_install(fw, d, c.bytes);
 }
 
+#if PMSM_LIVE_PARAMS
+bool fw_tunable_is_live(const fw_t *fw, size_t index)
+{
+    const ctrl_desc_t *d = fw != NULL ? fw->ctrl : NULL;
+    return d != NULL && d->retune != NULL && index < 32u && ((d->live >> index) & 1u) != 0u;
+}
+#endif
+
+int fw_speed_retune(fw_t *fw, double bw_hz, double pm_deg, double kp, double ki)
+{
+    if (fw == NULL || fw->machine == NULL) {
+        return FW_EINVAL;
+    }
+#if !PMSM_LIVE_PARAMS
+    (void)bw_hz;
+    (void)pm_deg;
+    (void)kp;
+    (void)ki;
+    return FW_EBUSY;
+#else
+    if (fw->req_speed_tune != 0u) {
+        return FW_EBUSY;
+    }
+    /* In fw->cfg (the interrupt reads none of these), back on a refusal. */
+    fw_config_t *c = &fw->cfg;
+    const double old[4] = {c->speed_bw_hz, c->speed_pm_deg, c->speed_kp, c->speed_ki};
+    c->speed_bw_hz = bw_hz;
+    c->speed_pm_deg = pm_deg;
+    c->speed_kp = kp;
+    c->speed_ki = ki;
+    fw_speed_info_t si = fw->speed_info;
+    const int rc = fw_speed_gains(fw, c, &fw->speed_pi_next, &si);
+    if (rc != FW_OK) {
+        c->speed_bw_hz = old[0];
+        c->speed_pm_deg = old[1];
+        c->speed_kp = old[2];
+        c->speed_ki = old[3];
+        return rc;
+    }
+    fw->speed_info = si;
+    fw_publish_barrier();
+    fw->req_speed_tune = 1u;
+    fw->req_any = 1u;
+    return FW_OK;
+#endif
+}
+
 int fw_tunable_set(fw_t *fw, const char *name, double value)
 {
     if (fw == NULL || fw->ctrl == NULL || name == NULL) {
         return FW_EINVAL;
     }
-    if (fw_gates_on_or_pending(fw)) {
+    const ctrl_desc_t *d = fw->ctrl;
+    /* With the gates on (or about to go on) only a live tunable, and not
+     * while the previous live change waits for the interrupt. */
+    const bool live = fw_gates_on_or_pending(fw);
+#if !PMSM_LIVE_PARAMS
+    if (live) {
         return FW_EBUSY; /* as fw_select_controller */
     }
+#else
+    if (live) {
+        size_t i = 0;
+        while (i < d->n_tunables && strcmp(d->tunables[i].name, name) != 0) {
+            i++;
+        }
+        if (i < d->n_tunables && (!fw_tunable_is_live(fw, i) || fw->req_ctrl_tune != 0u)) {
+            return FW_EBUSY;
+        }
+    }
+#endif
     union {
         max_align_t align;
         unsigned char bytes[CTRL_CFG_MAX];
     } c;
     memcpy(c.bytes, fw->ctrl_cfg.bytes, CTRL_CFG_MAX);
-    const int rc = ctrl_tunable_set(fw->ctrl, c.bytes, name, value);
+    const int rc = ctrl_tunable_set(d, c.bytes, name, value);
     if (rc == CTRL_ENOENT) {
         return FW_ENOENT;
     }
     if (rc != CTRL_OK) {
         return FW_EINVAL;
     }
-    return fw_ctrl_install(fw, fw->ctrl, c.bytes);
+    if (!live) {
+        return fw_ctrl_install(fw, d, c.bytes);
+    }
+#if !PMSM_LIVE_PARAMS
+    return FW_EBUSY; /* not reached: no controller is live (CTRL_RETUNE) */
+#else
+    /* Live (ctrl_desc_t.retune): the state for the changed configuration made
+     * here, the interrupt takes from it what the change sets at its next
+     * period (fw_apply_commands). */
+    memset(&fw->why, 0, sizeof fw->why);
+    const ctrl_setup_t setup = {fw->machine, &fw->bases, &fw->params, &fw->why};
+    if (ctrl_init(d, fw->ctrl_next.bytes, c.bytes, &setup) != CTRL_OK) {
+        return FW_ECTRL;
+    }
+    memcpy(fw->ctrl_cfg.bytes, c.bytes, CTRL_CFG_MAX);
+    fw_publish_barrier();
+    fw->req_ctrl_tune = 1u;
+    fw->req_any = 1u;
+    return FW_OK;
+#endif
 }
 
 int fw_tunable_get(const fw_t *fw, const char *name, double *value)

@@ -78,10 +78,17 @@ static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
     const fw_t *fw = l->fw;
     const size_t n_tun = fw->ctrl != NULL ? fw->ctrl->n_tunables : 0u;
     if (index >= n_tun) {
-        if (index - n_tun >= l->n_params) {
+        index -= n_tun;
+#if PMSM_LIVE_PARAMS
+        if (index < l->n_table_params) {
+            return l->table_at(l, index, info);
+        }
+        index -= l->n_table_params;
+#endif
+        if (index >= l->n_params) {
             return false;
         }
-        *info = l->params[index - n_tun].info;
+        *info = l->params[index].info;
         return true;
     }
     const ctrl_tunable_t *t = &fw->ctrl->tunables[index];
@@ -90,7 +97,7 @@ static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
     info->help = t->help;
     info->min = t->min;
     info->max = t->max;
-    info->read_only = false;
+    info->access = fw_tunable_is_live(fw, index) ? CMD_PARAM_LIVE : CMD_PARAM_RW;
     return true;
 }
 
@@ -117,7 +124,12 @@ static int op_param_get(void *ctx, const char *name, double *value)
     if (p != NULL) {
         return p->get(l->params_ctx, p, value);
     }
-    return fw_link_err(fw_tunable_get(l->fw, name, value));
+    const int rc = fw_link_err(fw_tunable_get(l->fw, name, value));
+#if PMSM_LIVE_PARAMS
+    return rc == CMD_E_NAME && l->table_get != NULL ? l->table_get(l, name, value) : rc;
+#else
+    return rc;
+#endif
 }
 
 /* A configuration op's result; on a refusal the core's reason is kept for
@@ -185,21 +197,60 @@ static int op_set_speed_ref(void *ctx, double rpm)
     return CMD_OK;
 }
 
+/* "in <state>" or "<request> pending (<state>)" into state_text: its length. */
+static size_t fw_link_state_text(fw_link_t *l)
+{
+    fw_state_id_t s;
+    const char *req = fw_gates_request_pending(l->fw, &s);
+    const int n = req != NULL
+                      ? snprintf(l->state_text, sizeof l->state_text, "%s pending (%s)", req,
+                                 fw_state_name(s))
+                      : snprintf(l->state_text, sizeof l->state_text, "in %s", fw_state_name(s));
+    return n > 0 && (size_t)n < sizeof l->state_text ? (size_t)n : 0u;
+}
+
 static int op_param_set(void *ctx, const char *name, double value)
 {
     fw_link_t *l = fw_link_of(ctx);
     const fw_link_param_t *p = fw_link_param(l, name);
+    int rc;
+    l->why_note = false;
     if (p != NULL) {
         memset(&l->why, 0, sizeof l->why); /* the application sets it (fw_link_set_why) */
-        return p->set != NULL ? p->set(l->params_ctx, p, value) : CMD_E_READONLY;
+        rc = p->set != NULL ? p->set(l->params_ctx, p, value) : CMD_E_READONLY;
+    } else {
+        rc = fw_link_cfg_err(l, fw_tunable_set(l->fw, name, value));
+#if PMSM_LIVE_PARAMS
+        if (rc == CMD_E_NAME && l->table_set != NULL) {
+            rc = l->table_set(l, name, value);
+        }
+#endif
     }
-    return fw_link_cfg_err(l, fw_tunable_set(l->fw, name, value));
+    if (rc == CMD_E_STATE) {
+        /* Why, for err 8: the state, and that the parameter changes only with
+         * the gates off, or that the last live change is still on its way. */
+        const size_t n = fw_link_state_text(l);
+        const bool pending = (l->fw->req_speed_tune | l->fw->req_ctrl_tune) != 0u;
+        (void)snprintf(l->state_text + n, sizeof l->state_text - n, ": %s%s",
+                       pending ? "the last live change is not taken yet" : name,
+                       pending ? "" : " changes with the gates off only");
+        l->state_note = true;
+    }
+    return rc;
 }
 
 void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why)
 {
     if (l != NULL && why != NULL) {
         l->why = *why;
+    }
+}
+
+void fw_link_set_why_text(fw_link_t *l, const char *why)
+{
+    if (l != NULL && why != NULL) {
+        (void)snprintf(l->why_text, CMD_OUT_MAX - 16u, "%s", why);
+        l->why_note = true;
     }
 }
 
@@ -210,6 +261,10 @@ static const char *op_failed_detail(void *ctx)
 {
     fw_link_t *l = fw_link_of(ctx);
     const ctrl_diag_t *d = &l->why;
+    if (l->why_note) {
+        l->why_note = false;
+        return l->why_text;
+    }
     if (d->code == CTRL_OK || d->quantity == NULL) {
         return NULL;
     }
@@ -469,17 +524,14 @@ static bool op_config_item_at(void *ctx, size_t index, cmd_config_item_t *it)
 static const char *op_state_detail(void *ctx)
 {
     fw_link_t *l = fw_link_of(ctx);
+    if (l->state_note) {
+        l->state_note = false; /* op_param_set's: the state and why */
+        return l->state_text;
+    }
     if (l->hold != NULL) {
         return l->hold; /* held off for good: that is the state */
     }
-    fw_state_id_t s;
-    const char *req = fw_gates_request_pending(l->fw, &s);
-    if (req != NULL) {
-        (void)snprintf(l->state_text, sizeof l->state_text, "%s pending (%s)", req,
-                       fw_state_name(s));
-    } else {
-        (void)snprintf(l->state_text, sizeof l->state_text, "in %s", fw_state_name(s));
-    }
+    (void)fw_link_state_text(l);
     return l->state_text;
 }
 

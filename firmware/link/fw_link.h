@@ -28,7 +28,8 @@ typedef void (*fw_link_write_fn)(void *ctx, const uint8_t *bytes, size_t len);
  * "param list" after the controller's tunables and reached by "param get/set"
  * (PROTOCOL.md: "the firmware's own parameters"). Names must not collide with
  * tunables (use a prefix such as "m." or "b."). get/set return CMD_OK or a
- * cmd_err_t code; set is NULL when info.read_only. They run in the main loop. */
+ * cmd_err_t code; set is NULL when info.access is CMD_PARAM_RO. They run in the
+ * main loop. */
 typedef struct fw_link_param fw_link_param_t;
 struct fw_link_param {
     cmd_param_info_t info;
@@ -38,14 +39,19 @@ struct fw_link_param {
     int (*set)(void *ctx, const fw_link_param_t *p, double value);
 };
 
-typedef struct {
+/* Tables of the firmware's configuration as parameters (fw_params.h). */
+typedef struct fw_params_table fw_params_table_t;
+#define FW_LINK_TABLES 2u
+
+typedef struct fw_link fw_link_t;
+struct fw_link {
     fw_t *fw;
     cmd_t cmd;
     tel_t tel;
     uint8_t send_meta;
     double speed_max_rpm;       /* |speed reference| limit (fw_speed_info_t: the rated speed) */
     char cm_detail[48];         /* detail of the last refused commissioning start */
-    char state_text[48];        /* detail of the last "err 8 state" (op_state_detail) */
+    char state_text[80];        /* detail of the last "err 8 state" (op_state_detail) */
     char cm_note[80];           /* what "bringup sense" says when it starts (the offsets) */
     ctrl_diag_t why;            /* why the core refused the last configuration op (CTRL_OK: none) */
     char why_text[CMD_OUT_MAX]; /* its "err 10 failed" detail */
@@ -63,7 +69,17 @@ typedef struct {
      * "arm", "ident ..." and "bringup ..." are then refused with it as the
      * detail of "err 8 state" (fw_link_set_hold). */
     const char *hold;
-} fw_link_t;
+    /* The firmware's configuration as parameters (fw_params_attach; listed
+     * after the tunables, before params): its tables and their ops, which
+     * answer CMD_E_NAME for a name not theirs. */
+    const fw_params_table_t *tables[FW_LINK_TABLES];
+    size_t n_table_params;
+    bool (*table_at)(const fw_link_t *l, size_t index, cmd_param_info_t *info);
+    int (*table_get)(const fw_link_t *l, const char *name, double *value);
+    int (*table_set)(fw_link_t *l, const char *name, double value);
+    bool state_note; /* state_text is the detail of the err 8 just returned (op_param_set) */
+    bool why_note;   /* why_text is the detail of the err 10 just returned */
+};
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
 /* Application parameters (after fw_link_init; the table must outlive the link). */
@@ -82,6 +98,8 @@ static inline void fw_link_set_hold(fw_link_t *l, const char *why)
  * refused the configuration: the reason (fw_t.why before the application
  * restores its previous data), sent as the detail of "err 10 failed". */
 void fw_link_set_why(fw_link_t *l, const ctrl_diag_t *why);
+/* The same as text (cut at the line's end). */
+void fw_link_set_why_text(fw_link_t *l, const char *why);
 /* "current offsets a b c counts, expected zero +- tol": the phase-current
  * offsets the calibration measured (Q8 counts, rounded to counts) and the
  * window it judges them by (hal_info_t). snprintf's result. */

@@ -513,7 +513,9 @@ static void cmd_param_line(cmd_t *c, const cmd_param_info_t *info)
     cmd_out_num(c, info->min);
     cmd_out_str(c, ", ");
     cmd_out_num(c, info->max);
-    cmd_out_str(c, info->read_only ? "] ro " : "] ");
+    cmd_out_str(c, info->access == CMD_PARAM_RO     ? "] ro "
+                   : info->access == CMD_PARAM_LIVE ? "] live "
+                                                    : "] ");
     cmd_out_str(c, info->help == NULL ? "" : info->help);
     cmd_out_flush(c);
 }
@@ -567,7 +569,7 @@ static void cmd_param(cmd_t *c, const cmd_tok_t *tok, size_t n)
             cmd_err(c, CMD_E_NAME, "see param list");
             return;
         }
-        if (info.read_only) {
+        if (info.access == CMD_PARAM_RO) {
             cmd_err(c, CMD_E_READONLY, NULL);
             return;
         }

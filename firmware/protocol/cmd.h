@@ -68,12 +68,19 @@ typedef struct {
     uint32_t tel_every;     /* telemetry decimation */
 } cmd_status_t;
 
+/* When a parameter can be written (cmd_param_info_t.access). */
+typedef enum {
+    CMD_PARAM_RW = 0,  /* with the gates off (the firmware refuses it while running: err 8) */
+    CMD_PARAM_RO = 1,  /* never: read-only (err 11) */
+    CMD_PARAM_LIVE = 2 /* also while the drive runs (listed with " live") */
+} cmd_param_access_t;
+
 /* One parameter as listed by the firmware (controller tunable or firmware parameter). */
 typedef struct {
     const char *name; /* printable, no spaces, e.g. "h_T" */
     const char *unit; /* e.g. "N*m", "" when dimensionless */
     const char *help; /* one line (truncated in listings) */
-    bool read_only;   /* here, not last: the doubles then need no padding */
+    uint8_t access;   /* cmd_param_access_t; here, not last: the doubles then need no padding */
     double min, max;  /* accepted range (inclusive), checked before param_set */
 } cmd_param_info_t;
 

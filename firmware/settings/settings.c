@@ -45,10 +45,10 @@ static const settings_field_t settings_fields[] = {
     SF_U32("enc.cpr", enc_cpr),
     SF("enc.dir", enc_direction, ST_I8, -1, 1),
     SF_U32("enc.offset", enc_offset),
-    SF("sensorless", sensorless, ST_U8, 0, 1),
+    SF("est.sensorless", sensorless, ST_U8, 0, 1),
     SF_F64("inv.dead_time_s", dead_time_s),
     SF_F64("inv.v_fwd_v", v_fwd_v),
-    SF("psi_adapt", psi_adapt, ST_U8, 0, 1),
+    SF("est.psi_adapt", psi_adapt, ST_U8, 0, 1),
     {"ctrl", (uint16_t)offsetof(settings_t, ctrl), ST_NAME, 1u, 0, 0},
     SF("ctrl.n_tunables", n_tunables, ST_U8, 0, (uint16_t)SETTINGS_TUNABLES_MAX),
     {"", (uint16_t)offsetof(settings_t, tunable_name), ST_NAME, SETTINGS_TUNABLES_MAX, 0, 0},
@@ -58,9 +58,9 @@ static const settings_field_t settings_fields[] = {
     SF_F64("speed.kp", speed_kp),
     SF_F64("speed.ki", speed_ki),
     SF("speed.unit", speed_unit, ST_U8, 0, 2),
-    SF_F64("speed.out_max_nm", speed_out_max_nm),
+    SF_F64("lim.torque_nm", speed_out_max_nm),
     SF_U32("speed.loop_hz", speed_loop_hz),
-    SF_F64("speed.overspeed_rpm", overspeed_rpm),
+    SF_F64("prot.overspeed_rpm", overspeed_rpm),
     SF("thr.mode", thr_mode, ST_U8, 0, 2),
     SF("thr.low_us", thr_low_us, ST_U16, 0, 65535),
     SF("thr.high_us", thr_high_us, ST_U16, 0, 65535),
@@ -360,4 +360,35 @@ bool settings_item_at(const settings_t *s, size_t index, settings_item_t *it)
     it->text = NULL;
     it->num = s->tunable_value[t];
     return true;
+}
+
+bool settings_field_find(settings_t *s, const char *key, settings_field_ref_t *r)
+{
+    /* the values of each integer type (settings_type_t order up to ST_U32) */
+    static const int64_t type_lo[] = {0, -128, 0, -2147483647 - 1, 0};
+    static const int64_t type_hi[] = {255, 127, 65535, 2147483647, 4294967295};
+    for (size_t k = 0; k < SETTINGS_NFIELDS; k++) {
+        const settings_field_t *f = &settings_fields[k];
+        if (f->count != 1u || f->type == ST_NAME || strcmp(f->key, key) != 0) {
+            continue;
+        }
+        r->at = (uint8_t *)s + f->offset;
+        r->f64 = f->type == ST_F64;
+        r->type = f->type;
+        const bool ranged = f->lo != 0 || f->hi != 0;
+        r->lo = r->f64 ? 0 : (ranged ? f->lo : type_lo[f->type]);
+        r->hi = r->f64 ? 0 : (ranged ? (int64_t)f->hi : type_hi[f->type]);
+        return true;
+    }
+    return false;
+}
+
+int64_t settings_field_int(const settings_field_ref_t *r)
+{
+    return settings_int_of(r->at, (settings_type_t)r->type);
+}
+
+void settings_field_set_int(const settings_field_ref_t *r, int64_t v)
+{
+    settings_int_to(r->at, (settings_type_t)r->type, (uint64_t)v);
 }

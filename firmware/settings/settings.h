@@ -137,4 +137,20 @@ typedef struct {
 } settings_item_t;
 bool settings_item_at(const settings_t *s, size_t index, settings_item_t *it);
 
+/* A scalar field by its key (settings_item_at's keys, not the tunables' nor
+ * the controller's name), to read or write it in place: where it is in the
+ * settings_t, and for an integer field the values it admits (its range in the
+ * layout, else its type's). f64: the field is a double (read and written as
+ * one at `at`). */
+typedef struct {
+    uint8_t *at;
+    bool f64;
+    uint8_t type; /* the layout's integer type (settings.c) */
+    int64_t lo, hi;
+} settings_field_ref_t;
+bool settings_field_find(settings_t *s, const char *key, settings_field_ref_t *r);
+int64_t settings_field_int(const settings_field_ref_t *r);
+/* lo <= v <= hi (the caller checks). */
+void settings_field_set_int(const settings_field_ref_t *r, int64_t v);
+
 #endif /* FIRMWARE_SETTINGS_SETTINGS_H */

@@ -252,11 +252,11 @@ static int esc1_thr_get(void *ctx, const fw_link_param_t *p, double *v)
 
 #define ESC1_RW(name, unit, lo, hi, help, get, set)                                                \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), false, lo, hi}, get, set                                     \
+        {name, unit, HELP_TEXT(help), CMD_PARAM_RW, lo, hi}, get, set                              \
     }
 #define ESC1_RO(name, unit, help, get)                                                             \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), true, 0.0, 0.0}, get, NULL                                   \
+        {name, unit, HELP_TEXT(help), CMD_PARAM_RO, 0.0, 0.0}, get, NULL                           \
     }
 
 static const fw_link_param_t esc1_params[ESC1_N_PARAMS] = {
@@ -298,8 +298,8 @@ static const fw_link_param_t esc1_params[ESC1_N_PARAMS] = {
                 "RCC_CSR reset flags at start-up >> 24: 2 option bytes, 4 pin, 8 brown-out, "
                 "16 software, 32 watchdog",
                 esc1_get_reset),
-    [P_TEMP_CHECK] = {{"b.temp_check", "-", HELP_TEXT("1 = board over-temperature trip on"), 0.0,
-                       1.0, false},
+    [P_TEMP_CHECK] = {{"b.temp_check", "-", HELP_TEXT("1 = board over-temperature trip on"),
+                       CMD_PARAM_LIVE, 0.0, 1.0},
                       esc1_get_temp_check,
                       esc1_set_temp_check},
     [P_T0 + T_MODE] =

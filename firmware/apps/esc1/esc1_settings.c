@@ -9,6 +9,7 @@
 #include "cmd.h"
 #include "controller.h"
 #include "esc1_app.h"
+#include "fw_params.h"
 #include "g4_flash.h"
 
 static int esc1_flash_read(void *ctx, unsigned page, uint32_t off, uint8_t *buf, size_t n)
@@ -91,6 +92,11 @@ void esc1_settings_start(esc1_t *s)
     g4_flash_set_clock(s->hal.board->sysclk_hz); /* started only when the clock is up */
     (void)fw_settings_boot(st);
     fw_link_set_settings(&s->link, st);
+#if PMSM_LIVE_PARAMS
+    /* The configuration beyond the machine data (esc1_params.c lists those
+     * with the board's limits) as parameters, written through the apply. */
+    fw_params_attach(&s->link, &fw_params_drive);
+#endif
     esc1_uart_puts(&s->uart, st->msg);
     esc1_uart_puts(&s->uart, "\r\n");
 }

@@ -16,13 +16,16 @@
  * time runs at about 1/20 of real time (-icount shift=3).
  * Settings ("config save|show|erase|default"): the record of fw_settings.h in
  * a RAM model of the G4 flash's two pages (settings_flash_model.h), empty at
- * each start of QEMU.
+ * each start of QEMU. The firmware's configuration as parameters (machine,
+ * encoder, inverter, speed loop, limits, protections: fw_params.h) changes
+ * through the same reconfiguration as a record.
  */
 #include <stdio.h>
 #include <string.h>
 
 #include "controller.h"
 #include "fw_link.h"
+#include "fw_params.h"
 #include "pil_cl.h"
 #include "pil_common.h"
 #include "pipeline.h"
@@ -124,6 +127,8 @@ int main(void)
     (void)fw_settings_boot(&app.settings);
     fw_link_init(&app.link, &app.run.fw, pil_uart_write, NULL);
     fw_link_set_settings(&app.link, &app.settings);
+    fw_params_attach(&app.link, &fw_params_machine); /* through app_settings_apply */
+    fw_params_attach(&app.link, &fw_params_drive);
     hal_qemu_uart_rx_enable();
     printf("pmsm-dtc on QEMU mps2-an386: %s, free rotor, passive load %.2f N*m; controller %s "
            "at %u Hz; calibrating (256 periods), then 'arm' (PROTOCOL.md, 'help')\n",
