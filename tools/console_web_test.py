@@ -16,8 +16,17 @@ what the page plots and shows):
   - the plots of signals at rest (zero or flat) get axes of their own size,
     at least 2 % of a per-unit step (the least span the META frame's scale
     gives), with round ticks;
-  - a tunable set out of range shows the firmware's own `err 4 range [min, max]`
-    in the parameter's row;
+  - the parameter tree: every group of the firmware's configuration (machine,
+    encoder, estimation, inverter, speed loop, limits, protections) and the
+    controller's tunables, each row with the firmware's unit, range, help
+    text and when it changes; the speed loop's marked live, the machine's
+    "gates off";
+  - while the drive runs at 1000 r/min: a live change (speed.bw_hz) is
+    answered ok in its row, the box keeps the new value, the drive keeps
+    running at its speed; a change the firmware refuses while running
+    (m.rs_ohm) shows the firmware's reason in red and the box reverts to the
+    firmware's value; so does a tunable set out of range (`err 4 range
+    [min, max]`);
   - STOP gives state=ready;
   - the firmware page without an ST-LINK (tools/flash sees no probe): the
     page says so, in red, and nothing was written; with a probe (a stand-in
@@ -144,7 +153,7 @@ def http_status(url):
         return e.code
 
 
-async def watcher_checks(ws_url, expect_stop_within):
+async def watcher_checks(ws_url, expect_stop_within, ready):
     """A second page (a plain WebSocket client): it is told it watches, its
     `arm` is refused, its `status` is answered (a watcher reads), and it sees
     the drive stopped once the controlling page is gone. Returns the seconds
@@ -175,6 +184,7 @@ async def watcher_checks(ws_url, expect_stop_within):
             print("  watcher: role=watch, arm refused (%s); status answered (%s)" %
                   (refused, [l.strip() for l in answered if "state=" in l][0]))
             # Hand over to the caller, who ends the controlling browser now.
+            ready.set()
             yield_at = time.monotonic()
             await ws.send_str(json.dumps({"type": "heartbeat"}))
             armed_seen = False
@@ -189,6 +199,93 @@ async def watcher_checks(ws_url, expect_stop_within):
                     if armed_seen and st.get("armed") == "0" and st.get("state") == "ready":
                         return time.monotonic() - yield_at
             raise Fail("the drive was not stopped after the controlling page was lost")
+
+
+GROUPS = ("", "m", "enc", "est", "inv", "speed", "lim", "prot")  # "": the tunables
+
+
+def rows(wd):
+    return wd.js(
+        "return [...document.querySelectorAll('#ptree tr[data-param]')].map((tr) => ({"
+        "name: tr.dataset.param, group: tr.closest('details').dataset.group,"
+        "value: tr.querySelector('input').value, unit: tr.children[2].textContent,"
+        "range: tr.children[3].textContent, when: tr.children[4].textContent,"
+        "help: (tr.querySelector('.phelp') || {}).textContent || '',"
+        "msg: tr.querySelector('td.msg').textContent,"
+        "err: tr.querySelector('td.msg').classList.contains('err')}))")
+
+
+def check_tree(wd):
+    """Every group, every row with unit, range, help and when it changes."""
+    wd.js("consoleState.params = []; pmsm.command('param list', {quiet: true});")
+    r = wait_for("the parameter tree", lambda: (lambda x: x if len(x) > 20 else None)(rows(wd)), 30)
+    groups = wd.js("return [...document.querySelectorAll('#ptree details')].map((d) => "
+                   "[d.dataset.group, d.querySelector('summary').textContent])")
+    have = [g for g, _ in groups]
+    missing = [g for g in GROUPS if g not in have]
+    bad = [x["name"] for x in r if not x["help"] or not x["range"].startswith("[") or
+           x["when"] not in ("live", "gates off", "read-only")]
+    live = {x["name"] for x in r if x["when"] == "live"}
+    if missing or bad or not {"speed.bw_hz", "speed.kp"} <= live or "m.rs_ohm" in live or \
+            not any(x["name"] == "m.rs_ohm" and x["unit"] == "ohm" for x in r):
+        raise Fail("parameter tree: groups %r (missing %r), rows without help/range/when %r, "
+                   "live %r" % (groups, missing, bad, sorted(live)))
+    print("  parameter tree: %d parameters in %d groups (%s); live: %s" % (
+        len(r), len(groups), ", ".join(t for _, t in groups), " ".join(sorted(live))))
+
+
+def row(wd, name):
+    return next(x for x in rows(wd) if x["name"] == name)
+
+
+def set_in_box(wd, name, value):
+    wd.js("delete consoleState.paramMsg[arguments[0]];"
+          "document.querySelector('tr[data-param=\"' + arguments[0] + '\"] td.msg').textContent = ''",
+          name)
+    wd.type('tr[data-param="%s"] input' % name, "%s\ue007" % value)
+    return wait_for("the answer in the row of %s" % name,
+                    lambda: (lambda x: x if x["msg"] else None)(row(wd, name)), 30)
+
+
+def check_live_change(wd, st):
+    """speed.bw_hz while running: ok, kept, the drive still at its speed."""
+    x = set_in_box(wd, "speed.bw_hz", "20")
+    if x["err"] or x["msg"] != "ok speed.bw_hz 20":
+        raise Fail("live change speed.bw_hz 20: %r" % x)
+    time.sleep(1.0)
+    x = row(wd, "speed.bw_hz")
+    tail = wd.js("const s = consoleState.charts.series; const k = s.names.indexOf('speed');"
+                 "return s.v[k].slice(-20)")
+    if x["value"] != "20" or (st() or {}).get("state") != "running" or \
+            not all(abs(v - SPEED_RPM) <= 0.03 * SPEED_RPM for v in tail):
+        raise Fail("after the live change: %r, state %r, speed %r" % (x, (st() or {}).get("state"),
+                                                                      tail))
+    print("  live: speed.bw_hz 20 while running -> %s; box %s; still running at %.0f r/min" % (
+        x["msg"], x["value"], tail[-1]))
+
+
+def check_refusals(wd):
+    """Refused while running, and out of range: the reason in red, the box
+    back at the firmware's value."""
+    before = row(wd, "m.rs_ohm")["value"]
+    x = set_in_box(wd, "m.rs_ohm", "1.2")
+    want = "err 8 state in running: m.rs_ohm changes with the gates off only"
+    if not x["err"] or x["msg"] != want:
+        raise Fail("m.rs_ohm 1.2 while running: %r" % x)
+    x = wait_for("the box of m.rs_ohm back at the firmware's value",
+                 lambda: (lambda y: y if y["value"] == before else None)(row(wd, "m.rs_ohm")), 30)
+    print("  refused: m.rs_ohm 1.2 -> %s; box back at %s" % (x["msg"], x["value"]))
+    p = wait_for("a writable tunable with a range", lambda: wd.js(
+        "for (const p of consoleState.params) { const m = /^\\[(\\S+), (\\S+)\\]$/.exec(p.range);"
+        " if (!p.ro && p.name.indexOf('.') < 0 && m && isFinite(+m[2])) "
+        "return {name: p.name, max: +m[2], value: p.value}; } return null"), 30)
+    bad = p["max"] * 10 + 1 if p["max"] > 0 else p["max"] + 1
+    x = set_in_box(wd, p["name"], "%g" % bad)
+    if not x["err"] or not x["msg"].startswith("err 4 range ["):
+        raise Fail("param set %s %g: %r" % (p["name"], bad, x))
+    x = wait_for("the box of %s back at the firmware's value" % p["name"],
+                 lambda: (lambda y: y if y["value"] == p["value"] else None)(row(wd, p["name"])), 30)
+    print("  refused: %s %g -> %s; box back at %s" % (p["name"], bad, x["msg"], x["value"]))
 
 
 def check_rest_axes(wd):
@@ -213,6 +310,7 @@ def check_rest_axes(wd):
 
 def check_firmware_page(wd, usb):
     """The firmware page: no probe -> the page's error; a probe -> the phases."""
+    wd.js("window.scrollTo(0, 0)")  # the tabs below the sticky header
     wd.click('button[data-tab="tab-fw"]')
     flash = lambda: wd.js("return consoleState.flash")
     wait_for("the image the page would flash", lambda: (flash().get("info") or {}).get("image"), 20)
@@ -255,6 +353,7 @@ def check_firmware_page(wd, usb):
     print("  firmware page, probe (stand-in openocd): %s -> %s" % (
         " -> ".join("%s %d%%" % x for x in seen), wd.js(
             "return document.getElementById('fw-verdict').textContent")))
+    wd.js("window.scrollTo(0, 0)")
     wd.click('button[data-tab="tab-cmd"]')
 
 
@@ -366,19 +465,11 @@ def main():
         if fps < 30:
             raise Fail("the page renders at %.1f frames/s (< 30)" % fps)
 
-        # A tunable out of range: the firmware's own error in its row.
+        # The parameter tree, a live change, refusals (the drive runs).
         wd.click('button[data-tab="tab-params"]')
-        p = wait_for("a writable tunable with a range", lambda: wd.js(
-            "for (const p of consoleState.params) { const m = /^\\[(\\S+), (\\S+)\\]$/.exec(p.range);"
-            " if (!p.ro && m && isFinite(+m[2])) return {name: p.name, max: +m[2]}; } return null"), 30)
-        bad = p["max"] * 10 + 1 if p["max"] > 0 else p["max"] + 1
-        wd.type('tr[data-param="%s"] input' % p["name"], "%g\ue007" % bad)
-        msg = wait_for("the error in the row of %s" % p["name"], lambda: wd.js(
-            "const t = document.querySelector('tr[data-param=\"%s\"] td.msg');"
-            "return t && t.classList.contains('err') ? t.textContent : null" % p["name"]), 30)
-        if not msg.startswith("err 4 range ["):
-            raise Fail("param set %s %g: %r" % (p["name"], bad, msg))
-        print("  param set %s %g -> %s" % (p["name"], bad, msg))
+        check_tree(wd)
+        check_live_change(wd, st)
+        check_refusals(wd)
 
         wd.click("#stop")
         wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready" and
@@ -394,9 +485,13 @@ def main():
         ws_url = base.replace("http://", "ws://") + "/ws?token=" + token
 
         async def loss():
-            gen = watcher_checks(ws_url, PAGE_TIMEOUT_S)
-            task = asyncio.ensure_future(gen)
-            await asyncio.sleep(3.0)     # the watcher has its role and its refusal by then
+            ready = asyncio.Event()
+            task = asyncio.ensure_future(watcher_checks(ws_url, PAGE_TIMEOUT_S, ready))
+            # the watcher has its role, its refusal and its answer by then
+            await asyncio.wait([task, asyncio.ensure_future(ready.wait())], timeout=30,
+                               return_when=asyncio.FIRST_COMPLETED)
+            if task.done():
+                return await task  # it failed before (raises)
             await asyncio.get_running_loop().run_in_executor(None, wd.quit)
             return await task
         dt = asyncio.run(loss())
