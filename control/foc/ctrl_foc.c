@@ -74,8 +74,10 @@ void ctrl_foc_reset(void *state)
     s->pi_q.integ = 0;
     s->v_d = 0;
     s->v_q = 0;
+#if PMSM_LIVE_PARAMS
     s->e_d = 0;
     s->e_q = 0;
+#endif
     ctrl_fieldweak_reset(&s->fieldweak);
 }
 
@@ -92,8 +94,10 @@ static void foc_pi_step(ctrl_foc_state_t *s, const ctrl_ctx_t *ctx, q24_t id_ref
     const q24_t v_q = fx_add(fx_mul(w, nx->psi_d), foc_pi_out(&s->pi_q, e_q));
     s->v_d = v_d;
     s->v_q = v_q;
-    s->e_d = e_d;
+#if PMSM_LIVE_PARAMS
+    s->e_d = e_d; /* foc_retune's */
     s->e_q = e_q;
+#endif
     /* Mean rotor angle over [k+1, k+2): theta(k+1) + omega Ts / 2 =
      * theta(k) + 3/2 delta: the estimator's sine and cosine at k turned by
      * 3/2 delta (formed in 64 bits, rounded, taken modulo one turn). */

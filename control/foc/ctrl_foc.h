@@ -58,7 +58,9 @@ typedef struct {
     ctrl_fieldweak_t fieldweak;
     ctrl_foc_pi_t pi_d, pi_q;
     q24_t v_d, v_q; /* last commanded voltage before the limit (telemetry/tests), Q24 pu */
+#if PMSM_LIVE_PARAMS
     q24_t e_d, e_q; /* last current errors, Q24 pu (a gain changed while running) */
+#endif
 } ctrl_foc_state_t;
 
 /* Current references for torque t (Q24 pu): i_d <= 0, i_q with the sign of t. */

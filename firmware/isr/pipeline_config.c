@@ -161,8 +161,10 @@ static FW_SPEED_GAINS_INLINE int fw_speed_gains(fw_t *fw, const fw_config_t *cfg
 static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t *ctrl,
                             const void *ctrl_cfg)
 {
+#if PMSM_LIVE_PARAMS
     fw->req_speed_tune = 0u; /* superseded by the gains set here */
     fw_publish_barrier();
+#endif
     const hal_info_t *in = &fw->info;
     if (ctrl_params_init_diag(&fw->params, &fw->bases, fw->machine, in->pwm_freq_hz, &fw->why) !=
         CTRL_OK) {
@@ -503,11 +505,13 @@ bool fw_commission_poll(fw_t *fw)
 /* Initialise desc with cfg into the state block; keep both on success. */
 static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *cfg)
 {
+#if PMSM_LIVE_PARAMS
     /* A live change the interrupt has not taken yet is superseded (cfg holds
      * it): withdrawn before the state is written, so that the interrupt no
      * longer touches the state. */
     fw->req_ctrl_tune = 0u;
     fw_publish_barrier();
+#endif
     union {
         max_align_t align;
         unsigned char bytes[CTRL_STATE_MAX];

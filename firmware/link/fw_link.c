@@ -214,7 +214,9 @@ static int op_param_set(void *ctx, const char *name, double value)
     fw_link_t *l = fw_link_of(ctx);
     const fw_link_param_t *p = fw_link_param(l, name);
     int rc;
+#if PMSM_LIVE_PARAMS
     l->why_note = false;
+#endif
     if (p != NULL) {
         memset(&l->why, 0, sizeof l->why); /* the application sets it (fw_link_set_why) */
         rc = p->set != NULL ? p->set(l->params_ctx, p, value) : CMD_E_READONLY;
@@ -226,9 +228,12 @@ static int op_param_set(void *ctx, const char *name, double value)
         }
 #endif
     }
+#if PMSM_LIVE_PARAMS
     if (rc == CMD_E_STATE) {
         /* Why, for err 8: the state, and that the parameter changes only with
-         * the gates off, or that the last live change is still on its way. */
+         * the gates off, or that the last live change is still on its way
+         * (where some parameters are live and others not; without live
+         * parameters the state alone says it). */
         const size_t n = fw_link_state_text(l);
         const bool pending = (l->fw->req_speed_tune | l->fw->req_ctrl_tune) != 0u;
         (void)snprintf(l->state_text + n, sizeof l->state_text - n, ": %s%s",
@@ -236,6 +241,7 @@ static int op_param_set(void *ctx, const char *name, double value)
                        pending ? "" : " changes with the gates off only");
         l->state_note = true;
     }
+#endif
     return rc;
 }
 
@@ -261,10 +267,12 @@ static const char *op_failed_detail(void *ctx)
 {
     fw_link_t *l = fw_link_of(ctx);
     const ctrl_diag_t *d = &l->why;
+#if PMSM_LIVE_PARAMS
     if (l->why_note) {
         l->why_note = false;
         return l->why_text;
     }
+#endif
     if (d->code == CTRL_OK || d->quantity == NULL) {
         return NULL;
     }
