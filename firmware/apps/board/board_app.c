@@ -6,6 +6,7 @@
 
 #include "board_app_cfg.h" /* the image's back-end of hal.h: its struct hal */
 #include "cmd.h"
+#include "fw_params.h"
 
 void board_app_config_default(const board_app_t *a, fw_config_t *c, const ctrl_machine_t *m,
                               const ctrl_desc_t *ctrl)
@@ -245,6 +246,9 @@ void board_app_settings_start(board_app_t *a, const settings_flash_t *flash)
     st->ctx = a;
     (void)fw_settings_boot(st);
     fw_link_set_settings(&a->link, st);
+#if PMSM_LIVE_PARAMS
+    fw_params_attach(&a->link, &fw_params_drive);
+#endif
     board_uart_puts(&a->uart, a->port->tag);
     board_uart_puts(&a->uart, st->msg);
     board_uart_puts(&a->uart, "\r\n");

@@ -130,18 +130,24 @@ void board_app_messages(board_app_t *a);
 
 /* The settings record in the board's flash (its two pages/sectors):
  * applied at start-up, or the defaults, said on the console; the "config"
- * commands attached. */
+ * commands attached; with PMSM_LIVE_PARAMS the configuration beyond the
+ * machine data (fw_params_drive: est.*, inv.*, speed.*, ...) as parameters
+ * too, written through the record's apply. */
 void board_app_settings_start(board_app_t *a, const settings_flash_t *flash);
 
-/* Entries of a parameter table (fw_link_param_t): read/write with its
- * range, read-only. */
+/* Entries of a parameter table (fw_link_param_t): written with the gates
+ * off, within its range; written also while the drive runs; read-only. */
 #define BOARD_APP_RW(name, unit, lo, hi, help, get, set)                                           \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), false, lo, hi}, get, set                                     \
+        {name, unit, HELP_TEXT(help), CMD_PARAM_RW, lo, hi}, get, set                              \
+    }
+#define BOARD_APP_LIVE(name, unit, lo, hi, help, get, set)                                         \
+    {                                                                                              \
+        {name, unit, HELP_TEXT(help), CMD_PARAM_LIVE, lo, hi}, get, set                            \
     }
 #define BOARD_APP_RO(name, unit, help, get)                                                        \
     {                                                                                              \
-        {name, unit, HELP_TEXT(help), true, 0.0, 0.0}, get, NULL                                   \
+        {name, unit, HELP_TEXT(help), CMD_PARAM_RO, 0.0, 0.0}, get, NULL                           \
     }
 
 /* The parameter table (board_params.c): the machine, encoder, common board

@@ -235,8 +235,8 @@ static const fw_link_param_t board_params[BOARD_N_PARAMS] = {
     [P_DUTY] = BOARD_APP_RO("b.duty_max", "-", "largest leg duty (current sampling window)",
                             board_get_duty_max),
     [P_TEMP] = BOARD_APP_RO("b.temp_c", "C", "power stage temperature", board_get_temp),
-    [P_TEMP_CHECK] = BOARD_APP_RW("b.temp_check", "-", 0.0, 1.0, "1 = over-temperature trip on",
-                                  board_get_temp_check, board_set_temp_check),
+    [P_TEMP_CHECK] = BOARD_APP_LIVE("b.temp_check", "-", 0.0, 1.0, "1 = over-temperature trip on",
+                                    board_get_temp_check, board_set_temp_check),
     [P_RESET] = BOARD_APP_RO("b.reset", "-", BOARD_APP_RESET_HELP, board_get_reset),
     [P_T0 + T_MODE] = TRW("throttle.mode", "-", 0.0, 2.0, "servo input: 0 off, 1 torque, 2 speed"),
     [P_T0 + T_LOW] =
