@@ -27,6 +27,8 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 STUDY = os.path.join(ROOT, "tools", "study")
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import study_spec  # noqa: E402
 PY = "/usr/bin/python3"
 SIM = None
 
@@ -94,14 +96,22 @@ class Base(unittest.TestCase):
 
 
 class BadInput(Base):
-    def refused(self, text, *pattern, args=()):
+    def refused(self, text, *pattern, cli=False):
+        """The file refused with the patterns in its message: through tools/study (exit
+        status 2, no traceback) with cli, else by the checker tools/study calls."""
         p = self.write(text)
-        r = study(p, "--dry-run", *args)
-        self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+        if cli:
+            r = study(p, "--dry-run")
+            self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+            self.assertNotIn("Traceback", r.stderr)
+            msg = r.stderr
+        else:
+            with self.assertRaises(study_spec.SpecError) as cm:
+                study_spec.Spec(p)
+            msg = f"study: error: {cm.exception}"
         for pat in pattern:
-            self.assertRegex(r.stderr, pat.replace("FILE", p))
-        self.assertNotIn("Traceback", r.stderr)
-        return r.stderr
+            self.assertRegex(msg, pat.replace("FILE", p))
+        return msg
 
     def test_good_file_counts_its_runs(self):
         r = study(self.write(GOOD), "--dry-run")
@@ -110,7 +120,7 @@ class BadInput(Base):
 
     def test_unknown_key(self):
         self.refused(GOOD.replace("seed = 3", "sede = 3"),
-                     r"FILE:3: study\.sede: unknown key \(allowed: ")
+                     r"^study: error: FILE:3: study\.sede: unknown key \(allowed: ", cli=True)
         self.refused(GOOD.replace("torque_pu = 0.5", "torque_pu = 0.5\nload_pu = 0.5"),
                      r"FILE:16: points\.0\.load_pu: does not apply to a torque-mode point")
         self.refused(GOOD.replace("rs = {", "rz = {"),
@@ -121,7 +131,7 @@ class BadInput(Base):
     def test_impossible_distribution(self):
         self.refused(GOOD.replace("lo = -0.1", "lo = -1.5"),
                      r"FILE:18: spread\.rs\.lo: -1\.5 is outside the parameter's domain: a "
-                     r"deviation in \(-1, 10\] \(the quantity would not be positive\)")
+                     r"deviation in \(-1, 10\] \(the quantity would not be positive\)", cli=True)
         self.refused(GOOD.replace("lo = -0.1, hi = 0.1", "lo = 0.1, hi = -0.1"),
                      r"FILE:18: spread\.rs\.hi: lo 0\.1 >= hi -0\.1: an empty distribution")
         self.refused(GOOD.replace('rs = { dist = "uniform", lo = -0.1, hi = 0.1 }',
