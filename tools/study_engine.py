@@ -334,10 +334,14 @@ class Store:
                                   cached=True)
         return out
 
-    def put(self, run, raw):
+    def put(self, run, raw, commit=True):
         self.db.execute("INSERT OR IGNORE INTO runs VALUES (?,?,?,?,?,?,?,?,?)",
                         (run.key, run.description, raw["rc"], raw["stderr"], raw["outputs"],
                          raw["wall_s"], raw["cpu_s"], raw["worker"], time.time()))
+        if commit:
+            self.db.commit()
+
+    def commit(self):
         self.db.commit()
 
     def count(self):
@@ -461,10 +465,16 @@ class Engine:
     # -- cluster
     def _connect(self):
         logging.getLogger("distributed").setLevel(logging.ERROR)
-        import cloudpickle
+        import dask
         from distributed import Client
-        cloudpickle.register_pickle_by_value(study_worker)
+        # The client reads the submitting code's source for the dashboard's record on
+        # every submit (inspect.getsource): none of it here.
+        dask.config.set({"distributed.diagnostics.computations.ignore-modules": [".*"]})
         if self.scheduler:
+            import cloudpickle
+            # The workers need the simulator, not this repository's code: the run's
+            # function travels by value.
+            cloudpickle.register_pickle_by_value(study_worker)
             try:
                 self.client = Client(self.scheduler, timeout=self.connect_timeout_s,
                                      set_as_default=False)
@@ -473,18 +483,19 @@ class Engine:
                                       f"reachable within {self.connect_timeout_s:g} s ({e})"
                                       ) from None
         else:
-            import dask
             from distributed import LocalCluster
             # Threads in this process: each run is a simulator process, a worker
             # thread only waits for it. No statistical profiler (it samples every
             # thread's stack every 10 ms) and slower housekeeping: the engine's own
             # CPU time per run is then a fraction of a simulator run's.
             dask.config.set({"distributed.worker.profile.enabled": False,
-                             "distributed.worker.memory.monitor-interval": "1s",
-                             "distributed.admin.system-monitor.interval": "2s",
-                             "distributed.admin.tick.interval": "200ms",
-                             # every worker is in this process: nothing to steal
-                             "distributed.scheduler.work-stealing": False})
+                             "distributed.worker.memory.monitor-interval": "5s",
+                             "distributed.admin.system-monitor.interval": "5s",
+                             "distributed.admin.tick.interval": "1s",
+                             "distributed.client.scheduler-info-interval": "10s",
+                             # every worker is in this process: nothing to steal or move
+                             "distributed.scheduler.work-stealing": False,
+                             "distributed.scheduler.active-memory-manager.start": False})
             # No dashboard (no bokeh here); the scheduler's HTTP server on a free
             # loopback port, not on 8787 (where another cluster may be).
             self.cluster = LocalCluster(n_workers=self.jobs, threads_per_worker=1,
@@ -597,10 +608,14 @@ class Engine:
         for f in ac:
             chunk = runs_of.pop(f.key)
             if f.status == "finished":
-                for r, raw in zip(chunk, f.result()):
-                    got[r.key] = self._arrived(r, raw, prog)
+                raws = f.result()
+                for r, raw in zip(chunk, raws):  # one transaction for the task's runs
+                    got[r.key] = self._arrived(r, raw, None, commit=False)
                     n, t = self._timed
                     self._timed = (n + 1, t + raw["wall_s"])
+                self.store.commit()
+                for r in chunk:
+                    prog.step(failed=got[r.key].status != "ok")
             else:
                 exc = f.exception()
                 name = type(exc).__name__
@@ -619,19 +634,22 @@ class Engine:
             f.release()
             submit_next()
 
-    def _arrived(self, run, raw, prog):
+    def _arrived(self, run, raw, prog, commit=True):
+        """The result of a raw one, stored (committed unless commit is False: the
+        caller commits the task's runs together); prog steps unless None."""
         if raw["timeout"]:
             res = Result(run.key, raw["rc"], raw["stderr"], _unpack(raw), raw["wall_s"],
                          raw["cpu_s"], raw["worker"], status="timeout",
                          reason=f"no result within {run.timeout_s:g} s")
         else:
-            self.store.put(run, raw)
+            self.store.put(run, raw, commit)
             res = Result(run.key, raw["rc"], raw["stderr"], _unpack(raw), raw["wall_s"],
                          raw["cpu_s"], raw["worker"])
             self.stats["sim_wall"] += raw["wall_s"]
             self.stats["sim_cpu"] += raw["cpu_s"]
         self._tick()
-        prog.step(failed=res.status != "ok")
+        if prog is not None:
+            prog.step(failed=res.status != "ok")
         return res
 
     # -- summary
