@@ -171,7 +171,8 @@ static const cli_opt_t k_opts[] = {
     {"--iq0", "A", K_REAL, -1e5, 1e5, "A", M_REPLAY, "--replay", NULL, F(iq0),
      "replay: initial q current (default 0)"},
     {"--identify", NULL, K_FLAG, 0, 0, "", M_IDENT, NULL, NULL, F(identify),
-     "run the firmware's identification (free rotor, no load): Rs, Ld, Lq, psi_pm, encoder; "
+     "run the firmware's identification (free rotor; of the machine file's [mechanics] the "
+     "friction, cogging and passive load act, no active load): Rs, Ld, Lq, psi_pm, encoder; "
      "--metrics writes \"identified\" beside the truth"},
     {"--identify-out", "FILE.ini", K_TEXT, 0, 0, "", M_IDENT, "--identify", NULL, F(identify_out),
      "write the configured machine with the identified values"},
