@@ -1,6 +1,13 @@
 """Build a CMake target with a progress bar: the count of build steps and the
 time left, for a tool that needs an image it can build itself (tools/console's
-interactive QEMU image, pil_interactive.elf).
+interactive QEMU image, pil_interactive.elf; tools/sim's simulator and PIL image;
+./tools/demo's builds).
+
+    python3 tools/build_progress.py BUILD_DIR TARGET [LABEL]
+
+builds TARGET in the configured BUILD_DIR with the bar on stderr, silently when it
+is up to date (the log in BUILD_DIR/TARGET-build.log; on failure its last lines and
+exit status 1).
 
     ok, why = ensure_built(root, "cm4", "pil_interactive", elf_path)
 
@@ -29,8 +36,8 @@ NEEDS = {"cm4": ["cmake", "ninja", "arm-none-eabi-gcc"]}
 class Bar:
     """Progress of one build on a stream: a bar on a terminal, lines otherwise."""
 
-    def __init__(self, label, out=sys.stderr, tty=None, clock=time.monotonic):
-        self.label, self.out, self.clock = label, out, clock
+    def __init__(self, label, out=sys.stderr, tty=None, clock=time.monotonic, quiet=False):
+        self.label, self.out, self.clock, self.quiet = label, out, clock, quiet
         self.tty = out.isatty() if tty is None else tty
         self.t0 = clock()
         self.total = None
@@ -82,6 +89,8 @@ class Bar:
         if self.tty:
             self.out.write("\r\033[K")
         if self.total is None:
+            if ok and self.quiet:
+                return  # nothing was built: nothing to say
             msg = "%s: up to date" % self.label if ok else "%s: failed" % self.label
         else:
             msg = "%s: %d steps in %s%s" % (self.label, self.done, el, "" if ok else ", FAILED")
@@ -93,12 +102,13 @@ def clock_text(s):
     return "%d:%02d" % (s // 60, s % 60)
 
 
-def run_with_bar(argv, label, env=None, out=sys.stderr, log=None):
+def run_with_bar(argv, label, env=None, out=sys.stderr, log=None, quiet=False):
     """Run argv (a build), its status lines drawn as a bar; every line also goes to
-    log (a file object, may be None). Returns (exit status, the last 20 lines)."""
+    log (a file object, may be None); quiet: no line at all when nothing was built.
+    Returns (exit status, the last 20 lines)."""
     e = dict(os.environ if env is None else env)
     e["NINJA_STATUS"] = "[%f/%t] "
-    bar = Bar(label, out)
+    bar = Bar(label, out, quiet=quiet)
     tail = []
     try:
         p = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
@@ -146,3 +156,24 @@ def ensure_built(root, preset, target, artefact, out=sys.stderr):
     if not os.path.isfile(artefact):
         return False, "the build of %s made no %s" % (target, artefact)
     return True, None
+
+
+def main(argv):
+    if len(argv) not in (3, 4):
+        print("usage: build_progress.py BUILD_DIR TARGET [LABEL]", file=sys.stderr)
+        return 2
+    bdir, target = argv[1], argv[2]
+    label = argv[3] if len(argv) == 4 else "building %s" % target
+    logpath = os.path.join(bdir, "%s-build.log" % target)
+    with open(logpath, "w") as log:
+        rc, tail = run_with_bar(["cmake", "--build", bdir, "--target", target, "-j2"], label,
+                                log=log, quiet=True)
+    if rc != 0:
+        print("\n".join(tail), file=sys.stderr)
+        print("%s failed (log: %s)" % (label, logpath), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
