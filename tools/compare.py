@@ -42,6 +42,7 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import analyses  # noqa: E402  (the open findings' mechanisms, checked by runs)
+import decide  # noqa: E402  (the decision table: its runs and its derivation)
 import study_engine as se  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -870,6 +871,8 @@ def main():
                 for kv in SET_OVERRIDE.get((name, rpm), []):
                     cmd += ["--set", kv]
                 job(("sweep", name, rpm, fs_s), sb, cmd)
+        for key, dbase, cmd in decide.jobs(name, sim, runs_dir, common, fast=a.fast):
+            job(key, dbase, cmd)
         base = os.path.join(runs_dir, f"{name}_dynamic")
         job(("dynamic", name), base,
             [sim, "--machine", MACHINE, "--controller", name, "--free", "--scenario", scn,
@@ -924,16 +927,17 @@ def main():
         if ok(res.get("m")) and os.path.exists(p):
             d = load_trace(p)
             chap[name] = float(np.max(d["torque"]) - np.min(d["torque"]))
-    bench = None
+    bench, bench_all = None, None
     bpath = os.path.join(a.out, "bench.json")
     if os.path.exists(bpath):
         try:
             with open(bpath) as f:
                 bj = json.load(f)
-            bench = {n: c.get("cm4_instr_mean") for n, c in bj.get("controllers", {}).items()
-                     if isinstance(c, dict)}
+            bench_all = {n: c for n, c in bj.get("controllers", {}).items()
+                         if isinstance(c, dict)}
+            bench = {n: c.get("cm4_instr_mean") for n, c in bench_all.items()}
         except (OSError, ValueError, KeyError):
-            bench = None
+            bench, bench_all = None, None
 
     # ---- plots ----
     figs = [(rpm, plot_indices(results, names, rpm, a.out)) for rpm in SPEEDS_USED]
@@ -968,6 +972,11 @@ def main():
       "thesis SPMSM and the 80 kW IPMSM (±10 % R and L, ±5 % ψpm, ±3° encoder, dead time "
       "0–1 µs, current-sense gains ±2 %), its small version; the full one in "
       "docs/studies.md: [tolerance.md](tolerance.md) (`tools/study`).\n")
+    dec_lines, _dec = decide.section(
+        names, results, SPEEDS_USED,
+        lambda n, rpm, key: interp_at(sweep_points(results, n, rpm, key), decide.FAV_HZ),
+        dyn, bench_all, {n: decide.tunables(sim, n) for n in names})
+    L += dec_lines
     w("## Findings\n")
     w("### The sources' claims beside the measurements\n")
     w("Verdicts: *reproduced* — same direction and a size within ±50 % of the claim (for "

@@ -21,6 +21,8 @@ import tempfile
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import decide  # noqa: E402  (the decision table's columns)
 SIM = None
 
 
@@ -43,10 +45,30 @@ class ReportTest(unittest.TestCase):
         self.assertEqual(self.rc, 0, self.err)
         self.assertTrue(self.md)
 
+    def test_decision_table_first(self):
+        """The report opens with the decision table: a row per controller with its best
+        and worst column and a number (or n/a, trips) in every column, then the "use X
+        for Y" sentences (tools/decide.py)."""
+        h2 = re.findall(r"^## (.+)$", self.md, re.M)
+        self.assertEqual(h2[0], "Which controller for which job")
+        sec = self.md.split("## Which controller for which job", 1)[1].split("\n## ", 1)[0]
+        for name in ("bst", "m2ptfc"):
+            row = re.search(r"^\| %s \| (.+) \|$" % name, sec, re.M)
+            self.assertIsNotNone(row, name)
+            cells = [c.strip() for c in row.group(1).split(" | ")]
+            self.assertEqual(len(cells), 2 + len(decide.COLUMNS), cells)
+            self.assertRegex(cells[0], r"\((1st|2nd) of 2\)")
+            for c in cells[2:]:
+                self.assertRegex(c, r"^([0-9.]+|n/a|trips)$", row.group(0))
+            # measured, not n/a: ripple, THD, step, |T_sse|, robustness, sensorless
+            self.assertTrue(all(re.match(r"^[0-9.]+$", c) for c in cells[2:8]), cells)
+        self.assertGreaterEqual(len(re.findall(r"^- Use \*\*(bst|m2ptfc)\*\* for ", sec, re.M)),
+                                5)
+
     def test_findings_first(self):
         h2 = re.findall(r"^## (.+)$", self.md, re.M)
         self.assertGreater(len(h2), 3)
-        self.assertEqual(h2[0], "Findings")
+        self.assertEqual(h2[1], "Findings")
         rows = re.findall(r"^\| (.+?) \| (.+?) \| .+? \| .+? \| \*\*(reproduced|direction only|"
                           r"not reproduced)\*\* \| .+ \|$", self.md, re.M)
         self.assertGreaterEqual(len(rows), 10)
