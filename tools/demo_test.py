@@ -1,0 +1,99 @@
+#!/usr/bin/python3
+"""./tools/demo's set-up and reuse decisions (tools/demo_main.py) and the quiet build
+bar (tools/build_progress.py), without running the demo: a missing package is named
+with the one command that installs it; the bench's fingerprint changes with any image
+it counts and not otherwise; a build with nothing to do prints nothing, one with
+steps prints its bar and its total."""
+import io
+import os
+import sys
+import tempfile
+import unittest
+from contextlib import redirect_stdout
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import build_progress  # noqa: E402
+import demo_main  # noqa: E402
+
+
+class SetUp(unittest.TestCase):
+    def setUp(self):
+        self.have, self.euid = demo_main.have, os.geteuid
+
+    def tearDown(self):
+        demo_main.have, os.geteuid = self.have, self.euid
+
+    def test_nothing_missing(self):
+        demo_main.have = lambda kind, what: True
+        self.assertEqual(demo_main.missing_packages(), [])
+        self.assertTrue(demo_main.set_up())
+
+    def test_missing_named_with_the_command(self):
+        demo_main.have = lambda kind, what: what not in ("tqdm", "qemu-system-arm")
+        os.geteuid = lambda: 1000  # not root: it cannot install
+        self.assertEqual(demo_main.missing_packages(), ["python3-tqdm", "qemu-system-arm"])
+        buf = io.StringIO()
+        with redirect_stdout(buf):
+            self.assertFalse(demo_main.set_up())
+        out = buf.getvalue()
+        self.assertIn("missing: python3-tqdm, qemu-system-arm", out)
+        self.assertIn("    sudo ./tools/setup cmake ninja-build", out)
+        self.assertEqual(sum(1 for ln in out.splitlines() if "sudo" in ln), 1)
+
+    def test_every_needed_package_is_one_tools_setup_installs(self):
+        with open(os.path.join(demo_main.ROOT, "tools", "setup")) as f:
+            setup = f.read()
+        for pkg, _ in demo_main.NEEDS:
+            self.assertRegex(setup, r"[\s(]%s[\s)]" % pkg.replace("+", r"\+"), pkg)
+
+
+class BenchReuse(unittest.TestCase):
+    def test_fingerprint_follows_the_images(self):
+        with tempfile.TemporaryDirectory() as root:
+            old = demo_main.ROOT
+            demo_main.ROOT = root
+            try:
+                self.assertIsNone(demo_main.bench_fingerprint())  # nothing built yet
+                rec = os.path.join(root, "build", "host-release", "tests", "bench", "bench_fw")
+                cm4 = os.path.join(root, "build", "cm4", "tests", "bench", "bench_fw")
+                os.makedirs(rec)
+                os.makedirs(cm4)
+                for p, data in ((os.path.join(rec, "bench_rec"), b"rec"),
+                                (os.path.join(cm4, "bench_cm4.elf"), b"isr"),
+                                (os.path.join(cm4, "bench_size_bst.elf"), b"bst")):
+                    with open(p, "wb") as f:
+                        f.write(data)
+                a = demo_main.bench_fingerprint()
+                self.assertEqual(a, demo_main.bench_fingerprint())
+                with open(os.path.join(cm4, "bench_cm4.map"), "w") as f:
+                    f.write("not counted")
+                self.assertEqual(a, demo_main.bench_fingerprint())
+                with open(os.path.join(cm4, "bench_size_bst.elf"), "wb") as f:
+                    f.write(b"bst, one instruction more")
+                self.assertNotEqual(a, demo_main.bench_fingerprint())
+            finally:
+                demo_main.ROOT = old
+
+
+class QuietBar(unittest.TestCase):
+    def run_bar(self, script, quiet):
+        buf = io.StringIO()
+        rc, _ = build_progress.run_with_bar(["sh", "-c", script], "building x", out=buf,
+                                            quiet=quiet)
+        return rc, buf.getvalue()
+
+    def test_nothing_built_says_nothing(self):
+        rc, out = self.run_bar("printf '[0/1] Re-checking globbed directories...\\n'", True)
+        self.assertEqual((rc, out), (0, ""))
+        rc, out = self.run_bar("printf '[0/1] Re-checking globbed directories...\\n'", False)
+        self.assertIn("building x: up to date", out)
+
+    def test_steps_show_count_and_total(self):
+        rc, out = self.run_bar("printf '[1/2] a\\n[2/2] b\\n'", True)
+        self.assertEqual(rc, 0)
+        self.assertIn("2/2", out)
+        self.assertIn("building x: 2 steps in", out)
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
