@@ -15,16 +15,20 @@ SPEEDS = (750, 2250)
 
 
 def fake(ripple, thd, rise, sse, robust_worst, sens, cpu, flash, tun, trips=()):
-    """results, fav, dyn, bench, tunables of one controller for decide.values."""
+    """results, fav, dyn, bench, tunables of one controller for decide.values;
+    robust_worst: the largest shift of the mean torque (% of T_ref) of the six cases."""
     res = {}
+    t_nom = decide.T_REF * (1 - sse / 100)
     for r in SPEEDS:
-        res[("steady", r)] = {"m": {"fault": "none", "torque_sse_nm": sse / 100 * decide.T_REF}}
-    for case, _ in decide.ROBUST_CASES:
+        res[("steady", r)] = {"m": {"fault": "none", "torque_sse_nm": sse / 100 * decide.T_REF,
+                                    "torque_mean_nm": t_nom}}
+    for i, (case, _) in enumerate(decide.ROBUST_CASES):
         if case in trips:
-            m = {"fault": "overcurrent", "torque_sse_nm": None}
+            m = {"fault": "overcurrent", "torque_mean_nm": None}
         else:
             e = robust_worst if case == "ψpm −20 %" else robust_worst / 2
-            m = {"fault": "none", "torque_sse_nm": e / 100 * decide.T_REF}
+            sign = 1 if i % 2 else -1
+            m = {"fault": "none", "torque_mean_nm": t_nom + sign * e / 100 * decide.T_REF}
         res[("robust", case)] = {"m": m}
     res[("sensorless",)] = {"m": {"fault": "none", "est_angle_err_rms_deg": sens}}
     return {"res": res, "fav": {"torque_ripple_nm": ripple, "thd_i_pct": thd},
@@ -65,7 +69,7 @@ class DecideTest(unittest.TestCase):
         text, val = self.section(self.ctrls())
         self.assertAlmostEqual(val["a"]["ripple"], 0.10)
         self.assertAlmostEqual(val["a"]["sse"], 1.0)
-        self.assertAlmostEqual(val["a"]["robust"], 4.0)  # the worst of the six cases
+        self.assertAlmostEqual(val["a"]["robust"], 4.0)  # the largest shift of the six
         self.assertEqual(val["c"]["robust"], math.inf)  # a trip is the worst
         self.assertIn("| c | ", text)
         row_b = next(ln for ln in text.splitlines() if ln.startswith("| b |"))
@@ -91,10 +95,28 @@ class DecideTest(unittest.TestCase):
 
     def test_all_round_choice(self):
         text, _ = self.section(self.ctrls())
-        # c trips: never the all-round choice; a is best on the mean position among the rest
+        # over the six quality columns: a 1st, 3rd, 3rd, 2nd, 2nd, 1st of 4 -> mean 0.25;
+        # b 2nd, 1st, 1st, 4th (its worst third), ...; c trips; d 2nd or 3rd everywhere
         line = next(ln for ln in text.splitlines() if "all-round choice" in ln)
-        self.assertNotIn("**c**", line)
-        self.assertIn("**a**", line)
+        self.assertIn("Use **a** as the all-round choice", line)
+        self.assertIn("1500 instructions per period, 5000 B of flash", line)
+        ctrls = self.ctrls()
+        ctrls["a"] = fake(0.10, 5.0, 0.30, 1.0, 4.0, 0.5, 1500, 5000, 6, trips=("Rs +20 %",))
+        text, _ = self.section(ctrls)
+        # a trips now, b, c and d each have a worst-third column: no all-round choice
+        self.assertNotIn("all-round choice", text)
+        ctrls["d"] = fake(0.104, 6.0, 0.28, 1.5, 5.0, 1.0, 1600, 5500, 5)
+        text, _ = self.section(ctrls)  # d's step moves out of the worst third
+        self.assertIn("Use **d** as the all-round choice", text)
+
+    def test_wrong_mean_torque_is_recommended_for_nothing(self):
+        ctrls = self.ctrls()
+        ctrls["e"] = fake(0.05, 1.0, 0.10, 10.0, 0.1, 0.1, 900, 1000, 1)  # T_sse 10 %
+        text, _ = self.section(ctrls)
+        self.assertIn("| e | ", text)  # in the table, with its numbers
+        self.assertIn("; not e.", text)
+        self.assertNotIn("**e**", text)
+        self.assertIn("Use **a** for the lowest torque ripple", text)
 
     def test_missing_bench_is_said(self):
         text, val = self.section(self.ctrls(), bench=False)
