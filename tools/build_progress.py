@@ -38,6 +38,9 @@ class Bar:
 
     def __init__(self, label, out=sys.stderr, tty=None, clock=time.monotonic, quiet=False):
         self.label, self.out, self.clock, self.quiet = label, out, clock, quiet
+        # PMSM_PROGRESS=none: no bar and no line for a build that succeeds (the example
+        # outputs of the documentation, tools/doc_examples.py, are what the tools print)
+        self.silent = os.environ.get("PMSM_PROGRESS") == "none"
         self.tty = out.isatty() if tty is None else tty
         self.t0 = clock()
         self.total = None
@@ -75,6 +78,8 @@ class Bar:
         return s
 
     def show(self, what=""):
+        if self.silent:
+            return
         if self.tty:
             self.out.write("\r\033[K" + self.text(what))
             self.out.flush()
@@ -86,6 +91,8 @@ class Bar:
 
     def end(self, ok):
         el = clock_text(self.clock() - self.t0)
+        if self.silent and ok:
+            return
         if self.tty:
             self.out.write("\r\033[K")
         if self.total is None:

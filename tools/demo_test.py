@@ -88,6 +88,17 @@ class QuietBar(unittest.TestCase):
         rc, out = self.run_bar("printf '[0/1] Re-checking globbed directories...\\n'", False)
         self.assertIn("building x: up to date", out)
 
+    def test_silent_for_the_documentation(self):
+        os.environ["PMSM_PROGRESS"] = "none"  # as tools/doc_examples.py runs the examples
+        try:
+            rc, out = self.run_bar("printf '[1/2] a\\n[2/2] b\\n'", True)
+            self.assertEqual((rc, out), (0, ""))
+            rc, out = self.run_bar("printf '[1/2] a\\n'; exit 1", True)
+            self.assertEqual(rc, 1)
+            self.assertIn("FAILED", out)  # a failure is always said
+        finally:
+            del os.environ["PMSM_PROGRESS"]
+
     def test_steps_show_count_and_total(self):
         rc, out = self.run_bar("printf '[1/2] a\\n[2/2] b\\n'", True)
         self.assertEqual(rc, 0)
