@@ -134,6 +134,11 @@ class WebDriver:
             fh.write(png)
 
 
+def parse_status(lines):
+    """`status` list lines ('  key=value') into a dict."""
+    return dict(l.strip().split("=", 1) for l in lines if "=" in l)
+
+
 def wait_for(what, fn, timeout, period=0.2):
     end = time.monotonic() + timeout
     last = None
@@ -155,9 +160,15 @@ def http_status(url):
 
 async def watcher_checks(ws_url, expect_stop_within, ready):
     """A second page (a plain WebSocket client): it is told it watches, its
-    `arm` is refused, its `status` is answered (a watcher reads), and it sees
-    the drive stopped once the controlling page is gone. Returns the seconds
-    from the browser's end to state=ready."""
+    `arm` is refused, its `status` is answered (a watcher reads) and says the
+    drive is armed; once the controlling page is gone it sees the drive
+    stopped. Returns the seconds from the hand-over to armed=0, state=ready.
+
+    The drive's being armed at the hand-over is taken from the watcher's own
+    `status` answer, not from a status poll after it: on a fast machine the
+    browser is gone and the drive stopped before the next poll (every 0.25 s
+    while the line is idle), and the first status after the hand-over
+    already says armed=0."""
     import aiohttp
     async with aiohttp.ClientSession() as s:
         async with s.ws_connect(ws_url, origin=ws_url.replace("ws://", "http://").split("/ws")[0]) as ws:
@@ -181,22 +192,22 @@ async def watcher_checks(ws_url, expect_stop_within, ready):
             if not answered or not answered[0].startswith("ok") or \
                     not any(l.strip().startswith("state=") for l in answered):
                 raise Fail("second page: status not answered (%r)" % answered)
-            print("  watcher: role=watch, arm refused (%s); status answered (%s)" %
-                  (refused, [l.strip() for l in answered if "state=" in l][0]))
+            st = parse_status(answered[1:])
+            if st.get("armed") != "1":
+                raise Fail("second page: the drive is not armed at the hand-over (%r)" % answered)
+            print("  watcher: role=watch, arm refused (%s); status answered (state=%s armed=%s)" %
+                  (refused, st.get("state"), st.get("armed")))
             # Hand over to the caller, who ends the controlling browser now.
             ready.set()
             yield_at = time.monotonic()
             await ws.send_str(json.dumps({"type": "heartbeat"}))
-            armed_seen = False
             while time.monotonic() - yield_at < expect_stop_within + 15:
                 msg = await ws.receive(timeout=20)
                 m = json.loads(msg.data)
                 await ws.send_str(json.dumps({"type": "heartbeat"}))
                 if m["type"] == "status":
                     st = m["status"]
-                    if st.get("armed") == "1":
-                        armed_seen = True
-                    if armed_seen and st.get("armed") == "0" and st.get("state") == "ready":
+                    if st.get("armed") == "0" and st.get("state") == "ready":
                         return time.monotonic() - yield_at
             raise Fail("the drive was not stopped after the controlling page was lost")
 
@@ -256,10 +267,10 @@ def check_live_change(wd, st):
     x = row(wd, "speed.bw_hz")
     tail = wd.js("const s = consoleState.charts.series; const k = s.names.indexOf('speed');"
                  "return s.v[k].slice(-20)")
-    if x["value"] != "20" or (st() or {}).get("state") != "running" or \
+    status = wd.js("return consoleState.status")
+    if x["value"] != "20" or status.get("state") != "running" or \
             not all(abs(v - SPEED_RPM) <= 0.03 * SPEED_RPM for v in tail):
-        raise Fail("after the live change: %r, state %r, speed %r" % (x, (st() or {}).get("state"),
-                                                                      tail))
+        raise Fail("after the live change: %r, status %r, speed %r" % (x, status, tail))
     print("  live: speed.bw_hz 20 while running -> %s; box %s; still running at %.0f r/min" % (
         x["msg"], x["value"], tail[-1]))
 
@@ -534,6 +545,8 @@ def main():
 
 
 if __name__ == "__main__":
+    # Line by line, in order with the failure (ctest reads both on one pipe).
+    sys.stdout.reconfigure(line_buffering=True)
     try:
         main()
     except Fail as e:

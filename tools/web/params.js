@@ -46,7 +46,7 @@
   function setParam(p, inp) {
     const v = inp.value.trim();
     if (!v) return;
-    inp.dataset.sent = v;
+    delete inp.dataset.edited; // sent: the firmware's answer decides what it shows
     P.command('param set ' + p.name + ' ' + v);
   }
 
@@ -68,6 +68,10 @@
     inp.disabled = p.ro || S.role !== 'control';
     inp.title = p.help || '';
     inp.addEventListener('keydown', (e) => { if (e.key === 'Enter') setParam(p, inp); });
+    // Edited and not yet sent: a listing's value must not overwrite it.
+    const edited = () => { inp.dataset.edited = '1'; };
+    inp.addEventListener('input', edited);
+    inp.addEventListener('change', edited);
     val.appendChild(inp);
     const unit = document.createElement('td');
     unit.textContent = p.unit;
@@ -93,7 +97,7 @@
     if (tree.dataset.names === names && tree.dataset.role === S.role) {
       for (const p of S.params) {
         const inp = tree.querySelector('tr[data-param="' + CSS.escape(p.name) + '"] input');
-        if (inp && document.activeElement !== inp) inp.value = p.value;
+        if (inp && document.activeElement !== inp && !inp.dataset.edited) inp.value = p.value;
       }
       return;
     }
@@ -143,7 +147,7 @@
     const p = S.params.find((x) => x.name === name);
     if (p) p.value = value;
     const inp = document.querySelector('#ptree tr[data-param="' + CSS.escape(name) + '"] input');
-    if (inp) inp.value = value;
+    if (inp) { inp.value = value; delete inp.dataset.edited; }
   }
 
   P.onReply((m) => {
