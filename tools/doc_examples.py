@@ -53,6 +53,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OPEN = re.compile(r"^<!-- example ([A-Za-z0-9_.-]+)((?: [a-z]+=[^ ]+)*) -->$")
 CLOSE = "<!-- /example -->"
 TRANSCRIPT = re.compile(r"^<!-- transcript: .+ -->$")
+NOT_OUTPUT = re.compile(r"^<!-- not output: .+ -->$")
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]|\x1b[()][A-Za-z0-9]|\x1b[=>]")
 LABELS = ("host", "qemu")
 DEFAULT_TIMEOUT = 120.0
@@ -172,8 +173,10 @@ def parse_file(path):
             k = first - 1
             while k >= 0 and not lines[k].strip():
                 k -= 1
-            excused = k >= 0 and TRANSCRIPT.match(lines[k].rstrip())
-            if not excused and is_transcript(text):
+            marker = lines[k].rstrip() if k >= 0 else ""
+            kind = block_kind(text)
+            excused = TRANSCRIPT.match(marker) or (kind == "other" and NOT_OUTPUT.match(marker))
+            if kind != "commands" and not excused:
                 loose.append("%s:%d" % (os.path.relpath(path, ROOT), first + 1))
             i = last
             continue
@@ -181,19 +184,54 @@ def parse_file(path):
     return examples, loose
 
 
-def is_transcript(text):
-    """A prompt ("$ " or "> ") followed by a line that is not one: a program's answer
-    (a line of "..." or in parentheses is the writer's aside, not an answer)."""
-    prompt = False
+# Programs a block of commands may name beside the repository's own executables.
+COMMANDS = {"cmake", "ctest", "git", "sudo", "openocd", "st-flash", "dask", "python3",
+            "qemu-system-arm", "gdb-multiarch", "arm-none-eabi-gdb", "apt-get", "ninja", "cd"}
+
+
+def is_command(line):
+    """A line a user types: a program of the repository (tools/demo, ./tools/sim,
+    build/...) or one of COMMANDS, with its arguments (after sudo or VAR=value)."""
+    words = line.split()
+    while words and (words[0] == "sudo" or re.match(r"^[A-Z_][A-Z0-9_]*=", words[0])):
+        words = words[1:]  # sudo, an environment variable's assignment
+    if words in ([], ["\\"]):
+        return words != line.split()  # assignments alone, the command on the next line
+    w = words[0]
+    if w in COMMANDS:
+        return True
+    path = os.path.join(ROOT, w[2:] if w.startswith("./") else w)
+    return "/" in w and (os.access(path, os.X_OK) and os.path.isfile(path)
+                         or w.startswith("build/") or w.startswith("./build/"))
+
+
+def block_kind(text):
+    """What a code block outside an example shows: "commands" (lines to type: commands,
+    prompts without answers, comments, asides), "transcript" (a prompt, "$ " or "> ",
+    followed by what the program answered) or "other" (a program's output without a
+    prompt, or text that is no command: equations, a file's format). A line of "..."
+    or in parentheses is the writer's aside."""
+    prompt = answer = False
+    continued = False
     for ln in text:
         s = ln.strip()
-        if not s or s.startswith("...") or s.startswith("("):
+        if continued:
+            continued = s.endswith("\\")
             continue
+        if not s or s.startswith("...") or s.startswith("(") or s.startswith("#"):
+            continue
+        continued = s.endswith("\\")
         if s.startswith("$ ") or s.startswith("> "):
             prompt = True
         elif prompt:
-            return True
-    return False
+            return "transcript"
+        elif not is_command(s):
+            answer = True
+    return "other" if answer else "commands"
+
+
+def is_transcript(text):
+    return block_kind(text) == "transcript"
 
 
 def markdown_files():
@@ -362,9 +400,11 @@ def cmd_check(a):
                 print("  " + ln)
     if not a.names and a.label in (None, "host"):
         for path in loose:
-            print("FAIL  a transcript outside an example: %s (wrap it in <!-- example NAME --> "
-                  "... <!-- /example -->, or say why CI cannot produce it: "
-                  "<!-- transcript: WHY --> before it; docs/examples.md)" % path)
+            print("FAIL  output outside an example: %s (a program's answer, or a block that "
+                  "is no list of commands: wrap it in <!-- example NAME --> ... "
+                  "<!-- /example -->; or say why CI cannot produce it, <!-- transcript: WHY -->, "
+                  "or what it is if no program prints it, <!-- not output: WHAT -->, on the "
+                  "line before it; docs/examples.md)" % path)
         failed += len(loose)
     print("doc_examples: %d example(s) checked, %d failed%s" % (
         len(chosen), failed, "" if not failed else

@@ -93,6 +93,24 @@ class DocExamplesTest(unittest.TestCase):
         self.assertEqual(ex, [])
         self.assertEqual([p.rsplit(":", 1)[1] for p in loose], ["3", "18"])
 
+    def test_output_without_a_prompt_outside_examples(self):
+        """A block that is no list of commands is output (or text) and needs an example or a
+        marker: a program's lines without a prompt fail, commands do not (repository
+        programs, known ones, sudo, VAR=value, continuations, comments), "not output"
+        excuses text but not a transcript."""
+        self.write("commands:\n\n" + block(
+            "./tools/sim --list-controllers   # the controllers", "tools/console --web \\",
+            "    --device /dev/ttyACM0", "sudo ./tools/setup", "PMSM_X=1 \\",
+            "    cmake --preset host", "(a few seconds)") +
+            "\n\nits output, no prompt:\n\n" + block("controller m2ptfc  fs 10000 Hz") +
+            "\n\n<!-- not output: an equation -->\n\n" + block("d' = d + s(i) t_d fs") +
+            "\n\n<!-- not output: wrongly -->\n\n" + block("> status", "ok 10") +
+            "\n\n<!-- transcript: a board's start-up report -->\n\n" + block("esc1: clock: ok") +
+            "\n\na program that is not here:\n\n" + block("tools/nosuch --x") + "\n")
+        ex, loose = de.parse_file(self.path)
+        self.assertEqual(ex, [])
+        self.assertEqual([p.rsplit(":", 1)[1] for p in loose], ["13", "21", "30"])
+
     def test_malformed_markers_are_errors(self):
         for text in ("<!-- example -->\n" + block("$ true") + "\n<!-- /example -->\n",
                      "<!-- example e -->\n" + block("$ true") + "\n",
