@@ -76,9 +76,46 @@ psi_pm = { dist = "uniform", lo = -0.05, hi = 0.05 }
 """
 
 
-def study(path, *args, timeout=300):
-    return subprocess.run([PY, STUDY, path, "--sim", SIM, "--progress", "text"] + list(args),
-                          capture_output=True, text=True, timeout=timeout)
+# A study that shows no progress (a new stored result, a line of output) for this long
+# is stuck (study_cluster_test.py: the same limit); a slow machine only takes longer.
+STALL_S = 240
+
+
+def stored(store):
+    """Results in store so far (0 before it exists)."""
+    if not store or not os.path.exists(store):
+        return 0
+    db = sqlite3.connect(store)
+    try:
+        return db.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
+    except sqlite3.OperationalError:
+        return 0
+    finally:
+        db.close()
+
+
+def study(path, *args):
+    """tools/study on path with args (stdout, stderr, exit status), given up only when
+    it is stuck: no new result in its store and no output for STALL_S."""
+    args = list(args)
+    store = os.path.join(args[args.index("--out") + 1], "runs.sqlite") if "--out" in args else None
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        p = subprocess.Popen([PY, STUDY, path, "--sim", SIM, "--progress", "text"] + args,
+                             stdout=out, stderr=err, text=True, start_new_session=True)
+        last, t_last = None, time.monotonic()
+        while p.poll() is None:
+            now = (os.fstat(out.fileno()).st_size, os.fstat(err.fileno()).st_size, stored(store))
+            if now != last:
+                last, t_last = now, time.monotonic()
+            elif time.monotonic() - t_last > STALL_S:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait()
+                raise AssertionError(f"tools/study {' '.join(args)}: stuck, no new result nor "
+                                     f"output for {STALL_S} s")
+            time.sleep(0.05)
+        out.seek(0)
+        err.seek(0)
+        return subprocess.CompletedProcess(p.args, p.returncode, out.read(), err.read())
 
 
 class Base(unittest.TestCase):
@@ -209,20 +246,16 @@ class Results(Base):
         proc = subprocess.Popen([PY, STUDY, p, "--sim", SIM, "--out", out, "--jobs", "1",
                                  "--progress", "none"], stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, start_new_session=True)
-        n = 0
-        t0 = time.monotonic()
+        n, t_last = 0, time.monotonic()
         try:
-            while proc.poll() is None and time.monotonic() - t0 < 200:
-                if os.path.exists(store):
-                    db = sqlite3.connect(store)
-                    try:
-                        n = db.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
-                    except sqlite3.OperationalError:
-                        n = 0
-                    db.close()
-                    if n >= 3:
-                        os.killpg(proc.pid, signal.SIGKILL)
-                        break
+            # until 3 results are stored; given up if none comes for STALL_S
+            while proc.poll() is None and time.monotonic() - t_last < STALL_S:
+                k = stored(store)
+                if k != n:
+                    n, t_last = k, time.monotonic()
+                if n >= 3:
+                    os.killpg(proc.pid, signal.SIGKILL)
+                    break
                 time.sleep(0.02)
         finally:
             if proc.poll() is None:
