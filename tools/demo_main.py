@@ -41,6 +41,8 @@ NEEDS = (
     ("libnewlib-arm-none-eabi", ("file", "/usr/lib/arm-none-eabi/newlib")),
     ("qemu-system-arm", ("cmd", "qemu-system-arm")),
 )
+SEED_MAX = 2 ** 53  # ./tools/sim --seed: a whole number a double holds exactly
+MAX_JOBS = 1024
 BENCH_ARGS = ["--no-cm0", "--no-callgrind", "--reps", "3", "--hotspots", ""]
 BENCH_BUILDS = (("host-release", ("bench_rec", "bench_host")), ("cm4", ("bench_cm4_all",)))
 
@@ -122,14 +124,34 @@ def clock(s):
     return "%d min %02d s" % (s // 60, s % 60) if s >= 60 else "%d s" % s
 
 
+def whole_in(lo, hi, what):
+    """An argparse type: a whole number in [lo, hi]; the error names value and range
+    (argparse adds the option and exits with status 2)."""
+    def parse(text):
+        try:
+            v = int(text)
+        except ValueError:
+            v = None
+        if v is None or not lo <= v <= hi:
+            raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [%d, %d] (%s)"
+                                             % (text, "out of range" if v is not None else
+                                                "not a whole number", lo, hi, what))
+        return v
+    return parse
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seed", type=int)
-    ap.add_argument("--jobs", type=int)
+    ap = argparse.ArgumentParser(prog="demo", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seed", type=whole_in(0, SEED_MAX, "the simulator's ADC noise seed"),
+                    help="ADC noise seed of every run, [0, 2^53]")
+    ap.add_argument("--jobs", type=whole_in(1, MAX_JOBS, "simulations at once"),
+                    help="simulations at once, [1, %d]" % MAX_JOBS)
     ap.add_argument("--out", default=os.path.join(ROOT, "out"))
     ap.add_argument("--rebench", action="store_true",
                     help="count the interrupt again even when out/bench.json matches the build")
-    a = ap.parse_args()
+    a = ap.parse_args()  # every value checked before anything is built (exit status 2)
+    if os.path.exists(a.out) and not os.path.isdir(a.out):
+        ap.error("--out %s is a file: a folder is expected (created when missing)" % a.out)
     t0 = time.time()
     os.chdir(ROOT)
     if not set_up():

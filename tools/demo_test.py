@@ -2,10 +2,12 @@
 """./tools/demo's set-up and reuse decisions (tools/demo_main.py) and the quiet build
 bar (tools/build_progress.py), without running the demo: a missing package is named
 with the one command that installs it; the bench's fingerprint changes with any image
-it counts and not otherwise; a build with nothing to do prints nothing, one with
+it counts and not otherwise; a bad option exits 2 naming it, its value and the range
+before anything starts; a build with nothing to do prints nothing, one with
 steps prints its bar and its total."""
 import io
 import os
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -14,6 +16,25 @@ from contextlib import redirect_stdout
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import build_progress  # noqa: E402
 import demo_main  # noqa: E402
+
+
+class BadInput(unittest.TestCase):
+    def test_each_exits_2_naming_option_value_and_range(self):
+        """Before anything is set up or built: a time-out of 20 s would show it started."""
+        demo = os.path.join(os.path.dirname(os.path.abspath(__file__)), "demo")
+        for args, want in ((["--jobs", "0"], "--jobs: '0' is out of range: allowed a whole "
+                            "number in [1, 1024]"),
+                           (["--jobs", "two"], "--jobs: 'two' is not a whole number: allowed a "
+                            "whole number in [1, 1024]"),
+                           (["--seed", "-1"], "--seed: '-1' is out of range: allowed a whole "
+                            "number in [0, 9007199254740992]"),
+                           (["--out", os.path.abspath(__file__)], "is a file: a folder is "
+                            "expected"),
+                           (["--nosuch"], "unrecognized arguments: --nosuch")):
+            r = subprocess.run([demo] + args, capture_output=True, text=True, timeout=20)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertIn(want, r.stderr, args)
+            self.assertEqual(r.stdout, "", args)
 
 
 class SetUp(unittest.TestCase):

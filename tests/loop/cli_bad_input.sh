@@ -40,7 +40,7 @@ expect_fail "machine file malformed" "machine file.*pole_pairs" --machine "$tmp/
 expect_fail "unknown controller" "unknown controller 'nosuch'" --machine "$m" --controller nosuch
 expect_fail "missing controller" "--controller NAME is required" --machine "$m"
 expect_fail "fs out of range" "--fs 10 is out of range" --machine "$m" --controller bst --fs 10
-expect_fail "fs not a number" "--fs expects a number" --machine "$m" --controller bst --fs 20k
+expect_fail "fs not a number" "--fs expects a number in \[1000, 200000\] Hz, got .20k." --machine "$m" --controller bst --fs 20k
 expect_fail "duration out of range" "--duration -1 is out of range" --machine "$m" --controller bst --duration -1
 expect_fail "option without value" "needs a value" --machine "$m" --controller bst --duration
 expect_fail "bad window" "--window" --machine "$m" --controller bst --duration 0.1 --window 0.2:0.1

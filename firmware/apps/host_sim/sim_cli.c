@@ -280,8 +280,8 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
     case K_UINT: {
         double x;
         if (parse_number(v, &x) != 0) {
-            return die("%s expects a number%s%s, got '%s'", o->name, o->unit[0] ? " in " : "",
-                       o->unit, v);
+            return die("%s expects a number in [%g, %g]%s%s, got '%s'", o->name, o->lo, o->hi,
+                       o->unit[0] ? " " : "", o->unit, v);
         }
         if (o->kind == K_UINT && x != floor(x)) {
             return die("%s %s: must be a whole number%s%s (allowed range [%g, %g])", o->name, v,
@@ -299,12 +299,16 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
         const char *colon = strchr(v, ':');
         char a[64];
         if (colon == NULL || (size_t)(colon - v) >= sizeof a) {
-            return die("%s expects START:END in seconds, got '%s'", o->name, v);
+            return die("%s expects START:END in seconds, 0 <= START < END <= the duration, "
+                       "got '%s'",
+                       o->name, v);
         }
         memcpy(a, v, (size_t)(colon - v));
         a[colon - v] = '\0';
         if (parse_number(a, &sp->start) != 0 || parse_number(colon + 1, &sp->end) != 0) {
-            return die("%s expects START:END in seconds, got '%s'", o->name, v);
+            return die("%s expects START:END in seconds, 0 <= START < END <= the duration, "
+                       "got '%s'",
+                       o->name, v);
         }
         return 0;
     }
@@ -352,7 +356,9 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
             }
         }
         if (parse_number(eq + 1, &st->value) != 0) {
-            return die("--set %s expects a number, got '%s'", st->name, eq + 1);
+            return die("--set %s expects a number, got '%s' (its unit and range: --list-tunables "
+                       "CONTROLLER)",
+                       st->name, eq + 1);
         }
         c->n_sets++;
         return 0;
