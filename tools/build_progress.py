@@ -30,7 +30,8 @@ import sys
 import time
 
 STATUS = re.compile(r"^\[(\d+)/(\d+)\] (.*)$")
-NEEDS = {"cm4": ["cmake", "ninja", "arm-none-eabi-gcc"]}
+NEEDS = {"cm4": ["cmake", "ninja", "arm-none-eabi-gcc"],
+         "host-release": ["cmake", "ninja", "gcc", "pkg-config"]}
 
 
 class Bar:
@@ -137,13 +138,18 @@ def missing_tools(preset):
     return [t for t in NEEDS.get(preset, ["cmake", "ninja"]) if shutil.which(t) is None]
 
 
-def ensure_built(root, preset, target, artefact, out=sys.stderr):
+def missing_message(root, missing):
+    return ("%s not installed: run 'sudo %s/tools/setup' (it installs what the project needs "
+            "from Debian)" % (", ".join(missing), root))
+
+
+def ensure_built(root, preset, target, artefact, out=sys.stderr, runs_with=()):
     """Configure build/<preset> if needed and build target; (True, None) when
-    artefact exists afterwards, else (False, why)."""
-    missing = missing_tools(preset)
+    artefact exists afterwards, else (False, why). runs_with: the programs that will
+    run it (qemu-system-arm), named with the build's tools when missing."""
+    missing = missing_tools(preset) + [t for t in runs_with if shutil.which(t) is None]
     if missing:
-        return False, ("%s not installed: run 'sudo %s/tools/setup' (it installs what the "
-                       "project needs from Debian)" % (", ".join(missing), root))
+        return False, missing_message(root, missing)
     bdir = os.path.join(root, "build", preset)
     logpath = os.path.join(bdir, "console-build.log")
     if not os.path.isfile(os.path.join(bdir, "build.ninja")):
@@ -166,8 +172,18 @@ def ensure_built(root, preset, target, artefact, out=sys.stderr):
 
 
 def main(argv):
+    if len(argv) >= 3 and argv[1] == "--needs":
+        # build_progress.py --needs PRESET [PROGRAM...]: exit 1 naming what is missing and
+        # the one command that installs it (before a configure that would fail obscurely)
+        missing = missing_tools(argv[2]) + [t for t in argv[3:] if shutil.which(t) is None]
+        if missing:
+            print(missing_message(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                  missing), file=sys.stderr)
+            return 1
+        return 0
     if len(argv) not in (3, 4):
-        print("usage: build_progress.py BUILD_DIR TARGET [LABEL]", file=sys.stderr)
+        print("usage: build_progress.py BUILD_DIR TARGET [LABEL]\n"
+              "       build_progress.py --needs PRESET [PROGRAM...]", file=sys.stderr)
         return 2
     bdir, target = argv[1], argv[2]
     label = argv[3] if len(argv) == 4 else "building %s" % target

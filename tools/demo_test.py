@@ -127,5 +127,25 @@ class QuietBar(unittest.TestCase):
         self.assertIn("building x: 2 steps in", out)
 
 
+class Needs(unittest.TestCase):
+    def test_a_missing_program_is_named_with_the_command(self):
+        """tools/sim and the console check before they configure a preset."""
+        bp = os.path.join(os.path.dirname(os.path.abspath(__file__)), "build_progress.py")
+        r = subprocess.run([sys.executable, bp, "--needs", "cm4", "no-such-program-here"],
+                           capture_output=True, text=True)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("no-such-program-here not installed: run 'sudo ", r.stderr)
+        self.assertIn("/tools/setup'", r.stderr)
+        missing = build_progress.missing_tools
+        build_progress.missing_tools = lambda preset: []
+        try:
+            ok, why = build_progress.ensure_built("/nonexistent", "cm4", "t", "/nonexistent/a",
+                                                  runs_with=("no-such-program-here",))
+        finally:
+            build_progress.missing_tools = missing
+        self.assertFalse(ok)
+        self.assertIn("no-such-program-here not installed", why)
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
