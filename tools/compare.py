@@ -102,6 +102,17 @@ def style_of(name):
                 marker=MARKERS[i % len(MARKERS)])
 
 
+def trace_style(name, npts, lw):
+    """style_of for a time series: its marker every eighth of the points, each member of a
+    family starting at its own offset so that the markers of overlapping lines alternate
+    (a dense trace of thin dashes alone does not tell six shades of one colour apart)."""
+    st = style_of(name)
+    step = max(npts // 8, 1)
+    _f, i = family_of(name)
+    return dict(color=st["color"], ls=st["ls"], lw=lw, marker=st["marker"], ms=4,
+                markevery=(min(i * step // 6, npts - 1) if npts else 0, step))
+
+
 # ---------------------------------------------------------------- running
 
 def sim_binary(override):
@@ -409,21 +420,20 @@ def plot_dynamic(dyn, out):
     for i, (title, members) in enumerate(fams):
         for n in members:
             d, r = dyn[n]
-            st = style_of(n)
             tm = d["t"] * 1e3
-            ax[i, 0].plot(tm, d["torque"], lw=0.5, color=st["color"], ls=st["ls"], label=n)
-            ax[i, 1].plot(tm, d["speed_rpm"], lw=0.9, color=st["color"], ls=st["ls"], label=n)
+            ax[i, 0].plot(tm, d["torque"], label=n, **trace_style(n, len(tm), 0.5))
+            ax[i, 1].plot(tm, d["speed_rpm"], label=n, **trace_style(n, len(tm), 0.9))
             # zoomed: the torque step and the reversal command
             w = (d["t"] >= DYN_STEP_S - 0.0005) & (d["t"] <= DYN_STEP_S + 0.0015)
-            zax[i, 0].plot((d["t"][w] - DYN_STEP_S) * 1e3, d["torque"][w], lw=0.8,
-                           color=st["color"], ls=st["ls"], label=n)
+            zax[i, 0].plot((d["t"][w] - DYN_STEP_S) * 1e3, d["torque"][w], label=n,
+                           **trace_style(n, int(w.sum()), 0.9))
             if r["t_rev"] is not None:
                 w = (d["t"] >= r["t_rev"] - 0.0005) & (d["t"] <= r["t_rev"] + 0.0015)
-                zax[i, 1].plot((d["t"][w] - r["t_rev"]) * 1e3, d["torque"][w], lw=0.8,
-                               color=st["color"], ls=st["ls"], label=n)
+                zax[i, 1].plot((d["t"][w] - r["t_rev"]) * 1e3, d["torque"][w], label=n,
+                               **trace_style(n, int(w.sum()), 0.9))
             else:
-                zax[i, 1].plot([], [], color=st["color"], ls=st["ls"],
-                               label=f"{n} (reversal not commanded)")
+                zax[i, 1].plot([], [], label=f"{n} (reversal not commanded)",
+                               **trace_style(n, 0, 0.9))
         ax[i, 0].plot(tm, d["torque_ref"] * np.nan, lw=0)  # keep the axes' limits
         ax[i, 0].set_title(f"{title}: torque", fontsize=10)
         ax[i, 1].set_title(f"{title}: speed", fontsize=10)

@@ -125,6 +125,55 @@ class PlotStyles(unittest.TestCase):
                 self.assertEqual(len(set(vals)), len(vals), (key, members))
 
 
+    def test_time_series_draw_the_whole_look(self):
+        """dynamic.png and dynamic_zoom.png: every controller's line has its colour, line
+        style and a marker (foc and hdtc_pred were both solid red; six thin dashes of one
+        colour in a panel were hard to tell apart), no two alike in a panel."""
+        sys.path.insert(0, HERE)
+        import numpy as np
+        import compare
+        names = [n for _f, members in compare.FAMILIES for n in members]
+        t = np.linspace(0.0, compare.DYN_DURATION, 4000)
+        dyn = {n: ({"t": t, "torque": np.sin(t * (k + 1)), "speed_rpm": t * 1e4,
+                    "torque_ref": t}, {"t_rev": 0.05 if k % 2 else None})
+               for k, n in enumerate(names)}
+        figs = []
+        subplots = compare.plt.subplots
+
+        def keep(*a, **kw):
+            fig, ax = subplots(*a, **kw)
+            figs.append(fig)
+            return fig, ax
+        compare.plt.subplots = keep
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                compare.plot_dynamic(dyn, tmp)
+                self.assertTrue(os.path.exists(os.path.join(tmp, "dynamic_zoom.png")))
+        finally:
+            compare.plt.subplots = subplots
+        self.assertEqual(len(figs), 2)
+        for fig in figs:
+            for ax in fig.axes:
+                looks = []
+                for ln in ax.get_lines():
+                    name = ln.get_label().split(" ")[0]
+                    if name not in names:
+                        continue
+                    st = compare.style_of(name)
+                    self.assertEqual(matplotlib_hex(ln.get_color()), st["color"], name)
+                    self.assertEqual(ln.get_marker(), st["marker"], name)
+                    self.assertIsNotNone(ln.get_markevery(), name)
+                    looks.append((ln.get_color(), str(ln.get_dashes() if hasattr(ln, "get_dashes")
+                                                      else ln.get_linestyle()), ln.get_marker()))
+                self.assertEqual(len(set(looks)), len(looks), ax.get_title())
+            compare.plt.close(fig)
+
+
+def matplotlib_hex(c):
+    import matplotlib.colors
+    return matplotlib.colors.to_hex(c)
+
+
 class HdtcPredCause(unittest.TestCase):
     """hdtc_pred (thesis SPMSM, 1.8 N*m, 10 kHz): one period's torque steps
     dwarf S1's band, so the three-level regulator goes from +1 straight to -1 and
