@@ -57,18 +57,27 @@ uint32_t drv8301_gain(uint32_t code)
 
 int drv8301_read(drv8301_t *d, uint32_t addr, uint16_t *data)
 {
-    uint16_t in = 0u;
+    uint16_t prev = 0u, in = 0u;
     /* The read command, then the same again: its response word is the
-     * first one's answer. */
+     * first one's answer (the first frame's own response answers the frame
+     * before it). */
     const uint16_t cmd = drv8301_frame(true, addr, 0u);
-    if (d->port.xfer(d->port.ctx, cmd, &in) != 0 || d->port.xfer(d->port.ctx, cmd, &in) != 0) {
-        d->reg = (uint8_t)addr;
+    d->reg = (uint8_t)addr;
+    d->answer = 0u;
+    if (d->port.xfer(d->port.ctx, cmd, &prev) != 0 || d->port.xfer(d->port.ctx, cmd, &in) != 0) {
         return DRV8301_E_SPI;
     }
     d->answer = in;
     if (((uint32_t)in & DRV8301_FRAME_ADDR_MASK) >> DRV8301_FRAME_ADDR_POS != addr) {
-        d->reg = (uint8_t)addr;
         return DRV8301_E_SILENT;
+    }
+    /* Bit 15 of a response word: the frame it answers was not a valid
+     * 16-clock frame and was ignored (a write lost, a read not done): the
+     * data cannot be trusted. Checked after the address, so that a bus
+     * pulled up (0xFFFF) stays "no answer". */
+    if (((prev | in) & DRV8301_FRAME_ERROR) != 0u) {
+        d->answer = (in & DRV8301_FRAME_ERROR) != 0u ? in : prev;
+        return DRV8301_E_SPI;
     }
     *data = (uint16_t)(in & DRV8301_FRAME_DATA_MASK);
     return DRV8301_OK;
@@ -79,6 +88,7 @@ int drv8301_write(drv8301_t *d, uint32_t addr, uint32_t data)
     uint16_t in = 0u;
     if (d->port.xfer(d->port.ctx, drv8301_frame(false, addr, data), &in) != 0) {
         d->reg = (uint8_t)addr;
+        d->answer = 0u;
         return DRV8301_E_SPI;
     }
     return DRV8301_OK;
@@ -199,7 +209,7 @@ const char *drv8301_strerror(int rc)
     case DRV8301_E_CONFIG:
         return "configuration has no register encoding";
     case DRV8301_E_SPI:
-        return "SPI time-out";
+        return "SPI time-out or frame error";
     case DRV8301_E_SILENT:
         return "no answer on SPI";
     case DRV8301_E_READBACK:
@@ -218,6 +228,14 @@ size_t drv8301_explain(const drv8301_t *d, char *buf, size_t cap)
     case DRV8301_E_SILENT:
         k = snprintf(buf, cap, "no answer on SPI (register %u came back as 0x%x)", (unsigned)d->reg,
                      (unsigned)d->answer);
+        break;
+    case DRV8301_E_SPI:
+        if ((d->answer & DRV8301_FRAME_ERROR) != 0u) {
+            k = snprintf(buf, cap, "SPI frame error (register %u, answer 0x%x)", (unsigned)d->reg,
+                         (unsigned)d->answer);
+        } else {
+            k = snprintf(buf, cap, "SPI time-out (register %u)", (unsigned)d->reg);
+        }
         break;
     case DRV8301_E_READBACK:
         k = snprintf(buf, cap, "control %u reads 0x%x, wrote 0x%x",

@@ -12,7 +12,8 @@
  *     16-bit frames, MSB first, SCLK up to 10 MHz.
  *   - Command word: bit 15 R/W (1 = read), bits 14:11 address, bits 10:0
  *     data. The response word shifted out during a frame answers the
- *     PREVIOUS frame: bit 15 frame-error flag, bits 14:11 the address of the
+ *     PREVIOUS frame: bit 15 frame-error flag (F0 in SLOS842 table 4 "SPI
+ *     Output Data Response Word Format"), bits 14:11 the address of the
  *     register it carries, bits 10:0 its data. A read therefore takes two
  *     frames.
  *   - Registers: 0 status 1, 1 status 2 (read-only; status bits latch until
@@ -45,7 +46,8 @@
 #define DRV8301_REG_CONTROL1 2u
 #define DRV8301_REG_CONTROL2 3u
 
-#define DRV8301_FRAME_READ 0x8000u
+#define DRV8301_FRAME_READ 0x8000u  /* command word: read */
+#define DRV8301_FRAME_ERROR 0x8000u /* response word: the answered frame was invalid */
 #define DRV8301_FRAME_ADDR_POS 11u
 #define DRV8301_FRAME_ADDR_MASK 0x7800u
 #define DRV8301_FRAME_DATA_MASK 0x07FFu
@@ -61,7 +63,7 @@
 /* Return codes. */
 #define DRV8301_OK 0
 #define DRV8301_E_CONFIG (-1)   /* a field outside its encoding */
-#define DRV8301_E_SPI (-2)      /* the transport failed (SPI time-out) */
+#define DRV8301_E_SPI (-2)      /* the transport failed (SPI time-out) or a frame error */
 #define DRV8301_E_SILENT (-3)   /* the answer names another register: nothing answered */
 #define DRV8301_E_READBACK (-4) /* a control register reads back other than written */
 #define DRV8301_E_FAULT (-5)    /* the status registers report a fault */
@@ -108,8 +110,10 @@ int drv8301_oc_adj_at_most(uint32_t vds_mv);
 uint32_t drv8301_gain(uint32_t code);
 
 /* A register's 11 data bits: a read frame, then a second frame whose
- * response must carry that register's address. DRV8301_OK, _E_SPI or
- * _E_SILENT (d->answer says what came back). */
+ * response must carry that register's address. DRV8301_OK, _E_SILENT
+ * (d->answer says what came back) or _E_SPI: the transport failed, or
+ * either response word has its frame-error bit set (d->answer is that
+ * word). */
 int drv8301_read(drv8301_t *d, uint32_t addr, uint16_t *data);
 int drv8301_write(drv8301_t *d, uint32_t addr, uint32_t data);
 /* Writes CR1 then CR2 and reads both back, up to three times while they
@@ -132,7 +136,7 @@ int drv8301_gate_reset(drv8301_t *d);
 size_t drv8301_fault_names(uint16_t s1, uint16_t s2, char *buf, size_t cap);
 /* One line about the last error of d: "no answer on SPI (register 2 came
  * back as 0x0000)", "control 1 reads 0x000, wrote 0x543", "fault GVDD_UV",
- * "SPI time-out". */
+ * "SPI frame error (register 2, answer 0x9000)", "SPI time-out (register 3)". */
 size_t drv8301_explain(const drv8301_t *d, char *buf, size_t cap);
 const char *drv8301_strerror(int rc);
 

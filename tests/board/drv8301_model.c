@@ -39,6 +39,11 @@ static uint16_t drv8301_model_frame(uint32_t spi, uint16_t out)
     const uint16_t answer = m->next;
     const uint32_t addr = (out >> 11) & 0xFu;
     const uint16_t data = (uint16_t)(out & 0x7FFu);
+    if (m->frame_fault) {
+        /* Ignored; its answer carries the frame-error bit. */
+        m->next = (uint16_t)(0x8000u | (addr << 11));
+        return answer;
+    }
     if ((out & 0x8000u) != 0u) {
         const uint16_t v = addr < 4u ? m->reg[addr] : 0u;
         m->next = (uint16_t)((addr << 11) | v);

@@ -7,7 +7,8 @@
  * its read unless the condition persists, EN_GATE low resetting everything
  * and silencing the bus (MISO floats: the model reads `idle`).
  * Failure switches for the tests: writes lost after a reset, control bits
- * that never take a 1, an answer that is always `idle` (not connected).
+ * that never take a 1, an answer that is always `idle` (not connected),
+ * frames the driver takes as invalid (frame error).
  */
 #ifndef TESTS_BOARD_DRV8301_MODEL_H
 #define TESTS_BOARD_DRV8301_MODEL_H
@@ -29,6 +30,8 @@ typedef struct {
     unsigned lost;
     uint16_t stuck_zero[2]; /* CR1 / CR2 bits that stay 0 */
     uint16_t persist1;      /* status 1 bits whose condition persists */
+    bool frame_fault;       /* every frame taken as invalid: ignored, its
+                               response word with the frame-error bit (15) */
     uint32_t frames, writes, gate_resets;
 } drv8301_model_t;
 

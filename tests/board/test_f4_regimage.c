@@ -327,6 +327,39 @@ static void test_drv_readback(void)
     TEST_ASSERT_FALSE(hal_trip_active(&hal));
 }
 
+/* Frames the driver takes as invalid (the frame-error bit, 15, of its
+ * response words; TI SLOS842 table 4): the read-back's answer carries the
+ * right address but its data is not the register's; refused as an SPI
+ * error naming the bit, not as a read-back mismatch or a clean status:
+ * gates held off, EN_GATE low. The same at run time: the gates off and the
+ * configuration taken as lost (written again once stopped). */
+static void test_drv_frame_error(void)
+{
+    const f4_board_t *b = &f4_board_vesc6;
+    attach_drv(b);
+    drv8301_model.frame_fault = true;
+    TEST_ASSERT_EQUAL_INT(F4_E_DRIVER, board_init(b));
+    TEST_ASSERT_EQUAL_INT(DRV8301_E_SPI, hal.drv.err);
+    char why[96];
+    (void)drv8301_explain(&hal.drv, why, sizeof why);
+    TEST_ASSERT_EQUAL_STRING("SPI frame error (register 2, answer 0x9000)", why);
+    TEST_ASSERT_FALSE(f4_model_pin_out(b->en_gate.port, b->en_gate.pin));
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+
+    f4_model_reset();
+    f4_cycle_counter_init();
+    attach_drv(b);
+    TEST_ASSERT_EQUAL_INT(F4_OK, board_init(b));
+    hal_gate_enable(&hal, true);
+    drv8301_model.frame_fault = true;
+    (void)f4_hal_drv_service(&hal, false);
+    ASSERT_BITS_CLEAR(F4_TIM_BDTR_MOE, reg(F4_TIM1 + F4_TIM_BDTR));
+    ASSERT_BITS_SET(F4_TRIP_CONFIG, f4_hal_trip_cause(&hal));
+    drv8301_model.frame_fault = false;
+    (void)f4_hal_drv_service(&hal, true);
+    ASSERT_BITS_CLEAR(F4_TRIP_CONFIG, f4_hal_trip_cause(&hal));
+}
+
 /* A fault present at start-up (GVDD under-voltage, persisting): configured
  * and read back, but its status names it: gates held off, "fault GVDD_UV
  * FAULT". nFAULT held low with a clean status (the other axis's driver on
@@ -573,6 +606,7 @@ int main(void)
     RUN_TEST(test_odrive_start_up_image);
     RUN_TEST(test_drv_silent);
     RUN_TEST(test_drv_readback);
+    RUN_TEST(test_drv_frame_error);
     RUN_TEST(test_drv_fault_at_start);
     RUN_TEST(test_clock_fall_back_holds);
     RUN_TEST(test_tim1_phase);
