@@ -52,7 +52,7 @@ int drv8301_oc_adj_at_most(uint32_t vds_mv)
 
 uint32_t drv8301_gain(uint32_t code)
 {
-    return 10u << (code & 3u);
+    return DRV8301_GAIN_VV(code);
 }
 
 int drv8301_read(drv8301_t *d, uint32_t addr, uint16_t *data)

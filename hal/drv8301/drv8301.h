@@ -106,7 +106,9 @@ uint32_t drv8301_vds_mv(uint32_t oc_adj);
 /* The largest OC_ADJ_SET code whose threshold is at most vds_mv; -1 below
  * the smallest (60 mV). */
 int drv8301_oc_adj_at_most(uint32_t vds_mv);
-/* Amplifier gain of a GAIN code, V/V (10, 20, 40, 80). */
+/* Amplifier gain of a GAIN code, V/V (10, 20, 40, 80); the macro for a
+ * constant initialiser (a board's sense gain). */
+#define DRV8301_GAIN_VV(code) (10u << ((code)&3u))
 uint32_t drv8301_gain(uint32_t code);
 
 /* A register's 11 data bits: a read frame, then a second frame whose

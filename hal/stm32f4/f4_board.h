@@ -38,6 +38,8 @@ typedef struct {
     double out_max_v;
     bool low_side; /* shunts in the low-side legs: valid only while that leg's low
                       switch conducts (else in-line phase shunts) */
+    bool drv_amp;  /* the amplifiers are the DRV8301's: |gain| must equal
+                      drv8301_gain(drv.gain) (f4_hal_describe refuses others) */
 } f4_current_sense_t;
 
 /* An NTC thermistor in a divider from VREF: with r_fixed to ground and the
@@ -58,8 +60,10 @@ typedef struct {
     uint32_t sysclk_hz; /* SYSCLK = HCLK = TIM1's clock */
     /* inverter */
     f4_pin_t pwm_high[3], pwm_low[3]; /* TIM1 CH1..3 (AF1), CH1N..3N (AF1) */
-    bool gate_active_low;             /* gate-driver inputs */
-    uint32_t dead_time_ns;            /* TIM1's (the gate driver may add its own) */
+    /* Gate-driver inputs active low: refused by f4_hal_describe (TIM1's
+     * idle levels are 0); f4_hal_gate_pins_safe drives the inactive level. */
+    bool gate_active_low;
+    uint32_t dead_time_ns; /* TIM1's (the gate driver may add its own) */
     /* Time from a leg's switching until its current signal is valid at the
      * ADC (amplifier settling); with the dead time it sets the window the HAL
      * keeps free of switching around the sampling instant (compare values

@@ -108,6 +108,17 @@ int f4_hal_describe(hal_t *h, const f4_board_t *b, const f4_hal_cfg_t *c, const 
         c->encoder_cpr > 0xFFFFu) {
         return F4_E_CONFIG;
     }
+    /* TIM1's outputs idle at 0 with MOE cleared (OISx = OISxN = 0,
+     * f4_tim.h): an active-low gate input would sit at its active level. */
+    if (b->gate_active_low) {
+        return F4_E_CONFIG;
+    }
+    /* The DRV8301's amplifiers as the sense: the gain currents are scaled by
+     * must be the one written to it (a mismatch mis-scales every current). */
+    if (b->sense.drv_amp &&
+        (b->drv.gain > 3u || fabs(b->sense.gain) != (double)drv8301_gain(b->drv.gain))) {
+        return F4_E_CONFIG;
+    }
     uint8_t dtg;
     int rc = stm32_pwm_timing(clk->tim_apb2_hz, c->fs_hz, &h->timing);
     if (rc == F4_OK) {
@@ -259,7 +270,6 @@ static int f4_hal_power_start(hal_t *h)
     }
     tc.break_input = f4_pin_used(b->break_in);
     tc.break_active_low = b->break_active_low;
-    tc.active_low = b->gate_active_low;
     f4_tim1_pwm_init(&tc);
 
     /* Injected sequences on TIM1_TRGO; the ADC that finishes last

@@ -25,9 +25,6 @@ void f4_tim1_pwm_init(const f4_tim1_cfg_t *c)
     uint32_t ccer = 0u;
     for (uint32_t ch = 1u; ch <= 3u; ch++) {
         ccer |= F4_TIM_CCER_CCE(ch) | F4_TIM_CCER_CCNE(ch);
-        if (c->active_low) {
-            ccer |= F4_TIM_CCER_CCP(ch) | F4_TIM_CCER_CCNP(ch);
-        }
     }
     f4_wr(t + F4_TIM_CCER, ccer);
     /* Idle levels 0 (OISx = OISxN = 0 = inactive), TRGO on update. */

@@ -25,13 +25,13 @@ typedef struct {
     uint8_t dtg;      /* stm32_dtg_encode */
     bool break_input; /* BKIN pin wired to a hardware over-current signal */
     bool break_active_low;
-    bool active_low; /* gate-driver inputs active low (CCxP = CCxNP = 1) */
 } f4_tim1_cfg_t;
 
 /* Configures TIM1 with the outputs safe and the counter stopped (RM0090
  * sec. 17.3): centre-aligned mode 1, ARR preload, PWM mode 1 on CH1..3 with
  * compare preload (new values act at the next update event), complementary
- * outputs with dead time, idle state inactive (OISx = OISxN = 0, OSSI = OSSR
+ * outputs with dead time, active high (CCxP = CCxNP = 0: the only gate
+ * inputs f4_hal_describe accepts), idle state inactive (OISx = OISxN = 0, OSSI = OSSR
  * = 1: with MOE = 0 all six outputs are driven to their inactive level, both
  * switches of every leg off), break from the BKIN pin when the board wires
  * one (BKE, its polarity, BIE; AOE = 0: after a break the gates stay off

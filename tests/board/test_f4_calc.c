@@ -207,6 +207,34 @@ static void test_board_descriptions(void)
     TEST_ASSERT_EQUAL_INT(F4_E_CONFIG, f4_hal_describe(&h, &f4_board_vesc6, &cpr, &clk));
 }
 
+/* Board descriptions f4_hal_describe refuses: active-low gate inputs (TIM1
+ * idles its outputs at 0 with MOE cleared: such inputs would sit active);
+ * the ODrive's DRV8301 gain changed alone (written 20 V/V, currents scaled
+ * for 40: every current read 2x too large), or the sense gain alone. The
+ * VESC 6's own amplifiers do not depend on the DRV8301's gain. */
+static void test_board_refusals(void)
+{
+    const f4_clocks_t clk = {168000000u, 42000000u, 84000000u, 84000000u, 168000000u, true};
+    const f4_hal_cfg_t cfg = {20000u, 4096u};
+    static hal_t h;
+    f4_board_t b = f4_board_vesc6;
+    b.gate_active_low = true;
+    TEST_ASSERT_EQUAL_INT(F4_E_CONFIG, f4_hal_describe(&h, &b, &cfg, &clk));
+    b = f4_board_odrive_v36;
+    TEST_ASSERT_TRUE(b.sense.drv_amp);
+    TEST_ASSERT_EQUAL_DOUBLE(40.0, b.sense.gain);
+    b.drv.gain = 1u;
+    TEST_ASSERT_EQUAL_INT(F4_E_CONFIG, f4_hal_describe(&h, &b, &cfg, &clk));
+    b = f4_board_odrive_v36;
+    b.sense.gain = 20.0;
+    TEST_ASSERT_EQUAL_INT(F4_E_CONFIG, f4_hal_describe(&h, &b, &cfg, &clk));
+    b.sense.gain = -40.0; /* the sign is the wiring's, not the driver's */
+    TEST_ASSERT_EQUAL_INT(F4_OK, f4_hal_describe(&h, &b, &cfg, &clk));
+    b = f4_board_vesc6;
+    b.drv.gain = 3u;
+    TEST_ASSERT_EQUAL_INT(F4_OK, f4_hal_describe(&h, &b, &cfg, &clk));
+}
+
 /* SPI_CR1.BR: f_PCLK / 2^(BR + 1) <= max. 42 MHz, 5 MHz: /2 21, /4 10.5,
  * /8 5.25, /16 2.625 MHz -> BR 3 (ODrive's prescaler 16); 16 MHz (the
  * fall-back): /4 = 4 MHz -> BR 1. USART BRR at 42 MHz, 115200 baud:
@@ -335,6 +363,7 @@ int main(void)
     RUN_TEST(test_adc_sequence);
     RUN_TEST(test_compare_limit);
     RUN_TEST(test_board_descriptions);
+    RUN_TEST(test_board_refusals);
     RUN_TEST(test_spi_and_usart_dividers);
     RUN_TEST(test_iwdg_window);
     RUN_TEST(test_drv8301_words);

@@ -26,6 +26,10 @@
 #define B 1u
 #define C 2u
 #define D 3u
+/* The DRV8301 amplifiers' GAIN code, 40 V/V: written to the driver and the
+ * sense chain's gain (f4_hal_describe checks the two agree). */
+#define ODRIVE_V36_GAIN_CODE 2u
+
 #define NONE                                                                                       \
     {                                                                                              \
         F4_PORT_NONE, 0u, 0u                                                                       \
@@ -70,7 +74,7 @@ const f4_board_t f4_board_odrive_v36 = {
     .drv = {.gate_current = 0u,
             .ocp_mode = 1u,
             .oc_adj = 21u,
-            .gain = 2u,
+            .gain = ODRIVE_V36_GAIN_CODE,
             .octw_mode = 0u,
             .oc_toff = false},
     .fet_rds_on_ohm = 0.0, /* not in the firmware sources: no VDS-trip current derived */
@@ -92,12 +96,13 @@ const f4_board_t f4_board_odrive_v36 = {
      * and the direction of positive current; docs/bringup-odrive-v36.md
      * step 2. */
     .sense = {.shunt_ohm = 0.0005,
-              .gain = 40.0,
+              .gain = (double)DRV8301_GAIN_VV(ODRIVE_V36_GAIN_CODE),
               .zero_v = 1.65,
               .zero_tol_v = 0.15,
               .out_min_v = 0.3,
               .out_max_v = 3.0,
-              .low_side = true},
+              .low_side = true,
+              .drv_amp = true},
     .current_smp_cycles = 15u, /* [CUBE] samples in 3 cycles; 15 kept for margin */
 
     /* VBUS_S PA6 = ADC12_IN6 on ADC1, injected rank 1 [MAIN][CUBE]; the
