@@ -54,8 +54,8 @@ uint32_t f4_adc_sample_end(const uint32_t *smp_cycles, unsigned rank, uint32_t l
 
 void f4_adc_clock_init(void)
 {
-    f4_set(F4_RCC + F4_RCC_APB2ENR,
-           F4_RCC_APB2ENR_ADC1EN | (F4_RCC_APB2ENR_ADC1EN << 1) | (F4_RCC_APB2ENR_ADC1EN << 2));
+    f4_rcc_enable(F4_RCC_APB2ENR, F4_RCC_APB2ENR_ADC1EN | (F4_RCC_APB2ENR_ADC1EN << 1) |
+                                      (F4_RCC_APB2ENR_ADC1EN << 2));
     /* ADCPRE = 01: PCLK2 / 4; MULTI = 0: the three ADCs independent, each
      * triggered by TIM1_TRGO itself. */
     f4_mod(F4_ADC_COMMON + F4_ADC_CCR, F4_ADC_CCR_ADCPRE_MASK, F4_FIELD(1u, F4_ADC_CCR_ADCPRE_POS));

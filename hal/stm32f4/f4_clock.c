@@ -147,7 +147,7 @@ int f4_clock_init(uint32_t hse_hz, uint32_t sysclk_hz, f4_clocks_t *out)
     /* Voltage scale 1 (PWR_CR.VOS = 1, its reset value on the F405/407):
      * needed above 144 MHz (sec. 5.1.4); written while the PLL is off, read
      * back once it runs. */
-    f4_set(F4_RCC + F4_RCC_APB1ENR, F4_RCC_APB1ENR_PWREN);
+    f4_rcc_enable(F4_RCC_APB1ENR, F4_RCC_APB1ENR_PWREN);
     f4_set(F4_PWR + F4_PWR_CR, F4_PWR_CR_VOS);
     /* HSE crystal (not bypass). */
     f4_set(F4_RCC + F4_RCC_CR, F4_RCC_CR_HSEON);

@@ -195,8 +195,7 @@ static int f4_hal_drv_start(hal_t *h)
     const uint32_t us = h->clk.sysclk_hz / 1000000u;
     f4_gpio_config(b->nfault, F4_PIN_INPUT, 1u); /* open drain: pulled up */
     f4_gpio_config(b->noctw, F4_PIN_INPUT, 1u);
-    f4_gpio_write(b->drv_cs, true);
-    f4_gpio_config(b->drv_cs, F4_PIN_OUTPUT, 0u);
+    f4_gpio_output(b->drv_cs, true, 0u);
     f4_gpio_config(b->drv_sck, F4_PIN_AF, 0u);
     f4_gpio_config(b->drv_miso, F4_PIN_AF, 1u);
     f4_gpio_config(b->drv_mosi, F4_PIN_AF, 0u);

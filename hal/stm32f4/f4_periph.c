@@ -24,7 +24,7 @@ void f4_gpio_config(f4_pin_t p, f4_pin_mode_t mode, uint32_t pull)
         return;
     }
     const uintptr_t b = f4_gpio_base(p.port);
-    f4_set(F4_RCC + F4_RCC_AHB1ENR, F4_BIT(p.port)); /* GPIOxEN = bit x */
+    f4_rcc_enable(F4_RCC_AHB1ENR, F4_BIT(p.port)); /* GPIOxEN = bit x */
     const uint32_t sh2 = 2u * p.pin;
     if (mode == F4_PIN_AF) {
         const uintptr_t afr = b + (p.pin < 8u ? F4_GPIO_AFRL : F4_GPIO_AFRH);
@@ -38,6 +38,18 @@ void f4_gpio_config(f4_pin_t p, f4_pin_mode_t mode, uint32_t pull)
     }
     f4_mod(b + F4_GPIO_PUPDR, 3u << sh2, (pull & 3u) << sh2);
     f4_mod(b + F4_GPIO_MODER, 3u << sh2, (uint32_t)mode << sh2);
+}
+
+void f4_gpio_output(f4_pin_t p, bool high, uint32_t pull)
+{
+    if (!f4_pin_used(p)) {
+        return;
+    }
+    /* The port's clock before the level: with it off the BSRR write is
+     * lost, and the pin would drive ODR's reset value (0) once an output. */
+    f4_rcc_enable(F4_RCC_AHB1ENR, F4_BIT(p.port));
+    f4_gpio_write(p, high);
+    f4_gpio_config(p, F4_PIN_OUTPUT, pull);
 }
 
 void f4_gpio_write(f4_pin_t p, bool high)
@@ -77,7 +89,7 @@ int f4_usart_find(uint32_t n, f4_usart_t *u)
 
 void f4_usart_init(const f4_usart_t *u, uint32_t brr)
 {
-    f4_set(F4_RCC + (u->apb == 2u ? F4_RCC_APB2ENR : F4_RCC_APB1ENR), u->en);
+    f4_rcc_enable(u->apb == 2u ? F4_RCC_APB2ENR : F4_RCC_APB1ENR, u->en);
     f4_wr(u->base + F4_USART_CR1, 0u);
     f4_wr(u->base + F4_USART_BRR, brr);
     f4_wr(u->base + F4_USART_CR1,
@@ -95,7 +107,7 @@ uint32_t f4_exti_irq(uint32_t line)
 uint32_t f4_exti_falling(f4_pin_t p)
 {
     const uint32_t line = p.pin;
-    f4_set(F4_RCC + F4_RCC_APB2ENR, F4_RCC_APB2ENR_SYSCFGEN);
+    f4_rcc_enable(F4_RCC_APB2ENR, F4_RCC_APB2ENR_SYSCFGEN);
     f4_mod(F4_SYSCFG + F4_SYSCFG_EXTICR(line), 0xFu << F4_SYSCFG_EXTICR_SHIFT(line),
            (uint32_t)p.port << F4_SYSCFG_EXTICR_SHIFT(line));
     f4_clr(F4_EXTI + F4_EXTI_RTSR, F4_BIT(line));

@@ -34,7 +34,11 @@ uintptr_t f4_gpio_base(uint32_t port);
  * the backup domain's switch supplies: DS8626 pin notes); pull-up (pull = 1),
  * pull-down (2) or none (0). A pin not used: nothing. */
 void f4_gpio_config(f4_pin_t p, f4_pin_mode_t mode, uint32_t pull);
-/* Output level (BSRR: atomic). */
+/* A push-pull output that drives `high` from its first instant: the port's
+ * clock on, the level written (BSRR), then the mode (a pin already an
+ * output changes level once at most). */
+void f4_gpio_output(f4_pin_t p, bool high, uint32_t pull);
+/* Output level (BSRR: atomic; the port's clock must be on). */
 void f4_gpio_write(f4_pin_t p, bool high);
 /* Input level (IDR). */
 bool f4_gpio_read(f4_pin_t p);

@@ -139,6 +139,18 @@ static inline void f4_clr(uintptr_t reg, uint32_t bits)
 {
     f4_wr(reg, f4_rd(reg) & ~bits);
 }
+/* A peripheral's clock on: bits of the RCC enable register at offset enr
+ * (RCC_AHB1ENR, RCC_APB1ENR, RCC_APB2ENR), then that register read back.
+ * ST erratum sheet ES0182 (STM32F405/407), "Delay after an RCC peripheral
+ * clock enabling": a peripheral access within 2 AHB cycles (AHB peripheral)
+ * or 1 + AHB/APB prescaler cycles (APB) of the enable is lost; the dummy
+ * read of the RCC register is the erratum's workaround (and what ST's HAL
+ * does in its clock-enable macros). Every clock enable goes through here. */
+static inline void f4_rcc_enable(uint32_t enr, uint32_t bits)
+{
+    f4_set(F4_RCC + enr, bits);
+    (void)f4_rd(F4_RCC + enr);
+}
 
 #define F4_BIT(n) (1u << (n))
 #define F4_FIELD(v, pos) ((uint32_t)(v) << (pos))

@@ -36,7 +36,7 @@ int f4_spi_br(uint32_t pclk_hz, uint32_t max_hz, uint32_t *br, uint32_t *sck_hz)
 
 void f4_spi_init(const f4_spi_t *s, uint32_t br, bool cpol, bool cpha)
 {
-    f4_set(F4_RCC + (s->apb == 2u ? F4_RCC_APB2ENR : F4_RCC_APB1ENR), s->en);
+    f4_rcc_enable(s->apb == 2u ? F4_RCC_APB2ENR : F4_RCC_APB1ENR, s->en);
     /* Configured while disabled (sec. 28.3.3), then SPE. */
     const uint32_t cr1 = F4_SPI_CR1_MSTR | F4_SPI_CR1_SSM | F4_SPI_CR1_SSI | F4_SPI_CR1_DFF |
                          F4_FIELD(br & 7u, F4_SPI_CR1_BR_POS) | (cpol ? F4_SPI_CR1_CPOL : 0u) |

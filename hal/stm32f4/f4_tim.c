@@ -7,7 +7,7 @@
 void f4_tim1_pwm_init(const f4_tim1_cfg_t *c)
 {
     const uintptr_t t = F4_TIM1;
-    f4_set(F4_RCC + F4_RCC_APB2ENR, F4_RCC_APB2ENR_TIM1EN);
+    f4_rcc_enable(F4_RCC_APB2ENR, F4_RCC_APB2ENR_TIM1EN);
     /* Counter stopped, outputs off before anything else. */
     f4_wr(t + F4_TIM_CR1, 0u);
     f4_clr(t + F4_TIM_BDTR, F4_TIM_BDTR_MOE);
@@ -92,7 +92,7 @@ uintptr_t f4_gptim_base(uint32_t n)
 
 void f4_gptim_enable(uint32_t n)
 {
-    f4_set(F4_RCC + F4_RCC_APB1ENR, F4_RCC_APB1ENR_TIM2EN << (n - 2u));
+    f4_rcc_enable(F4_RCC_APB1ENR, F4_RCC_APB1ENR_TIM2EN << (n - 2u));
 }
 
 void f4_ticks_init(uint32_t n, uint32_t f_tim_hz)

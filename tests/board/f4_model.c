@@ -172,9 +172,25 @@ static int f4_model_index(uintptr_t reg, const uintptr_t *bases, unsigned n, uin
     return -1;
 }
 
+/* The access to reg after an RCC clock enable: the read-back of that
+ * enable register, or counted as too early. */
+static void f4_model_rcc_sync(uintptr_t reg, bool read)
+{
+    if (f4_model.rcc_enable_pending == 0u) {
+        return;
+    }
+    if (read && reg == f4_model.rcc_enable_pending) {
+        f4_model.rcc_enable_pending = 0u;
+    } else if (reg != f4_model.rcc_enable_pending) {
+        f4_model.rcc_enable_unsynced++;
+        f4_model.rcc_enable_pending = 0u;
+    }
+}
+
 uint32_t f4_trace_read(uintptr_t reg)
 {
     uint32_t *c = f4_model_cell(reg);
+    f4_model_rcc_sync(reg, true);
     if (c == NULL) {
         return 0u;
     }
@@ -303,8 +319,14 @@ void f4_trace_write(uintptr_t reg, uint32_t value)
     } else {
         f4_model.log_overflow = true;
     }
+    f4_model_rcc_sync(reg, false);
     if (c == NULL) {
         return;
+    }
+    if ((reg == F4_RCC + F4_RCC_AHB1ENR || reg == F4_RCC + F4_RCC_APB1ENR ||
+         reg == F4_RCC + F4_RCC_APB2ENR) &&
+        (value & ~*c) != 0u) {
+        f4_model.rcc_enable_pending = reg;
     }
     if ((reg >= F4_FLASH && reg < F4_FLASH + 0x18u) ||
         (reg >= (uintptr_t)f4_mem_flash_settings &&

@@ -49,6 +49,12 @@ typedef struct {
     bool rcr_written;
     bool flash_key1; /* KEY1 written, KEY2 expected */
     uint32_t spi_frames;
+    /* ES0182 "Delay after an RCC peripheral clock enabling": an RCC enable
+     * register whose write set a new bit and has not been read back since
+     * (0: none), and how many accesses to another register came first (each
+     * could reach a peripheral whose clock is not yet on). */
+    uintptr_t rcc_enable_pending;
+    uint32_t rcc_enable_unsynced;
 } f4_model_t;
 
 extern f4_model_t f4_model;

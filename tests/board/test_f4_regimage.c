@@ -67,12 +67,21 @@ static void attach_drv(const f4_board_t *b)
     drv8301_model_attach(b->en_gate, b->drv_cs, b->nfault, b->drv_spi);
 }
 
+/* Every peripheral clock enable read back before any other access (ST
+ * erratum ES0182, "Delay after an RCC peripheral clock enabling"). */
+static void assert_rcc_synced(void)
+{
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE(0u, f4_model.rcc_enable_unsynced,
+                                     "an access right after an RCC clock enable (ES0182)");
+}
+
 static int board_init(const f4_board_t *b)
 {
     int rc = f4_clock_init(b->hse_hz, b->sysclk_hz, &clk);
     TEST_ASSERT_EQUAL_INT(F4_OK, rc);
     rc = f4_hal_init(&hal, b, &cfg20k, &clk);
     TEST_ASSERT_FALSE_MESSAGE(f4_model.log_overflow, "write log full");
+    assert_rcc_synced();
     return rc;
 }
 
@@ -530,6 +539,7 @@ static void test_servo_capture(void)
 {
     f4_capture_t cap;
     f4_capture_init(4u, 1u, 83u, 15u);
+    assert_rcc_synced();
     f4_capture_start(&cap, 4u, 1u);
     TEST_ASSERT_EQUAL_HEX32(0xF2F1u, reg(F4_TIM4 + F4_TIM_CCMR1));
     TEST_ASSERT_EQUAL_HEX32(0x31u, reg(F4_TIM4 + F4_TIM_CCER));
@@ -566,6 +576,55 @@ static void test_gate_pins_safe(void)
         TEST_ASSERT_FALSE(f4_model_pin_out(b->pwm_high[x].port, b->pwm_high[x].pin));
         TEST_ASSERT_EQUAL_UINT32(1u, f4_model_pin_mode(b->pwm_low[x].port, b->pwm_low[x].pin));
         TEST_ASSERT_FALSE(f4_model_pin_out(b->pwm_low[x].port, b->pwm_low[x].pin));
+    }
+}
+
+/* From the reset values (every GPIO clock off but the debug ports'): each
+ * pin f4_hal_gate_pins_safe drives gets its port's clock before its level
+ * (a BSRR write to a port without clock is lost) and its level before its
+ * output mode (else it drives ODR's reset value 0 for a moment: the ODrive's
+ * M1 nSCS PC14 would select the other driver). */
+static void test_gate_pins_clock_level_mode(void)
+{
+    const f4_board_t *boards[2] = {&f4_board_vesc6, &f4_board_odrive_v36};
+    for (unsigned k = 0; k < 2u; k++) {
+        const f4_board_t *b = boards[k];
+        f4_model_reset();
+        f4_hal_gate_pins_safe(b);
+        f4_pin_t pins[19];
+        bool level[19];
+        unsigned n = 0u;
+        pins[n] = b->en_gate;
+        level[n++] = false;
+        for (unsigned x = 0; x < 3u; x++) {
+            pins[n] = b->pwm_high[x];
+            level[n++] = false;
+            pins[n] = b->pwm_low[x];
+            level[n++] = false;
+        }
+        for (unsigned j = 0; j < 8u; j++) {
+            pins[n] = b->hold_low[j];
+            level[n++] = false;
+        }
+        for (unsigned j = 0; j < 2u; j++) {
+            pins[n] = b->hold_high[j];
+            level[n++] = true;
+        }
+        for (unsigned j = 0; j < n; j++) {
+            const f4_pin_t p = pins[j];
+            if (!f4_pin_used(p)) {
+                continue;
+            }
+            const int clock =
+                f4_model_find(F4_RCC + F4_RCC_AHB1ENR, F4_BIT(p.port), F4_BIT(p.port), 0);
+            const int lvl = pin_write(p, level[j], 0);
+            const int mode = f4_model_find(f4_gpio_base(p.port) + F4_GPIO_MODER, 3u << (2u * p.pin),
+                                           1u << (2u * p.pin), 0);
+            assert_before(clock, lvl, "the port's clock before the pin's level (BSRR)");
+            assert_before(lvl, mode, "the pin's level before its output mode");
+            TEST_ASSERT_EQUAL(level[j], f4_model_pin_out(p.port, p.pin));
+        }
+        assert_rcc_synced();
     }
 }
 
@@ -616,6 +675,7 @@ int main(void)
     RUN_TEST(test_pwm_limit_ack_and_encoder);
     RUN_TEST(test_servo_capture);
     RUN_TEST(test_gate_pins_safe);
+    RUN_TEST(test_gate_pins_clock_level_mode);
     RUN_TEST(test_iwdg_start_and_lsi);
     return UNITY_END();
 }
