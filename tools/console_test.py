@@ -156,6 +156,28 @@ class RecordedStreamTest(unittest.TestCase):
                                (self.samples[clean[-1]][0] - tick) / self.meta[2], places=9)
 
 
+class BadInputTest(unittest.TestCase):
+    def test_each_exits_2_naming_option_value_and_range(self):
+        """Checked before anything connects or starts (a negative --timeout ran and ended
+        with 'target went away', exit 3; --port 99999 with --web a traceback)."""
+        console = os.path.join(os.path.dirname(os.path.abspath(__file__)), "console")
+        cases = (
+            (["--timeout", "-1"], "--timeout: '-1' is out of range: allowed (0, 3600] s"),
+            (["--timeout", "nan"], "--timeout: 'nan' is out of range"),
+            (["--duration", "-5"], "--duration: '-5' is out of range: allowed [0, "),
+            (["--shift", "99"], "--shift: '99' is out of range: allowed [0, 10]"),
+            (["--baud", "fast"], "--baud: 'fast' is not a whole number: allowed [50, "),
+            (["--port", "99999", "--web"], "--port: '99999' is out of range: allowed [0, 65535]"),
+            (["--tcp", "localhost"], "--tcp: 'localhost': expected HOST:PORT with the port in "
+             "[1, 65535]"))
+        for args, want in cases:
+            r = subprocess.run([sys.executable, console, "--exec", "true"] + args
+                               if "--tcp" not in args else [sys.executable, console] + args,
+                               capture_output=True, text=True, timeout=20)
+            self.assertEqual(r.returncode, 2, args)
+            self.assertIn(want, r.stderr, args)
+
+
 class BuildProgressTest(unittest.TestCase):
     def test_counts_the_build_not_its_preamble_nor_an_inner_build(self):
         now = [0.0]
