@@ -102,6 +102,18 @@ def style_of(name):
                 marker=MARKERS[i % len(MARKERS)])
 
 
+HATCHES = ("", "////", "\\\\\\\\", "....", "xxxx", "oo")
+
+
+def bar_style(name):
+    """style_of for a bar: the controller's colour and, for its place in the family, a
+    hatch (a bar has no line style or marker)."""
+    st = style_of(name)
+    _f, i = family_of(name)
+    return dict(color=st["color"], hatch=HATCHES[i % len(HATCHES)], edgecolor="white",
+                linewidth=0.0)
+
+
 def trace_style(name, npts, lw):
     """style_of for a time series: its marker every eighth of the points, each member of a
     family starting at its own offset so that the markers of overlapping lines alternate

@@ -125,6 +125,46 @@ class PlotStyles(unittest.TestCase):
                 self.assertEqual(len(set(vals)), len(vals), (key, members))
 
 
+    def test_bars(self):
+        """fieldweak_robust.png drew 20 bars in matplotlib's ten default colours (fst and
+        m2ptfc alike): a bar takes its controller's colour and its family place's hatch."""
+        sys.path.insert(0, HERE)
+        import compare
+        names = [n for _f, members in compare.FAMILIES for n in members]
+        looks = {n: compare.bar_style(n) for n in names}
+        self.assertEqual(len({(s["color"], s["hatch"]) for s in looks.values()}), len(names))
+        for _f, members in compare.FAMILIES:
+            self.assertEqual(len({looks[n]["hatch"] for n in members}), len(members))
+        # the robustness plot draws with them
+        import fieldweak_studies as fws
+        ctrls = [n for n in names if n not in ("foc", "foc_hyst", "hdtc", "svm_dtc", "hpdtc",
+                                               "hdtc_pred")]
+        res = {(case, c, rpm): {"torque_ripple_nm": 0.1, "rc": 0, "fault": "none",
+                                "torque_sse_nm": 0.0}
+               for case, _ in fws.ROBUST_CASES for c in ctrls for rpm in fws.SPEEDS}
+        self.assertTrue(all(fws.ok(m) for m in res.values()))
+        figs = []
+        subplots = fws.plt.subplots
+
+        def keep(*a, **kw):
+            fig, ax = subplots(*a, **kw)
+            figs.append(fig)
+            return fig, ax
+        fws.plt.subplots = keep
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                fws.plot_robust(res, ctrls, tmp)
+        finally:
+            fws.plt.subplots = subplots
+        for ax in figs[0].axes:
+            bars = [c.get_label() for c in ax.containers]
+            for c in ax.containers:
+                p0 = c.patches[0]
+                self.assertEqual((matplotlib_hex(p0.get_facecolor()), p0.get_hatch() or ""),
+                                 (looks[c.get_label()]["color"], looks[c.get_label()]["hatch"]))
+            self.assertEqual(sorted(bars), sorted(ctrls))
+        fws.plt.close(figs[0])
+
     def test_time_series_draw_the_whole_look(self):
         """dynamic.png and dynamic_zoom.png: every controller's line has its colour, line
         style and a marker (foc and hdtc_pred were both solid red; six thin dashes of one

@@ -474,6 +474,38 @@ def robust_ctrls(names):
     return out
 
 
+def plot_robust(res, ctrls, out):
+    """fieldweak_robust.png: each controller's ripple under each parameter error over its
+    nominal run's; a bar in the report's colour of the controller and its family hatch."""
+    from compare import bar_style  # the report's looks (compare imports this module's users)
+    fig, ax = plt.subplots(1, len(SPEEDS), figsize=(14, 5), sharey=True)
+    cases = [c for c, _ in ROBUST_CASES if c != "nominal"]
+    for k, rpm in enumerate(SPEEDS):
+        w = 0.8 / len(ctrls)
+        for i, c in enumerate(ctrls):
+            nom = res[("nominal", c, rpm)]
+            vals = []
+            for case in cases:
+                m = res[(case, c, rpm)]
+                vals.append(m["torque_ripple_nm"] / nom["torque_ripple_nm"]
+                            if ok(m) and ok(nom) else math.nan)
+            ax[k].bar([j + i * w for j in range(len(cases))], vals, width=w, label=c,
+                      **bar_style(c))
+        ax[k].set_xticks([j + 0.4 for j in range(len(cases))])
+        ax[k].set_xticklabels(cases, rotation=30, fontsize=8)
+        ax[k].axhline(1.0, color="k", lw=0.6)
+        ax[k].axhline(1.5, color="r", lw=0.6, ls=":")
+        ax[k].set_yscale("log")
+        ax[k].set_title(f"{rpm} r/min: torque ripple / nominal", fontsize=9)
+        ax[k].grid(True, axis="y", lw=0.3)
+    ax[-1].legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fn = "fieldweak_robust.png"
+    fig.savefig(os.path.join(out, fn), dpi=DPI)
+    plt.close(fig)
+    return fn
+
+
 def study_robust(names, fsd, tmp, eng, out):
     files = {}
     for case, ch in ROBUST_CASES:
@@ -532,30 +564,7 @@ def study_robust(names, fsd, tmp, eng, out):
                              f"{m['torque_ripple_nm']:.4f} N·m / {m['torque_sse_nm']:+.3f}")
             lines.append(f"| {c} | " + " | ".join(cells) + " |")
         lines.append("")
-    fig, ax = plt.subplots(1, len(SPEEDS), figsize=(14, 5), sharey=True)
-    cases = [c for c, _ in ROBUST_CASES if c != "nominal"]
-    for k, rpm in enumerate(SPEEDS):
-        w = 0.8 / len(ctrls)
-        for i, c in enumerate(ctrls):
-            nom = res[("nominal", c, rpm)]
-            vals = []
-            for case in cases:
-                m = res[(case, c, rpm)]
-                vals.append(m["torque_ripple_nm"] / nom["torque_ripple_nm"]
-                            if ok(m) and ok(nom) else math.nan)
-            ax[k].bar([j + i * w for j in range(len(cases))], vals, width=w, label=c)
-        ax[k].set_xticks([j + 0.4 for j in range(len(cases))])
-        ax[k].set_xticklabels(cases, rotation=30, fontsize=8)
-        ax[k].axhline(1.0, color="k", lw=0.6)
-        ax[k].axhline(1.5, color="r", lw=0.6, ls=":")
-        ax[k].set_yscale("log")
-        ax[k].set_title(f"{rpm} r/min: torque ripple / nominal", fontsize=9)
-        ax[k].grid(True, axis="y", lw=0.3)
-    ax[-1].legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fn = "fieldweak_robust.png"
-    fig.savefig(os.path.join(out, fn), dpi=DPI)
-    plt.close(fig)
+    fn = plot_robust(res, ctrls, out)
     lines += [f"![robustness]({fn})", ""]
     bad = []
     for rpm in SPEEDS:
