@@ -7,8 +7,9 @@ stopped); EXITING.elf: an image that ends by itself (a PIL test image).
 Checks that the console waits for the calibration before its first command
 (so "arm" is answered ok, not err 8 state), that the target obeys the user's
 commands only (the speed it reaches is the one commanded), that QEMU's own
-exit is reported with exit status 3, and that a target it cannot reach gives
-exit status 2.
+exit is reported with exit status 3, that a target it cannot reach gives
+exit status 2, and that long commands while the drive runs (listings) leave it
+running.
 """
 import os
 import subprocess
@@ -55,6 +56,23 @@ class ConsoleQemuTest(unittest.TestCase):
             # The speed loop holds the commanded 500 r/min (the estimate's
             # quantisation and the loop's ripple: a few r/min).
             self.assertLess(max(abs(s - 500.0) for s in tail), 25.0, tail)
+
+    def test_long_commands_while_running(self):
+        # A command runs with the interrupts masked in the QEMU images: a long
+        # one (a listing) delays the period's interrupt past its tick. The next
+        # tick must not cut short that period's medium task (a deadline fault,
+        # 29 of 30 listings faulted before the timer's realignment).
+        cmds = ["ref speed 1000", "arm"]
+        for _ in range(30):
+            cmds += ["param list", "status"]
+        args = ["--qemu", ELF, "--timeout", "30"]
+        for c in cmds:
+            args += ["--cmd", c]
+        r = console(*args)
+        states = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("state=")]
+        faults = [ln.strip() for ln in r.stdout.splitlines() if ln.strip().startswith("fault=")]
+        self.assertEqual(r.returncode, 0, r.stderr[-800:])
+        self.assertEqual(states, ["state=running"] * 30, faults)
 
     def test_settings_commands(self):
         # The settings record in the image's RAM model of the flash pages:

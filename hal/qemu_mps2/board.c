@@ -34,6 +34,7 @@
 #define NVIC_ISER0 REG32(0xE000E100u)
 #define NVIC_ICER0 REG32(0xE000E180u)
 #define NVIC_ICPR0 REG32(0xE000E280u)
+#define NVIC_ISPR0 REG32(0xE000E200u) /* set-pending; reads 1 for a pending IRQ (B3.4.5) */
 /* System control block: ICSR, SHPR3 (PendSV's priority in bits 23:16) */
 #define SCB_ICSR REG32(0xE000ED04u)
 #define SCB_ICSR_PENDSVSET (1u << 28)
@@ -116,6 +117,13 @@ int timer0_start(uint32_t hz, timer0_callback_t callback)
     NVIC_ISER0 = 1u << TIMER0_IRQ;
     TIMER_CTRL(TIMER0_BASE) = TIMER_CTRL_EN | TIMER_CTRL_IRQ_EN;
     return 0;
+}
+
+void timer0_realign(void)
+{
+    if (timer0_period != 0u && (NVIC_ISPR0 & (1u << TIMER0_IRQ)) != 0u) {
+        TIMER_VALUE(TIMER0_BASE) = timer0_period - 1u; /* reload now (CMSDK timer VALUE) */
+    }
 }
 
 void timer0_stop(void)

@@ -48,6 +48,10 @@ void semihost_exit(int code) __attribute__((noreturn));
 typedef void (*timer0_callback_t)(void);
 int timer0_start(uint32_t hz, timer0_callback_t callback);
 void timer0_stop(void);
+/* Called with interrupts masked: when a tick came while they were (its
+ * interrupt pending), its period restarts now, so that the late interrupt has
+ * a whole period, as every other, before the next tick. */
+void timer0_realign(void);
 /* Timer0 period in 25 MHz ticks (RELOAD + 1) while running, else 0. */
 uint32_t timer0_period_ticks(void);
 

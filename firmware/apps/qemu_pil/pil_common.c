@@ -46,6 +46,13 @@ void pil_poll_uart(fw_link_t *link)
     for (int c = hal_qemu_uart_getc(); c >= 0; c = hal_qemu_uart_getc()) {
         board_irq_disable();
         fw_link_rx(link, (uint8_t)c);
+        /* A command runs masked (the engine's state is the interrupt's), a
+         * long one (a listing: thousands of instructions) past a tick: that
+         * period's interrupt comes late, and without the realignment the
+         * next tick cuts short its medium task (PendSV) - a deadline fault
+         * while running, the Timer0 period being only the interrupt's cost
+         * and a quarter (pil_timer_account). */
+        timer0_realign();
         board_irq_enable();
     }
     fw_link_poll(link);
