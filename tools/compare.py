@@ -842,6 +842,8 @@ def main():
     if not (0.0 <= a.settle < a.duration <= 10.0):
         sys.exit("compare: need 0 <= --settle < --duration <= 10")
 
+    # The engine first: an unreachable --scheduler is refused before the build (exit 2).
+    eng = se.engine_or_exit(a, a.out, "compare")
     t_all = time.time()
     sim, ctrls = sim_binary(a.sim)
     want = a.controllers.split(",") if a.controllers else (list(FAST_CTRLS) if a.fast else [])
@@ -918,7 +920,7 @@ def main():
     conv = [(j,) + se.run_of_command(build, j["cmd"][1:], " ".join(str(x) for x in j["key"]))
             for j in jobs]
     print(f"compare: {len(jobs)} simulations ({len(ctrls)} controllers)")
-    with se.engine_or_exit(a, a.out, "compare") as eng:
+    with eng:
         for (j, _, paths), r in zip(conv, eng.run([c[1] for c in conv])):
             res = results[j["key"]] = result_of(r, paths)
             if res["m"] is None:
