@@ -133,6 +133,12 @@ void f4_iwdg_window(uint32_t pr, uint32_t rlr, uint32_t *min_ms, uint32_t *max_m
     *max_ms = stm32_iwdg_timeout_ms(pr, rlr, F4_LSI_MIN_HZ);
 }
 
+uint32_t f4_iwdg_update_ms(uint32_t pr)
+{
+    const uint32_t div = 4u << (pr < 6u ? pr : 6u);
+    return (F4_IWDG_UPDATE_PERIODS * div * 1000u + F4_LSI_MIN_HZ - 1u) / F4_LSI_MIN_HZ + 1u;
+}
+
 int f4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)
 {
     /* LSION as well: the start key forces the LSI on (sec. 21.3.2), LSION
@@ -144,9 +150,9 @@ int f4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)
     f4_wr(F4_IWDG + F4_IWDG_KR, F4_IWDG_KR_UNLOCK);
     f4_wr(F4_IWDG + F4_IWDG_PR, pr);
     f4_wr(F4_IWDG + F4_IWDG_RLR, rlr);
-    /* PVU and RVU clear once the values have crossed into the LSI domain:
-     * up to 5 LSI periods (sec. 21.4.4), 0.3 ms at the slowest LSI; 10 ms. */
-    if (!f4_wait_bits(F4_IWDG + F4_IWDG_SR, 0x3u, 0u, 10u * (f_cpu_hz / 1000u))) {
+    /* PVU and RVU clear once the values have crossed into the LSI domain
+     * (f4_iwdg_update_ms: the prescaled LSI's periods). */
+    if (!f4_wait_bits(F4_IWDG + F4_IWDG_SR, 0x3u, 0u, f4_iwdg_update_ms(pr) * (f_cpu_hz / 1000u))) {
         return F4_E_LSI;
     }
     /* The start key forces the LSI on (sec. 21.3.2); it is ready within

@@ -73,8 +73,14 @@ uint32_t f4_exti_irq(uint32_t line);
 #define F4_LSI_TYP_HZ 32000u
 #define F4_LSI_MAX_HZ 47000u
 void f4_iwdg_window(uint32_t pr, uint32_t rlr, uint32_t *min_ms, uint32_t *max_ms);
+/* How long IWDG_SR's PVU / RVU may stay set after PR / RLR are written, ms:
+ * 5 periods of the prescaled LSI (ST's STM32F4 HAL, stm32f4xx_hal_iwdg.c:
+ * "5 RC LSI divided by prescaler clock"; it waits 6), 6 here, at the slowest
+ * LSI, + 1 ms for the LSI's start-up: 3 ms at /4 .. 92 ms at /256. */
+#define F4_IWDG_UPDATE_PERIODS 6u
+uint32_t f4_iwdg_update_ms(uint32_t pr);
 /* Start (0xCCCC: it also turns the LSI on), unlock (0x5555), PR, RLR, wait
- * until SR = 0 (the values reached the LSI domain), refresh. It cannot be
+ * until SR = 0 (the values reached the LSI domain: f4_iwdg_update_ms), refresh. It cannot be
  * stopped afterwards. Also changes PR and RLR of a running watchdog (the
  * start key then has no further effect). f_cpu_hz for the wait. */
 int f4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz);

@@ -213,6 +213,10 @@ uint32_t f4_trace_read(uintptr_t reg)
     if (reg == F4_FLASH + F4_FLASH_ACR && f4_model.latency_stuck) {
         *c &= ~F4_FLASH_ACR_LATENCY_MASK;
     }
+    if (reg == F4_IWDG + F4_IWDG_SR) {
+        const uint32_t since = *f4_reg(F4_DWT, F4_DWT_CYCCNT) - f4_model.iwdg_written_at;
+        *c = since < f4_model.iwdg_update_cycles ? 0x3u : 0u; /* PVU, RVU */
+    }
     if (reg == F4_FLASH + F4_FLASH_SR) {
         *c = (*c & ~F4_FLASH_SR_BSY) | (f4_model.flash_bsy_stuck ? F4_FLASH_SR_BSY : 0u);
     }
@@ -402,6 +406,9 @@ void f4_trace_write(uintptr_t reg, uint32_t value)
             (*c & F4_TIM_CR1_CEN) == 0u) {
             f4_model.rcr_before_cen = f4_model.rcr_written;
         }
+    }
+    if (reg == F4_IWDG + F4_IWDG_PR || reg == F4_IWDG + F4_IWDG_RLR) {
+        f4_model.iwdg_written_at = *f4_reg(F4_DWT, F4_DWT_CYCCNT);
     }
     /* IWDG: the start key forces the LSI on, which is ready at once here
      * (RM0090 sec. 21.3.2; RCC_CSR LSION, LSIRDY); SR stays 0. */

@@ -29,18 +29,20 @@ typedef struct {
     uint32_t n_log;
     bool log_overflow;
     /* behaviour switches */
-    bool hse_broken;      /* HSERDY never rises */
-    bool pll_broken;      /* PLLRDY never rises */
-    bool sws_stuck;       /* RCC_CFGR.SWS keeps its value */
-    bool latency_stuck;   /* FLASH_ACR.LATENCY reads 0 */
-    bool uev_at_valley;   /* the TIM1 update falls at the counter valley */
-    bool tim1_dead;       /* TIM1 never updates (as in QEMU) */
-    bool adc_dead;        /* regular conversions never end (EOC) */
-    uint16_t adc_regular; /* result of every regular conversion */
-    uint16_t gpio_in[4];  /* levels of the input pins of ports A..D */
-    bool flash_wrp[12];   /* write-protected sectors */
-    bool flash_bsy_stuck; /* BSY never clears */
-    bool lsi_dead;        /* LSIRDY never rises (as in QEMU, which has no RCC) */
+    bool hse_broken;             /* HSERDY never rises */
+    bool pll_broken;             /* PLLRDY never rises */
+    bool sws_stuck;              /* RCC_CFGR.SWS keeps its value */
+    bool latency_stuck;          /* FLASH_ACR.LATENCY reads 0 */
+    bool uev_at_valley;          /* the TIM1 update falls at the counter valley */
+    bool tim1_dead;              /* TIM1 never updates (as in QEMU) */
+    bool adc_dead;               /* regular conversions never end (EOC) */
+    uint16_t adc_regular;        /* result of every regular conversion */
+    uint16_t gpio_in[4];         /* levels of the input pins of ports A..D */
+    bool flash_wrp[12];          /* write-protected sectors */
+    bool flash_bsy_stuck;        /* BSY never clears */
+    bool lsi_dead;               /* LSIRDY never rises (as in QEMU, which has no RCC) */
+    uint32_t iwdg_update_cycles; /* IWDG_SR PVU / RVU stay set this many core
+                                    cycles (CYCCNT) after PR / RLR are written */
     /* SPI peer: frames written to SPIn's DR go to it, its answer is read
      * back; NULL: the bus reads 0 (nothing connected). */
     uint16_t (*spi_peer)(uint32_t spi, uint16_t out);
@@ -49,6 +51,7 @@ typedef struct {
     bool rcr_written;
     bool flash_key1; /* KEY1 written, KEY2 expected */
     uint32_t spi_frames;
+    uint32_t iwdg_written_at; /* CYCCNT when PR or RLR was last written */
     /* ES0182 "Delay after an RCC peripheral clock enabling": an RCC enable
      * register whose write set a new bit and has not been read back since
      * (0: none), and how many accesses to another register came first (each

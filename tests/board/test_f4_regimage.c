@@ -653,6 +653,18 @@ static void test_iwdg_start_and_lsi(void)
     f4_model_reset();
     f4_model.lsi_dead = true;
     TEST_ASSERT_EQUAL_INT(F4_E_LSI, f4_iwdg_start(pr, rlr, 16000000u));
+
+    /* PVU / RVU clear within 5 periods of the prescaled LSI (ST's HAL,
+     * stm32f4xx_hal_iwdg.c): the wait covers them at the slowest LSI for
+     * every prescaler; at /256 (PR 6) 5 x 256 / 17 kHz = 75.3 ms, 1 204 706
+     * cycles at 16 MHz: the start waits them out (a fixed 10 ms did not). */
+    for (uint32_t p = 0u; p <= 6u; p++) {
+        TEST_ASSERT_TRUE((uint64_t)f4_iwdg_update_ms(p) * F4_LSI_MIN_HZ >=
+                         5ull * (4u << p) * 1000u);
+    }
+    f4_model_reset();
+    f4_model.iwdg_update_cycles = 1204706u;
+    TEST_ASSERT_EQUAL_INT(F4_OK, f4_iwdg_start(6u, 0xFFFu, 16000000u));
     TEST_ASSERT_NOT_NULL(strstr(f4_strerror(F4_E_LSI), "LSI"));
 }
 
