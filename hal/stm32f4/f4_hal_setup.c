@@ -337,8 +337,11 @@ int f4_hal_init(hal_t *h, const f4_board_t *b, const f4_hal_cfg_t *c, const f4_c
 
 bool f4_hal_drv_service(hal_t *h, bool stopped)
 {
-    if (h->drv_rc != DRV8301_OK) {
-        return false; /* never configured: held off, EN_GATE low */
+    if (h->drv_rc != DRV8301_OK || h->hold) {
+        /* Never configured, or a later start-up step failed: held off for
+         * good with EN_GATE low, the driver reset and its SPI silent (its
+         * read-back would fail every time and be written again forever). */
+        return false;
     }
     const uint32_t n = h->fault_n;
     bool report = n != h->faults_seen;

@@ -400,6 +400,15 @@ static void test_clock_fall_back_holds(void)
     TEST_ASSERT_EQUAL_INT(-1,
                           f4_model_find(F4_TIM1 + F4_TIM_CR1, F4_TIM_CR1_CEN, F4_TIM_CR1_CEN, 0));
     TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    /* Held for good: the main loop's service leaves the reset driver
+     * alone (no frame, no configuration lost, nothing to report). */
+    const uint32_t frames = f4_model.spi_frames;
+    for (unsigned k = 0; k < 3u; k++) {
+        TEST_ASSERT_FALSE(f4_hal_drv_service(&hal, true));
+    }
+    TEST_ASSERT_EQUAL_UINT32(frames, f4_model.spi_frames);
+    TEST_ASSERT_FALSE(hal.cfg_lost);
+    TEST_ASSERT_FALSE(f4_model_pin_out(b->en_gate.port, b->en_gate.pin));
 }
 
 /* TIM1's update at the valley (RCR written after the start): F4_E_TIM,
