@@ -116,15 +116,19 @@ typedef struct {
      * driver sharing EN_GATE, named in its description. */
     f4_pin_t hold_low[8];
     f4_pin_t hold_high[2];
+    /* Inputs held high by their internal pull-up, before the outputs above:
+     * another chip's active-low select on a line that some variants of the
+     * board use otherwise (a pull-up fights no driver). */
+    f4_pin_t pull_up[2];
     /* ratings of the power stage */
     double current_peak_a; /* the highest current the hardware trip may be set to */
     double vbus_max_v;
 } f4_board_t;
 
 /* EN_GATE low (the DRV8301 holds every gate low), the six gate pins as GPIO
- * outputs at their inactive level, the board's hold_low / hold_high pins at
- * their levels: f4_hal_init's first step, the fault handlers' last, the PIL
- * image's first (f4_gates.c: GPIO only). */
+ * outputs at their inactive level, the board's pull_up inputs, its
+ * hold_low / hold_high pins at their levels: f4_hal_init's first step, the fault handlers' last,
+ * the PIL image's first (f4_gates.c: GPIO only). */
 void f4_hal_gate_pins_safe(const f4_board_t *b);
 
 #endif /* HAL_STM32F4_F4_BOARD_H */

@@ -11,6 +11,9 @@ void f4_hal_gate_pins_safe(const f4_board_t *b)
         f4_gpio_output(b->pwm_high[x], b->gate_active_low, 2u);
         f4_gpio_output(b->pwm_low[x], b->gate_active_low, 2u);
     }
+    for (unsigned k = 0; k < 2u; k++) {
+        f4_gpio_config(b->pull_up[k], F4_PIN_INPUT, 1u);
+    }
     for (unsigned k = 0; k < 8u; k++) {
         f4_gpio_output(b->hold_low[k], false, 0u);
     }

@@ -635,6 +635,16 @@ static void test_gate_pins_clock_level_mode(void)
         }
         assert_rcc_synced();
     }
+    /* The VESC 6's PB12 (the first hardware 60's NRF24 CSN) an input
+     * pulled up before PD2 (its MISO there) becomes an output. */
+    const f4_board_t *b = &f4_board_vesc6;
+    f4_model_reset();
+    f4_hal_gate_pins_safe(b);
+    TEST_ASSERT_EQUAL_UINT32(0u, f4_model_pin_mode(1u, 12u));
+    TEST_ASSERT_EQUAL_HEX32(1u, (reg(F4_GPIOB + F4_GPIO_PUPDR) >> 24) & 3u);
+    const int pull = f4_model_find(F4_GPIOB + F4_GPIO_PUPDR, 3u << 24, 1u << 24, 0);
+    const int pd2 = f4_model_find(F4_GPIOD + F4_GPIO_MODER, 3u << 4, 1u << 4, 0);
+    assert_before(pull, pd2, "the NRF24's CSN pulled up before PD2 drives");
 }
 
 /* The watchdog: started with the start key (which forces the LSI on),

@@ -168,6 +168,7 @@ const f4_board_t f4_board_odrive_v36 = {
                  {B, 10u, 0u},
                  {B, 11u, 0u}},
     .hold_high = {{C, 14u, 0u}, NONE},
+    .pull_up = {NONE, NONE},
 
     .current_peak_a = ODRIVE_V36_CURRENT_PEAK_A,
     .vbus_max_v = ODRIVE_V36_VBUS_MAX_V,

@@ -136,9 +136,15 @@ const f4_board_t f4_board_vesc6 = {
     .tick_tim = 2u,           /* TIM2 is free on this board */
     .led = {B, 0u, 0u},       /* green [HW60] LED_GREEN */
     .led_fault = {B, 1u, 0u}, /* red [HW60] LED_RED */
-    /* PD2 low: the current filter off, as hw_init_gpio leaves it [HW60]. */
+    /* PD2 low: the current filter off, as hw_init_gpio leaves it [HW60]. On
+     * the first hardware 60 (HW_HAS_PERMANENT_NRF) PD2 is the permanent
+     * NRF24's MISO instead, and its CSN PB12 [HW60] NRF_PIN_CSN floats
+     * unless driven: PB12 pulled up first, so the NRF stays deselected and
+     * its MISO high-impedance (PB12 is another chip's pin on later variants:
+     * a pull-up, not an output). */
     .hold_low = {{D, 2u, 0u}, NONE, NONE, NONE, NONE, NONE, NONE, NONE},
     .hold_high = {NONE, NONE},
+    .pull_up = {{B, 12u, 0u}, NONE},
 
     .current_peak_a = VESC6_CURRENT_PEAK_A,
     .vbus_max_v = VESC6_VBUS_MAX_V,
