@@ -839,8 +839,11 @@ def main():
         sweep_dur, sweep_settle = 0.05, 0.02
         dyn_duration = 0.04
         chap_dur, chap_settle = 0.06, 0.03
+    if not 0 <= a.seed <= 2 ** 53:
+        ap.error(f"--seed {a.seed} is out of range: allowed [0, 2^53] (the ADC noise seed)")
     if not (0.0 <= a.settle < a.duration <= 10.0):
-        sys.exit("compare: need 0 <= --settle < --duration <= 10")
+        ap.error(f"--settle {a.settle:g}, --duration {a.duration:g} s: allowed "
+                 "0 <= settle < duration <= 10 s")
 
     # The engine first: an unreachable --scheduler is refused before the build (exit 2).
     eng = se.engine_or_exit(a, a.out, "compare")
@@ -850,7 +853,8 @@ def main():
     if want:
         unknown = [w for w in want if w not in [c[0] for c in ctrls]]
         if unknown:
-            sys.exit(f"compare: unknown controller(s): {', '.join(unknown)}")
+            ap.error(f"--controllers: unknown {', '.join(unknown)} (allowed: "
+                     f"{', '.join(c[0] for c in ctrls)})")
         ctrls = [c for c in ctrls if c[0] in want]
     names = [c[0] for c in ctrls]
     os.makedirs(a.out, exist_ok=True)

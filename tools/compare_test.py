@@ -214,6 +214,28 @@ def matplotlib_hex(c):
     return matplotlib.colors.to_hex(c)
 
 
+class BadInput(unittest.TestCase):
+    """Each exits 2 naming option, value and range before a run starts (--jobs 0 ran the
+    whole comparison on the CPU count, an unknown controller exited 1)."""
+
+    def test_each(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            for args, want in (
+                    (["--jobs", "0"], "--jobs: '0' is out of range: allowed a whole number in "
+                     "[1, 1024] workers"),
+                    (["--seed", "-1"], "--seed -1 is out of range: allowed [0, 2^53]"),
+                    (["--settle", "0.5"], "--settle 0.5, --duration 0.3 s: allowed 0 <= settle "
+                     "< duration <= 10 s"),
+                    (["--controllers", "nosuch,bst"], "--controllers: unknown nosuch (allowed: "
+                     "bst, ")):
+                r = subprocess.run([sys.executable, os.path.join(HERE, "compare.py"), "--sim",
+                                    SIM, "--out", tmp] + args, capture_output=True, text=True,
+                                   timeout=60)
+                self.assertEqual(r.returncode, 2, (args, r.stderr))
+                self.assertIn(want, r.stderr, args)
+                self.assertEqual(os.listdir(tmp), [], args)
+
+
 class HdtcPredCause(unittest.TestCase):
     """hdtc_pred (thesis SPMSM, 1.8 N*m, 10 kHz): one period's torque steps
     dwarf S1's band, so the three-level regulator goes from +1 straight to -1 and

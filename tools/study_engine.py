@@ -708,11 +708,28 @@ class Engine:
         return False
 
 
+MAX_JOBS = 1024
+
+
+def _workers(text):
+    """--jobs: a whole number in [1, MAX_JOBS] (0 read as 'the CPU count' before)."""
+    try:
+        v = int(text)
+    except ValueError:
+        v = None
+    if v is None or not 1 <= v <= MAX_JOBS:
+        raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [1, %d] workers"
+                                         % (text, "out of range" if v is not None else
+                                            "not a whole number", MAX_JOBS))
+    return v
+
+
 def add_arguments(ap, jobs_default=None):
     """The engine's options on a tool's command line."""
     g = ap.add_argument_group("execution (tools/study_engine.py, docs/studies.md)")
-    g.add_argument("--jobs", type=int, default=jobs_default,
-                   help="workers of the local dask cluster (default: the CPU count)")
+    g.add_argument("--jobs", type=_workers, default=jobs_default,
+                   help="workers of the local dask cluster, [1, %d] (default: the CPU count)"
+                   % MAX_JOBS)
     g.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                    help="run on an existing dask cluster instead of a local one")
     g.add_argument("--store", default=None, metavar="FILE.sqlite",
