@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cmd.h"
+#include "ctrl_units.h"
 #include "fw_settings.h"
 #include "settings.h"
 
@@ -79,10 +80,11 @@ static const fw_param_t fw_params_drive_p[] = {
     P("inv.dead_time_s", U_S, 0, 1e-4, 0u, "inverter dead time (compensated; observers' voltage)"),
     P("inv.v_fwd_v", U_V, 0, 100, 0u, "device forward drop of the inverter"),
     P("speed.bw_hz", U_HZ, 0, 1e4, FW_PARAM_LIVE,
-      "speed-loop bandwidth (crossover), 0 = the highest the phase margin allows"),
-    P("speed.pm_deg", U_DEG, 0, 80, FW_PARAM_LIVE, "speed-loop phase margin, 20..80, 0 = 60"),
+      "speed-loop crossover; setting it designs the gains (0: the most the margin allows)"),
+    P("speed.pm_deg", U_DEG, 0, 80, FW_PARAM_LIVE,
+      "speed-loop phase margin, 20..80 (0: 60); setting it designs the gains"),
     P("speed.kp", U_KP, 0, 1e6, FW_PARAM_LIVE,
-      "speed PI Kp; with speed.ki both 0 = designed from J, bandwidth, margin"),
+      "speed PI Kp (with speed.ki 0: designed); setting it fixes both"),
     P("speed.ki", U_KI, 0, 1e8, FW_PARAM_LIVE, "speed PI Ki (see speed.kp)"),
     P("speed.unit", U_NONE, 0, 2, 0u,
       "speed of speed.kp/ki: 0 mechanical rad/s, 1 r/min, 2 electrical rad/s"),
@@ -224,6 +226,25 @@ static int fw_params_set(fw_link_t *l, const char *name, double v)
     }
     fw_t *fw = l->fw;
     if ((p->flags & FW_PARAM_LIVE) != 0u) {
+        /* The bandwidth and the margin are the design's: setting one designs
+         * the gains (explicit ones cleared). Setting a gain makes both
+         * explicit, the other as it is in force (the design's, in speed.unit,
+         * when they were designed). */
+        if (r.at == (uint8_t *)&s.speed_bw_hz || r.at == (uint8_t *)&s.speed_pm_deg) {
+            s.speed_kp = 0.0;
+            s.speed_ki = 0.0;
+        } else if (!(fw->cfg.speed_kp > 0.0) && !(fw->cfg.speed_ki > 0.0)) {
+            /* fw_speed_info_t's gains are per mechanical rad/s (fw_speed_gains) */
+            const unsigned su = (unsigned)fw->cfg.speed_unit;
+            const double per_rad = su == 1u   ? 60.0 / CTRL_TWO_PI
+                                   : su == 2u ? (double)fw->machine->pole_pairs
+                                              : 1.0;
+            if (r.at == (uint8_t *)&s.speed_kp) {
+                s.speed_ki = fw->speed_info.ki_nm_rad / per_rad;
+            } else {
+                s.speed_kp = fw->speed_info.kp_nm_s_rad / per_rad;
+            }
+        }
         const int rc = fw_speed_retune(fw, s.speed_bw_hz, s.speed_pm_deg, s.speed_kp, s.speed_ki);
         if (rc == FW_EBUSY) {
             return CMD_E_STATE;

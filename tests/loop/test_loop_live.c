@@ -263,7 +263,7 @@ static void test_parameter_tree(void)
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, head, strlen(head)));
     TEST_ASSERT_NOT_NULL(strstr(lt.out, "] live corner of the mean-torque-error integrator"));
     TEST_ASSERT_TRUE(strstr(lt.out, "  f_i ") < strstr(lt.out, "  m.p "));
-    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  speed.bw_hz 0 Hz [0, 10000] live speed-loop bandwidth"));
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  speed.bw_hz 0 Hz [0, 10000] live speed-loop crossover"));
     TEST_ASSERT_NOT_NULL(strstr(lt.out, "  speed.kp 0 N*m*s/rad [0, 1000000] live speed PI Kp"));
     TEST_ASSERT_NOT_NULL(strstr(lt.out, "  m.rs_ohm 0.901 ohm [0, 100] stator"));
 
@@ -297,6 +297,21 @@ static void test_parameter_tree(void)
     TEST_ASSERT_EQUAL_STRING("ok speed.pm_deg 45\r\n", lt.out);
     periods_b(1);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 45.0, run_b.fw.speed_info.phase_margin_deg);
+    /* A gain makes both explicit, the other as in force; the bandwidth
+     * designs them again. */
+    const double ki_design = run_b.fw.speed_info.ki_nm_rad;
+    send("param set speed.kp 0.05");
+    TEST_ASSERT_EQUAL_STRING("ok speed.kp 0.05\r\n", lt.out);
+    periods_b(1);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.05, run_b.fw.cfg.speed_kp);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12 * ki_design, ki_design, run_b.fw.cfg.speed_ki);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.05, run_b.fw.speed_info.kp_nm_s_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, run_b.fw.speed_info.bandwidth_hz); /* explicit */
+    send("param set speed.bw_hz 20");
+    TEST_ASSERT_EQUAL_STRING("ok speed.bw_hz 20\r\n", lt.out);
+    periods_b(1);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.0, run_b.fw.cfg.speed_kp);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 20.0, run_b.fw.speed_info.bandwidth_hz);
 
     /* Gates off: the record path (the drive calibrates again), tunables and
      * the rest of the configuration kept; telemetry goes on. */
