@@ -258,6 +258,8 @@ class WebConsole:
         self.last_status = {}
         self.meta = None
         self.flashing = False     # a tools/flash run is under way
+        self._flash_boards = None  # tools/flash --boards
+        self.flash_board = args.flash_board  # None: tools/flash's default (the first it lists)
 
     # ---- events from the link thread
     def _emit_threadsafe(self, ev):
@@ -361,29 +363,47 @@ class WebConsole:
                                 headers={"Cache-Control": "no-store"})
 
     # ---- the firmware page
-    def _flash_argv(self, *opts):
-        argv = [FLASH] + list(opts)
+    def flash_boards(self):
+        """The boards tools/flash flashes (tools/flash --boards), once."""
+        if self._flash_boards is None:
+            r = subprocess.run([FLASH, "--boards"], stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, text=True)
+            self._flash_boards = r.stdout.split() if r.returncode == 0 else []
+            if self.flash_board is None and self._flash_boards:
+                self.flash_board = self._flash_boards[0]
+        return self._flash_boards
+
+    def _hello_flash_info(self):
+        self.flash_boards()  # settles the default board
+        return self.flash_info(self.flash_board)
+
+    def _flash_argv(self, board, *opts):
+        argv = [FLASH, "--board", board] + list(opts)
         if self.args.flash_tool:
             argv += ["--tool", self.args.flash_tool]
         if self.args.flash_image:
             argv.append(self.args.flash_image)
         return argv
 
-    def flash_info(self):
-        """What a flash would write and with what: the image (tools/flash
-        --which), its size and time, and the programmer's command or why
-        there is none (tools/flash --dry-run)."""
-        info = {"image": None, "bytes": None, "mtime": None, "command": None, "problem": None}
-        r = subprocess.run(self._flash_argv("--which"), stdout=subprocess.PIPE,
+    def flash_info(self, board):
+        """What a flash of the board would write and with what: the image
+        (tools/flash --which; st-flash writes an F405 board's image in two
+        parts), its size and time, and the programmer's command or why there
+        is none (tools/flash --dry-run)."""
+        info = {"board": board, "boards": self.flash_boards(), "image": None, "bytes": None,
+                "mtime": None, "command": None, "problem": None}
+        r = subprocess.run(self._flash_argv(board, "--which"), stdout=subprocess.PIPE,
                            stderr=subprocess.PIPE, text=True)
         if r.returncode == 0:
-            info["image"] = r.stdout.strip()
+            parts = r.stdout.split()
+            info["image"] = " + ".join(parts)
             try:
-                st = os.stat(info["image"])
-                info["bytes"], info["mtime"] = st.st_size, st.st_mtime
+                sts = [os.stat(f) for f in parts]
+                info["bytes"] = sum(st.st_size for st in sts)
+                info["mtime"] = max(st.st_mtime for st in sts)
             except OSError:
                 pass
-        r = subprocess.run(self._flash_argv("--dry-run"), stdout=subprocess.PIPE,
+        r = subprocess.run(self._flash_argv(board, "--dry-run"), stdout=subprocess.PIPE,
                            stderr=subprocess.PIPE, text=True)
         if r.returncode == 0:
             info["command"] = r.stdout.strip()
@@ -392,7 +412,7 @@ class WebConsole:
                                                                 r.returncode])[-1]
         return info
 
-    async def _flash(self, page):
+    async def _flash(self, page, board):
         """One tools/flash --progress run; every line to every page with its phase."""
         self.flashing = True
         pct = 0
@@ -401,9 +421,9 @@ class WebConsole:
             if self.link.gone is None:
                 self.link.submit("stop", "page%d" % page)  # flashing resets the board
             await self._broadcast({"type": "flash", "start": True, "page": page,
-                                   "info": self.flash_info()})
+                                   "info": self.flash_info(board)})
             proc = await asyncio.create_subprocess_exec(
-                *self._flash_argv("--progress"), stdout=asyncio.subprocess.PIPE,
+                *self._flash_argv(board, "--progress"), stdout=asyncio.subprocess.PIPE,
                 stderr=asyncio.subprocess.STDOUT)
             while True:
                 raw = await proc.stdout.readline()
@@ -442,7 +462,7 @@ class WebConsole:
                               "page_timeout_s": self.args.page_timeout,
                               "target_pid": self.tr.proc.pid if self.tr.proc else None,
                               "status": self.last_status, "meta": self.meta,
-                              "gone": self.link.gone, "flash": self.flash_info(),
+                              "gone": self.link.gone, "flash": self._hello_flash_info(),
                               "read_only": sorted(" ".join(k) for k in READ_ONLY)})
         await self._announce_roles()
         try:
@@ -482,6 +502,12 @@ class WebConsole:
                 await self._send(ws, {"type": "refused", "line": "",
                                       "why": "another page controls the drive"})
             return
+        board = m.get("board") or self.flash_board
+        if kind in ("flash", "flash_info") and board not in self.flash_boards():
+            await self._send(ws, {"type": "refused", "line": "flash",
+                                  "why": "board %r: tools/flash flashes %s" % (
+                                      board, ", ".join(self.flash_boards()) or "none")})
+            return
         if kind == "flash":
             if ws is not self.controller:
                 await self._send(ws, {"type": "refused", "line": "flash",
@@ -493,10 +519,13 @@ class WebConsole:
                 await self._send(ws, {"type": "refused", "line": "flash",
                                       "why": "a flash run is already under way"})
             else:
-                asyncio.ensure_future(self._flash(page))
+                self.flash_board = board
+                asyncio.ensure_future(self._flash(page, board))
             return
         if kind == "flash_info":
-            await self._send(ws, {"type": "flash_info", "info": self.flash_info()})
+            if ws is self.controller:
+                self.flash_board = board  # the board the pages show from now on
+            await self._send(ws, {"type": "flash_info", "info": self.flash_info(board)})
             return
         if kind != "cmd":
             return
@@ -559,6 +588,12 @@ def serve(tr, args, target_label):
         print("console: --web needs python3-aiohttp (tools/setup installs it)", file=sys.stderr)
         return 2
     wc = WebConsole(tr, args, target_label)
+    boards = wc.flash_boards()
+    if args.flash_board is not None and args.flash_board not in boards:
+        print("console: --flash-board %s: tools/flash flashes %s" % (
+            args.flash_board, ", ".join(boards) or "no board (tools/flash --boards failed)"),
+            file=sys.stderr)
+        return 2
     import signal
     loop = asyncio.new_event_loop()
     main = loop.create_task(wc.serve())

@@ -21,17 +21,19 @@ what the page plots and shows):
     controller's tunables, each row with the firmware's unit, range, help
     text and when it changes; the speed loop's marked live, the machine's
     "gates off";
-  - while the drive runs at 1000 r/min: a live change (speed.bw_hz) is
-    answered ok in its row, the box keeps the new value, the drive keeps
-    running at its speed; a change the firmware refuses while running
+  - while the drive runs at 1000 r/min: a live change (speed.kp) is
+    answered ok in its row, the box keeps the new value, speed.ki stays, the
+    drive keeps running at its speed; a change the firmware refuses while running
     (m.rs_ohm) shows the firmware's reason in red and the box reverts to the
     firmware's value; so does a tunable set out of range (`err 4 range
     [min, max]`);
   - STOP gives state=ready;
-  - the firmware page without an ST-LINK (tools/flash sees no probe): the
-    page says so, in red, and nothing was written; with a probe (a stand-in
-    programmer on PATH that prints openocd's lines) it follows the phases to
-    "written and verified";
+  - the firmware page offers the boards tools/flash flashes; without an
+    ST-LINK (tools/flash sees no probe) the page says so, in red, with the
+    board's own hint, and nothing was written (the B-G431B-ESC1, then a VESC 6
+    with its STM32F4 target); with a probe (a stand-in programmer on PATH
+    that prints openocd's lines) it follows the phases to "written and
+    verified" (flashing itself is verified on hardware only);
   - a second page watches: its `arm` is refused, its `status` answered;
   - the controlling page lost (browser gone) with the drive armed: the drive is
     stopped within the page time-out;
@@ -57,6 +59,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CONSOLE = os.path.join(HERE, "console")
 PAGE_TIMEOUT_S = 1.5
 SPEED_RPM = 1000.0
+# The live change: the speed PI's Kp times this (the image's own gains cross
+# over near 87 Hz, Kp / J; a loop several times slower - speed.bw_hz 20 - lets
+# the FST torque ripple and the 0.3 N*m load move the speed beyond the 3 % the
+# check allows, a faster one nears the 1 kHz speed loop's limit).
+LIVE_KP_SCALE = 0.8
 
 
 # What openocd prints for `program IMAGE verify reset exit` (its phases).
@@ -259,20 +266,26 @@ def set_in_box(wd, name, value):
 
 
 def check_live_change(wd, st):
-    """speed.bw_hz while running: ok, kept, the drive still at its speed."""
-    x = set_in_box(wd, "speed.bw_hz", "20")
-    if x["err"] or x["msg"] != "ok speed.bw_hz 20":
-        raise Fail("live change speed.bw_hz 20: %r" % x)
+    """speed.kp while running: ok, kept, speed.ki as it was, the drive still at
+    its speed."""
+    kp_before = row(wd, "speed.kp")["value"]
+    ki_before = row(wd, "speed.ki")["value"]
+    kp_new = "%.4g" % (LIVE_KP_SCALE * float(kp_before))
+    x = set_in_box(wd, "speed.kp", kp_new)
+    if x["err"] or x["msg"] != "ok speed.kp %s" % kp_new:
+        raise Fail("live change speed.kp %s: %r" % (kp_new, x))
     time.sleep(1.0)
-    x = row(wd, "speed.bw_hz")
+    x = row(wd, "speed.kp")
+    ki = row(wd, "speed.ki")["value"]
     tail = wd.js("const s = consoleState.charts.series; const k = s.names.indexOf('speed');"
                  "return s.v[k].slice(-20)")
     status = wd.js("return consoleState.status")
-    if x["value"] != "20" or status.get("state") != "running" or \
+    if x["value"] != kp_new or ki != ki_before or status.get("state") != "running" or \
             not all(abs(v - SPEED_RPM) <= 0.03 * SPEED_RPM for v in tail):
-        raise Fail("after the live change: %r, status %r, speed %r" % (x, status, tail))
-    print("  live: speed.bw_hz 20 while running -> %s; box %s; still running at %.0f r/min" % (
-        x["msg"], x["value"], tail[-1]))
+        raise Fail("after the live change: %r, speed.ki %s (was %s), status %r, speed %r" % (
+            x, ki, ki_before, status, tail))
+    print("  live: speed.kp %s -> %s while running: %s; box %s; speed.ki kept (%s); still running "
+          "at %.0f r/min" % (kp_before, kp_new, x["msg"], x["value"], ki, tail[-1]))
 
 
 def check_refusals(wd):
@@ -327,20 +340,42 @@ def check_firmware_page(wd, usb):
     wait_for("the image the page would flash", lambda: (flash().get("info") or {}).get("image"), 20)
 
     def start_flash():
+        wait_for("the flash button enabled", lambda: wd.js(
+            "return !document.getElementById('fw-flash').disabled"), 20, 0.05)
         wd.click("#fw-flash")
         if wd.js("return document.getElementById('modal').classList.contains('hidden')"):
-            raise Fail("flash did not ask for a confirmation")
+            raise Fail("flash did not ask for a confirmation (%r)" % wd.js(
+                "const b = document.getElementById('fw-flash'); const r = b.getBoundingClientRect();"
+                "const e = document.elementFromPoint(r.x + r.width / 2, r.y + r.height / 2);"
+                "return [b.disabled, r.y, e && (e.id || e.tagName), consoleState.flash.running, "
+                "consoleState.role]"))
         wd.click("#modal-ok")
         wait_for("the flash run to start", lambda: not flash()["done"], 20, 0.02)
 
-    start_flash()
-    f = wait_for("the flash run's end", lambda: flash()["done"] and flash(), 60)
-    shown = wd.js("const v = document.getElementById('fw-verdict');"
-                  "return [v.textContent, getComputedStyle(v).color]")
-    if f["ok"] or f["rc"] != 2 or "no ST-LINK probe found" not in f["verdict"] or \
-            "no ST-LINK probe found" not in shown[0] or shown[1] != "rgb(183, 28, 28)":
-        raise Fail("firmware page without a probe: %r, shown %r" % (f, shown))
-    print("  firmware page, no probe: %s" % shown[0])
+    def no_probe(hint):
+        start_flash()
+        f = wait_for("the flash run's end", lambda: flash()["done"] and flash(), 60)
+        shown = wd.js("const v = document.getElementById('fw-verdict');"
+                      "return [v.textContent, getComputedStyle(v).color]")
+        if f["ok"] or f["rc"] != 2 or "no ST-LINK probe found" not in f["verdict"] or \
+                hint not in shown[0] or shown[1] != "rgb(183, 28, 28)":
+            raise Fail("firmware page without a probe: %r, shown %r" % (f, shown))
+        print("  firmware page, no probe (%s): %s" % (f["info"]["board"], shown[0]))
+
+    boards = flash()["info"]["boards"]
+    if flash()["info"]["board"] != "b-g431b-esc1" or \
+            set(boards) != {"b-g431b-esc1", "vesc6", "odrive-v36"}:
+        raise Fail("firmware page: board %r of %r" % (flash()["info"]["board"], boards))
+    no_probe("connect the B-G431B-ESC1's ST-LINK")
+    # Another board: its own programmer target, its own hint.
+    wd.js("const s = document.getElementById('fw-board'); s.value = 'vesc6';"
+          "s.dispatchEvent(new Event('change'));")
+    info = wait_for("the vesc6's flash command", lambda: (lambda i: i if i.get("board") == "vesc6"
+                                                           and i.get("command") else None)(
+        flash()["info"]), 20)
+    if "target/stm32f4x.cfg" not in info["command"]:
+        raise Fail("firmware page, vesc6: %r" % info)
+    no_probe("connect an ST-LINK to the vesc6's SWD connector")
     dev = os.path.join(usb, "1-1")  # an ST-LINK/V2-1 appears
     os.makedirs(dev)
     with open(os.path.join(dev, "idVendor"), "w") as fh:
@@ -361,7 +396,9 @@ def check_firmware_page(wd, usb):
     if not f["done"] or not f["ok"] or f["pct"] != 100 or "writing" not in phases or \
             "verifying" not in phases or [q for _, q in seen] != sorted(q for _, q in seen):
         raise Fail("firmware page with a probe: %r, phases seen %r" % (f, seen))
-    print("  firmware page, probe (stand-in openocd): %s -> %s" % (
+    if f["info"]["board"] != "vesc6":
+        raise Fail("firmware page: flashed %r, not the board chosen (vesc6)" % f["info"]["board"])
+    print("  firmware page, vesc6 on a probe (stand-in openocd): %s -> %s" % (
         " -> ".join("%s %d%%" % x for x in seen), wd.js(
             "return document.getElementById('fw-verdict').textContent")))
     wd.js("window.scrollTo(0, 0)")
@@ -408,8 +445,12 @@ def main():
                           stderr=subprocess.DEVNULL)
     wd = WebDriver(dport)
     try:
-        url = wait_for("the server's URL", lambda: os.path.exists(url_file) and
-                       open(url_file).read().strip(), 30)
+        def served():
+            if server.poll() is not None:
+                raise Fail("the console server exited (%s) before it served" % server.returncode)
+            return os.path.exists(url_file) and open(url_file).read().strip()
+        # tools/console builds the image first when it is not up to date
+        url = wait_for("the server's URL (after any build of the image)", served, 300)
         base, _, token = url.partition("/?token=")
         print("server:", base)
         # Access control.

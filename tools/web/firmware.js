@@ -12,6 +12,18 @@
 
   function showInfo(info) {
     S.flash.info = info;
+    const sel = $('fw-board');
+    const boards = (info && info.boards) || [];
+    if (sel.dataset.boards !== boards.join(' ')) {
+      sel.dataset.boards = boards.join(' ');
+      sel.textContent = '';
+      for (const b of boards) {
+        const o = document.createElement('option');
+        o.value = o.textContent = b;
+        sel.appendChild(o);
+      }
+    }
+    if (info && info.board) sel.value = info.board;
     const img = info && info.image;
     let t = img ? img : '(no image)';
     if (img && info.bytes !== null) {
@@ -34,6 +46,7 @@
     v.className = 'readout ' + (f.done ? (f.ok ? 'oktext' : 'errtext') : '');
     $('fw-log').textContent = f.lines.join('\n');
     $('fw-flash').disabled = f.running || S.role !== 'control';
+    $('fw-board').disabled = f.running || S.role !== 'control';
   }
 
   P.onMessage('hello', (m) => { if (m.flash) showInfo(m.flash); });
@@ -65,12 +78,15 @@
   P.onRender(draw);
 
   document.addEventListener('DOMContentLoaded', () => {
-    $('fw-refresh').onclick = () => P.send({ type: 'flash_info' });
+    const board = () => $('fw-board').value;
+    $('fw-board').onchange = () => P.send({ type: 'flash_info', board: board() });
+    $('fw-refresh').onclick = () => P.send({ type: 'flash_info', board: board() });
     $('fw-flash').onclick = () => {
       const img = S.flash.info && S.flash.info.image ? S.flash.info.image : 'the image';
-      P.confirmThen('Flash ' + img + ' onto the board on the ST-LINK? The drive is stopped ' +
-        'first and the board restarts with the new firmware.',
-      () => P.send({ type: 'flash', confirm: true }));
+      const b = board();
+      P.confirmThen('Flash ' + img + ' onto the ' + b + ' on the ST-LINK? The drive is ' +
+        'stopped first and the board restarts with the new firmware.',
+      () => P.send({ type: 'flash', confirm: true, board: b }));
     };
   });
 })();
