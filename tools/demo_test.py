@@ -36,6 +36,20 @@ class BadInput(unittest.TestCase):
             self.assertIn(want, r.stderr, args)
             self.assertEqual(r.stdout, "", args)
 
+    def test_the_demos_tools_too(self):
+        """./tools/bench (the demo's cost columns) and ./tools/demo --qemu: --reps 0 and
+        --jobs 0 started the builds; demo_qemu ran with any argument."""
+        here = os.path.dirname(os.path.abspath(__file__))
+        for cmd, want in (([os.path.join(here, "bench"), "--reps", "0"],
+                           "--reps: '0' is out of range: allowed a whole number in [1, 10000]"),
+                          ([os.path.join(here, "bench"), "--jobs", "x"],
+                           "--jobs: 'x' is not a whole number: allowed a whole number in [1, "),
+                          ([os.path.join(here, "demo"), "--qemu", "--fast"],
+                           "demo_qemu: error: no options (got '--fast')")):
+            r = subprocess.run(cmd, capture_output=True, text=True, timeout=20)
+            self.assertEqual(r.returncode, 2, cmd)
+            self.assertIn(want, r.stderr, cmd)
+
 
 class SetUp(unittest.TestCase):
     def setUp(self):

@@ -318,8 +318,24 @@ def stats(v):
     return {"mean": round(statistics.fmean(v), 1), "max": max(v), "min": min(v), "n": len(v)}
 
 
+def whole_in(lo, hi, what):
+    """An argparse type: a whole number in [lo, hi], refused (exit status 2) with the
+    value and the range before anything is built."""
+    def parse(text):
+        try:
+            v = int(text)
+        except ValueError:
+            v = None
+        if v is None or not lo <= v <= hi:
+            raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [%d, %d] %s"
+                                             % (text, "out of range" if v is not None else
+                                                "not a whole number", lo, hi, what))
+        return v
+    return parse
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="bench", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench.json"))
     ap.add_argument("--host-build", default=os.environ.get(
         "BENCH_HOST_BUILD", os.path.join(ROOT, "build", "host-release")))
@@ -328,8 +344,10 @@ def main():
     ap.add_argument("--host-bin", default=None,
                     help="directory with already built bench_rec and bench_host (no host build)")
     ap.add_argument("--work", default=None, help="scratch directory (default out/bench/)")
-    ap.add_argument("--periods", type=int, default=2000, help="running periods per recording")
-    ap.add_argument("--reps", type=int, default=31, help="host timing repetitions")
+    ap.add_argument("--periods", type=whole_in(1, 1000000, "periods"), default=2000,
+                    help="running periods per recording")
+    ap.add_argument("--reps", type=whole_in(1, 10000, "repetitions"), default=31,
+                    help="host timing repetitions")
     ap.add_argument("--ctrl", default=None, help="comma-separated subset (default: all)")
     ap.add_argument("--no-callgrind", action="store_true")
     ap.add_argument("--quick", action="store_true",
@@ -338,10 +356,10 @@ def main():
                     help="the firmware without its encoder (fw_config_t.sensorless): recorded at "
                          "5 %% of rated speed (the forced start's final speed), so that the forced "
                          "start, the handover (about 1100 periods) and the observer are counted")
-    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--jobs", type=whole_in(1, 1024, "at once"), default=2)
     ap.add_argument("--cm0-build", default=os.environ.get(
         "BENCH_CM0_BUILD", os.path.join(ROOT, "build", "cm0")))
-    ap.add_argument("--cm0-periods", type=int, default=1000,
+    ap.add_argument("--cm0-periods", type=whole_in(1, 1700, "periods"), default=1000,
                     help="running periods per ARMv6-M recording (its flash holds about 1700)")
     ap.add_argument("--no-cm0", dest="cm0", action="store_false",
                     help="no ARMv6-M (QEMU microbit) counts")
@@ -362,7 +380,7 @@ def main():
         want = args.ctrl.split(",")
         bad = [n for n in want if n not in names]
         if bad:
-            raise SystemExit("bench: unknown controller(s): " + ",".join(bad))
+            ap.error("--ctrl: unknown %s (allowed: %s)" % (",".join(bad), ",".join(names)))
         names = want
     if args.quick:
         names = names if args.ctrl else ["m2ptfc"]
