@@ -208,12 +208,21 @@ class BuildProgressTest(unittest.TestCase):
 class WebRulesTest(unittest.TestCase):
     def test_a_watching_page_may_read_only(self):
         for line in ("status", "help", "fault", "param list", "param get h_T", "tel list",
-                     "ctrl list", "ident status", "ident result", "ident ini", "bringup status"):
+                     "ctrl list", "ident status", "ident result", "ident ini", "bringup status",
+                     "cogging status"):
             self.assertTrue(cw.reads_only(line), line)
         for line in ("", "arm", "fault clear", "param set h_T 0.1", "ctrl select bst", "stop",
                      "ident run", "bringup gates", "tel start speed", "config save", "disarm",
-                     "ref speed 100", "statusx", "config show"):
+                     "ref speed 100", "statusx", "config show", "ident cogging", "cogging on"):
             self.assertFalse(cw.reads_only(line), line)
+
+    def test_energising_commands_need_a_confirmation(self):
+        for line in ("arm", "ident run", "ident resume", "ident step rs", "ident cogging",
+                     "bringup gates", "bringup run"):
+            self.assertTrue(cw.energises(line), line)
+        for line in ("", "stop", "disarm", "ident status", "ident result", "bringup status",
+                     "cogging on", "cogging status", "param set speed.kp 0.1"):
+            self.assertFalse(cw.energises(line), line)
 
     def test_flash_phases_of_an_openocd_run(self):
         pct, phases = 0, []

@@ -49,7 +49,8 @@ POLL_PERIOD_S = 0.25         # `status` when the line is idle
 CM_STATES = ("commission",)  # state names in which the commissioning status is polled
 
 # First words (and second, for ident) of commands that put voltage on the motor.
-ENERGISING = {("arm",), ("ident", "run"), ("ident", "resume"), ("ident", "step"), ("bringup",)}
+ENERGISING = {("arm",), ("ident", "run"), ("ident", "resume"), ("ident", "step"),
+              ("ident", "cogging"), ("bringup",)}
 NOT_ENERGISING_BRINGUP = {"status"}
 
 
@@ -57,7 +58,7 @@ NOT_ENERGISING_BRINGUP = {"status"}
 # One word alone, or the first two words (any arguments after: `param get NAME`).
 READ_ONLY = {("status",), ("help",), ("fault",), ("param", "list"), ("param", "get"),
              ("tel", "list"), ("ctrl", "list"), ("ident", "status"), ("ident", "result"),
-             ("ident", "ini"), ("bringup", "status")}
+             ("ident", "ini"), ("bringup", "status"), ("cogging", "status")}
 
 # Phases of a flash run: a text in a line of tools/flash --progress (its own,
 # openocd's `program ... verify reset`, st-flash's `write`) and the share of

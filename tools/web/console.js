@@ -68,7 +68,7 @@ function send(m) {
 }
 
 // Energising commands are confirmed by the user in a dialog first.
-const ENERGISING = /^(arm\b|ident (run|resume|step)\b|bringup (?!status\b)\S)/;
+const ENERGISING = /^(arm\b|ident (run|resume|step|cogging)\b|bringup (?!status\b)\S)/;
 
 function command(line, opts) {
   line = line.trim();
@@ -171,6 +171,8 @@ function onReply(m) {
     onCmStatus(m.line, first);
   } else if (m.line === 'ident result') {
     buildResults(listLines(m));
+  } else if (w[0] === 'cogging') {
+    $('cog-status').textContent = first.replace(/^ok\s+/, '');
   }
 }
 
