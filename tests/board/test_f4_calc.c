@@ -347,6 +347,18 @@ static void test_ntc(void)
     TEST_ASSERT_DOUBLE_WITHIN(0.05, 25.0, f4_hal_temp_c(&f4_board_vesc6, 2048));
     TEST_ASSERT_DOUBLE_WITHIN(0.05, 25.0, f4_hal_temp_c(&f4_board_odrive_v36, 1016));
     TEST_ASSERT_DOUBLE_WITHIN(0.05, 100.0, f4_hal_temp_c(&f4_board_odrive_v36, 3151));
+    /* ODrive's own conversion of the same readings, independent of the
+     * model (its v3 board.cpp fet_thermistor_poly_coeffs, a cubic in the
+     * normalised voltage): 25.7 C and 101.1 C; with the NTC placed to ground
+     * the model would give 96.9 C and 23.0 C for these codes. */
+    static const double odrive_poly[4] = {363.93910201, -462.15369634, 307.55129571, -27.72569531};
+    const int32_t codes[2] = {1016, 3151};
+    for (unsigned k = 0; k < 2u; k++) {
+        const double x = (double)codes[k] / 4095.0;
+        const double t_odrive =
+            ((odrive_poly[0] * x + odrive_poly[1]) * x + odrive_poly[2]) * x + odrive_poly[3];
+        TEST_ASSERT_DOUBLE_WITHIN(2.0, t_odrive, f4_hal_temp_c(&f4_board_odrive_v36, codes[k]));
+    }
     TEST_ASSERT_TRUE(isnan(f4_hal_temp_c(&f4_board_vesc6, 0)));
     TEST_ASSERT_TRUE(isnan(f4_hal_temp_c(&f4_board_vesc6, 4095)));
     TEST_ASSERT_TRUE(isnan(f4_hal_temp_c(&f4_board_vesc6, -1)));

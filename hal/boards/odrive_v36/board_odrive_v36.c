@@ -15,7 +15,10 @@
  *   [DRV]   Drivers/DRV8301/drv8301.cpp (SPI mode, the control words ODrive
  *           writes: OC_ADJ 21, latch shut-down, gain from the current range)
  *   [THERM] tools/odrive/utils.py calculate_thermistor_coeffs and
- *           analysis/thermistors.py (Rload 3.3 kOhm, 10 kOhm, beta 3434)
+ *           analysis/thermistors.py: the component values only (Rload
+ *           3.3 kOhm, 10 kOhm, beta 3434); the latter models the NTC to
+ *           ground (thermistor_bottom=True), which [BRD]'s polynomial
+ *           contradicts (see .temp)
  *   [DS]    STM32F405 data sheet DS8626, alternate functions and ADC inputs
  * Values no source confirmed are marked UNVERIFIED; docs/bringup-odrive-v36.md
  * checks them on the bench before the gates are enabled.
@@ -110,11 +113,14 @@ const f4_board_t f4_board_odrive_v36 = {
     .vbus = {1u, 6u, 1u, {A, 6u, 0u}},
     .vbus_ratio = 1.0 / 19.0,
     .vbus_smp_cycles = 28u,
-    /* M0_TEMP PC5 = ADC12_IN15 [MAIN][CUBE]: a 10 kOhm NTC (beta 3434) to
-     * VREF over 3.3 kOhm to ground [THERM]; ODrive's fit of that curve
-     * ([BRD] fet_thermistor_poly_coeffs) gives 25.7 C at 25 C and 101 C at
-     * 100 C with this model. Regular conversions on ADC2. Trip at 100 C
-     * (ODrive limits the current from 100 C on). */
+    /* M0_TEMP PC5 = ADC12_IN15 [MAIN][CUBE]: a 10 kOhm NTC (beta 3434)
+     * [THERM] to VREF over 3.3 kOhm to ground. The placement's evidence is
+     * ODrive's own conversion, [BRD] fet_thermistor_poly_coeffs (a cubic in
+     * the normalised ADC voltage): with the NTC to VREF it gives 25.7 C at
+     * 25 C and 101.1 C at 100 C; with the NTC to ground (as
+     * analysis/thermistors.py models it) 96.9 C at 25 C and 23.0 C at
+     * 100 C. Regular conversions on ADC2. Trip at 100 C (ODrive limits the
+     * current from 100 C on). */
     .temp = {.pin = {C, 5u, 0u},
              .adc = 2u,
              .channel = 15u,
