@@ -427,6 +427,10 @@ def check_scheduler_address(addr):
     return addr
 
 
+NUMBER_RE = re.compile(r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?")
+SUMMARY_GROUPS = 10  # kinds of failure the summary lists
+
+
 class Engine:
     """Runs batches of Run on a dask.distributed cluster (or, serial=True, one by one
     in this process: the reference the cluster's results are compared with), through
@@ -668,13 +672,25 @@ class Engine:
         L = [f"{self.name}: {s['runs']} runs: {s['computed']} computed ({how}), {s['cached']} "
              f"from the store ({where})"]
         if self.failures:
+            # Grouped by status and reason with its numbers left out (a fault's time, a
+            # value), so that a large study's summary stays a few lines; each group
+            # shows its first reason in full, the table every run's.
             groups = {}
             for st, why, lab in self.failures:
-                groups.setdefault((st, why), []).append(lab)
+                g = groups.setdefault((st, NUMBER_RE.sub("#", why)), [why, set(), []])
+                g[1].add(why)
+                g[2].append(lab)
             L.append(f"{self.name}: {len(self.failures)} not ok:")
-            for (st, why), labs in sorted(groups.items(), key=lambda g: (-len(g[1]), g[0])):
+            ranked = sorted(groups.items(), key=lambda g: (-len(g[1][2]), g[0]))
+            for (st, _), (why, whys, labs) in ranked[:SUMMARY_GROUPS]:
+                alike = (f" (and {len(whys) - 1} alike with other numbers)"
+                         if len(whys) > 1 else "")
                 more = f" and {len(labs) - 3} more" if len(labs) > 3 else ""
-                L.append(f"  {len(labs)} {st}: {why} [{'; '.join(labs[:3])}{more}]")
+                L.append(f"  {len(labs)} {st}: {why}{alike} [{'; '.join(labs[:3])}{more}]")
+            if len(ranked) > SUMMARY_GROUPS:
+                rest = sum(len(g[2]) for _, g in ranked[SUMMARY_GROUPS:])
+                L.append(f"  {rest} more in {len(ranked) - SUMMARY_GROUPS} other kinds "
+                         "(every run's reason is in the results)")
         line = (f"{self.name}: wall {wall:.1f} s; simulator {s['sim_wall']:.1f} s wall, "
                 f"{s['sim_cpu']:.1f} s CPU; this process (engine and tool) "
                 f"{time.process_time() - self.cpu0:.1f} s "

@@ -222,6 +222,9 @@ class Results(Base):
         r = study(p, "--out", a, "--jobs", "2")
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertIn("local dask cluster, 2 workers", r.stderr)
+        # the summary groups the three faults (each at its own time) as one kind
+        self.assertRegex(r.stderr, r"\n  3 fault: the drive faulted: overcurrent at t = [0-9.]+ s "
+                                   r"\(and 2 alike with other numbers\) \[mbst ")
         with open(os.path.join(a, "f.csv")) as f:
             rows = f.read().splitlines()
         mbst = [ln for ln in rows if ",mbst," in ln]
