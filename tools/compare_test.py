@@ -233,7 +233,8 @@ class BadInput(unittest.TestCase):
                                    timeout=60)
                 self.assertEqual(r.returncode, 2, (args, r.stderr))
                 self.assertIn(want, r.stderr, args)
-                self.assertEqual(os.listdir(tmp), [], args)
+                # nothing run: no runs, no report (the engine's store may be opened first)
+                self.assertEqual(set(os.listdir(tmp)) - {"runs.sqlite"}, set(), args)
 
 
 class HdtcPredCause(unittest.TestCase):
