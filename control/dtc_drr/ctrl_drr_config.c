@@ -53,9 +53,8 @@ static const ctrl_tunable_t drr_tunables[] = {
      HELP_TEXT("1 = centre-aligned PWM: T_e at the active-vector start (Fig. 5.4); 0 = AVV first"),
      offsetof(ctrl_drr_cfg_t, centre), 0.0, 1.0},
     {"rs_dt", "-",
-     HELP_TEXT(
-         "1 = zero-vector deviation with the resistive term -(Rs Ts/Ls) T_e of (4.10); 0 = thesis "
-         "(5.6)/(5.7); default 1 when Rs i_rated >= 10 % of the rated back-EMF"),
+     HELP_TEXT("1 = ZVV deviation with -(Rs Ts/Ls) T_e of (4.10), default if Rs i_rated >= 10 % "
+               "of the back-EMF"),
      offsetof(ctrl_drr_cfg_t, rs_dt), 0.0, 1.0},
 };
 

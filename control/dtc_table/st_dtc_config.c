@@ -36,13 +36,10 @@ static const ctrl_tunable_t fst_tunables[] = {
     {"sigma", "rad", HELP_TEXT("subsector width of the voltage replacement (4.19), 0 = off"),
      offsetof(st_fst_cfg_t, sigma), 0.0, ST_SIGMA_MAX},
     {"dT_step", "N*m",
-     HELP_TEXT(
-         "reference-step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)"),
+     HELP_TEXT("step detection |dT_ref| > dT_step (sec. 4.5.3; 0 = any change, as the thesis)"),
      offsetof(st_fst_cfg_t, dt_step), 0.0, 1000.0},
     {"f_i", "Hz",
-     HELP_TEXT(
-         "corner of the mean-torque-error integrator; 0 = off (thesis); default 50 Hz where one "
-         "20 kHz period moves the torque by >= T_rated / 2, else 0"),
+     HELP_TEXT("corner of the mean-torque-error integrator; 0 = off (thesis), default 50 Hz or 0"),
      offsetof(st_fst_cfg_t, f_i), 0.0, 1000.0},
 };
 

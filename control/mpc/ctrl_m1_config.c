@@ -7,8 +7,7 @@
 #include "estimator.h"
 
 static const ctrl_tunable_t m1_tunables[] = {
-    CTRL_MPC_ZETA_TUNABLE(ctrl_m1_cfg_t, "Table 6.2's 250 / 640 exceed the stability limit "
-                                         "sqrt(3) 1.5 p psi_pm/Ls (ctrl_m1.h)"),
+    CTRL_MPC_ZETA_TUNABLE(ctrl_m1_cfg_t, "Table 6.2's 250, 640 exceed ctrl_m1.h's limit"),
     CTRL_MPC_MODEL_TUNABLES(ctrl_m1_cfg_t),
 };
 

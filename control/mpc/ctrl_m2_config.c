@@ -10,9 +10,7 @@
 
 static const ctrl_tunable_t m2_tunables[] = {
     {"eps_psi", "Wb",
-     HELP_TEXT(
-         "flux band of the hard constraint (6.17); Table 6.2: 0.0066 at 750 r/min, 0.00942 at "
-         "2250 r/min"),
+     HELP_TEXT("flux band of the hard constraint (6.17); Table 6.2: 0.0066, 0.00942 at 2250 r/min"),
      offsetof(ctrl_m2_cfg_t, eps_psi), 1e-6, 1.0},
     {"y", "1", HELP_TEXT("number of discrete duty steps D = nu/y (6.15); Table 6.1: 4"),
      offsetof(ctrl_m2_cfg_t, y), 1.0, (double)CTRL_M2_Y_MAX},

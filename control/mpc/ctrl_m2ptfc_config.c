@@ -14,9 +14,8 @@ static const ctrl_tunable_t m2ptfc_tunables[] = {
      HELP_TEXT("EMA coefficient of sigma_T (6.8); Table 6.2: 0.03 (750 and 2250 r/min)"),
      offsetof(ctrl_m2ptfc_cfg_t, lambda), 1e-4, 1.0},
     {"centre", "0/1",
-     HELP_TEXT(
-         "1: Te of (6.5)-(6.8) shifted by half the zero-vector change, mean torque on T_ref with "
-         "centre-aligned PWM (default); 0: the thesis' literal equations (ctrl_m2ptfc.h)"),
+     HELP_TEXT("1: Te of (6.5)-(6.8) shifted half the ZVV change, mean on T_ref (default); 0: "
+               "thesis"),
      offsetof(ctrl_m2ptfc_cfg_t, centre), 0.0, 1.0},
     CTRL_MPC_MODEL_TUNABLES(ctrl_m2ptfc_cfg_t),
 };

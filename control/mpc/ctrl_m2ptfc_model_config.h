@@ -58,8 +58,8 @@ int ctrl_mpc_winit(void *state, const void *cfg, const ctrl_setup_t *setup);
  * T), with what this controller's help adds. */
 #define CTRL_MPC_ZETA_TUNABLE(T, more)                                              \
     {"zeta", "N*m/Wb",                                                             \
-     HELP_TEXT("weighting factor of (6.13); 0 = T_rated/psi_pm (default, equal importance, " \
-               "6.5); " more), offsetof(T, zeta), 0.0, 1e5}
+     HELP_TEXT("weight of (6.13); 0 = T_rated/psi_pm (6.5); " more), offsetof(T, zeta),  \
+     0.0, 1e5}
 /* clang-format on */
 
 /* Model constants for the setup (with the overrides of c). CTRL_OK,

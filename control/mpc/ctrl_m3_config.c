@@ -7,8 +7,7 @@
 #include "estimator.h"
 
 static const ctrl_tunable_t m3_tunables[] = {
-    CTRL_MPC_ZETA_TUNABLE(ctrl_m3_cfg_t, "Table 6.2: 110 at 2250 r/min (fs 16 kHz) works, 440 "
-                                         "at 750 r/min exceeds the limit of ctrl_m1.h"),
+    CTRL_MPC_ZETA_TUNABLE(ctrl_m3_cfg_t, "Table 6.2's 440 exceeds ctrl_m1.h's limit"),
     CTRL_MPC_MODEL_TUNABLES(ctrl_m3_cfg_t),
 };
 

@@ -355,11 +355,45 @@ static void test_parameter_tree(void)
     TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&run_b.fw));
 }
 
+/* Every line of every controller's listing whole: the interpreter cuts a
+ * response line at CMD_OUT_MAX bytes with its "\r\n" (cmd.c), and a help text
+ * that reaches the cut reaches the page cut. A line of CMD_OUT_MAX - 2
+ * characters may have been cut: none may be that long. */
+static void test_listing_lines_whole(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "fst", 750.0, 1.2, 1.0, 0.99);
+    loop_start(&run_b, &c);
+    attach_tree(&run_b);
+    periods_b(5);
+    send("disarm");
+    periods_b(5);
+    for (size_t k = 0; ctrl_at(k) != NULL; k++) {
+        const char *name = ctrl_at(k)->name;
+        char line[48];
+        (void)snprintf(line, sizeof line, "ctrl select %s", name);
+        send(line);
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(lt.out, "ok", 2), lt.out);
+        periods_b(2);
+        send("param list");
+        TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(lt.out, "ok ", 3), lt.out);
+        for (const char *at = lt.out; *at != '\0';) {
+            const char *eol = strstr(at, "\r\n");
+            TEST_ASSERT_NOT_NULL(eol);
+            char msg[CMD_OUT_MAX + 48];
+            (void)snprintf(msg, sizeof msg, "%s: %.*s", name, (int)(eol - at), at);
+            TEST_ASSERT_TRUE_MESSAGE((size_t)(eol - at) < CMD_OUT_MAX - 2u, msg);
+            at = eol + 2;
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_speed_loop_live_is_bumpless);
     RUN_TEST(test_foc_gain_live_is_bumpless);
     RUN_TEST(test_parameter_tree);
+    RUN_TEST(test_listing_lines_whole);
     return UNITY_END();
 }
