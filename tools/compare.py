@@ -991,6 +991,12 @@ def main():
       "deviation of the torque, ψ_rip of |ψs|, T_sse = mean(T_ref − T), f_av = mean per-leg "
       "switching frequency, THD_I of phase a up to 10 kHz; from the plant's true signals on a "
       "Ts/10 grid. n/a: undefined (no fundamental, a trip, or not commanded).\n")
+    dec_lines, _dec = decide.section(
+        names, results, SPEEDS_USED,
+        lambda n, rpm, key: interp_at(sweep_points(results, n, rpm, key), decide.FAV_HZ),
+        dyn, bench_all, {n: decide.tunables(sim, n) for n in names})
+    L += dec_lines
+    # the other studies after the decision table, so that the report opens with it
     w("The book chapter's output filters (§6) on its IPMSM: [filters.md](filters.md) "
       "(`tools/filters.py`).\n")
     w("Field weakening (torque-speed envelope of every controller), the voltage-replacement "
@@ -1000,11 +1006,6 @@ def main():
       "thesis SPMSM and the 80 kW IPMSM (±10 % R and L, ±5 % ψpm, ±3° encoder, dead time "
       "0–1 µs, current-sense gains ±2 %), its small version; the full one in "
       "docs/studies.md: [tolerance.md](tolerance.md) (`tools/study`).\n")
-    dec_lines, _dec = decide.section(
-        names, results, SPEEDS_USED,
-        lambda n, rpm, key: interp_at(sweep_points(results, n, rpm, key), decide.FAV_HZ),
-        dyn, bench_all, {n: decide.tunables(sim, n) for n in names})
-    L += dec_lines
     w("## Findings\n")
     w("### The sources' claims beside the measurements\n")
     w("Verdicts: *reproduced* — same direction and a size within ±50 % of the claim (for "
