@@ -530,10 +530,17 @@ def main():
 
         check_firmware_page(wd, usb)
 
-        # Second page; then the controlling page is lost with the drive armed.
+        # Second page; then the controlling page is lost with the drive armed
+        # (armed once the page shows the drive ready: the flash runs' `stop`).
+        wait_for("state=ready before arming", lambda: (st() or {}).get("state") == "ready", 60)
         wd.click("#arm")
         wd.click("#modal-ok")
-        wait_for("armed again", lambda: (st() or {}).get("armed") == "1", 30)
+        try:
+            wait_for("armed again", lambda: (st() or {}).get("armed") == "1", 30)
+        except Fail as e:
+            raise Fail("%s; status %r; last replies %r" % (e, wd.js("return consoleState.status"),
+                                                          wd.js("return consoleState.replies"
+                                                                ".slice(-4)"))) from e
         ws_url = base.replace("http://", "ws://") + "/ws?token=" + token
 
         async def loss():
