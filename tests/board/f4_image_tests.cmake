@@ -21,7 +21,7 @@ else()
   message(FATAL_ERROR "f4_image_tests.cmake: no checks for board '${PMSM_BOARD}'")
 endif()
 set(f405_tests ${PMSM_BOARD}_image ${PMSM_BOARD}_image_printf ${PMSM_BOARD}_flash
-    ${PMSM_BOARD}_qemu_boot)
+    ${PMSM_BOARD}_qemu_boot ${PMSM_BOARD}_qemu_wdg)
 add_test(NAME ${PMSM_BOARD}_image
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_f4_image.py ${PMSM_F405_ELF}
                  ${f405_console_irq} ${f405_nfault_irq} ${PMSM_CONTROLLERS_ALL})
@@ -34,6 +34,11 @@ add_test(NAME ${PMSM_BOARD}_flash
 add_test(NAME ${PMSM_BOARD}_qemu_boot
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_boot.py ${PMSM_F405_ELF}
                  ${PMSM_BOARD} ${f405_qemu_serial} ${f405_console_irq})
+# The start-up on the fall-back clock (QEMU's path) within the watchdog's
+# boot window: its instructions counted with the bench's QEMU plugin.
+add_test(NAME ${PMSM_BOARD}_qemu_wdg
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_wdg.py ${PROJECT_SOURCE_DIR}
+                 ${PMSM_F405_ELF})
 # The board's PIL image in QEMU, its console on a pseudo-terminal:
 # ./tools/sim --target board:/dev/pts/N against it (the simulator from
 # build/host-release, which tools/sim builds when missing).
@@ -43,4 +48,5 @@ add_test(NAME ${PMSM_BOARD}_qemu_pil
                  ${PMSM_F405_PIL_ELF} ${f405_qemu_serial})
 set_tests_properties(${f405_tests} PROPERTIES LABELS "board")
 set_tests_properties(${PMSM_BOARD}_qemu_boot PROPERTIES LABELS "board;qemu" TIMEOUT 150)
+set_tests_properties(${PMSM_BOARD}_qemu_wdg PROPERTIES LABELS "board;qemu" TIMEOUT 120)
 set_tests_properties(${PMSM_BOARD}_qemu_pil PROPERTIES LABELS "board;qemu;pil" TIMEOUT 300)
