@@ -332,6 +332,37 @@ def check_rest_axes(wd):
         charts[0]["axis"]["step"]))
 
 
+def check_identification_start(wd):
+    """run all… (confirmed) starts the identification; the page's status line
+    follows it as `ident` (the server polls `ident status` and `bringup
+    status`, both of the one engine); `stop step` stops it."""
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-cm"]')
+    wd.js("consoleState.cm = null")
+    wd.click('button[data-cm="ident run"]')
+    if wd.js("return document.getElementById('modal').classList.contains('hidden')"):
+        raise Fail("ident run did not ask for a confirmation")
+    wd.click("#modal-ok")
+    seen = []
+
+    def running():
+        text = wd.js("return document.getElementById('cm-status').textContent")
+        seen.append(text)
+        c = wd.js("return consoleState.cm") or {}
+        return text if c.get("verdict") == "running" else None
+    text = wait_for("the identification running on the page", running, 60, 0.1)
+    wd.click('button[data-cm="stop"]')
+    c = wait_for("the identification stopped", lambda: (lambda c: c if c and c.get("verdict") not in
+                                                        ("running", "idle") else None)(
+        wd.js("return consoleState.cm")), 60)
+    bad = [t for t in seen if t.startswith("bringup")]
+    if not text.startswith("ident: running step=") or bad or c["verdict"] != "stopped":
+        raise Fail("identification on the page: %r, then %r; shown %r" % (text, c, bad or seen[-3:]))
+    print("  identification: %s -> stop step -> %s" % (text, c["text"]))
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-cmd"]')
+
+
 def check_firmware_page(wd, usb):
     """The firmware page: no probe -> the page's error; a probe -> the phases."""
     wd.js("window.scrollTo(0, 0)")  # the tabs below the sticky header
@@ -528,6 +559,7 @@ def main():
                  (st() or {}).get("armed") == "0", 30)
         print("  STOP -> state=ready")
 
+        check_identification_start(wd)
         check_firmware_page(wd, usb)
 
         # Second page; then the controlling page is lost with the drive armed

@@ -156,6 +156,8 @@ function onReply(m) {
   for (const fn of replyHooks) fn(m);
   if (!m.ok) return;
   const w = m.line.split(/\s+/);
+  if (/^ident (run|resume|step|cogging)\b/.test(m.line)) S.cmWhich = 'ident status';
+  else if (/^bringup (?!status\b)\S/.test(m.line)) S.cmWhich = 'bringup status';
   if (m.line === 'tel list') {
     S.signals = listLines(m).map((l) => {
       const p = l.trim().split(/\s+/);
@@ -168,7 +170,9 @@ function onReply(m) {
   } else if ((w[0] === 'ctrl' && w[1] === 'select') || m.line === 'ident apply') {
     command('ctrl list', { quiet: true });
   } else if (m.line === 'ident status' || m.line === 'bringup status') {
-    onCmStatus(m.line, first);
+    // Both describe the one commissioning engine (the server polls both while
+    // it runs): the page shows the one of what was started.
+    if (m.line === (S.cmWhich || 'ident status')) onCmStatus(m.line, first);
   } else if (m.line === 'ident result') {
     buildResults(listLines(m));
   } else if (w[0] === 'cogging') {
