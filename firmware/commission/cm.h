@@ -19,7 +19,7 @@
  *                 phase's axis: phase balance
  *   cm_ldq.c      Ld, Lq at standstill: alternating pulses on a DC bias,
  *                 saliency
- *   cm_flux.c     psi_pm from the back-EMF while coasting; inertia, friction
+ *   cm_flux.c     psi_pm from the back-EMF at two held speeds; friction, inertia
  *   cm_gates.c    bring-up: gate test at low duty without a motor
  *   cm_sense.c    bring-up: current-sense polarity and gain, one pulse per phase
  *   cm_run.c      bring-up: first closed-loop run at 10 % of the rated torque
@@ -38,6 +38,13 @@
 
 #include "ctrl_params.h"
 #include "fx.h"
+
+/* 1: the flux step identifies the mechanics too (inertia, Coulomb and
+ * viscous friction: cm_flux.c); 0 leaves them out of a flash-tight image
+ * (CMake option PMSM_CM_MECH): psi_pm is measured the same way. */
+#ifndef CM_MECH
+#define CM_MECH 1
+#endif
 
 /* Steps. The numbers are sent in telemetry (signal cm_step): append only. */
 typedef enum {
@@ -86,6 +93,7 @@ typedef enum {
     CM_E_RUN_CURRENT,    /* first run drew far more current than the torque needs */
     CM_E_NEEDS,          /* a result this step needs is missing (detail: step) */
     CM_E_SUPPLY,         /* the supply cannot drive the smallest test current */
+    CM_E_LOAD,           /* the rotor does not follow: more torque needed than the step makes */
     CM_E_COUNT
 } cm_err_t;
 
@@ -149,14 +157,22 @@ typedef struct {
     q24_t psi;              /* permanent-magnet flux linkage, pu */
     q24_t psi_pos, psi_neg; /* v_q / omega at +i_d and -i_d, pu */
     q24_t omega_flux;       /* speed of the flux measurement, pu electrical */
-    /* Mechanics (cm_flux.c): accelerating torque sum (pu torque x periods)
-     * and the speed it gained (pu electrical); coasting: speed at the start
-     * and end of n_coast periods and the mean speed. SI in cm_config.c. */
-    int64_t acc_torque_sum;
-    uint32_t acc_n;
-    q24_t acc_dw;
-    q24_t coast_w0, coast_w1, coast_wm;
-    uint32_t coast_n;
+    /* Mechanics (cm_flux.c; SI in cm_config.c): the four speed windows
+     * (0: w_lo +i_d, 1: w_hi +i_d, 2: w_hi -i_d, 3: w_lo -i_d) - mean v_q, speed
+     * (pu electrical), i_q, the speed's change and the periods; the two transitions between them
+     * (0: 0 -> 1, 1: 2 -> 3) - sum of i_q (pu x periods), rotor angle travelled (fx_angle_t units,
+     * electrical), periods. */
+    q24_t fw_vq[4], fw_w[4];
+    q24_t fw_iq[4]; /* less the samples' dead-time offset (cm_flux.c) */
+    q24_t fw_eq[4]; /* the inverter's error along q in each window (cm_flux.c), pu */
+#if CM_MECH
+    q24_t fw_dw[4];     /* the last block's mean speed less the first block's, pu */
+    uint32_t fw_n[4];   /* periods between the two blocks' middles */
+    uint32_t fw_len[4]; /* periods of the window */
+    int64_t jx_iq[2], jx_th[2];
+    uint32_t jx_n[2];
+#endif
+    q24_t i_fd; /* the windows' |i_d| */
 } cm_results_t;
 
 /* Limits and timings in pu and periods (cm_config.c fills them). */
@@ -171,22 +187,27 @@ typedef struct {
     q24_t i_guard;                         /* abort above this phase current, pu */
     q24_t i_min;                           /* smallest test current a step accepts, pu */
     q24_t i_hold;                          /* alignment / scan / bias current, pu */
+    q24_t i_hold_max, i_hold_max_nom;      /* the scan's current rises up to this, pu */
     q24_t i_hold_nom, i_acc_nom, i_fd_nom; /* configured levels before the voltage caps, pu */
     q24_t i_rs1, i_rs2;                    /* the two DC levels, pu */
     q24_t i_probe;                         /* probe target peak, pu */
     q24_t i_open;                          /* below this at the largest probe: open phase, pu */
-    q24_t i_acc;                           /* q current to accelerate (flux step), pu */
-    q24_t i_fd;                            /* +-d current while coasting (flux step), pu */
-    q24_t i_sense;                         /* sense pulse target peak, pu */
-    q24_t i_gate_max;                      /* gate test: current above this = load connected, pu */
-    q24_t v_lim;                           /* standstill voltage limit per axis, pu */
-    q24_t v_lim_run;                       /* spinning voltage limit per axis, pu */
-    q24_t v_probe0;                        /* first probe amplitude, pu */
-    q24_t vbus_min, vbus_max;              /* test window, pu */
-    q24_t l_min;                           /* below: shorted phase, pu */
-    q24_t l_max;                           /* above: implausible, pu */
-    q24_t loop_g;                          /* current-loop crossover x Ts (rad), Q24 */
+    q24_t i_acc;              /* inertia: twice the q current over the friction's, pu */
+    q24_t i_spin, i_spin_nom; /* flux step: the speed loop's q current limit, pu */
+    q24_t i_fd;               /* +-d current of the flux step, pu */
+    q24_t i_sense;            /* sense pulse target peak, pu */
+    q24_t i_gate_max;         /* gate test: current above this = load connected, pu */
+    q24_t v_lim;              /* standstill voltage limit per axis, pu */
+    q24_t v_lim_run;          /* spinning voltage limit per axis, pu */
+    q24_t v_probe0;           /* first probe amplitude, pu */
+    q24_t vbus_min, vbus_max; /* test window, pu */
+    q24_t l_min;              /* below: shorted phase, pu */
+    q24_t l_max;              /* above: implausible, pu */
+    q24_t loop_g;             /* current-loop crossover x Ts (rad), Q24 */
     int32_t damp_k;           /* rotor damping w_base / Omega, Q16 (i_q = -i slip_pu damp_k) */
+    q24_t td;                 /* the inverter's dead time, pu time (cm_config_t.dead_time_s) */
+    q24_t w_kp, w_ki;         /* flux step's speed loop: pu q current per pu speed error, and
+                                 per period, Q24 */
     q24_t w_rated;            /* rated electrical speed, pu */
     q24_t w_flux;             /* flux-step target speed, pu */
     q24_t w_guard;            /* abort above this speed, pu */
@@ -202,6 +223,8 @@ typedef struct {
     q24_t psi_cfg;            /* configured flux linkage, pu */
     q24_t gate_duty;          /* gate test duty, Q24 */
     fx_angle_t scan_inc;      /* scan speed, angle per period */
+    uint32_t n_turn;          /* periods of one electrical turn at scan_inc */
+    uint32_t enc_count;       /* one encoder count, electrical fx_angle_t units */
     uint32_t n_vbus, n_ramp, n_settle, n_win, n_hold, n_hold_max, n_hf, n_scan_acc;
     uint32_t n_flux_max, n_flux_win, n_run, n_gate, n_rest;
     uint8_t has_i_c;
@@ -274,7 +297,9 @@ typedef struct {
     q24_t hold_i; /* current magnitude of the last hold, pu */
     uint8_t hold_valid;
     cm_io_t io;
+    q24_t mon_id, mon_iq; /* the regulated frame's measured currents (cm_monitor), pu */
     cm_pi_t pi_d, pi_q;
+    cm_pi_t pi_w; /* the flux step's speed loop */
     cm_scratch_t x;
 } cm_t;
 
@@ -284,6 +309,16 @@ typedef struct {
  * false when the sequence ended this period (cm->err tells how; the gates
  * are off in *out). */
 bool cm_period(cm_t *cm, const cm_in_t *in, cm_out_t *out);
+
+/* What the running step does, for telemetry (all Q24 pu): the measured
+ * currents in the frame it regulates (*id along its field or the rotor's d
+ * axis; 0 with the gates off), the rotor's electrical speed (the drive's
+ * direction) and the torque psi i_q + (Ld - Lq) i_d i_q (the identified
+ * values where known, else the configured ones) of the current in the rotor
+ * frame - the identified one once the encoder step has passed, else the
+ * drive's angle theta_drive. */
+void cm_monitor(const cm_t *cm, fx_angle_t theta_drive, q24_t *id, q24_t *iq, q24_t *w,
+                q24_t *torque);
 
 /* A drive protection fired (gates already off): end with CM_E_FAULT, or the
  * step's diagnosis of it (an over-current during the probe is a shorted

@@ -13,56 +13,72 @@
 /* The defaults as data, copied whole: 43 stores of double constants took
  * more flash as code than the table (-104 B on the board image). */
 static const cm_config_t cm_config_defaults = {
-    .i_hold = 0.3,
-    .i_rs1 = 0.25,
-    .i_rs2 = 0.5,
-    .i_probe = 0.1,
-    .i_open = 0.02,
-    .i_acc = 0.5,
-    .i_fd = 0.2,
-    .i_sense = 0.2,
-    .i_guard = 1.0,
-    .i_gate_max = 0.05,
-    .i_min = 0.1,
-    .v_lim = 0.25,
-    .v_lim_run = 0.4,
-    .v_probe0 = 0.02,
-    .vbus_min = 0.8,
-    .vbus_max = 1.2,
-    .l_min_h = 1e-6,
-    .l_max_h = 10.0,
-    .loop_g = 0.2,
-    .damp_rad_s = 30.0,
-    .w_flux = 0.3,
-    .w_guard = 0.8,
-    .w_settle = 0.01,
-    .torque_run = 0.1,
-    .unbalance_max = 0.15,
-    .sense_lo = 0.75,
-    .sense_hi = 1.3,
-    .cpr_tol = 0.03,
-    .salient_min = 0.05,
-    .gate_duty = 0.05,
-    .scan_hz = 4.0,
-    .t_vbus = 0.05,
-    .t_ramp = 0.02,
-    .t_settle = 0.05,
-    .t_win = 0.1,
-    .t_hold = 0.15,
-    .t_hold_max = 1.0,
-    .t_hf = 0.25,
-    .t_scan_acc = 0.05,
-    .t_flux_max = 1.0,
-    .t_flux_win = 0.1,
-    .t_run = 0.5,
-    .t_gate = 0.02,
+    .i_hold = 0.3f,
+    .i_hold_max = 0.6f,
+    .i_rs1 = 0.25f,
+    .i_rs2 = 0.5f,
+    .i_probe = 0.1f,
+    .i_open = 0.02f,
+    .i_acc = 0.5f,
+    .i_spin = 0.8f,
+    .i_fd = 0.3f,
+    .i_sense = 0.2f,
+    .i_guard = 1.0f,
+    .i_gate_max = 0.05f,
+    .i_min = 0.1f,
+    .v_lim = 0.25f,
+    .v_lim_run = 0.4f,
+    .v_probe0 = 0.02f,
+    .vbus_min = 0.8f,
+    .vbus_max = 1.2f,
+    .l_min_h = 1e-6f,
+    .l_max_h = 10.0f,
+    .loop_g = 0.2f,
+    .damp_rad_s = 30.0f,
+    .w_flux = 0.5f,
+    .w_loop_rad_s = 100.0f,
+    .w_guard = 0.8f,
+    .w_settle = 0.01f,
+    .torque_run = 0.1f,
+    .unbalance_max = 0.15f,
+    .sense_lo = 0.75f,
+    .sense_hi = 1.3f,
+    .cpr_tol = 0.03f,
+    .salient_min = 0.05f,
+    .gate_duty = 0.05f,
+    .scan_hz = 4.0f,
+    .t_vbus = 0.05f,
+    .t_ramp = 0.02f,
+    .t_settle = 0.05f,
+    .t_win = 0.1f,
+    .t_hold = 0.15f,
+    .t_hold_max = 1.0f,
+    .t_hf = 0.25f,
+    .t_scan_acc = 0.05f,
+    .t_flux_max = 1.0f,
+    .t_flux_win = 0.1f,
+    .t_run = 0.5f,
+    .t_gate = 0.02f,
 };
 
 void cm_config_default(cm_config_t *c)
 {
+    /* Read through a pointer the compiler cannot follow: it would otherwise
+     * write the constants one by one into the copy (+250 B on the board
+     * image). */
+    const cm_config_t *volatile src = &cm_config_defaults;
     if (c != NULL) {
-        *c = cm_config_defaults;
+        *c = *src;
     }
+}
+
+/* String n (0-based) of a list of NUL-terminated strings. */
+static const char *cm_nth(const char *list, size_t n)
+{
+    while (n-- != 0u) {
+        list += strlen(list) + 1u;
+    }
+    return list;
 }
 
 /* x (pu) -> Q24, or false when it does not fit. */
@@ -114,7 +130,12 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
     q->has_i_c = info->has_i_c ? 1u : 0u;
     q->pole_pairs = (uint8_t)p->pole_pairs;
     /* value = (the configuration's field, or 1) x scale[kind] -> Q24 field */
-    enum { S_I, S_V, S_W, S_T, S_1, S_L, S_LD, S_LQ, S_RS, S_PSI, S_LSB, S_N };
+    enum { S_I, S_V, S_W, S_T, S_1, S_L, S_LD, S_LQ, S_RS, S_PSI, S_LSB, S_KP, S_KI, S_N };
+    /* The flux step's speed loop: crossover w_loop with the configured
+     * inertia, i_q = kp e + ki sum e (pu): kp = J w_loop w_base / (p T_base
+     * psi), the PI zero at a quarter of the crossover. */
+    const double kp = m->inertia_kgm2 * b->w_rad_s /
+                      ((double)m->pole_pairs * b->torque_nm * m->psi_pm_wb / b->psi_wb);
     const double scale[S_N] = {ir,
                                vn,
                                wr,
@@ -125,67 +146,84 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
                                m->lq_h / b->l_h,
                                m->rs_ohm / b->r_ohm,
                                m->psi_pm_wb / b->psi_wb,
-                               info->adc_current_a_per_count / b->i_a};
-#define CM_C(f) ((int16_t)offsetof(cm_config_t, f))
-#define CM_P(f) ((uint16_t)offsetof(cm_par_t, f))
+                               info->adc_current_a_per_count / b->i_a,
+                               kp,
+                               kp * c->w_loop_rad_s / 4.0 / fs};
+    /* Field offsets in 4-byte words (every field is a float or a 32-bit word):
+     * a row in three bytes. */
+    _Static_assert(sizeof(cm_config_t) < 4u * 255u && offsetof(cm_par_t, n_vbus) < 4u * 256u,
+                   "the rows' offsets fit a byte");
+#define CM_C(f) ((uint8_t)(offsetof(cm_config_t, f) / 4u))
+#define CM_P(f) ((uint8_t)(offsetof(cm_par_t, f) / 4u))
+    /* (name, source field or 255 for 1.0, scale, destination field); the names
+     * in one string, in the rows' order (a pointer per row took 168 B). */
+#define CM_ROWS(X)                                                                                 \
+    X("adc current lsb", 255u, S_LSB, CM_P(i_lsb))                                                 \
+    X("rated current", 255u, S_I, CM_P(i_rated))                                                   \
+    X("i_guard", CM_C(i_guard), S_I, CM_P(i_guard))                                                \
+    X("i_hold", CM_C(i_hold), S_I, CM_P(i_hold))                                                   \
+    X("i_hold_max", CM_C(i_hold_max), S_I, CM_P(i_hold_max))                                       \
+    X("i_rs1", CM_C(i_rs1), S_I, CM_P(i_rs1))                                                      \
+    X("i_rs2", CM_C(i_rs2), S_I, CM_P(i_rs2))                                                      \
+    X("i_probe", CM_C(i_probe), S_I, CM_P(i_probe))                                                \
+    X("i_open", CM_C(i_open), S_I, CM_P(i_open))                                                   \
+    X("i_acc", CM_C(i_acc), S_I, CM_P(i_acc))                                                      \
+    X("i_spin", CM_C(i_spin), S_I, CM_P(i_spin))                                                   \
+    X("i_fd", CM_C(i_fd), S_I, CM_P(i_fd))                                                         \
+    X("i_sense", CM_C(i_sense), S_I, CM_P(i_sense))                                                \
+    X("i_gate_max", CM_C(i_gate_max), S_I, CM_P(i_gate_max))                                       \
+    X("i_min", CM_C(i_min), S_I, CM_P(i_min))                                                      \
+    X("v_lim", CM_C(v_lim), S_V, CM_P(v_lim))                                                      \
+    X("v_lim_run", CM_C(v_lim_run), S_V, CM_P(v_lim_run))                                          \
+    X("v_probe0", CM_C(v_probe0), S_V, CM_P(v_probe0))                                             \
+    X("vbus_min", CM_C(vbus_min), S_V, CM_P(vbus_min))                                             \
+    X("vbus_max", CM_C(vbus_max), S_V, CM_P(vbus_max))                                             \
+    X("l_min", CM_C(l_min_h), S_L, CM_P(l_min))                                                    \
+    X("l_max", CM_C(l_max_h), S_L, CM_P(l_max))                                                    \
+    X("loop_g", CM_C(loop_g), S_1, CM_P(loop_g))                                                   \
+    X("rated speed", 255u, S_W, CM_P(w_rated))                                                     \
+    X("w_flux", CM_C(w_flux), S_W, CM_P(w_flux))                                                   \
+    X("w_guard", CM_C(w_guard), S_W, CM_P(w_guard))                                                \
+    X("w_settle", CM_C(w_settle), S_W, CM_P(w_settle))                                             \
+    X("torque_run", CM_C(torque_run), S_T, CM_P(torque_run))                                       \
+    X("rated torque", 255u, S_T, CM_P(torque_rated))                                               \
+    X("unbalance_max", CM_C(unbalance_max), S_1, CM_P(unbalance_max))                              \
+    X("sense_lo", CM_C(sense_lo), S_1, CM_P(sense_lo))                                             \
+    X("sense_hi", CM_C(sense_hi), S_1, CM_P(sense_hi))                                             \
+    X("cpr_tol", CM_C(cpr_tol), S_1, CM_P(cpr_tol))                                                \
+    X("salient_min", CM_C(salient_min), S_1, CM_P(salient_min))                                    \
+    X("gate_duty", CM_C(gate_duty), S_1, CM_P(gate_duty))                                          \
+    X("configured Ld", 255u, S_LD, CM_P(l_cfg_d))                                                  \
+    X("configured Lq", 255u, S_LQ, CM_P(l_cfg_q))                                                  \
+    X("configured Rs", 255u, S_RS, CM_P(rs_cfg))                                                   \
+    X("configured psi_pm", 255u, S_PSI, CM_P(psi_cfg))                                             \
+    X("w_loop_rad_s", CM_C(w_loop_rad_s), S_KP, CM_P(w_kp))                                        \
+    X("w_loop_rad_s", CM_C(w_loop_rad_s), S_KI, CM_P(w_ki))
+#define CM_ROW_NAME(n, src, kind, dst) n "\0"
+#define CM_ROW(n, src, kind, dst) {src, kind, dst},
+    static const char names[] = CM_ROWS(CM_ROW_NAME);
     static const struct {
-        const char *name;
-        int16_t src; /* offsetof(cm_config_t, field), or -1 for 1.0 */
+        uint8_t src; /* offsetof(cm_config_t, field) / 4, or 255 for 1.0 */
         uint8_t kind;
-        uint16_t dst; /* offsetof(cm_par_t, field) */
-    } t[] = {
-        {"adc current lsb", -1, S_LSB, CM_P(i_lsb)},
-        {"rated current", -1, S_I, CM_P(i_rated)},
-        {"i_guard", CM_C(i_guard), S_I, CM_P(i_guard)},
-        {"i_hold", CM_C(i_hold), S_I, CM_P(i_hold)},
-        {"i_rs1", CM_C(i_rs1), S_I, CM_P(i_rs1)},
-        {"i_rs2", CM_C(i_rs2), S_I, CM_P(i_rs2)},
-        {"i_probe", CM_C(i_probe), S_I, CM_P(i_probe)},
-        {"i_open", CM_C(i_open), S_I, CM_P(i_open)},
-        {"i_acc", CM_C(i_acc), S_I, CM_P(i_acc)},
-        {"i_fd", CM_C(i_fd), S_I, CM_P(i_fd)},
-        {"i_sense", CM_C(i_sense), S_I, CM_P(i_sense)},
-        {"i_gate_max", CM_C(i_gate_max), S_I, CM_P(i_gate_max)},
-        {"i_min", CM_C(i_min), S_I, CM_P(i_min)},
-        {"v_lim", CM_C(v_lim), S_V, CM_P(v_lim)},
-        {"v_lim_run", CM_C(v_lim_run), S_V, CM_P(v_lim_run)},
-        {"v_probe0", CM_C(v_probe0), S_V, CM_P(v_probe0)},
-        {"vbus_min", CM_C(vbus_min), S_V, CM_P(vbus_min)},
-        {"vbus_max", CM_C(vbus_max), S_V, CM_P(vbus_max)},
-        {"l_min", CM_C(l_min_h), S_L, CM_P(l_min)},
-        {"l_max", CM_C(l_max_h), S_L, CM_P(l_max)},
-        {"loop_g", CM_C(loop_g), S_1, CM_P(loop_g)},
-        {"rated speed", -1, S_W, CM_P(w_rated)},
-        {"w_flux", CM_C(w_flux), S_W, CM_P(w_flux)},
-        {"w_guard", CM_C(w_guard), S_W, CM_P(w_guard)},
-        {"w_settle", CM_C(w_settle), S_W, CM_P(w_settle)},
-        {"torque_run", CM_C(torque_run), S_T, CM_P(torque_run)},
-        {"rated torque", -1, S_T, CM_P(torque_rated)},
-        {"unbalance_max", CM_C(unbalance_max), S_1, CM_P(unbalance_max)},
-        {"sense_lo", CM_C(sense_lo), S_1, CM_P(sense_lo)},
-        {"sense_hi", CM_C(sense_hi), S_1, CM_P(sense_hi)},
-        {"cpr_tol", CM_C(cpr_tol), S_1, CM_P(cpr_tol)},
-        {"salient_min", CM_C(salient_min), S_1, CM_P(salient_min)},
-        {"gate_duty", CM_C(gate_duty), S_1, CM_P(gate_duty)},
-        {"configured Ld", -1, S_LD, CM_P(l_cfg_d)},
-        {"configured Lq", -1, S_LQ, CM_P(l_cfg_q)},
-        {"configured Rs", -1, S_RS, CM_P(rs_cfg)},
-        {"configured psi_pm", -1, S_PSI, CM_P(psi_cfg)},
-    };
+        uint8_t dst; /* offsetof(cm_par_t, field) / 4 */
+    } t[] = {CM_ROWS(CM_ROW)};
+#undef CM_ROW
+#undef CM_ROW_NAME
+#undef CM_ROWS
 #undef CM_C
 #undef CM_P
     for (size_t k = 0; k < sizeof t / sizeof t[0]; k++) {
-        double src = 1.0;
-        if (t[k].src >= 0) {
-            memcpy(&src, (const char *)c + t[k].src, sizeof src);
+        float src = 1.0f;
+        if (t[k].src != 255u) {
+            memcpy(&src, (const char *)c + 4u * t[k].src, sizeof src);
         }
-        double v = src * scale[t[k].kind];
-        if (t[k].dst == offsetof(cm_par_t, l_max)) {
+        double v = (double)src * scale[t[k].kind];
+        if (t[k].dst == offsetof(cm_par_t, l_max) / 4u) {
             v = fmin(v, 127.0); /* "no limit" within Q24 */
         }
-        q24_t *dst = (q24_t *)(void *)((char *)q + t[k].dst);
+        q24_t *dst = (q24_t *)(void *)((char *)q + 4u * t[k].dst);
         if (!isfinite(v) || v < 0.0 || !cm_q24(v, dst) || (*dst == 0 && v > 0.0)) {
-            *what = t[k].name;
+            *what = cm_nth(names, k);
             return -1;
         }
     }
@@ -201,18 +239,37 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
         return -1;
     }
     q->scan_inc = (fx_angle_t)floor(inc + 0.5);
-    q->n_vbus = cm_periods(c->t_vbus, fs);
-    q->n_ramp = cm_periods(c->t_ramp, fs);
-    q->n_settle = cm_periods(c->t_settle, fs);
-    q->n_win = cm_periods(c->t_win, fs);
-    q->n_hold = cm_periods(c->t_hold, fs);
-    q->n_hold_max = cm_periods(c->t_hold_max, fs);
-    q->n_hf = cm_periods(c->t_hf, fs);
-    q->n_scan_acc = cm_periods(c->t_scan_acc, fs);
-    q->n_flux_max = cm_periods(c->t_flux_max, fs);
-    q->n_flux_win = cm_periods(c->t_flux_win, fs);
-    q->n_run = cm_periods(c->t_run, fs);
-    q->n_gate = cm_periods(c->t_gate, fs);
+    /* The scan's count windows need 2 1/8 turns of constant speed in a
+     * three-turn move (cm_encoder.c): each ramp at most 3/8 of a turn. */
+    if (c->scan_hz * c->t_scan_acc > 0.75) {
+        *what = "t_scan_acc";
+        return -1;
+    }
+    if (!(c->dead_time_s >= 0.0f) || !cm_q24((double)c->dead_time_s * b->w_rad_s, &q->td)) {
+        *what = "dead_time_s";
+        return -1;
+    }
+    q->n_turn = (uint32_t)((((uint64_t)1 << 32) + q->scan_inc / 2u) / q->scan_inc);
+    q->enc_count = (uint32_t)(((uint64_t)(uint32_t)p->pole_pairs << 32) / enc_cpr);
+    /* "At rest" tolerates a rotor that toggles one count at the edge it
+     * rests on: 1.5 counts over the speed window (a fine encoder on a
+     * many-pole motor: 1 count in 16 periods is 2.4 % of the gimbal
+     * motor's rated speed) */
+    q->w_settle =
+        fx_max(q->w_settle, fx_round_sat((int64_t)(q->enc_count * 3u / 32u) * p->dangle_to_omega,
+                                         CTRL_DANGLE_SHIFT));
+    /* The times t_vbus .. t_gate, in the order of n_vbus .. n_gate (one loop
+     * takes less flash than the twelve conversions written out). */
+    _Static_assert(
+        offsetof(cm_config_t, t_gate) - offsetof(cm_config_t, t_vbus) == 11u * sizeof(float) &&
+            offsetof(cm_par_t, n_gate) - offsetof(cm_par_t, n_vbus) == 11u * sizeof(uint32_t),
+        "the times and their periods in one order");
+    for (size_t k = 0; k < 12u; k++) {
+        float t_s;
+        memcpy(&t_s, (const char *)c + offsetof(cm_config_t, t_vbus) + k * sizeof t_s, sizeof t_s);
+        const uint32_t n = cm_periods(t_s, fs);
+        memcpy((char *)q + offsetof(cm_par_t, n_vbus) + k * sizeof n, &n, sizeof n);
+    }
     q->n_rest = cm_periods(0.005, fs);
     /* Test currents within the voltage: at most what CM_V_USE of the step's
      * voltage limit drives through the configured Rs (standstill: alignment,
@@ -224,7 +281,9 @@ int cm_configure(cm_t *cm, const cm_config_t *c, const ctrl_params_t *p, const c
      * below it ends with CM_E_SUPPLY. */
     q->i_min = fx_max(q->i_min, 64 * q->i_lsb);
     q->i_hold_nom = q->i_hold;
+    q->i_hold_max_nom = q->i_hold_max;
     q->i_acc_nom = q->i_acc;
+    q->i_spin_nom = q->i_spin;
     q->i_fd_nom = q->i_fd;
     {
         const double rs = m->rs_ohm / b->r_ohm;
@@ -280,10 +339,14 @@ static const struct {
     {CM_R(psi_pos), 1u, CM_B(psi_wb), CM_S(psi_pos_wb)},
     {CM_R(psi_neg), 1u, CM_B(psi_wb), CM_S(psi_neg_wb)},
     {CM_R(omega_flux), 1u, CM_B(w_rad_s), CM_S(omega_flux_rad_s)},
-    {CM_R(acc_dw), 1u, CM_B(w_rad_s), CM_SI_NONE},
-    {CM_R(coast_w0), 1u, CM_B(w_rad_s), CM_SI_NONE},
-    {CM_R(coast_w1), 1u, CM_B(w_rad_s), CM_SI_NONE},
-    {CM_R(coast_wm), 1u, CM_B(w_rad_s), CM_SI_NONE},
+    {CM_R(fw_vq), 4u, CM_B(v_v), CM_SI_NONE},
+    {CM_R(fw_w), 4u, CM_B(w_rad_s), CM_SI_NONE},
+    {CM_R(fw_iq), 4u, CM_B(i_a), CM_SI_NONE},
+    {CM_R(fw_eq), 4u, CM_B(v_v), CM_SI_NONE},
+#if CM_MECH
+    {CM_R(fw_dw), 4u, CM_B(w_rad_s), CM_SI_NONE},
+#endif
+    {CM_R(i_fd), 1u, CM_B(i_a), CM_SI_NONE},
 };
 #undef CM_R
 #undef CM_B
@@ -311,8 +374,12 @@ void cm_rebase(cm_t *cm, const ctrl_bases_t *nb, bool enc_adopted)
             memcpy(f, &x, sizeof x);
         }
     }
-    /* Inertia data: sum i_q (current). */
-    r->acc_torque_sum = (int64_t)floor((double)r->acc_torque_sum * ob.i_a / nb->i_a + 0.5);
+#if CM_MECH
+    /* Inertia data: sums of i_q (current). */
+    for (int t = 0; t < 2; t++) {
+        r->jx_iq[t] = (int64_t)floor((double)r->jx_iq[t] * ob.i_a / nb->i_a + 0.5);
+    }
+#endif
     if (enc_adopted) {
         /* The drive now counts in the identified direction; the offset is
          * taken against the angle without the drive's offset, so it stays. */
@@ -344,21 +411,77 @@ void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double t
     o->salient = r->salient != 0u;
     o->inertia_kgm2 = NAN;
     o->friction_nms = NAN;
-    if ((r->have & CM_HAVE_MECH) != 0u && r->acc_dw > 0 && r->acc_n > 0u && pole_pairs > 0u) {
-        /* J = integral(T dt) / d(omega_m), T = psi i_q (pu, i_d = 0). */
-        const double psi = (double)r->psi / 16777216.0;
-        const double iq_sum = (double)r->acc_torque_sum / 16777216.0;
-        const double tdt = psi * iq_sum * b->torque_nm * ts_s;
-        const double dwm = cm_si(r->acc_dw, b->w_rad_s) / (double)pole_pairs;
-        o->inertia_kgm2 = tdt / dwm;
-        if (r->coast_n > 0u && r->coast_wm > 0) {
-            /* Coasting with no torque: J dw/dt = -B w (mechanical; the ratio
-             * dw / w is the same in electrical units). */
-            const double dw = cm_si(fx_sub(r->coast_w1, r->coast_w0), b->w_rad_s);
-            const double wm = cm_si(r->coast_wm, b->w_rad_s);
-            o->friction_nms = -o->inertia_kgm2 * dw / ((double)r->coast_n * ts_s) / wm;
+    o->coulomb_nm = NAN;
+#if !CM_MECH
+    (void)pole_pairs;
+    (void)ts_s;
+#else
+    if ((r->have & CM_HAVE_MECH) != 0u && pole_pairs > 0u && r->jx_n[0] > 0u && r->jx_n[1] > 0u) {
+        /* Torque T = (psi +- D) i_q (pu) in the +i_d and -i_d windows and
+         * transitions, D the reluctance term (Ld - Lq) i_d: at one speed the
+         * two windows carry the same friction, (psi + D) i_+ = (psi - D) i_-,
+         * so D = psi (i_- - i_+) / (i_- + i_+), least squares over the two
+         * speeds (an incremental Ld from the ldq step is not the secant one
+         * a saturating machine's torque follows); with less friction than
+         * 5 % of the rated current it is not resolved and (Ld - Lq) i_d is
+         * taken. The window's torque less J dw/dt over it against its
+         * mechanical speed: the friction F + B w_m from the two speeds (the
+         * mean of the two windows at each); each transition's J = (integral
+         * T dt - F t - B angle_m) / (w_m at its end - at its start), those
+         * from the windows' means and changes (a linear drift). Three
+         * rounds from J = 0. */
+        const double tb = b->torque_nm, pp = (double)pole_pairs;
+        const double psi = cm_si(r->psi, 1.0);
+        double iq[4], w[4], dw[4], tw[4], tn[4], j = 0.0, bv = 0.0, fc = 0.0;
+        /* The current samples' offset (cm_flux.c: taken out of the windows'
+         * i_q already), over a transition: kd x the angle it turned / Ts. */
+        const double kd = cm_si(cm->par.td, 1.0) / 2.0 * psi / cm_si(r->lq, 1.0);
+        for (int k = 0; k < 4; k++) {
+            iq[k] = cm_si(r->fw_iq[k], 1.0);
+            w[k] = cm_si(r->fw_w[k], b->w_rad_s) / pp;
+            dw[k] = cm_si(r->fw_dw[k], b->w_rad_s) / pp;
+            tw[k] = (double)r->fw_n[k] * ts_s;
+            tn[k] = (double)r->fw_len[k] * ts_s;
+        }
+        const double sl = iq[3] + iq[0], sh = iq[2] + iq[1];
+        const double s2 = sl * sl + sh * sh;
+        const double imin = 0.05 * cm_si(cm->par.i_rated, 1.0);
+        double d = cm_si(fx_mul(fx_sub(r->ld, r->lq), r->i_fd), 1.0);
+        if (s2 > 4.0 * imin * imin) {
+            d = psi * ((iq[3] - iq[0]) * sl + (iq[2] - iq[1]) * sh) / s2;
+        }
+        const double kt[4] = {(psi + d) * tb, (psi + d) * tb, (psi - d) * tb, (psi - d) * tb};
+        const double w_lo = (w[0] + w[3]) / 2.0, w_hi = (w[1] + w[2]) / 2.0;
+        for (int round = 0; round < 3 && w_hi - w_lo > 0.0; round++) {
+            double t[4];
+            for (int k = 0; k < 4; k++) {
+                t[k] = kt[k] * iq[k] - (tw[k] > 0.0 ? j * dw[k] / tw[k] : 0.0);
+            }
+            bv = ((t[1] + t[2]) - (t[0] + t[3])) / 2.0 / (w_hi - w_lo);
+            fc = (t[0] + t[3]) / 2.0 - bv * w_lo;
+            j = 0.0;
+            for (int k = 0; k < 2; k++) {
+                const int a = k == 0 ? 0 : 2, e = a + 1; /* from window a to e */
+                /* the offset over the transition: kd x the angle it turned / Ts */
+                const double tdt = kt[a] *
+                                   ((double)r->jx_iq[k] / 16777216.0 -
+                                    kd * (double)r->jx_th[k] / 4294967296.0 * 2.0 * CTRL_PI /
+                                        cm_si(cm->par.ts, 1.0)) *
+                                   ts_s;
+                const double n = (double)r->jx_n[k] * ts_s;
+                const double ang = (double)r->jx_th[k] / 4294967296.0 * 2.0 * CTRL_PI / pp;
+                const double dwt =
+                    (w[e] - dw[e] / 2.0 * tn[e] / tw[e]) - (w[a] + dw[a] / 2.0 * tn[a] / tw[a]);
+                j += (tdt - fc * n - bv * ang) / dwt / 2.0;
+            }
+        }
+        if (w_hi - w_lo > 0.0) {
+            o->inertia_kgm2 = j;
+            o->friction_nms = bv;
+            o->coulomb_nm = fc;
         }
     }
+#endif
 }
 
 bool cm_si_has(const cm_si_t *r, uint32_t have)
@@ -410,8 +533,11 @@ static const struct {
     CM_F(CM_HAVE_ENC, "sensors", "encoder_lines", CM_F_LINES, enc_cpr_cfg),
     CM_F(CM_HAVE_ENC, "sensors", "encoder_offset_deg", CM_FIELD_SI, enc_offset_deg),
     CM_F(CM_HAVE_ENC, "sensors", "encoder_direction", CM_FIELD_INT, enc_dir),
+#if CM_MECH
     CM_F(CM_HAVE_MECH, "mechanics", "inertia_kgm2", CM_FIELD_SI, inertia_kgm2),
     CM_F(CM_HAVE_MECH, "mechanics", "friction_nms", CM_F_FRICTION, friction_nms),
+    CM_F(CM_HAVE_MECH, "mechanics", "coulomb_nm", CM_F_FRICTION, coulomb_nm),
+#endif
 };
 #undef CM_F
 
@@ -420,7 +546,7 @@ bool cm_fragment_item(const cm_si_t *r, size_t index, cm_item_t *it)
     for (size_t k = 0; k < sizeof cm_fragment / sizeof cm_fragment[0]; k++) {
         const uint8_t kind = cm_fragment[k].kind;
         if (!cm_si_has(r, cm_fragment[k].have) ||
-            (kind == CM_F_FRICTION && !isfinite(r->friction_nms))) {
+            (kind == CM_F_FRICTION && !isfinite(cm_si_field(r, cm_fragment[k].off, CM_FIELD_SI)))) {
             continue;
         }
         if (index-- != 0u) {
@@ -445,40 +571,123 @@ bool cm_fragment_item(const cm_si_t *r, size_t index, cm_item_t *it)
 
 typedef enum { K_NONE, K_A, K_V, K_H, K_OHM, K_WB, K_RAD_S, K_FRAC, K_INT, K_NM, K_DEG } cm_kind_t;
 
+/* The detail numbers of each error: their labels (L_*, the 1-based order of
+ * cm_labels; L_NONE: none) and kinds. The labels as one string (each ends in a
+ * NUL): a third of the flash of a pointer per label. */
 typedef struct {
-    const char *label[3];
+    uint8_t label[3];
     uint8_t kind[3];
 } cm_detail_t;
 
+enum {
+    L_NONE,
+    L_FAULT_CODE,
+    L_VBUS,
+    L_MIN,
+    L_MAX,
+    L_PHASE,
+    L_MEAN,
+    L_TOL,
+    L_SD,
+    L_CURRENT,
+    L_NEEDED,
+    L_VOLTAGE,
+    L_INDUCTANCE,
+    L_UNBALANCE,
+    L_V_LIM,
+    L_LIMIT,
+    L_DV,
+    L_DI,
+    L_COUNTS_MEASURED,
+    L_COUNTS_CONFIGURED,
+    L_RATIO,
+    L_SPEED,
+    L_TARGET,
+    L_PSI,
+    L_D_SIGN,
+    L_MEASURED,
+    L_PREDICTED,
+    L_SUM,
+    L_TEST,
+    L_AT_START,
+    L_SPEED_GAIN,
+    L_PERIODS,
+    L_TORQUE,
+    L_STEP,
+    L_CURRENT_MIN,
+    L_V_NEEDED,
+    L_MOVED_PERMILLE,
+    L_TORQUE_MAX,
+};
+
+static const char cm_labels[] = "fault_code\0"
+                                "vbus\0"
+                                "min\0"
+                                "max\0"
+                                "phase\0"
+                                "mean\0"
+                                "tol\0"
+                                "sd\0"
+                                "current\0"
+                                "needed\0"
+                                "voltage\0"
+                                "inductance\0"
+                                "unbalance\0"
+                                "v_lim\0"
+                                "limit\0"
+                                "dv\0"
+                                "di\0"
+                                "counts_measured\0"
+                                "counts_configured\0"
+                                "ratio\0"
+                                "speed\0"
+                                "target\0"
+                                "psi\0"
+                                "d_sign\0"
+                                "measured\0"
+                                "predicted\0"
+                                "sum\0"
+                                "test\0"
+                                "at_start\0"
+                                "speed_gain\0"
+                                "periods\0"
+                                "torque\0"
+                                "step\0"
+                                "current_min\0"
+                                "v_needed\0"
+                                "moved_permille\0"
+                                "torque_max\0";
+
 static const cm_detail_t cm_err_detail[CM_E_COUNT] = {
-    [CM_E_FAULT] = {{"fault_code", NULL, NULL}, {K_INT, K_NONE, K_NONE}},
-    [CM_E_VBUS_LOW] = {{"vbus", "min", NULL}, {K_V, K_V, K_NONE}},
-    [CM_E_VBUS_HIGH] = {{"vbus", "max", NULL}, {K_V, K_V, K_NONE}},
-    [CM_E_OFFSET] = {{"phase", "mean", "tol"}, {K_INT, K_A, K_A}},
-    [CM_E_NOISE] = {{"phase", "sd", "tol"}, {K_INT, K_A, K_A}},
-    [CM_E_OPEN_PHASE] = {{"current", "needed", "voltage"}, {K_A, K_A, K_V}},
-    [CM_E_SHORTED_PHASE] = {{"current", "inductance", "fault_code"}, {K_A, K_H, K_INT}},
-    [CM_E_UNBALANCED] = {{"unbalance", "max", NULL}, {K_FRAC, K_FRAC, K_NONE}},
-    [CM_E_VOLTAGE_LIMIT] = {{"current", "v_lim", NULL}, {K_A, K_V, K_NONE}},
-    [CM_E_CURRENT_LIMIT] = {{"current", "limit", NULL}, {K_A, K_A, K_NONE}},
-    [CM_E_RS_RANGE] = {{"dv", "di", NULL}, {K_V, K_A, K_NONE}},
-    [CM_E_L_RANGE] = {{"inductance", "min", "max"}, {K_H, K_H, K_H}},
-    [CM_E_ENC_NO_MOTION] = {{"moved_permille", "expected_permille", NULL}, {K_INT, K_INT, K_NONE}},
-    [CM_E_ENC_CPR] = {{"counts_measured", "counts_configured", "ratio"}, {K_INT, K_INT, K_FRAC}},
-    [CM_E_ENC_UNSTEADY] = {{"speed", "limit", NULL}, {K_RAD_S, K_RAD_S, K_NONE}},
-    [CM_E_SPEED_LOW] = {{"speed", "target", "at_voltage_limit"}, {K_RAD_S, K_RAD_S, K_INT}},
-    [CM_E_OVERSPEED] = {{"speed", "limit", NULL}, {K_RAD_S, K_RAD_S, K_NONE}},
-    [CM_E_FLUX_RANGE] = {{"psi", "speed", "d_sign"}, {K_WB, K_RAD_S, K_INT}},
-    [CM_E_SENSE_POLARITY] = {{"phase", "measured", "predicted"}, {K_INT, K_A, K_A}},
-    [CM_E_SENSE_GAIN] = {{"phase", "ratio", "measured"}, {K_INT, K_FRAC, K_A}},
-    [CM_E_SENSE_SUM] = {{"sum", "current", "phase"}, {K_A, K_A, K_INT}},
-    [CM_E_GATES_CURRENT] = {{"phase", "current", "test"}, {K_INT, K_A, K_INT}},
-    [CM_E_GATES_VBUS] = {{"vbus", "at_start", "test"}, {K_V, K_V, K_INT}},
-    [CM_E_RUN_DIRECTION] = {{"speed_gain", "periods", "torque"}, {K_RAD_S, K_INT, K_NM}},
-    [CM_E_RUN_NO_ACCEL] = {{"speed_gain", "periods", "torque"}, {K_RAD_S, K_INT, K_NM}},
-    [CM_E_RUN_CURRENT] = {{"current", "needed", "torque"}, {K_A, K_A, K_NM}},
-    [CM_E_NEEDS] = {{"step", NULL, NULL}, {K_INT, K_NONE, K_NONE}},
-    [CM_E_SUPPLY] = {{"current_min", "v_needed", "v_lim"}, {K_A, K_V, K_V}},
+    [CM_E_FAULT] = {{L_FAULT_CODE, L_NONE, L_NONE}, {K_INT, K_NONE, K_NONE}},
+    [CM_E_VBUS_LOW] = {{L_VBUS, L_MIN, L_NONE}, {K_V, K_V, K_NONE}},
+    [CM_E_VBUS_HIGH] = {{L_VBUS, L_MAX, L_NONE}, {K_V, K_V, K_NONE}},
+    [CM_E_OFFSET] = {{L_PHASE, L_MEAN, L_TOL}, {K_INT, K_A, K_A}},
+    [CM_E_NOISE] = {{L_PHASE, L_SD, L_TOL}, {K_INT, K_A, K_A}},
+    [CM_E_OPEN_PHASE] = {{L_CURRENT, L_NEEDED, L_VOLTAGE}, {K_A, K_A, K_V}},
+    [CM_E_SHORTED_PHASE] = {{L_CURRENT, L_INDUCTANCE, L_FAULT_CODE}, {K_A, K_H, K_INT}},
+    [CM_E_UNBALANCED] = {{L_UNBALANCE, L_MAX, L_NONE}, {K_FRAC, K_FRAC, K_NONE}},
+    [CM_E_VOLTAGE_LIMIT] = {{L_CURRENT, L_V_LIM, L_NONE}, {K_A, K_V, K_NONE}},
+    [CM_E_CURRENT_LIMIT] = {{L_CURRENT, L_LIMIT, L_NONE}, {K_A, K_A, K_NONE}},
+    [CM_E_RS_RANGE] = {{L_DV, L_DI, L_NONE}, {K_V, K_A, K_NONE}},
+    [CM_E_L_RANGE] = {{L_INDUCTANCE, L_MIN, L_MAX}, {K_H, K_H, K_H}},
+    [CM_E_ENC_NO_MOTION] = {{L_MOVED_PERMILLE, L_CURRENT, L_TORQUE_MAX}, {K_INT, K_A, K_NM}},
+    [CM_E_ENC_CPR] = {{L_COUNTS_MEASURED, L_COUNTS_CONFIGURED, L_RATIO}, {K_INT, K_INT, K_FRAC}},
+    [CM_E_ENC_UNSTEADY] = {{L_SPEED, L_LIMIT, L_NONE}, {K_RAD_S, K_RAD_S, K_NONE}},
+    [CM_E_SPEED_LOW] = {{L_SPEED, L_TARGET, L_CURRENT}, {K_RAD_S, K_RAD_S, K_A}},
+    [CM_E_OVERSPEED] = {{L_SPEED, L_LIMIT, L_NONE}, {K_RAD_S, K_RAD_S, K_NONE}},
+    [CM_E_FLUX_RANGE] = {{L_PSI, L_SPEED, L_D_SIGN}, {K_WB, K_RAD_S, K_INT}},
+    [CM_E_SENSE_POLARITY] = {{L_PHASE, L_MEASURED, L_PREDICTED}, {K_INT, K_A, K_A}},
+    [CM_E_SENSE_GAIN] = {{L_PHASE, L_RATIO, L_MEASURED}, {K_INT, K_FRAC, K_A}},
+    [CM_E_SENSE_SUM] = {{L_SUM, L_CURRENT, L_PHASE}, {K_A, K_A, K_INT}},
+    [CM_E_GATES_CURRENT] = {{L_PHASE, L_CURRENT, L_TEST}, {K_INT, K_A, K_INT}},
+    [CM_E_GATES_VBUS] = {{L_VBUS, L_AT_START, L_TEST}, {K_V, K_V, K_INT}},
+    [CM_E_RUN_DIRECTION] = {{L_SPEED_GAIN, L_PERIODS, L_TORQUE}, {K_RAD_S, K_INT, K_NM}},
+    [CM_E_RUN_NO_ACCEL] = {{L_SPEED_GAIN, L_PERIODS, L_TORQUE}, {K_RAD_S, K_INT, K_NM}},
+    [CM_E_RUN_CURRENT] = {{L_CURRENT, L_NEEDED, L_TORQUE}, {K_A, K_A, K_NM}},
+    [CM_E_NEEDS] = {{L_STEP, L_NONE, L_NONE}, {K_INT, K_NONE, K_NONE}},
+    [CM_E_SUPPLY] = {{L_CURRENT_MIN, L_V_NEEDED, L_V_LIM}, {K_A, K_V, K_V}},
+    [CM_E_LOAD] = {{L_MOVED_PERMILLE, L_CURRENT, L_TORQUE_MAX}, {K_INT, K_A, K_NM}},
 };
 
 static const char *const cm_units[] = {"",      "A", "V", "H",   "Ohm", "Wb",
@@ -549,8 +758,9 @@ void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
         o->verdict = "fail";
         const cm_detail_t *d = &cm_err_detail[cm->err];
         for (int k = 0; k < 3; k++) {
-            if (d->label[k] != NULL) {
-                cm_add_pu(o, d->label[k], cm->detail[k], d->kind[k], b);
+            if (d->label[k] != 0u) {
+                cm_add_pu(o, cm_nth(cm_labels, (size_t)d->label[k] - 1u), cm->detail[k], d->kind[k],
+                          b);
             }
         }
         return;

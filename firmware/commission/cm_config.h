@@ -13,40 +13,47 @@
 #include "ctrl_params.h"
 #include "hal.h"
 
-/* Test levels as fractions of the machine's ratings, times in seconds.
+/* Test levels as fractions of the machine's ratings, times in seconds
+ * (float: enough for every level and time, half the flash of the defaults).
  * Each step's current is the smaller of its level here and what the voltage
  * it may use drives through the configured machine (cm_configure; the steps
  * after "rs" with the measured Rs and inverter error), down to i_min. */
 typedef struct {
-    double i_hold;             /* alignment, scan and bias current / rated (0.3) */
-    double i_rs1, i_rs2;       /* the two DC levels / rated (0.25, 0.5) */
-    double i_probe;            /* probe target / rated (0.1) */
-    double i_open;             /* probe: less at the largest pattern = open / rated (0.02) */
-    double i_acc;              /* accelerating q current / rated (0.5) */
-    double i_fd;               /* +-d current while coasting / rated (0.2) */
-    double i_sense;            /* sense pulse target / rated (0.2) */
-    double i_guard;            /* abort above this phase current / rated (1.0) */
-    double i_gate_max;         /* gate test: current meaning "load connected" / rated (0.05) */
-    double i_min;              /* smallest test current / rated (0.1); at least 64 ADC counts */
-    double v_lim;              /* standstill voltage limit per axis / Vdc (0.25) */
-    double v_lim_run;          /* spinning voltage limit per axis / Vdc (0.4) */
-    double v_probe0;           /* first probe amplitude / Vdc (0.02) */
-    double vbus_min, vbus_max; /* test window / nominal Vdc (0.8, 1.2) */
-    double l_min_h, l_max_h;   /* plausible inductance (1 uH, 10 H) */
-    double loop_g;             /* current-loop crossover x Ts, rad (0.2) */
-    double damp_rad_s;         /* rotor damping rate Omega, rad/s electrical (30) */
-    double w_flux;             /* flux-step speed / rated (0.3) */
-    double w_guard;            /* abort above / rated (0.8) */
-    double w_settle;           /* at rest below / rated (0.01) */
-    double torque_run;         /* first run torque / rated (0.1) */
-    double unbalance_max;      /* (0.15) */
-    double sense_lo, sense_hi; /* (0.75, 1.3) */
-    double cpr_tol;            /* (0.03) */
-    double salient_min;        /* (0.05) */
-    double gate_duty;          /* (0.05) */
-    double scan_hz;            /* encoder scan, electrical turns per second (4) */
-    double t_vbus, t_ramp, t_settle, t_win, t_hold, t_hold_max, t_hf, t_scan_acc;
-    double t_flux_max, t_flux_win, t_run, t_gate;
+    float i_hold;             /* alignment, scan and bias current / rated (0.3) */
+    float i_hold_max;         /* the scan's current rises to this until the rotor follows (0.6) */
+    float i_rs1, i_rs2;       /* the two DC levels / rated (0.25, 0.5) */
+    float i_probe;            /* probe target / rated (0.1) */
+    float i_open;             /* probe: less at the largest pattern = open / rated (0.02) */
+    float i_acc;              /* inertia: twice the q current over the friction's / rated (0.5) */
+    float i_spin;             /* flux step: q current limit of its speed loop / rated (0.8) */
+    float i_fd;               /* +-d current of the flux step / rated (0.2) */
+    float i_sense;            /* sense pulse target / rated (0.2) */
+    float i_guard;            /* abort above this phase current / rated (1.0) */
+    float i_gate_max;         /* gate test: current meaning "load connected" / rated (0.05) */
+    float i_min;              /* smallest test current / rated (0.1); at least 64 ADC counts */
+    float v_lim;              /* standstill voltage limit per axis / Vdc (0.25) */
+    float v_lim_run;          /* spinning voltage limit per axis / Vdc (0.4) */
+    float v_probe0;           /* first probe amplitude / Vdc (0.02) */
+    float vbus_min, vbus_max; /* test window / nominal Vdc (0.8, 1.2) */
+    float l_min_h, l_max_h;   /* plausible inductance (1 uH, 10 H) */
+    float loop_g;             /* current-loop crossover x Ts, rad (0.2) */
+    float damp_rad_s;         /* rotor damping rate Omega, rad/s electrical (30) */
+    float w_flux; /* flux step: the higher speed / rated (0.5; less where the voltage ends it; the
+                      test currents are sized for 3/5 of it); the lower a third */
+    float w_loop_rad_s;       /* flux step: speed-loop crossover, rad/s (100) */
+    float w_guard;            /* abort above / rated (0.8) */
+    float w_settle;           /* at rest below / rated (0.01) */
+    float torque_run;         /* first run torque / rated (0.1) */
+    float unbalance_max;      /* (0.15) */
+    float sense_lo, sense_hi; /* (0.75, 1.3) */
+    float cpr_tol;            /* (0.03) */
+    float salient_min;        /* (0.05) */
+    float gate_duty;          /* (0.05) */
+    float scan_hz;            /* encoder scan, electrical turns per second (4) */
+    float t_vbus, t_ramp, t_settle, t_win, t_hold, t_hold_max, t_hf, t_scan_acc;
+    float t_flux_max, t_flux_win, t_run, t_gate;
+    float dead_time_s; /* the inverter's dead time (the drive's configuration; 0 unknown): the
+                          mechanics take out the current samples' offset it causes */
 } cm_config_t;
 
 void cm_config_default(cm_config_t *c);
@@ -78,6 +85,7 @@ typedef struct {
     bool salient;
     double psi_wb, psi_pos_wb, psi_neg_wb, omega_flux_rad_s;
     double inertia_kgm2, friction_nms; /* NaN when not measured */
+    double coulomb_nm;                 /* Coulomb friction and passive load, NaN idem */
 } cm_si_t;
 
 void cm_results_si(const cm_t *cm, int enc_dir_cfg, uint8_t pole_pairs, double ts_s, cm_si_t *o);

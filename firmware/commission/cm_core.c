@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cm_internal.h"
+#include "svpwm.h"
 #include "transforms.h"
 
 /* ---- step table ---- */
@@ -17,7 +18,8 @@ static const cm_step_desc_t cm_steps[CM_STEP_COUNT] = {
     {"encoder", CM_HAVE_ENC, CM_HAVE_LPROBE, cm_encoder_begin, cm_encoder_period},
     {"rs", CM_HAVE_RS | CM_HAVE_BALANCE, CM_HAVE_ENC, cm_rs_begin, cm_rs_period},
     {"ldq", CM_HAVE_LDQ, CM_HAVE_ENC, cm_ldq_begin, cm_ldq_period},
-    {"flux", CM_HAVE_FLUX | CM_HAVE_MECH, CM_HAVE_ENC | CM_HAVE_LDQ, cm_flux_begin, cm_flux_period},
+    {"flux", CM_HAVE_FLUX | (CM_MECH ? CM_HAVE_MECH : 0u), CM_HAVE_ENC | CM_HAVE_LDQ, cm_flux_begin,
+     cm_flux_period},
     {"gates", 0u, 0u, cm_gates_begin, cm_gates_period},
     {"sense", 0u, 0u, cm_sense_begin, cm_sense_period},
     {"run", 0u, 0u, cm_run_begin, cm_run_period},
@@ -63,6 +65,7 @@ static const char *const cm_err_names[CM_E_COUNT] = {
     "enc_cpr",        "enc_unsteady",  "speed_low",   "overspeed",     "flux_range",
     "sense_polarity", "sense_gain",    "sense_sum",   "gates_current", "gates_vbus",
     "run_direction",  "run_no_accel",  "run_current", "needs",         "supply",
+    "load",
 };
 
 const char *cm_err_name(uint8_t err)
@@ -182,6 +185,7 @@ void cm_out_off(cm_t *cm, cm_out_t *out)
     out->torque_ref = 0;
     cm->io.va_valid[2] = 0u;
     cm->io.va_al[2] = cm->io.va_be[2] = 0;
+    cm->mon_id = cm->mon_iq = 0;
 }
 
 void cm_abort_fault(cm_t *cm, uint32_t fault_code)
@@ -452,21 +456,26 @@ int cm_fail_supply(cm_t *cm, q24_t r, q24_t v_lim)
     return cm_fail(cm, CM_E_SUPPLY, cm->par.i_min, need, v_lim);
 }
 
-void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_run)
+void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_scan, q24_t cap_run)
 {
     q->i_hold = fx_min(q->i_hold_nom, cap_st);
+    q->i_hold_max = fx_max(q->i_hold, fx_min(q->i_hold_max_nom, cap_scan));
     q->i_acc = fx_min(q->i_acc_nom, cap_run);
     q->i_fd = fx_min(q->i_fd_nom, cap_run);
+    q->i_spin = fx_min(q->i_spin_nom, cap_scan); /* break-away at rest: no back-EMF */
 }
 
 void cm_refit_currents(cm_t *cm)
 {
     const cm_par_t *p = &cm->par;
     const q24_t r = cm_rs_best(cm);
-    /* spinning at w_flux: back-EMF w psi (configured), w L in series */
-    const q24_t e = fx_mul(p->w_flux, p->psi_cfg);
-    const q24_t r_run = fx_add(r, fx_mul(p->w_flux, fx_max(p->l_cfg_d, p->l_cfg_q)));
-    cm_fit_currents(&cm->par, cm_i_within(cm, p->v_lim, 0, r),
+    /* spinning at 3/5 of w_flux: back-EMF w psi (configured), w L in series
+     * (the flux step lowers its higher speed where the voltage reaches 80 %
+     * of its limit; a machine with room goes up to w_flux) */
+    const q24_t wc = p->w_flux / 5 * 3;
+    const q24_t e = fx_mul(wc, p->psi_cfg);
+    const q24_t r_run = fx_add(r, fx_mul(wc, fx_max(p->l_cfg_d, p->l_cfg_q)));
+    cm_fit_currents(&cm->par, cm_i_within(cm, p->v_lim, 0, r), cm_i_within(cm, p->v_lim_run, 0, r),
                     cm_i_within(cm, p->v_lim_run, e, r_run));
 }
 
@@ -492,33 +501,15 @@ void cm_pi_tune_dq(cm_t *cm, q24_t ld, q24_t lq, q24_t lim)
 void cm_modulate(cm_t *cm, q24_t v_al, q24_t v_be, cm_out_t *out)
 {
     cm_io_t *io = &cm->io;
-    q24_t ph[3];
-    ctrl_inv_clarke(v_al, v_be, &ph[0], &ph[1], &ph[2]);
-    const q24_t hi = fx_max(ph[0], fx_max(ph[1], ph[2]));
-    const q24_t lo = fx_min(ph[0], fx_min(ph[1], ph[2]));
-    /* Min-max zero sequence (centre the three legs): the linear range of
-     * space-vector modulation, |v| <= vdc / sqrt(3). */
-    const q24_t mid = (q24_t)(((int64_t)hi + lo) / 2);
-    const q24_t vdc = io->vdc > (FX_ONE >> 4) ? io->vdc : (FX_ONE >> 4);
-    const q24_t inv_vdc = fx_div(FX_ONE, vdc);
-    const uint32_t n = cm->par.pwm_n;
-    uint32_t cmp[3];
-    for (int x = 0; x < 3; x++) {
-        const q24_t d =
-            fx_clamp(fx_add(FX_ONE / 2, fx_mul(fx_sub(ph[x], mid), inv_vdc)), 0, FX_ONE);
-        /* Compare value (the pipeline's rounding) and the duty on its grid. */
-        cmp[x] = (uint32_t)(((uint64_t)(uint32_t)d * n + (1u << 23)) >> 24);
-        const uint64_t g = ((uint64_t)cmp[x] * cm->par.inv_n_q32 + 128u) >> 8;
-        out->legs[x] = g > (uint64_t)FX_ONE ? FX_ONE : (q24_t)g;
-    }
-    out->mode = CM_OUT_LEGS;
-    out->ctrl_reset = 0u;
-    out->torque_ref = 0;
-    /* Leg voltages the compare values make at this DC link: cmp vdc / N. */
+    /* Min-max zero sequence (the control core's space-vector modulation):
+     * the steps keep within its linear range, |v| <= vdc / sqrt(3). */
+    ctrl_legs_t legs;
+    ctrl_svpwm_duties(v_al, v_be, io->vdc > (FX_ONE >> 4) ? io->vdc : (FX_ONE >> 4), &legs);
+    cm_legs(cm, legs.duty[0], legs.duty[1], legs.duty[2], out);
+    /* Leg voltages the duties on the compare grid make at this DC link. */
     q24_t vl[3];
     for (int x = 0; x < 3; x++) {
-        const uint64_t v = ((uint64_t)cmp[x] * (uint64_t)(uint32_t)io->vdc) * cm->par.inv_n_q32;
-        vl[x] = (q24_t)(v >> 32);
+        vl[x] = fx_mul(out->legs[x], io->vdc);
     }
     const q24_t m = (q24_t)(((int64_t)vl[0] + vl[1] + vl[2]) / 3);
     ctrl_clarke(fx_sub(vl[0], m), fx_sub(vl[1], m), &io->va_al[2], &io->va_be[2]);
@@ -564,6 +555,8 @@ void cm_regulate(cm_t *cm, fx_angle_t ang, fx_angle_t ang_cmd, q24_t d_ref, q24_
         be = (q24_t)(((int64_t)be + cm->io.i_be_prev) / 2);
     }
     cm_to_frame(al, be, ang, &id, &iq);
+    cm->mon_id = id;
+    cm->mon_iq = iq;
     const q24_t vd = fx_add(cm_pi_step(&cm->pi_d, fx_sub(d_ref, id)), extra_d);
     const q24_t vq = fx_add(cm_pi_step(&cm->pi_q, fx_sub(q_ref, iq)), extra_q);
     cm_from_frame(vd, vq, ang_cmd, &al, &be);
@@ -592,6 +585,24 @@ fx_angle_t cm_rotor_angle(const cm_t *cm)
 {
     const fx_angle_t th = cm->res.enc_dir < 0 ? (fx_angle_t)(0u - cm->io.th) : cm->io.th;
     return cm->res.enc_off + th;
+}
+
+void cm_monitor(const cm_t *cm, fx_angle_t theta_drive, q24_t *id, q24_t *iq, q24_t *w,
+                q24_t *torque)
+{
+    const cm_results_t *r = &cm->res;
+    *id = cm->mon_id;
+    *iq = cm->mon_iq;
+    *w = cm_speed(cm);
+    /* the encoder step sets the direction before it has the offset */
+    const bool enc = (r->have & CM_HAVE_ENC) != 0u && cm->step != CM_STEP_ENCODER;
+    q24_t d, q;
+    cm_to_frame(cm->io.i_al, cm->io.i_be, enc ? cm_rotor_angle(cm) : theta_drive, &d, &q);
+    const bool ldq = (r->have & CM_HAVE_LDQ) != 0u;
+    const q24_t psi = (r->have & CM_HAVE_FLUX) != 0u ? r->psi : cm->par.psi_cfg;
+    const q24_t dl = ldq ? fx_sub(r->ld, r->lq) : fx_sub(cm->par.l_cfg_d, cm->par.l_cfg_q);
+    /* (3.10) Te = i_q (psi_pm + (Ld - Lq) i_d), pu */
+    *torque = fx_mul(fx_add(psi, fx_mul(dl, d)), q);
 }
 
 /* Slip: the rotor's angle increments (identified direction) against the

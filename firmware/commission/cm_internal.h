@@ -70,9 +70,13 @@ void cm_pi_tune_dq(cm_t *cm, q24_t ld, q24_t lq, q24_t lim);
 q24_t cm_l_best(const cm_t *cm);
 
 /* Test currents within the voltage (cm_config.c, "rs"): i_hold at most
- * cap_st (standstill), i_acc and i_fd at most cap_run (at w_flux), each
- * from its configured level. */
-void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_run);
+ * cap_st (standstill), the encoder scan's rising current and the flux
+ * step's speed-loop limit i_spin at most cap_scan (what the spinning limit
+ * drives through Rs: the scan turns slowly, the break-away is at rest; at
+ * speed the flux step's voltage check holds), i_acc and i_fd at most cap_run
+ * (at the speed the flux step's currents are sized for), each from its
+ * configured level. */
+void cm_fit_currents(cm_par_t *q, q24_t cap_st, q24_t cap_scan, q24_t cap_run);
 /* The same with the measured Rs and inverter error (after "rs"). */
 void cm_refit_currents(cm_t *cm);
 /* Largest current (pu) a share CM_V_USE of v drives through r after the

@@ -353,7 +353,9 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     /* Commissioning limits: a machine the steps cannot represent only
      * disables commissioning (fw_commission_start names the quantity). */
     fw->cm_what = NULL;
-    if (cm_configure(&fw->cm, &cfg->cm, &fw->params, &fw->bases, fw->machine, in, fw->enc_cpr,
+    cm_config_t cmc = cfg->cm;
+    cmc.dead_time_s = (float)cfg->dead_time_s; /* the drive's, for the mechanics */
+    if (cm_configure(&fw->cm, &cmc, &fw->params, &fw->bases, fw->machine, in, fw->enc_cpr,
                      &fw->cm_what) != 0 &&
         fw->cm_what == NULL) {
         fw->cm_what = "commissioning configuration";

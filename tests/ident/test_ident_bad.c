@@ -5,7 +5,11 @@
  * wrong (enc_cpr), DC link too low for the test (vbus_low). Also: stop in
  * the middle of a step (back to ready, gates off), a drive protection during
  * a step (fault), a step whose prerequisite is missing (refused), and the
- * bring-up checks' pass and fail answers (gates, sense, first run).
+ * bring-up checks' pass and fail answers (gates, sense, first run). A
+ * passive load on the shaft: the encoder step passes with the counts and the
+ * offset right under one the field can move (the interactive QEMU image's
+ * 0.3 N*m), and names the step, the largest current and the torque it makes
+ * under one it cannot.
  * Host closed loop (plant, hal/sim, firmware), thesis SPMSM, ideal inverter
  * (the exact plant path keeps these runs short), rotor at rest at 1 rad.
  */
@@ -94,6 +98,47 @@ static void test_encoder_counts_wrong(void)
     /* detail: measured counts (8192 true) and the configured 10000 */
     TEST_ASSERT_INT32_WITHIN(82, 8192, run.fw.cm.detail[0]);
     TEST_ASSERT_EQUAL_INT32(10000, run.fw.cm.detail[1]);
+}
+
+static const uint8_t plan_enc[] = {CM_STEP_VBUS, CM_STEP_PROBE, CM_STEP_ENCODER};
+
+/* The interactive QEMU image's case: its 0.3 N*m passive load holds the
+ * rotor about 25 deg electrical short of the 0.3 I_r field at every hold
+ * (the scan read 9324 of 10000 counts before). The counts within 1 %, the
+ * offset within 2 deg electrical (the plant's encoder: 0 deg). */
+static void test_encoder_passive_load(void)
+{
+    start(&spm, &spm);
+    plant_set_load_passive(&run.plant, 0.3);
+    ident(plan_enc, 3, SIM_BAD_NONE, 10.0);
+    TEST_ASSERT_TRUE(id.finished);
+    TEST_ASSERT_EQUAL_STRING("none", cm_err_name(id.err));
+    TEST_ASSERT_UINT32_WITHIN(100u, 10000u, id.res.enc_cpr);
+    TEST_ASSERT_EQUAL_INT(1, id.res.enc_dir);
+    const double off = fmod(id.res.enc_offset_deg + 540.0, 360.0) - 180.0;
+    TEST_ASSERT_DOUBLE_WITHIN(2.0, 0.0, off);
+}
+
+/* A passive load of 2 N*m (83 % of the rated torque) is more than the
+ * scan's largest current, 0.6 I_r = 2.52 A, makes (about 1.4 N*m): the rotor
+ * does not turn. The failure names the step, what moved, that current and
+ * its torque. */
+static void test_load_too_large(void)
+{
+    start(&spm, &spm);
+    plant_set_load_passive(&run.plant, 2.0);
+    ident(plan_enc, 3, SIM_BAD_NONE, 10.0);
+    expect_fail(CM_E_ENC_NO_MOTION, FW_FAULT_COMMISSION);
+    TEST_ASSERT_EQUAL_UINT8(CM_STEP_ENCODER, id.step);
+    cm_outcome_t o;
+    cm_outcome(&run.fw.cm, &run.fw.bases, &o);
+    TEST_ASSERT_EQUAL_STRING("encoder", o.step);
+    TEST_ASSERT_EQUAL_size_t(3u, o.n);
+    TEST_ASSERT_EQUAL_STRING("moved_permille", o.label[0]);
+    TEST_ASSERT_EQUAL_STRING("current", o.label[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.05 * 2.52, 2.52, o.value[1]);
+    TEST_ASSERT_EQUAL_STRING("torque_max", o.label[2]);
+    TEST_ASSERT_TRUE(o.value[2] > 1.0 && o.value[2] < 2.0);
 }
 
 static void test_vbus_low(void)
@@ -238,6 +283,8 @@ int main(void)
     RUN_TEST(test_encoder_stuck);
     RUN_TEST(test_encoder_counts_wrong);
     RUN_TEST(test_vbus_low);
+    RUN_TEST(test_encoder_passive_load);
+    RUN_TEST(test_load_too_large);
     RUN_TEST(test_stop);
     RUN_TEST(test_protection_during_step);
     RUN_TEST(test_needs);

@@ -2,7 +2,7 @@
  * Host generator of pil_ident_data.c (pil_ident.h): records the whole
  * identification on the host closed loop, then the adoption of the results
  * and 1000 periods of m2ptfc in torque mode with them.
- *   pil_ident_gen --machine thesis_spmsm.ini --out pil_ident_data.c
+ *   pil_ident_gen --machine nonideal/thesis_spmsm_stress.ini --out pil_ident_data.c
  */
 #include <math.h>
 #include <stdio.h>

@@ -36,8 +36,9 @@ typedef enum { K_FLAG, K_REAL, K_UINT, K_TEXT, K_SPAN, K_SET, K_ABC } cli_kind_t
 /* Which kind of run an option belongs to. */
 typedef enum { M_ANY, M_LOOP, M_REPLAY, M_INFO, M_IDENT } cli_mode_t;
 /* Closed-loop options that also apply to --identify. */
-static const char *const k_ident_loop_opts[] = {"--control-machine", "--controller", "--seed",
-                                                "--metrics", "--trace-decimation"};
+static const char *const k_ident_loop_opts[] = {
+    "--control-machine", "--controller",       "--seed",
+    "--metrics",         "--trace-decimation", "--load-passive-nm"};
 
 typedef struct {
     double start, end;
@@ -427,7 +428,9 @@ static int cli_check(cli_t *c, const int *given)
         if (ident && o->mode == M_REPLAY) {
             return die("give either --identify or --replay, not both");
         }
-        if (o->needs != NULL && !is_given(given, o->needs)) {
+        /* The identification always runs on free mechanics. */
+        if (o->needs != NULL && !is_given(given, o->needs) &&
+            !(ident && strcmp(o->needs, "--free") == 0)) {
             return die("%s needs %s%s", o->name, o->needs,
                        strcmp(o->needs, "--free") == 0
                            ? " (a dynamometer imposes the speed: no load, no speed loop)"
@@ -685,7 +688,7 @@ static int parse_steps(const char *list, uint8_t *steps, size_t cap)
     return (int)n;
 }
 
-static int identify_main(const cli_t *c, const sim_machine_t *pm)
+static int identify_main(const cli_t *c, const sim_machine_t *pm, bool load_given)
 {
     const char *ctrl_machine_path = c->control_machine, *ctrl_name = c->controller;
     const char *steps_arg = c->identify_steps, *inject = c->inject, *out_ini = c->identify_out;
@@ -737,6 +740,11 @@ static int identify_main(const cli_t *c, const sim_machine_t *pm)
             fclose(tf);
         }
         return SIM_EXIT_USAGE;
+    }
+    /* A passive load on the shaft (a brake, a gearbox's friction), instead of
+     * the machine file's: the identification must move it. */
+    if (load_given) {
+        plant_set_load_passive(&run.plant, c->load_passive_nm);
     }
     static sim_ident_t id;
     if (sim_ident_run(&run, steps, (uint8_t)n, 30.0, bad, &id, err, sizeof err) != 0) {
@@ -820,7 +828,7 @@ int main(int argc, char **argv)
         return replay_main(&c, &pm);
     }
     if (c.identify) {
-        return identify_main(&c, &pm);
+        return identify_main(&c, &pm, is_given(given, "--load-passive-nm"));
     }
 
     /* ---- closed loop: everything is checked before the run starts ---- */

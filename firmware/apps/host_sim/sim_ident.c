@@ -199,7 +199,7 @@ static double sim_pct(double got, double want)
 
 /* Truth of the simulated machine (the plant's parameters and encoder). */
 typedef struct {
-    double rs, ld, lq, psi, off, j, b;
+    double rs, ld, lq, psi, off, j, b, c;
     int dir, lines;
 } sim_truth_t;
 
@@ -215,6 +215,9 @@ static void sim_truth(const sim_run_t *r, sim_truth_t *t)
     t->lines = m->encoder_lines;
     t->j = m->inertia_kgm2;
     t->b = m->friction_nms;
+    /* Coulomb friction as the drive sees it: the bearings' and a passive load
+     * on the shaft (both oppose the motion with a constant torque) */
+    t->c = r->plant.cfg.coulomb_nm + r->plant.load_passive_nm;
 }
 
 void sim_ident_write_json(FILE *f, const sim_run_t *r, const sim_ident_t *id)
@@ -254,10 +257,34 @@ void sim_ident_write_json(FILE *f, const sim_run_t *r, const sim_ident_t *id)
     sim_jnum(f, "encoder_counts_measured", he ? (double)q->enc_cpr : NAN, true);
     sim_jnum(f, "inertia_kgm2", q->inertia_kgm2, true);
     sim_jnum(f, "friction_nms", q->friction_nms, true);
+    sim_jnum(f, "coulomb_nm", q->coulomb_nm, true);
     sim_jnum(f, "probe_inductance_mh", q->l_probe_h * 1e3, true);
     sim_jnum(f, "inverter_voltage_error_v", hr ? q->v_inv_v : NAN, true);
     sim_jnum(f, "unbalance", hr ? q->unbalance : NAN, false);
-    fprintf(f, "  },\n  \"truth\": {\n");
+    {
+        /* The flux step's four speed windows (cm_flux.c): mechanical speed,
+         * mean q current and v_q, SI. */
+        const cm_results_t *cr = &r->fw.cm.res;
+        const ctrl_bases_t *b = &cr->bases;
+        const double p = (double)r->cfg.ctrl_machine.pole_pairs;
+        fprintf(f, "  },\n  \"flux_windows\": [\n");
+        for (int k = 0; k < 4; k++) {
+            fprintf(f,
+                    "    {\"speed_rad_s\": %.9g, \"i_q_a\": %.9g, \"v_q_v\": %.9g, "
+                    "\"inverter_error_q_v\": %.9g",
+                    cr->fw_w[k] / 16777216.0 * b->w_rad_s / p, cr->fw_iq[k] / 16777216.0 * b->i_a,
+                    cr->fw_vq[k] / 16777216.0 * b->v_v, cr->fw_eq[k] / 16777216.0 * b->v_v);
+#if CM_MECH
+            fprintf(f,
+                    ", \"speed_change_rad_s\": %.9g, \"periods\": %u, "
+                    "\"periods_between_blocks\": %u",
+                    cr->fw_dw[k] / 16777216.0 * b->w_rad_s / p, (unsigned)cr->fw_len[k],
+                    (unsigned)cr->fw_n[k]);
+#endif
+            fprintf(f, "}%s\n", k < 3 ? "," : "");
+        }
+        fprintf(f, "  ],\n  \"truth\": {\n");
+    }
     sim_jnum(f, "rs_ohm", t.rs, true);
     sim_jnum(f, "ld_mh", t.ld * 1e3, true);
     sim_jnum(f, "lq_mh", t.lq * 1e3, true);
@@ -266,14 +293,17 @@ void sim_ident_write_json(FILE *f, const sim_run_t *r, const sim_ident_t *id)
     sim_jnum(f, "encoder_direction", (double)t.dir, true);
     sim_jnum(f, "encoder_lines", (double)t.lines, true);
     sim_jnum(f, "inertia_kgm2", t.j, true);
-    sim_jnum(f, "friction_nms", t.b, false);
+    sim_jnum(f, "friction_nms", t.b, true);
+    sim_jnum(f, "coulomb_nm", t.c, false);
     fprintf(f, "  },\n  \"error\": {\n");
     sim_jnum(f, "rs_pct", hr ? sim_pct(q->rs_ohm, t.rs) : NAN, true);
     sim_jnum(f, "ld_pct", hl ? sim_pct(q->ld_h, t.ld) : NAN, true);
     sim_jnum(f, "lq_pct", hl ? sim_pct(q->lq_h, t.lq) : NAN, true);
     sim_jnum(f, "psi_pm_pct", hf ? sim_pct(q->psi_wb, t.psi) : NAN, true);
     sim_jnum(f, "encoder_offset_deg", he ? sim_wrap180(q->enc_offset_deg - t.off) : NAN, true);
-    sim_jnum(f, "inertia_pct", sim_pct(q->inertia_kgm2, t.j), false);
+    sim_jnum(f, "inertia_pct", sim_pct(q->inertia_kgm2, t.j), true);
+    sim_jnum(f, "friction_pct", sim_pct(q->friction_nms, t.b), true);
+    sim_jnum(f, "coulomb_pct", sim_pct(q->coulomb_nm, t.c), false);
     fprintf(f, "  }\n}\n");
 }
 
@@ -316,6 +346,7 @@ void sim_ident_print(FILE *f, const sim_run_t *r, const sim_ident_t *id)
         fprintf(f, "  %-20s %14.6g %14.6g %9.3f%%\n", "inertia_kgm2", q->inertia_kgm2, t.j,
                 sim_pct(q->inertia_kgm2, t.j));
         fprintf(f, "  %-20s %14.6g %14.6g\n", "friction_nms", q->friction_nms, t.b);
+        fprintf(f, "  %-20s %14.6g %14.6g\n", "coulomb_nm", q->coulomb_nm, t.c);
     }
     if ((q->have & CM_HAVE_ENC) != 0u) {
         fprintf(f, "  %-20s %14.4f %14.4f %9.3f deg\n", "encoder_offset_deg", q->enc_offset_deg,
@@ -357,9 +388,10 @@ int sim_ident_write_ini(const char *path, const sim_machine_t *base, const sim_i
     if (base->dc_cap_f > 0.0) {
         fprintf(f, "dc_src_r_ohm = %.9g\n", base->dc_src_r_ohm);
     }
-    fprintf(f, "\n[mechanics]\ninertia_kgm2 = %.9g\nfriction_nms = %.9g\n",
+    fprintf(f, "\n[mechanics]\ninertia_kgm2 = %.9g\nfriction_nms = %.9g\ncoulomb_nm = %.9g\n",
             hj ? q->inertia_kgm2 : base->inertia_kgm2,
-            hj && isfinite(q->friction_nms) ? fmax(q->friction_nms, 0.0) : base->friction_nms);
+            hj && isfinite(q->friction_nms) ? fmax(q->friction_nms, 0.0) : base->friction_nms,
+            hj && isfinite(q->coulomb_nm) ? fmax(q->coulomb_nm, 0.0) : base->coulomb_nm);
     fprintf(f,
             "\n[sensors]\nencoder_lines = %d\nencoder_offset_deg = %.6f\nencoder_direction = %d\n",
             he ? (int)(q->enc_cpr_cfg / 4u) : base->encoder_lines,
