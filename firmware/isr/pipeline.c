@@ -711,6 +711,8 @@ static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
         fw->ref_mode = FW_REF_TORQUE;
         return fw_control(fw, tm, m);
     }
+    /* What the step does, in the running drive's signals (telemetry, status) */
+    cm_monitor(&fw->cm, m->theta_e, &tm->i_d, &tm->i_q, &tm->omega_e, &tm->torque);
     ctrl_legs_t legs = {{out.legs[0], out.legs[1], out.legs[2]}};
     /* uncompensated: the steps measure the inverter's error themselves */
     fw_pwm_out(fw, hal, tm, &legs, NULL);

@@ -39,8 +39,12 @@ static void op_get_status(void *ctx, cmd_status_t *st)
     st->fault = fw_fault(fw);
     st->fault_name = fw_fault_name(st->fault);
     st->mode = fw->ref_mode == FW_REF_SPEED ? CMD_MODE_SPEED : CMD_MODE_TORQUE;
-    st->speed_rpm = fw_link_rpm(fw, fw->estimate.omega_e);
-    st->torque_nm = ctrl_q24_to_double(fw->estimate.now.torque) * fw->bases.torque_nm;
+    /* The last period's record: the estimate while running, the
+     * commissioning step's (cm_monitor) while it runs, else none (0: the
+     * record's "no estimate") - never the last run's estimate after a stop. */
+    const fw_telemetry_t *r = fw_telemetry(fw);
+    st->speed_rpm = fw_link_rpm(fw, r->omega_e);
+    st->torque_nm = ctrl_q24_to_double(r->torque) * fw->bases.torque_nm;
     st->torque_ref_nm = ctrl_q24_to_double(fw->torque_ref_now) * fw->bases.torque_nm;
     st->speed_ref_rpm = fw_link_rpm(fw, fw->speed_ref);
     st->torque_max_nm = ctrl_q24_to_double(fw->torque_ref_max) * fw->bases.torque_nm;
@@ -391,8 +395,11 @@ static const struct {
     FW_R(CM_HAVE_LDQ, "lq_mh", "mH", CM_FIELD_MILLI, lq_h),
     FW_R(CM_HAVE_LDQ, "salient", "", CM_FIELD_BOOL, salient),
     FW_R(CM_HAVE_FLUX, "psi_pm_wb", "Wb", CM_FIELD_SI, psi_wb),
+#if CM_MECH /* else not measured (cm.h) */
     FW_R(CM_HAVE_MECH, "inertia_kgm2", "kg*m^2", CM_FIELD_SI, inertia_kgm2),
     FW_R(CM_HAVE_MECH, "friction_nms", "N*m*s", CM_FIELD_SI, friction_nms),
+    FW_R(CM_HAVE_MECH, "coulomb_nm", "N*m", CM_FIELD_SI, coulomb_nm),
+#endif
 };
 #undef FW_R
 

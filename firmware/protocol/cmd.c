@@ -746,15 +746,19 @@ static const char *cmd_cm_find(cmd_t *c, cmd_tok_t tok, unsigned kind)
     return NULL;
 }
 
-/* "ok <verdict> step=<s> [error=<e>] [<label>=<value>[<unit>]]..." */
-static void cmd_cm_status_line(cmd_t *c)
+/* "ok <verdict> step=<s> [error=<e>] [<label>=<value>[<unit>]]..."; "ok idle
+ * step=none" for `kind` (CMD_CM_*) when the last start was the other kind's
+ * (a page polling both shows the one that runs). */
+static void cmd_cm_status_line(cmd_t *c, unsigned kind)
 {
     cmd_cm_status_t st;
     memset(&st, 0, sizeof st);
     st.verdict = "idle";
     st.step = "none";
     st.error = "none";
-    c->ops->cm_status(c->ctx, &st);
+    if (c->cm_kind == 0u || c->cm_kind == kind) {
+        c->ops->cm_status(c->ctx, &st);
+    }
     cmd_ok_begin(c);
     cmd_out_char(c, ' ');
     cmd_out_str(c, st.verdict);
@@ -798,6 +802,7 @@ static void cmd_cm_start(cmd_t *c, const char *word, const char *what)
         cmd_err(c, (rc > 0 && rc < (int)CMD_E_COUNT) ? rc : CMD_E_FAILED, detail);
         return;
     }
+    c->cm_kind = (uint8_t)(word[0] == 'i' ? CMD_CM_IDENT : CMD_CM_BRINGUP);
     cmd_ok_begin(c);
     cmd_out_char(c, ' ');
     cmd_out_str(c, word);
@@ -870,7 +875,7 @@ static void cmd_ident(cmd_t *c, const cmd_tok_t *tok, size_t n)
         return;
     }
     if (n == 2 && cmd_tok_is(tok[1], "status")) {
-        cmd_cm_status_line(c);
+        cmd_cm_status_line(c, CMD_CM_IDENT);
         return;
     }
     if (n == 2 && cmd_tok_is(tok[1], "result")) {
@@ -931,7 +936,7 @@ static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
         return;
     }
     if (cmd_tok_is(tok[1], "status")) {
-        cmd_cm_status_line(c);
+        cmd_cm_status_line(c, CMD_CM_BRINGUP);
         return;
     }
     const char *name = cmd_cm_find(c, tok[1], CMD_CM_BRINGUP);

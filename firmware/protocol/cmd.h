@@ -184,6 +184,8 @@ typedef struct {
     bool overflow;             /* the current line exceeded CMD_LINE_MAX */
     bool bad_char;             /* the current line contained a rejected byte */
     bool echo;                 /* echo input (for terminals without local echo) */
+    uint8_t cm_kind;           /* CMD_CM_IDENT or _BRINGUP: what the last start began (0: none
+                                  since reset); the other's status answers idle */
     char out[CMD_OUT_MAX + 1]; /* response line being built */
     size_t out_len;
 } cmd_t;

@@ -4,12 +4,19 @@
  * say why, progress shows in "ident status" and in the telemetry signals
  * cm_step / cm_progress, "stop" ends a step with the gates off, a failed
  * bring-up check answers "fail" with its reason, and the results read back
- * as values and as a machine-file fragment.
+ * as values and as a machine-file fragment. While a step runs, the
+ * telemetry's i_d, i_q, speed and torque and "status" show what it does
+ * (not zeros, not the last run's estimate), and "bringup status" answers
+ * idle while an identification runs (a page polling both shows "ident").
+ * After a stop, "status" follows the rotor (a motor with friction stops),
+ * not the last run's speed and torque.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "ctrl_units.h"
 #include "fw_link.h"
 #include "link_text.h"
 #include "sim_ident.h"
@@ -43,6 +50,20 @@ static void send(const char *line)
 static void periods(int n)
 {
     link_text_periods(&run, &link, n);
+}
+
+/* The number after `key` in the captured reply. */
+static double reply_num(const char *key)
+{
+    const char *p = strstr(lt.out, key);
+    TEST_ASSERT_NOT_NULL_MESSAGE(p, lt.out);
+    return strtod(p + strlen(key), NULL);
+}
+
+/* The true rotor speed, r/min. */
+static double true_rpm(void)
+{
+    return plant_omega_m(&run.plant) * 30.0 / CTRL_PI;
 }
 
 static void test_ident_commands(void)
@@ -79,6 +100,34 @@ static void test_ident_commands(void)
     TEST_ASSERT_EQUAL_UINT8(CM_STEP_ENCODER, fw_telemetry(&run.fw)->cm_step);
     TEST_ASSERT_TRUE(fw_telemetry(&run.fw)->cm_progress > 0u);
     TEST_ASSERT_TRUE(hal_sim_gates_on(&run.hal));
+    /* The scan's field current is the frame's i_d (the regulator holds it
+     * within a few per cent), the speed the rotor's over the same 16 periods
+     * (the encoder's average: 1 count in 16 periods is 7.5 r/min); the
+     * bring-up status is idle. Sampled over the scan's moves. */
+    const double i_b = run.fw.bases.i_a, w_b = run.fw.bases.w_rad_s;
+    const double p = (double)run.fw.params.pole_pairs;
+    double w_max = 0.0;
+    for (int k = 0; k < 40; k++) {
+        periods(500 - (int)CM_SPEED_AVG);
+        const double th0 = run.plant.theta_m;
+        periods((int)CM_SPEED_AVG);
+        /* the rotor's true mean speed over the firmware's speed window */
+        const double w_true = (run.plant.theta_m - th0) / ((double)CM_SPEED_AVG / run.cfg.fs_hz);
+        const fw_telemetry_t *r = fw_telemetry(&run.fw);
+        const double id = ctrl_q24_to_double(r->i_d) * i_b;
+        const double hold = ctrl_q24_to_double(run.fw.cm.hold_i) * i_b;
+        TEST_ASSERT_DOUBLE_WITHIN(0.1 * hold, hold, id);
+        const double rpm = ctrl_q24_to_double(r->omega_e) * w_b / p * 30.0 / CTRL_PI;
+        TEST_ASSERT_DOUBLE_WITHIN(10.0, w_true * 30.0 / CTRL_PI, rpm);
+        w_max = fmax(w_max, fabs(rpm));
+        send("status");
+        TEST_ASSERT_DOUBLE_WITHIN(0.01, rpm, reply_num("speed_rpm="));
+    }
+    TEST_ASSERT_TRUE(w_max > 30.0); /* the scan turns at 4 Hz electrical: 60 r/min */
+    send("bringup status");
+    TEST_ASSERT_EQUAL_STRING("ok idle step=none\r\n", lt.out);
+    send("ident status");
+    TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok running step=encoder", 23));
     send("tel stop");
     send("stop");
     TEST_ASSERT_EQUAL_STRING("ok stopped\r\n", lt.out);
@@ -125,10 +174,45 @@ static void test_bringup_fail_and_ini(void)
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "err 8", 5));
 }
 
+/* A motor with friction and a passive load (the stress file): after a run at
+ * 500 r/min and a disarm it stops within milliseconds; "status" then says
+ * so, and no torque. */
+static void test_status_after_stop(void)
+{
+    sim_run_free(&run);
+    static sim_machine_t m;
+    char err[256];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0,
+                                  sim_machine_load(PMSM_MACHINES_DIR
+                                                   "/nonideal/thesis_spmsm_stress.ini",
+                                                   &m, err, sizeof err),
+                                  err);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        0, sim_ident_setup(&run, &m, &m, ctrl_find("m2ptfc"), 1.0, 1u, err, sizeof err), err);
+    fw_link_init(&link, &run.fw, NULL, NULL);
+    link.write = link_text_capture;
+    link.write_ctx = &lt;
+    send("ref speed 500");
+    send("arm");
+    TEST_ASSERT_EQUAL_STRING("ok armed\r\n", lt.out);
+    periods(4000);
+    send("status");
+    const double running = reply_num("speed_rpm=");
+    TEST_ASSERT_DOUBLE_WITHIN(50.0, 500.0, running);
+    TEST_ASSERT_TRUE(reply_num("torque_nm=") > 0.5); /* the friction's 0.72 N*m and more */
+    send("disarm");
+    periods(4000); /* 0.72 N*m of friction and load stop 1.2e-4 kg*m^2 in a few ms */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 0.0, true_rpm());
+    send("status");
+    TEST_ASSERT_DOUBLE_WITHIN(2.0, 0.0, reply_num("speed_rpm="));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, reply_num("torque_nm="));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_ident_commands);
     RUN_TEST(test_bringup_fail_and_ini);
+    RUN_TEST(test_status_after_stop);
     return UNITY_END();
 }
