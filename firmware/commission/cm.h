@@ -23,6 +23,7 @@
  *   cm_gates.c    bring-up: gate test at low duty without a motor
  *   cm_sense.c    bring-up: current-sense polarity and gain, one pulse per phase
  *   cm_run.c      bring-up: first closed-loop run at 10 % of the rated torque
+ *   cm_cogging.c  anti-cogging table: slow sweeps both ways under a position loop
  * Shared per-period machinery (frames, current regulator, modulation, the
  * applied-voltage record, rotor damping): cm_core.c / cm_internal.h.
  *
@@ -58,6 +59,9 @@ typedef enum {
     CM_STEP_GATES = 7,   /* bring-up: gate test without a motor */
     CM_STEP_SENSE = 8,   /* bring-up: current-sense polarity and gain */
     CM_STEP_RUN = 9,     /* bring-up: first closed-loop run */
+#if CTRL_COGGING
+    CM_STEP_COGGING = 10, /* anti-cogging table (cm_cogging.h) */
+#endif
     CM_STEP_COUNT
 } cm_step_id_t;
 
@@ -94,6 +98,11 @@ typedef enum {
     CM_E_NEEDS,          /* a result this step needs is missing (detail: step) */
     CM_E_SUPPLY,         /* the supply cannot drive the smallest test current */
     CM_E_LOAD,           /* the rotor does not follow: more torque needed than the step makes */
+#if CTRL_COGGING
+    CM_E_COG_FOLLOW, /* cogging: the rotor does not follow the sweep (cm_cogging.h) */
+    CM_E_COG_RANGE,  /* cogging: a bin beyond +-rated torque, or not reached */
+    CM_E_COG_CONFIG, /* cogging: its loop does not fit (cm_cogging.h) */
+#endif
     CM_E_COUNT
 } cm_err_t;
 
@@ -112,6 +121,9 @@ typedef struct {
                             and WITHOUT the configured offset */
     q24_t omega_est;     /* estimator speed, Q24 pu (only meaningful in CM_OUT_CTRL) */
     q24_t torque_est;    /* estimator torque, Q24 pu (idem) */
+#if CTRL_COGGING
+    uint32_t enc_pos; /* encoder position in [0, cpr), configured direction */
+#endif
 } cm_in_t;
 
 typedef struct {
@@ -301,6 +313,11 @@ typedef struct {
     cm_pi_t pi_d, pi_q;
     cm_pi_t pi_w; /* the flux step's speed loop */
     cm_scratch_t x;
+#if CTRL_COGGING
+    /* the anti-cogging table and its step's state (cm_cogging.h; the
+     * firmware's): last, to move no offset */
+    struct cm_cog *cog;
+#endif
 } cm_t;
 
 /* ---- per period (ISR) ---- */

@@ -618,6 +618,13 @@ enum {
     L_V_NEEDED,
     L_MOVED_PERMILLE,
     L_TORQUE_MAX,
+#if CTRL_COGGING
+    L_LAG_COUNTS,
+    L_MAX_COUNTS,
+    L_DIRECTION,
+    L_BIN,
+    L_Q15_OF_RATED,
+#endif
 };
 
 static const char cm_labels[] = "fault_code\0"
@@ -656,7 +663,15 @@ static const char cm_labels[] = "fault_code\0"
                                 "current_min\0"
                                 "v_needed\0"
                                 "moved_permille\0"
-                                "torque_max\0";
+                                "torque_max\0"
+#if CTRL_COGGING
+                                "lag_counts\0"
+                                "max_counts\0"
+                                "direction\0"
+                                "bin\0"
+                                "q15_of_rated\0"
+#endif
+    ;
 
 static const cm_detail_t cm_err_detail[CM_E_COUNT] = {
     [CM_E_FAULT] = {{L_FAULT_CODE, L_NONE, L_NONE}, {K_INT, K_NONE, K_NONE}},
@@ -688,6 +703,10 @@ static const cm_detail_t cm_err_detail[CM_E_COUNT] = {
     [CM_E_NEEDS] = {{L_STEP, L_NONE, L_NONE}, {K_INT, K_NONE, K_NONE}},
     [CM_E_SUPPLY] = {{L_CURRENT_MIN, L_V_NEEDED, L_V_LIM}, {K_A, K_V, K_V}},
     [CM_E_LOAD] = {{L_MOVED_PERMILLE, L_CURRENT, L_TORQUE_MAX}, {K_INT, K_A, K_NM}},
+#if CTRL_COGGING
+    [CM_E_COG_FOLLOW] = {{L_LAG_COUNTS, L_MAX_COUNTS, L_DIRECTION}, {K_INT, K_INT, K_INT}},
+    [CM_E_COG_RANGE] = {{L_BIN, L_Q15_OF_RATED, L_DIRECTION}, {K_INT, K_INT, K_INT}},
+#endif
 };
 
 static const char *const cm_units[] = {"",      "A", "V", "H",   "Ohm", "Wb",
@@ -794,6 +813,13 @@ void cm_outcome(const cm_t *cm, const ctrl_bases_t *b, cm_outcome_t *o)
             cm_add(o, names[k], (double)cm->detail[k] / 16777216.0, "");
         }
         break;
+#if CTRL_COGGING
+    case CM_STEP_COGGING:
+        cm_add_pu(o, "cogging_peak", cm->detail[0], K_NM, b);
+        cm_add_pu(o, "friction", cm->detail[1], K_NM, b);
+        cm_add_pu(o, "bins", cm->detail[2], K_INT, b);
+        break;
+#endif
     case CM_STEP_RUN:
         cm_add_pu(o, "speed_gain", cm->detail[0], K_RAD_S, b);
         cm_add_pu(o, "periods", cm->detail[1], K_INT, b);

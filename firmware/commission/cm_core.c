@@ -23,6 +23,9 @@ static const cm_step_desc_t cm_steps[CM_STEP_COUNT] = {
     {"gates", 0u, 0u, cm_gates_begin, cm_gates_period},
     {"sense", 0u, 0u, cm_sense_begin, cm_sense_period},
     {"run", 0u, 0u, cm_run_begin, cm_run_period},
+#if CTRL_COGGING
+    {"cogging", 0u, 0u, cm_cogging_begin, cm_cogging_period},
+#endif
 };
 
 const cm_step_desc_t *cm_step_desc(uint8_t step)
@@ -66,6 +69,9 @@ static const char *const cm_err_names[CM_E_COUNT] = {
     "sense_polarity", "sense_gain",    "sense_sum",   "gates_current", "gates_vbus",
     "run_direction",  "run_no_accel",  "run_current", "needs",         "supply",
     "load",
+#if CTRL_COGGING
+    "cog_follow",     "cog_range",     "cog_config",
+#endif
 };
 
 const char *cm_err_name(uint8_t err)

@@ -46,6 +46,10 @@ void cm_sense_begin(cm_t *cm);
 int cm_sense_period(cm_t *cm, const cm_in_t *in, cm_out_t *out);
 void cm_run_begin(cm_t *cm);
 int cm_run_period(cm_t *cm, const cm_in_t *in, cm_out_t *out);
+#if CTRL_COGGING
+void cm_cogging_begin(cm_t *cm);
+int cm_cogging_period(cm_t *cm, const cm_in_t *in, cm_out_t *out);
+#endif
 
 /* ---- helpers (cm_core.c) ---- */
 

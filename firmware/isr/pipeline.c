@@ -575,6 +575,13 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
             fx_clamp(fx_add(fw->trim, fx_mul(fw->trim_k, trim_in)), fx_neg(trim_lim), trim_lim);
     }
     fw->refs.torque = fx_add(tref, fw->trim);
+#if CTRL_COGGING
+    if (fw->cog_on != 0u && fw->sm.state == FW_STATE_RUNNING) {
+        /* anti-cogging: the table at the rotor's position, within the limit */
+        const q24_t ff = ctrl_cogging_ff(&fw->cog.map, fw->enc_pos);
+        fw->refs.torque = fx_clamp(fx_add(fw->refs.torque, ff), fx_neg(torque_max), torque_max);
+    }
+#endif
     fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
     fw->torque_ref_now = tref;
     tm->torque_max = torque_max;
@@ -677,6 +684,9 @@ static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
     in.theta = m->theta_e - fw->enc_offset;
     in.omega_est = fw->estimate.omega_e;
     in.torque_est = fw->estimate.now.torque;
+#if CTRL_COGGING
+    in.enc_pos = fw->enc_pos;
+#endif
     cm_out_t out;
     if (!cm_period(&fw->cm, &in, &out)) {
         fw->cm_gates = 0u;

@@ -66,6 +66,7 @@
 #include <stdint.h>
 
 #include "cm.h"
+#include "cm_cogging.h"
 #include "cm_config.h"
 #include "controller.h"
 #include "ctrl_params.h"
@@ -228,6 +229,10 @@ typedef struct {
      * encoder and its protections unused, psi_adapt off (the observer's
      * correction needs the configured psi_pm). Default off. */
     bool sensorless;
+#if CTRL_COGGING
+    /* Anti-cogging calibration's sweep (cm_cogging.h; zeroes: its defaults). */
+    cm_cog_config_t cog;
+#endif
     /* Torque supervision (torque_follow.h): consecutive 50 ms windows in
      * which the mean torque estimate misses the applied reference by more
      * than max(5 %, 2 % of rated) before the fault torque_follow; 0 (the
@@ -371,6 +376,14 @@ typedef struct {
         unsigned char bytes[CTRL_STATE_MAX];
     } ctrl_next;
 #endif
+#if CTRL_COGGING
+    /* Anti-cogging (cogging_ff.h, cm_cogging.h): the table, which the step
+     * "cogging" measures, and cog_on (main loop: fw_cogging_enable), which
+     * adds it to the torque reference in the running state. Last, for the
+     * same reason as above. */
+    cm_cog_t cog;
+    volatile uint8_t cog_on;
+#endif
 } fw_t;
 
 /* Configuration defaults: speed loop sized from the machine (speed_loop.h),
@@ -491,6 +504,25 @@ int fw_commission_apply(fw_t *fw);
 bool fw_commission_poll(fw_t *fw);
 /* Results in SI (direction absolute). */
 void fw_commission_results(const fw_t *fw, cm_si_t *out);
+
+/*
+ * Anti-cogging feed-forward (main loop; docs/anticogging.md). The table of
+ * the step "cogging" (cm_cogging.h) or one loaded (settings, tests) is added
+ * to the torque reference of every controller while running with the
+ * encoder, within the period's torque limit.
+ * fw_cogging_enable: on (FW_ENOENT without a table measured with this
+ *   encoder's counts and direction, FW_EINVAL sensorless: no mechanical
+ *   angle) or off; taken at the next period.
+ * fw_cogging_load: n entries of Q15 of the rated torque against the encoder
+ *   position (cogging_ff.h), n = CTRL_COG_N (else FW_ERANGE); gates off
+ *   (FW_EBUSY); the feed-forward stays as it was (off after a load that
+ *   replaces a table in use).
+ * fw_cogging_table: the table and its entries (NULL when there is none).
+ * All FW_ENOENT / NULL in an image without it (CTRL_COGGING 0).
+ */
+int fw_cogging_enable(fw_t *fw, bool on);
+int fw_cogging_load(fw_t *fw, const int16_t *table, uint32_t n);
+const int16_t *fw_cogging_table(const fw_t *fw, uint32_t *n);
 
 /* Controller state block (for tests). */
 void *fw_ctrl_state(fw_t *fw);

@@ -360,6 +360,19 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         fw->cm_what == NULL) {
         fw->cm_what = "commissioning configuration";
     }
+#if CTRL_COGGING
+    /* The table stays across a new machine (it is against the encoder's
+     * counts), not across a new encoder direction. A loop that does not fit
+     * leaves the step to say so (cog_config). */
+    fw->cm.cog = &fw->cog;
+    (void)cm_cogging_configure(&fw->cog, &cfg->cog, fw->machine, &fw->params, &fw->bases,
+                               in->pwm_freq_hz, fw->enc_cpr);
+    if (fw->cog.enc_neg != fw->enc_neg) {
+        fw->cog_on = 0u;
+        fw->cog.valid = 0u;
+        fw->cog.enc_neg = fw->enc_neg;
+    }
+#endif
     return FW_OK;
 }
 
@@ -697,3 +710,72 @@ void fw_set_speed_ref_rpm(fw_t *fw, double rpm)
         fw_set_speed_ref(fw, ctrl_q24_from_double(we / fw->bases.w_rad_s));
     }
 }
+
+#if CTRL_COGGING
+int fw_cogging_enable(fw_t *fw, bool on)
+{
+    if (fw == NULL) {
+        return FW_EINVAL;
+    }
+    if (!on) {
+        fw->cog_on = 0u;
+        return FW_OK;
+    }
+    if (fw->cfg.sensorless) {
+        return FW_EINVAL;
+    }
+    if (fw->cog.valid == 0u || fw->cog.map.cpr != fw->enc_cpr) {
+        return FW_ENOENT;
+    }
+    fw->cog_on = 1u;
+    return FW_OK;
+}
+
+int fw_cogging_load(fw_t *fw, const int16_t *table, uint32_t n)
+{
+    if (fw == NULL || table == NULL) {
+        return FW_EINVAL;
+    }
+    if (n != CTRL_COG_N) {
+        return FW_ERANGE;
+    }
+    if (fw_gates_on_or_pending(fw)) {
+        return FW_EBUSY;
+    }
+    memcpy(fw->cog.table, table, sizeof fw->cog.table);
+    fw->cog.valid = 1u;
+    return FW_OK;
+}
+
+const int16_t *fw_cogging_table(const fw_t *fw, uint32_t *n)
+{
+    if (fw == NULL || fw->cog.valid == 0u) {
+        return NULL;
+    }
+    if (n != NULL) {
+        *n = CTRL_COG_N;
+    }
+    return fw->cog.table;
+}
+#else
+int fw_cogging_enable(fw_t *fw, bool on)
+{
+    (void)fw;
+    return on ? FW_ENOENT : FW_OK;
+}
+
+int fw_cogging_load(fw_t *fw, const int16_t *table, uint32_t n)
+{
+    (void)fw;
+    (void)table;
+    (void)n;
+    return FW_ENOENT;
+}
+
+const int16_t *fw_cogging_table(const fw_t *fw, uint32_t *n)
+{
+    (void)fw;
+    (void)n;
+    return NULL;
+}
+#endif

@@ -550,6 +550,29 @@ static const char *op_state_detail(void *ctx)
     return l->state_text;
 }
 
+#if CTRL_COGGING
+/* "cogging on | off | status" (cmd.h): the feed-forward (pipeline.h). */
+static int op_cogging(void *ctx, const char *what, const char **detail)
+{
+    fw_t *fw = fw_link_of(ctx)->fw;
+    const bool have = fw_cogging_table(fw, NULL) != NULL;
+    if (strcmp(what, "status") == 0) {
+        *detail = fw->cog_on != 0u ? "on" : (have ? "off" : "none");
+        return CMD_OK;
+    }
+    const int rc = fw_cogging_enable(fw, strcmp(what, "on") == 0);
+    if (rc == FW_ENOENT) {
+        *detail = "no table for this encoder: ident cogging";
+        return CMD_E_STATE;
+    }
+    if (rc == FW_EINVAL) {
+        *detail = "sensorless: no mechanical angle";
+        return CMD_E_STATE;
+    }
+    return fw_link_err(rc);
+}
+#endif
+
 static const cmd_ops_t fw_link_ops = {
     op_write,
     op_get_status,
@@ -576,6 +599,11 @@ static const cmd_ops_t fw_link_ops = {
     op_config,
     op_config_item_at,
     op_state_detail,
+#if CTRL_COGGING
+    op_cogging,
+#else
+    NULL, /* no anti-cogging in this image: "err 12 unsupported" */
+#endif
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx)

@@ -266,6 +266,9 @@ static const struct {
     {"ident status | result | ini | apply", HELP_TEXT("progress, values, machine file")},
     {"bringup NAME | bringup status", HELP_TEXT("bench checks: vbus gates sense encoder run")},
     {"config save | show | erase | default", HELP_TEXT("settings kept in flash")},
+#if CTRL_COGGING
+    {"ident cogging | cogging on | off | status", HELP_TEXT("anti-cogging table, feed-forward")},
+#endif
 };
 
 static void cmd_help(cmd_t *c)
@@ -878,6 +881,12 @@ static void cmd_ident(cmd_t *c, const cmd_tok_t *tok, size_t n)
         cmd_cm_status_line(c, CMD_CM_IDENT);
         return;
     }
+#if CTRL_COGGING
+    if (n == 2 && cmd_tok_is(tok[1], "cogging")) {
+        cmd_cm_start(c, "ident", "cogging"); /* = ident step cogging */
+        return;
+    }
+#endif
     if (n == 2 && cmd_tok_is(tok[1], "result")) {
         const char *key = NULL;
         const char *unit = NULL;
@@ -924,6 +933,35 @@ static void cmd_ident(cmd_t *c, const cmd_tok_t *tok, size_t n)
     }
     cmd_err(c, CMD_E_ARGS, usage);
 }
+
+#if CTRL_COGGING
+/* "cogging on | off | status": the anti-cogging feed-forward. */
+static void cmd_cogging(cmd_t *c, const cmd_tok_t *tok, size_t n)
+{
+    if (c->ops->cogging == NULL) {
+        cmd_err(c, CMD_E_UNSUPPORTED, NULL);
+        return;
+    }
+    const char *what = n == 2 && cmd_tok_is(tok[1], "on")       ? "on"
+                       : n == 2 && cmd_tok_is(tok[1], "off")    ? "off"
+                       : n == 2 && cmd_tok_is(tok[1], "status") ? "status"
+                                                                : NULL;
+    if (what == NULL) {
+        cmd_err(c, CMD_E_ARGS, "cogging on|off|status");
+        return;
+    }
+    const char *detail = NULL;
+    const int rc = c->ops->cogging(c->ctx, what, &detail);
+    if (rc != CMD_OK) {
+        cmd_err(c, rc, detail);
+        return;
+    }
+    cmd_ok_begin(c);
+    cmd_out_str(c, " cogging ");
+    cmd_out_str(c, detail != NULL ? detail : what);
+    cmd_out_flush(c);
+}
+#endif
 
 static void cmd_bringup(cmd_t *c, const cmd_tok_t *tok, size_t n)
 {
@@ -1113,6 +1151,10 @@ void cmd_execute(cmd_t *c, const char *line, size_t len)
         cmd_stop(c, n);
     } else if (cmd_tok_is(tok[0], "config")) {
         cmd_config(c, tok, n);
+#if CTRL_COGGING
+    } else if (cmd_tok_is(tok[0], "cogging")) {
+        cmd_cogging(c, tok, n);
+#endif
     } else {
         cmd_err(c, CMD_E_UNKNOWN, "try help");
     }

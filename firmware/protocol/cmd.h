@@ -174,6 +174,10 @@ typedef struct {
      * in ("in commission", "arm pending (ready)"), appended to "err 8 state".
      * Appended. */
     const char *(*state_detail)(void *ctx);
+    /* optional: the anti-cogging feed-forward (docs/anticogging.md); what:
+     * "on", "off" (state-changing) or "status". *detail: "on", "off" or
+     * "none" (no table) on CMD_OK, why not on a refusal. Appended. */
+    int (*cogging)(void *ctx, const char *what, const char **detail);
 } cmd_ops_t;
 
 typedef struct {

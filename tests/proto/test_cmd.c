@@ -99,7 +99,8 @@ static void assert_rejected(const char *line, int code)
 
 static void test_help_status_lists(void)
 {
-    assert_ok("help", "ok 14\r\n  help");
+    /* one more line with the anti-cogging commands in the image */
+    assert_ok("help", CTRL_COGGING ? "ok 15\r\n  help" : "ok 14\r\n  help");
     assert_ok("status", "ok 10\r\n  state=ready\r\n  armed=0\r\n  ctrl=bst\r\n");
     TEST_ASSERT_NOT_NULL(strstr(run("status"), "  speed_rpm=1500\r\n  torque_nm=1.8\r\n"));
     assert_ok("ctrl list", "ok 3\r\n  * bst mock controller\r\n  - fst");
@@ -179,6 +180,9 @@ static void test_unknown_and_argument_errors(void)
     assert_rejected("tel stop now", CMD_E_ARGS);
     assert_rejected("echo", CMD_E_ARGS);
     assert_rejected("help me", CMD_E_ARGS);
+#if CTRL_COGGING
+    assert_rejected("cogging on", CMD_E_UNSUPPORTED); /* the mock has no feed-forward */
+#endif
     assert_rejected("config save", CMD_E_UNSUPPORTED); /* the mock keeps no settings */
     assert_rejected("a b c d e f g h i j k l m n o p q r s t u v w x y", CMD_E_ARGS);
 }
