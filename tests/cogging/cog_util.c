@@ -1,0 +1,166 @@
+#include "cog_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "sim_ident.h"
+#include "unity.h"
+
+#define COG_PI 3.14159265358979323846
+
+double cog_truth(const plant_config_t *pc, double th)
+{
+    double t = 0.0;
+    for (int k = 0; k < pc->cog_n; k++) {
+        t += pc->cog_amp_nm[k] * sin((double)(k + 1) * pc->cog_per_rev * th + pc->cog_phase_rad[k]);
+    }
+    return t;
+}
+
+void cog_table_truth(const sim_machine_t *m, int16_t *table)
+{
+    plant_config_t pc;
+    sim_machine_to_plant(m, &pc);
+    for (uint32_t i = 0; i < CTRL_COG_N; i++) {
+        const double th = 2.0 * COG_PI * (double)i / (double)CTRL_COG_N;
+        const double q = -cog_truth(&pc, th) / m->torque_rated_nm * 32768.0;
+        table[i] = (int16_t)lround(q);
+    }
+}
+
+/* RSS of the harmonics' amplitudes from the sums of x cos, x sin over n samples. */
+static double cog_harmonics(const double *fc, const double *fs, int k_n, uint64_t n)
+{
+    double a2 = 0.0;
+    for (int k = 0; k < k_n; k++) {
+        const double a = 2.0 * hypot(fc[k], fs[k]) / (double)n;
+        a2 += a * a;
+    }
+    return sqrt(a2);
+}
+
+static void cog_start(sim_run_t *r, sim_run_cfg_t *c, const int16_t *table)
+{
+    char err[256];
+    c->defer_start = true;
+    if (sim_run_init(r, c, err, sizeof err) != 0) {
+        TEST_FAIL_MESSAGE(err);
+    }
+    if (table != NULL) {
+        TEST_ASSERT_EQUAL_INT(FW_OK, fw_cogging_load(&r->fw, table, CTRL_COG_N));
+        TEST_ASSERT_EQUAL_INT(FW_OK, fw_cogging_enable(&r->fw, true));
+    }
+}
+
+void cog_ripple(const sim_machine_t *m, const char *ctrl, const int16_t *table, double settle_s,
+                double window_s, cog_ripple_t *out)
+{
+    static sim_run_t r; /* large */
+    static sim_run_cfg_t c;
+    const ctrl_desc_t *d = ctrl_find(ctrl);
+    TEST_ASSERT_NOT_NULL(d);
+    plant_config_t pc;
+    sim_machine_to_plant(m, &pc);
+    const double n_cog = (double)pc.cog_per_rev;
+    /* whole cogging periods at 30 r/min in the window */
+    const double per = n_cog > 0.0 ? 1.0 / (0.5 * n_cog) : window_s;
+    const double win = ceil(window_s / per) * per;
+
+    /* speed ripple: free rotor, speed loop at 30 r/min */
+    sim_run_config_default(&c, m, d);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = true;
+    c.speed_mode = true;
+    c.speed_ref_rpm = 30.0;
+    c.duration_s = settle_s + win;
+    c.calib_samples = 64u;
+    c.theta0_e_rad = 0.0;
+    cog_start(&r, &c, table);
+    double s1 = 0.0, s2 = 0.0;
+    uint64_t n = 0;
+    double fc[PLANT_COG_MAX] = {0}, fs[PLANT_COG_MAX] = {0};
+    while (!sim_run_done(&r)) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+        if (r.armed && sim_run_time(&r) >= settle_s) {
+            const double w = plant_omega_m(&r.plant) * 60.0 / (2.0 * COG_PI);
+            const double th = plant_theta_m(&r.plant);
+            s1 += w;
+            s2 += w * w;
+            n++;
+            for (int k = 0; k < pc.cog_n; k++) {
+                fc[k] += w * cos((double)(k + 1) * n_cog * th);
+                fs[k] += w * sin((double)(k + 1) * n_cog * th);
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    out->speed_sd_rpm = sqrt(fmax(s2 / (double)n - (s1 / (double)n) * (s1 / (double)n), 0.0));
+    out->speed_cog_rpm = cog_harmonics(fc, fs, pc.cog_n, n);
+
+    /* torque ripple: dynamometer at 30 r/min, torque mode at 5 % rated */
+    sim_run_config_default(&c, m, d);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = false;
+    c.speed_rpm = 30.0;
+    c.torque_ref_nm = 0.05 * m->torque_rated_nm;
+    c.duration_s = settle_s + win;
+    c.calib_samples = 64u;
+    cog_start(&r, &c, table);
+    s1 = s2 = 0.0;
+    n = 0;
+    memset(fc, 0, sizeof fc);
+    memset(fs, 0, sizeof fs);
+    while (!sim_run_done(&r)) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+        if (r.armed && sim_run_time(&r) >= settle_s) {
+            const double th = plant_theta_m(&r.plant);
+            const double t = plant_torque(&r.plant) + cog_truth(&pc, th);
+            s1 += t;
+            s2 += t * t;
+            n++;
+            for (int k = 0; k < pc.cog_n; k++) {
+                fc[k] += t * cos((double)(k + 1) * n_cog * th);
+                fs[k] += t * sin((double)(k + 1) * n_cog * th);
+            }
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    out->torque_sd_nm = sqrt(fmax(s2 / (double)n - (s1 / (double)n) * (s1 / (double)n), 0.0));
+    out->torque_cog_nm = cog_harmonics(fc, fs, pc.cog_n, n);
+}
+
+int cog_calibrate(const sim_machine_t *m, double rpm, double bw_hz, int16_t *table,
+                  double *friction_nm, double *peak_nm, double *seconds)
+{
+    static sim_run_t r;
+    char err[256];
+    const ctrl_desc_t *d = ctrl_find("foc");
+    if (sim_ident_setup(&r, m, m, d, 0.3, 1u, err, sizeof err) != 0) {
+        TEST_FAIL_MESSAGE(err);
+    }
+    const cm_cog_config_t cc = {rpm, bw_hz, 1u};
+    fw_t *fw = &r.fw;
+    TEST_ASSERT_EQUAL_INT(0, cm_cogging_configure(&fw->cog, &cc, fw->machine, &fw->params,
+                                                  &fw->bases, fw->info.pwm_freq_hz, fw->enc_cpr));
+    const uint8_t steps[1] = {CM_STEP_COGGING};
+    sim_ident_t id;
+    if (sim_ident_run(&r, steps, 1u, 600.0, SIM_BAD_NONE, &id, err, sizeof err) != 0) {
+        TEST_FAIL_MESSAGE(err);
+    }
+    *seconds = id.motor_time_s;
+    if (!id.finished || id.err != CM_E_NONE) {
+        printf("cogging calibration: %s (%d %d %d)\n", cm_err_name(id.err), (int)fw->cm.detail[0],
+               (int)fw->cm.detail[1], (int)fw->cm.detail[2]);
+        return id.err != CM_E_NONE ? id.err : -1;
+    }
+    *peak_nm = fw->cm.detail[0] / 16777216.0 * fw->bases.torque_nm;
+    *friction_nm = fw->cm.detail[1] / 16777216.0 * fw->bases.torque_nm;
+    uint32_t n = 0;
+    const int16_t *t = fw_cogging_table(fw, &n);
+    TEST_ASSERT_NOT_NULL(t);
+    memcpy(table, t, sizeof(int16_t) * CTRL_COG_N);
+    return 0;
+}
