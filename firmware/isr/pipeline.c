@@ -271,6 +271,9 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             ctrl_psi_track_reset(&fw->psi_track); /* from the current model at the first period */
             fw_mid_restart(fw);
             fw_torque_follow_reset(&fw->tqf);
+#if CTRL_SL_START_CHECK
+            fw->sl_forced_n = fw->sl_obs_n = 0u;
+#endif
             fw->trim = 0;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
             hal_gate_enable(fw->hal, true);
@@ -527,6 +530,24 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
         f = fw_torque_follow_step(&fw->tqf, fw->torque_ref_now, est->now.torque,
                                   sl == NULL || sl->out.mode == CTRL_SL_OBSERVER);
     }
+#if CTRL_SL_START_CHECK
+    if (f == FW_FAULT_NONE && sl != NULL) {
+        /* A start that does not end: periods off the observer while the
+         * speed asked for is beyond the handover's (a rotor held by a load
+         * or friction the start's torque cannot move falls back to the
+         * forced angle again and again); forgotten once the observer has
+         * held as long. */
+        if (sl->out.mode != CTRL_SL_OBSERVER) {
+            fw->sl_obs_n = 0u;
+            fw->sl_forced_n += fx_abs(sl->speed_ref) >= sl->sl.w_on ? 1u : 0u;
+        } else if (++fw->sl_obs_n >= fw->sl_forced_max) {
+            fw->sl_forced_n = 0u;
+        }
+        if (fw->sl_forced_n > fw->sl_forced_max) {
+            f = FW_FAULT_SL_START;
+        }
+    }
+#endif
 
     if (hold != 0u) {
         /* the sensorless start's reference (above) */

@@ -376,6 +376,11 @@ typedef struct {
         unsigned char bytes[CTRL_STATE_MAX];
     } ctrl_next;
 #endif
+    /* Sensorless start supervision (pipeline.c, FW_FAULT_SL_START): periods
+     * off the observer with a speed asked for beyond the handover's, periods
+     * on it since, and the bound (3 x the ramp, settle and polarity pulses'
+     * periods + 0.25 s; pipeline_config.c). */
+    uint32_t sl_forced_n, sl_obs_n, sl_forced_max;
 #if CTRL_COGGING
     /* Anti-cogging (cogging_ff.h, cm_cogging.h): the table, which the step
      * "cogging" measures, and cog_on (main loop: fw_cogging_enable), which

@@ -264,6 +264,17 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         if (ctrl_sl_init(&sl->sl, &fw->params, &fw->bases, &sc, &fw->why) != CTRL_OK) {
             return FW_EINVAL;
         }
+#if CTRL_SL_START_CHECK
+        /* The start's own time: the ramp to the handover speed, the settling
+         * at it and a salient machine's polarity pulses; three times that
+         * and 0.25 s before the start counts as failed (FW_FAULT_SL_START). */
+        const ctrl_sl_t *s = &sl->sl;
+        const double ramp_n = s->ramp_dw > 0 ? (double)s->w_on / (double)s->ramp_dw : 0.0;
+        const double n =
+            3.0 * (ramp_n + (double)s->settle_n + 2.0 * (double)s->pol_n + (double)s->zero_n) +
+            0.25 * (double)in->pwm_freq_hz;
+        fw->sl_forced_max = n < 4.0e9 ? (uint32_t)n : 4000000000u;
+#endif
     }
     const int sel = fw_select_controller(fw, ctrl, ctrl_cfg);
     if (sel != FW_OK) {

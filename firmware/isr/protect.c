@@ -10,7 +10,7 @@ const char *fw_fault_name(uint32_t code)
     static const char *const names[FW_FAULT_COUNT] = {
         "none",          "overcurrent",  "hw_trip",      "dc_overvoltage", "dc_undervoltage",
         "encoder_stuck", "encoder_jump", "deadline",     "watchdog",       "adc_calibration",
-        "overspeed",     "commission",   "speed_follow", "torque_follow",
+        "overspeed",     "commission",   "speed_follow", "torque_follow",  "sl_start",
     };
     return code < (uint32_t)FW_FAULT_COUNT ? names[code] : "unknown";
 }

@@ -64,8 +64,9 @@ enum {
     FW_FAULT_COMMISSION = 11,   /* a commissioning step failed (cm_t.err names why) */
     FW_FAULT_SPEED_FOLLOW = 12, /* speed moves away from its reference at full torque */
     FW_FAULT_TORQUE_FOLLOW =
-        13, /* mean torque estimate off the applied reference (torque_follow.h) */
-    FW_FAULT_COUNT = 14
+        13,                 /* mean torque estimate off the applied reference (torque_follow.h) */
+    FW_FAULT_SL_START = 14, /* sensorless start: still on the forced angle after its time */
+    FW_FAULT_COUNT = 15
 };
 
 /* Overspeed level relative to the machine's maximum speed (criteria above). */

@@ -90,9 +90,44 @@ static void test_start_36_angles(void)
     TEST_ASSERT_EQUAL_INT_MESSAGE(START_N - ok, named, "a failed start named no fault");
 }
 
+/* A start that cannot succeed - a passive load of 2.8 N*m, above the rated
+ * torque, holds the rotor - ends in the named fault sl_start (the forced
+ * angle's time is over), not in a drive that stays on the forced angle. */
+static void test_start_blocked_named(void)
+{
+    static sim_machine_t m;
+    char err[256];
+    char path[512];
+    snprintf(path, sizeof path, "%s/nonideal/thesis_spmsm_stress.ini", PMSM_MACHINES_DIR);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+    const ctrl_desc_t *d = ctrl_find("foc");
+    static sim_run_cfg_t c;
+    static sim_run_t r;
+    sim_run_config_default(&c, &m, d);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = true;
+    c.speed_mode = true;
+    c.speed_ref_rpm = START_RPM;
+    c.load_passive_nm = 2.8;
+    c.duration_s = 1.5;
+    c.calib_samples = 64u;
+    c.sensorless = true;
+    c.stop_on_fault = true;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
+    TEST_ASSERT_EQUAL_INT(0, sim_run_all(&r, err, sizeof err));
+    printf("blocked start: fault %s at %.3f s, rotor at %.1f r/min\n",
+           fw_fault_name(fw_fault(&r.fw)), r.fault_time_s,
+           plant_omega_m(&r.plant) * 60.0 / (2.0 * 3.14159265358979323846));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_SL_START, fw_fault(&r.fw));
+    TEST_ASSERT_EQUAL_STRING("sl_start", fw_fault_name(fw_fault(&r.fw)));
+    sim_run_free(&r);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_start_36_angles);
+    RUN_TEST(test_start_blocked_named);
     return UNITY_END();
 }
