@@ -76,5 +76,14 @@ bool hal_trip_active(const hal_t *h);
 void hal_trip_clear(hal_t *h);
 /* Free-running cycle counter for deadline checks (DWT CYCCNT on a board). */
 uint32_t hal_cycles(const hal_t *h);
+/* Main loop: hold the control interrupt off (true) while the firmware
+ * rewrites what it reads, and let it run as before (false). Holds nest; the
+ * outermost release restores the interrupt's enable as it was at the
+ * outermost hold (so a hold before the interrupt was first enabled leaves it
+ * disabled). The PWM and the gates keep their state meanwhile; a period
+ * that falls inside the hold runs late, once, when it ends. A back-end
+ * whose control period is not an interrupt (the host simulation, the replay
+ * and PIL targets) does nothing. */
+void hal_ctrl_hold(hal_t *h, bool hold);
 
 #endif /* HAL_HAL_H */

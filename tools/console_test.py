@@ -241,6 +241,38 @@ class WebRulesTest(unittest.TestCase):
         self.assertEqual(cw.flash_progress("  12/24 pages written", 20), ("writing", 40))
 
 
+# A target that answers each line after 0.2 s (a flash erase: it reads
+# nothing meanwhile) and says whether the next line had already arrived.
+SLOW_TARGET = r"""
+import os, select, sys
+buf = b""
+while True:
+    while b"\n" not in buf:
+        d = os.read(0, 256)
+        if not d:
+            sys.exit(0)
+        buf += d
+    line, buf = buf.split(b"\n", 1)
+    select.select([], [], [], 0.2)
+    early = bool(buf) or bool(select.select([0], [], [], 0)[0])
+    os.write(1, b"err 99 overlapped\n" if early else b"ok 1\n  got=" + line + b"\n")
+"""
+
+
+class InteractiveTest(unittest.TestCase):
+    def test_one_line_at_a_time(self):
+        """Pasted lines go out one at a time, each after the reply before it."""
+        console = os.path.join(os.path.dirname(os.path.abspath(__file__)), "console")
+        r = subprocess.run([sys.executable, console, "--exec",
+                            "%s -c '%s'" % (sys.executable, SLOW_TARGET.replace("'", "'\\''")),
+                            "--wait-ready", "0", "--timeout", "3"],
+                           input="config save\nconfig show\nstatus\n", capture_output=True,
+                           text=True, timeout=30)
+        self.assertNotIn("overlapped", r.stdout)
+        self.assertEqual([ln.strip() for ln in r.stdout.splitlines() if "got=" in ln],
+                         ["got=config save", "got=config show", "got=status"])
+
+
 if __name__ == "__main__":
     if len(sys.argv) < 2:
         sys.exit("usage: console_test.py PATH/TO/proto_stream_gen")

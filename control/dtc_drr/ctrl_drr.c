@@ -11,7 +11,8 @@
 #include "vectors.h"
 
 /* Inputs of the duty formulas are clamped to [-4, 4) pu (rated torque is
- * ~0.3 pu, flux ~1 pu, rated speed ~0.5 pu for the shipped machines): with
+ * ~0.3 pu and flux ~1 pu for the shipped machines; rated speed is 1 pu, the
+ * speed base of ctrl_params.h): with
  * that bound every int64 intermediate below stays under 2^62. One SSAT. */
 #define DRR_LIM (4 * FX_ONE)
 _Static_assert(DRR_LIM == (q24_t)1 << 26, "FX_SAT(x, 27) is the +-DRR_LIM clamp");

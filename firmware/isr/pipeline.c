@@ -13,6 +13,12 @@
 #define FW_NOINLINE
 #endif
 
+/* The main loop's side of the shared state (pipeline.h, fw_from_main_t): the
+ * stores before this one are not moved after it by the compiler (the
+ * Cortex-M core itself keeps its stores in order for an interrupt of the
+ * same core). */
+#define FW_RELEASE() atomic_signal_fence(memory_order_release)
+
 static void fw_fault_now(fw_t *fw, uint32_t code)
 {
     /* Gates off before anything else, then latch the code. */
@@ -73,14 +79,17 @@ static void fw_calibrate(fw_t *fw, const hal_adc_raw_t *raw)
     }
     /* Average in Q8 counts, rounded (sum < 2^16 * 2^16, times 2^8 fits 64 bits). */
     const uint64_t n = fw->calib_n;
-    /* Plausible offset: within adc_zero_tol of adc_zero (pipeline_config.c). */
+    /* Plausible offset: within adc_zero_tol of adc_zero (pipeline_config.c),
+     * for every channel the HAL has (the third one's offset is used by the
+     * commissioning steps' i_c: a broken sense path there faults too). */
     const int32_t tol = (int32_t)fw->adc_zero_tol * 256;
+    const int n_ch = fw->info.has_i_c ? 3 : 2;
     bool ok = true;
     for (int x = 0; x < 3; x++) {
         const uint64_t avg = ((uint64_t)fw->calib_sum[x] * 256u + n / 2u) / n;
         fw->off_q8[x] = (int32_t)avg;
         const int32_t dev = fw->off_q8[x] - (int32_t)fw->adc_zero * 256;
-        if (x < 2 && (dev > tol || dev < -tol)) {
+        if (x < n_ch && (dev > tol || dev < -tol)) {
             ok = false;
         }
     }
@@ -205,45 +214,58 @@ static void fw_mid_restart(fw_t *fw)
     fw->mid_n = 0u;
 }
 
+/* The request k made since the last period: taken (its count copied). */
+static bool fw_take(fw_t *fw, fw_req_t k)
+{
+    const uint32_t n = fw->ml.req[k];
+    if (n == fw->isr.taken[k]) {
+        return false;
+    }
+    fw->isr.taken[k] = n;
+    return true;
+}
+
 #if PMSM_LIVE_PARAMS
 /* A live change the main loop published (pipeline.h): the speed PI's new
  * gains with the latest speed error (the next run's will be close to it), the
- * controller's retune from the state made for its new configuration. Out of
+ * controller's retune from the state made for its new configuration; taken
+ * and dropped when the main loop withdrew it (fw_request_withdraw). Out of
  * line: once per change. */
 static FW_NOINLINE void fw_apply_tune(fw_t *fw)
 {
-#if defined(__GNUC__)
-    __asm__ volatile("" ::: "memory"); /* the change is read after its request */
-#endif
-    if (fw->req_speed_tune != 0u) {
-        const q24_t e = fx_sat32((int64_t)fw->speed_ref - fw->estimate.omega_e);
+    if (fw_take(fw, FW_REQ_SPEED_TUNE) &&
+        fw->ml.withdrawn[0] != fw->isr.taken[FW_REQ_SPEED_TUNE]) {
+        const q24_t e = fx_sat32((int64_t)fw->ml.speed_ref - fw->estimate.omega_e);
         ctrl_speed_pi_retune(&fw->speed_pi, &fw->speed_pi_next, e);
-        fw->req_speed_tune = 0u;
     }
-    if (fw->req_ctrl_tune != 0u) {
+    if (fw_take(fw, FW_REQ_CTRL_TUNE) && fw->ml.withdrawn[1] != fw->isr.taken[FW_REQ_CTRL_TUNE]) {
         fw->ctrl->retune(fw->ctrl_state.bytes, fw->ctrl_next.bytes);
-        fw->req_ctrl_tune = 0u;
     }
 }
 #endif
 
-static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
+/* The main loop's requests, in this order (pipeline.h, fw_req_t). Out of
+ * line: a period with a request is rare. */
+static FW_NOINLINE void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm, uint32_t sum)
 {
+    fw->isr.taken_sum = sum;
 #if PMSM_LIVE_PARAMS
-    if ((fw->req_speed_tune | fw->req_ctrl_tune) != 0u) {
-        fw_apply_tune(fw);
-    }
+    fw_apply_tune(fw);
 #endif
-    if (fw->req_clear != 0u) {
-        fw->req_clear = 0u;
+    if (fw_take(fw, FW_REQ_TM)) {
+        /* a new stream: the records of the last one are not for it */
+        fw->tm_every = fw->ml.tm_every;
+        fw->tm_count = 1u;
+        fw->isr.tm_drop = fw->isr.tm_head;
+    }
+    if (fw_take(fw, FW_REQ_CLEAR)) {
         if (fw_state_event(&fw->sm, FW_EV_CLEAR, 0u)) {
             hal_trip_clear(fw->hal);
             fw_protect_reset(&fw->prot);
             fw->enc_primed = false;
         }
     }
-    if (fw->req_disarm != 0u) {
-        fw->req_disarm = 0u;
+    if (fw_take(fw, FW_REQ_DISARM)) {
         fw->psi_due = 0u;
         const bool cm = fw->sm.state == FW_STATE_COMMISSION;
         if (fw_state_event(&fw->sm, FW_EV_DISARM, 0u) && cm) {
@@ -253,8 +275,7 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             fw_pwm_off(fw, tm);
         }
     }
-    if (fw->req_cm != 0u) {
-        fw->req_cm = 0u;
+    if (fw_take(fw, FW_REQ_CM)) {
         if (fw_state_event(&fw->sm, FW_EV_CM_START, 0u)) {
             /* The steps enable the gates when they first drive the legs. */
             fw->cm_gates = 0u;
@@ -262,8 +283,7 @@ static void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm)
             cm_begin(&fw->cm);
         }
     }
-    if (fw->req_arm != 0u) {
-        fw->req_arm = 0u;
+    if (fw_take(fw, FW_REQ_ARM)) {
         if (fw_state_event(&fw->sm, FW_EV_ARM, 0u)) {
             /* Fresh dynamic state; the first gated period is k+1. */
             fw->ctrl->reset(fw->ctrl_state.bytes);
@@ -389,11 +409,11 @@ static FW_NOINLINE void fw_psi_apply(fw_t *fw)
  * the estimate of this period - the speed wanted (in torque mode one of the
  * torque's sign, so that the forced start turns the right way) and the
  * torque estimate of the last period. */
-static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl)
+static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl, uint8_t mode, q24_t tref)
 {
-    q24_t w = fw->speed_ref;
-    if (fw->ref_mode != FW_REF_SPEED) {
-        w = fw->torque_ref_lim > 0 ? FX_ONE : (fw->torque_ref_lim < 0 ? -FX_ONE : 0);
+    q24_t w = fw->ml.speed_ref;
+    if (mode != FW_REF_SPEED) {
+        w = tref > 0 ? FX_ONE : (tref < 0 ? -FX_ONE : 0);
     }
     sl->speed_ref = w;
     sl->torque_est = fw->estimate.now.torque;
@@ -408,6 +428,7 @@ static inline bool fw_mid_track_request(fw_t *fw)
     in->track = 1u;
     in->run = 0u;
     in->first = 0u;
+    FW_RELEASE(); /* the slot before its count */
     fw->mid_req = req;
     return true;
 }
@@ -415,7 +436,8 @@ static inline bool fw_mid_track_request(fw_t *fw)
 /* The DC link summed for the medium task; once in mid_div periods (or at
  * once, mid_count = 1) its inputs into the free slot, with the tracker's
  * correction when due: true, a run is due. */
-static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req, uint8_t hold)
+static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_req, uint8_t hold,
+                                  uint8_t mode)
 {
     fw->mid_vdc_sum += est->vdc;
     fw->mid_n++;
@@ -433,9 +455,9 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
     in->omega_e = est->omega_e;
     in->tref = t_req;
     in->torque_now = fw->torque_ref_now;
-    in->speed_ref = fw->speed_ref;
+    in->speed_ref = fw->ml.speed_ref;
     in->bump_torque = fw->mid_bump_t;
-    in->ref_mode = (uint8_t)fw->ref_mode;
+    in->ref_mode = mode;
     in->hold = hold;
     in->reset = fw->mid_reset;
     in->bump = fw->mid_bump;
@@ -444,6 +466,7 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
     fw->mid_reset = 0u;
     fw->mid_bump = 0u;
     fw->mid_fresh = 1u;
+    FW_RELEASE(); /* the slot before its count */
     fw->mid_req = req;
     return true;
 }
@@ -451,7 +474,7 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
 /* The estimate, the torque reference within the medium task's limits, the
  * controller's step, the compare values; true when the medium task is due. */
 static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t *sl, q24_t tref,
-                                  uint8_t hold, const fw_mid_out_t *mo, q24_t *t_req);
+                                  uint8_t hold, uint8_t mode, const fw_mid_out_t *mo, q24_t *t_req);
 
 /* The sensorless angle source's state (fw_config_t.sensorless), else NULL. */
 static inline ctrl_angle_sl_t *fw_sl(fw_t *fw)
@@ -459,12 +482,15 @@ static inline ctrl_angle_sl_t *fw_sl(fw_t *fw)
     return fw->cfg.sensorless ? (ctrl_angle_sl_t *)ctrl_estimator_angle_state(&fw->est) : NULL;
 }
 
-static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m)
+/* mode, tref0: the reference of this period (the main loop's, taken once;
+ * a commissioning step's torque). */
+static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m, uint8_t mode,
+                              q24_t tref0)
 {
     ctrl_estimate_t *const est = &fw->estimate;
     ctrl_angle_sl_t *const sl = fw_sl(fw);
     if (sl != NULL) {
-        fw_sl_inputs(fw, sl);
+        fw_sl_inputs(fw, sl, mode, tref0);
     } else if (fw->psi_due != 0u) {
         fw_psi_apply(fw);
     }
@@ -486,7 +512,7 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
      * the forced q axis, the speed loop waiting, sensorless.h), or torque
      * mode's (torque_ref clamped by fw_set_torque_ref). */
     const uint8_t hold = sl != NULL && sl->out.mode != CTRL_SL_OBSERVER ? 1u : 0u;
-    const q24_t tref = hold != 0u ? sl->out.torque_ref : fw->torque_ref_lim;
+    const q24_t tref = hold != 0u ? sl->out.torque_ref : tref0;
     q24_t t_req = tref;
     if (fw->mid_fresh == 0u) {
         /* The first period after a reset (arming, a commissioning step's
@@ -502,10 +528,11 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
          * first period at zero torque and the limits of standstill). */
         fw->mid_count = 1u;
         fw->mid_first = tm;
-    } else if (!fw_control_out(fw, tm, sl, tref, hold, &fw->mid_out[fw->mid_done & 1u], &t_req)) {
+    } else if (!fw_control_out(fw, tm, sl, tref, hold, mode, &fw->mid_out[fw->mid_done & 1u],
+                               &t_req)) {
         return false; /* a fault: gates off */
     }
-    return fw_mid_trigger(fw, est, t_req, hold);
+    return fw_mid_trigger(fw, est, t_req, hold, mode);
 }
 
 /* The rest of the period after the estimate (fw_control; in the first period
@@ -514,7 +541,7 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
  * controller's step, the compare values. False after a fault (gates off);
  * *t_req: the torque reference before the limits, for the medium task. */
 static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t *sl, q24_t tref,
-                                  uint8_t hold, const fw_mid_out_t *mo, q24_t *t_req)
+                                  uint8_t hold, uint8_t mode, const fw_mid_out_t *mo, q24_t *t_req)
 {
     hal_t *const hal = fw->hal;
     const ctrl_meas_t *const m = &tm->meas;
@@ -551,7 +578,7 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
 
     if (hold != 0u) {
         /* the sensorless start's reference (above) */
-    } else if (fw->ref_mode == FW_REF_SPEED) {
+    } else if (mode == FW_REF_SPEED) {
         if (sl != NULL && sl->out.handover != 0u) {
             /* bumpless: the speed loop restarts from the torque it takes over,
              * in a run of the medium task now */
@@ -636,7 +663,7 @@ void fw_mid_first_step(fw_t *fw, const fw_mid_in_t *in, const fw_mid_out_t *mo)
 {
     fw_telemetry_t *const tm = fw->mid_first;
     q24_t t_req;
-    (void)fw_control_out(fw, tm, fw_sl(fw), in->tref, in->hold, mo, &t_req);
+    (void)fw_control_out(fw, tm, fw_sl(fw), in->tref, in->hold, in->ref_mode, mo, &t_req);
     /* the record's tail as the interrupt wrote it, after a fault here */
     tm->state = (uint8_t)fw->sm.state;
     tm->fault = (uint8_t)fw->sm.fault_code;
@@ -663,7 +690,7 @@ static inline bool fw_period_running(fw_t *fw, hal_t *hal, fw_telemetry_t *tm,
         }
     }
     if (f == FW_FAULT_NONE) {
-        return fw_control(fw, tm, m);
+        return fw_control(fw, tm, m, fw->ml.ref_mode, fw->ml.torque_ref_lim);
     }
     fw_tm_no_estimate(tm);
     fw_pwm_off(fw, tm);
@@ -738,9 +765,10 @@ static bool fw_period_commission(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, const
             fw->trim = 0;
             fw->applied.duty[0] = fw->applied.duty[1] = fw->applied.duty[2] = 0;
         }
-        fw->torque_ref_lim = fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max);
-        fw->ref_mode = FW_REF_TORQUE;
-        return fw_control(fw, tm, m);
+        /* the step's torque, not the main loop's reference (which only the
+         * main loop writes) */
+        return fw_control(fw, tm, m, FW_REF_TORQUE,
+                          fx_clamp(out.torque_ref, fw->torque_ref_min, fw->torque_ref_max));
     }
     /* What the step does, in the running drive's signals (telemetry, status) */
     cm_monitor(&fw->cm, m->theta_e, &tm->i_d, &tm->i_q, &tm->omega_e, &tm->torque);
@@ -804,9 +832,9 @@ bool fw_isr_fast(fw_t *fw)
     hal_adc_read(hal, &raw);
     hal_encoder_read(hal, &enc);
 
-    if (fw->req_any != 0u) {
-        fw->req_any = 0u;
-        fw_apply_commands(fw, tm);
+    const uint32_t req_sum = fw->ml.req_sum;
+    if (req_sum != fw->isr.taken_sum) {
+        fw_apply_commands(fw, tm, req_sum);
     }
     /* Running: one predictable branch to the straight path; boot,
      * calibration, ready and fault take the general one. */
@@ -819,7 +847,7 @@ bool fw_isr_fast(fw_t *fw)
         fw_period_idle(fw, tm, &raw, &enc);
     }
 
-    const uint32_t wf = fw_protect_watchdog_tick(&fw->prot);
+    const uint32_t wf = fw_protect_watchdog_tick(&fw->prot, fw->period - fw->ml.wdg_stamp);
     if (wf != FW_FAULT_NONE && fw->sm.state != FW_STATE_FAULT) {
         fw_fault_now(fw, wf);
     }
@@ -847,11 +875,13 @@ bool fw_isr_fast(fw_t *fw)
     const uint32_t every = fw->tm_every;
     if (every != 0u && --fw->tm_count == 0u) {
         fw->tm_count = every;
-        if (fw->tm_head - fw->tm_tail < FW_TM_RING - 1u) {
-            fw->tm_head++;
-            fw->tm_slot = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
+        const uint32_t head = fw->isr.tm_head;
+        if (head - fw->ml.tm_tail < FW_TM_RING - 1u) {
+            fw->tm_slot = &fw->tm_ring[(head + 1u) & (FW_TM_RING - 1u)];
+            FW_RELEASE(); /* the record before its publication */
+            fw->isr.tm_head = head + 1u;
         } else {
-            fw->tm_dropped++;
+            fw->isr.tm_dropped++;
         }
     }
     fw->busy = false;
@@ -865,43 +895,74 @@ void fw_isr(fw_t *fw)
     }
 }
 
+void fw_request(fw_t *fw, fw_req_t k)
+{
+    FW_RELEASE();
+    fw->ml.req[k] = fw->ml.req[k] + 1u;
+    FW_RELEASE();
+    fw->ml.req_sum = fw->ml.req_sum + 1u;
+}
+
 void fw_cmd_arm(fw_t *fw)
 {
     if (fw != NULL) {
-        fw->req_arm = 1u;
-        fw->req_any = 1u;
+        fw_request(fw, FW_REQ_ARM);
     }
 }
 
 void fw_cmd_disarm(fw_t *fw)
 {
     if (fw != NULL) {
-        fw->req_disarm = 1u;
-        fw->req_any = 1u;
+        fw_request(fw, FW_REQ_DISARM);
     }
 }
 
 void fw_cmd_clear(fw_t *fw)
 {
     if (fw != NULL) {
-        fw->req_clear = 1u;
-        fw->req_any = 1u;
+        fw_request(fw, FW_REQ_CLEAR);
     }
 }
+
+static inline bool fw_pending(const fw_t *fw, fw_req_t k)
+{
+    return fw->ml.req[k] != fw->isr.taken[k];
+}
+
+bool fw_cmd_pending(const fw_t *fw, fw_req_t k)
+{
+    return fw != NULL && (unsigned)k < FW_REQ_N && fw_pending(fw, k);
+}
+
+#if PMSM_LIVE_PARAMS
+void fw_request_withdraw(fw_t *fw, fw_req_t k)
+{
+    const unsigned i = k == FW_REQ_CTRL_TUNE ? 1u : 0u;
+    fw->ml.withdrawn[i] = fw->ml.req[k];
+    FW_RELEASE(); /* withdrawn before its data is rewritten */
+}
+
+bool fw_tune_pending(const fw_t *fw, fw_req_t k)
+{
+    const unsigned i = k == FW_REQ_CTRL_TUNE ? 1u : 0u;
+    return fw_pending(fw, k) && fw->ml.withdrawn[i] != fw->ml.req[k];
+}
+#endif
 
 void fw_watchdog_kick(fw_t *fw)
 {
     if (fw != NULL) {
-        fw_protect_watchdog_kick(&fw->prot);
+        fw->ml.wdg_stamp = fw_period_count(fw);
     }
 }
 
 void fw_set_torque_ref(fw_t *fw, q24_t torque_pu)
 {
     if (fw != NULL) {
-        fw->torque_ref = torque_pu;
-        fw->torque_ref_lim = fx_clamp(torque_pu, fw->torque_ref_min, fw->torque_ref_max);
-        fw->ref_mode = FW_REF_TORQUE;
+        fw->ml.torque_ref = torque_pu;
+        fw->ml.torque_ref_lim = fx_clamp(torque_pu, fw->torque_ref_min, fw->torque_ref_max);
+        FW_RELEASE(); /* the reference before the mode */
+        fw->ml.ref_mode = FW_REF_TORQUE;
     }
 }
 
@@ -910,21 +971,52 @@ void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu)
     if (fw != NULL) {
         /* Bumpless: until the medium task's next run the speed loop's output
          * is the present torque reference, from which that run starts it. */
-        fw->speed_ref = omega_e_pu;
-        fw->ref_mode = FW_REF_SPEED;
+        fw->ml.speed_ref = omega_e_pu;
+        FW_RELEASE(); /* the reference before the mode */
+        fw->ml.ref_mode = FW_REF_SPEED;
     }
+}
+
+fw_ref_mode_t fw_ref_mode(const fw_t *fw)
+{
+    return fw != NULL && fw->ml.ref_mode == FW_REF_SPEED ? FW_REF_SPEED : FW_REF_TORQUE;
+}
+
+q24_t fw_torque_ref(const fw_t *fw)
+{
+    return fw != NULL ? fw->ml.torque_ref : 0;
+}
+
+q24_t fw_speed_ref(const fw_t *fw)
+{
+    return fw != NULL ? fw->ml.speed_ref : 0;
+}
+
+q24_t fw_speed_loop_torque(const fw_t *fw)
+{
+    const volatile fw_mid_out_t *mo = &fw->mid_out[fw->mid_done & 1u];
+    return mo->speed_tref;
+}
+
+uint32_t fw_period_count(const fw_t *fw)
+{
+    return *(const volatile uint32_t *)&fw->period;
 }
 
 fw_state_id_t fw_state(const fw_t *fw)
 {
-    return fw != NULL ? fw->sm.state : FW_STATE_FAULT;
+    return fw != NULL ? *(const volatile fw_state_id_t *)&fw->sm.state : FW_STATE_FAULT;
 }
 
 const char *fw_gates_request_pending(const fw_t *fw, fw_state_id_t *state)
 {
-    const char *req = fw->req_arm != 0u ? "arm" : fw->req_cm != 0u ? "commissioning start" : NULL;
-    atomic_signal_fence(memory_order_seq_cst); /* no load of the state before those */
-    *state = fw->sm.state;
+    const char *req = fw_pending(fw, FW_REQ_ARM)  ? "arm"
+                      : fw_pending(fw, FW_REQ_CM) ? "commissioning start"
+                                                  : NULL;
+    /* the state after the requests (acquire): an interrupt that takes one in
+     * between has set the state by then */
+    atomic_signal_fence(memory_order_acquire);
+    *state = *(const volatile fw_state_id_t *)&fw->sm.state;
     return req;
 }
 
@@ -937,7 +1029,7 @@ bool fw_gates_on_or_pending(const fw_t *fw)
 
 uint32_t fw_fault(const fw_t *fw)
 {
-    return fw != NULL ? fw->sm.fault_code : FW_FAULT_NONE;
+    return fw != NULL ? *(const volatile uint32_t *)&fw->sm.fault_code : FW_FAULT_NONE;
 }
 
 const fw_telemetry_t *fw_telemetry(const fw_t *fw)
@@ -950,25 +1042,40 @@ void fw_tm_stream(fw_t *fw, uint32_t every)
     if (fw == NULL) {
         return;
     }
-    fw->tm_every = 0u; /* the interrupt publishes nothing while this runs */
-    fw->tm_tail = fw->tm_head;
-    fw->tm_count = 1u;
-    fw->tm_every = every;
+    fw->ml.tm_every = every;
+    fw_request(fw, FW_REQ_TM);
 }
 
-const fw_telemetry_t *fw_tm_peek(const fw_t *fw)
+/* The oldest record of the present stream not yet taken (main loop): none
+ * while a stream request waits; records of an earlier stream skipped. */
+const fw_telemetry_t *fw_tm_peek(fw_t *fw)
 {
-    if (fw == NULL || fw->tm_tail == fw->tm_head) {
+    if (fw == NULL || fw_pending(fw, FW_REQ_TM)) {
         return NULL;
     }
-    return &fw->tm_ring[fw->tm_tail & (FW_TM_RING - 1u)];
+    const uint32_t drop = fw->isr.tm_drop;
+    uint32_t tail = fw->ml.tm_tail;
+    if (drop - tail - 1u < 0x7FFFFFFFu) { /* drop ahead of tail (modulo 2^32) */
+        tail = drop;
+        fw->ml.tm_tail = tail;
+    }
+    if (tail == fw->isr.tm_head) {
+        return NULL;
+    }
+    atomic_signal_fence(memory_order_acquire); /* the record after its publication */
+    return &fw->tm_ring[tail & (FW_TM_RING - 1u)];
 }
 
 void fw_tm_release(fw_t *fw)
 {
-    if (fw != NULL && fw->tm_tail != fw->tm_head) {
-        fw->tm_tail++;
+    if (fw != NULL && fw->ml.tm_tail != fw->isr.tm_head) {
+        fw->ml.tm_tail = fw->ml.tm_tail + 1u;
     }
+}
+
+uint32_t fw_tm_dropped(const fw_t *fw)
+{
+    return fw != NULL ? fw->isr.tm_dropped : 0u;
 }
 
 void *fw_ctrl_state(fw_t *fw)

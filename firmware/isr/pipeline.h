@@ -133,6 +133,59 @@ typedef struct {
 
 typedef enum { FW_REF_TORQUE = 0, FW_REF_SPEED = 1 } fw_ref_mode_t;
 
+/* The main loop's requests, taken by the interrupt at its next period start
+ * (fw_cmd_*, fw_commission_start, fw_tm_stream). */
+typedef enum {
+    FW_REQ_ARM = 0,
+    FW_REQ_DISARM = 1, /* also "stop" of a commissioning step */
+    FW_REQ_CLEAR = 2,  /* fault clear */
+    FW_REQ_CM = 3,     /* commissioning start (fw_t.cm set up before) */
+    FW_REQ_TM = 4,     /* telemetry: publish one record in fw_from_main_t.tm_every periods */
+#if PMSM_LIVE_PARAMS
+    FW_REQ_SPEED_TUNE = 5, /* live change: the speed PI's gains in fw_t.speed_pi_next */
+    FW_REQ_CTRL_TUNE = 6,  /* live change: the controller's retune from fw_t.ctrl_next */
+#endif
+    FW_REQ_N
+} fw_req_t;
+
+/* State shared between the main loop and the interrupt, one writer per block
+ * (docs/architecture.md, "State shared between the contexts"; the test
+ * tests/loop/test_shared_state.c checks it around every period).
+ *
+ * fw_from_main_t: written by the main loop only, read by the interrupt. The
+ * main loop stores with volatile stores and orders them with release signal
+ * fences: a reference before its mode, a request's data before its count,
+ * every count before req_sum. The interrupt, which the main loop cannot
+ * interrupt, reads a consistent set in any order; the medium task reads none
+ * of it (the interrupt hands it what it needs in its slot, fw_mid_in_t). */
+typedef struct {
+    volatile uint32_t req[FW_REQ_N]; /* requests made, per kind (counted up) */
+    volatile uint32_t req_sum;       /* their sum, counted up after them */
+    volatile q24_t torque_ref;       /* torque mode: as requested, Q24 pu */
+    volatile q24_t torque_ref_lim;   /* torque_ref clamped to +-torque_ref_max, Q24 pu */
+    volatile q24_t speed_ref;        /* speed mode: Q24 pu electrical */
+    volatile uint8_t ref_mode;       /* fw_ref_mode_t, stored after its reference */
+    volatile uint32_t wdg_stamp;     /* fw_t.period at the last fw_watchdog_kick */
+    volatile uint32_t tm_every;      /* decimation the next FW_REQ_TM sets (0: stop) */
+    volatile uint32_t tm_tail;       /* telemetry records taken (fw_tm_release) */
+#if PMSM_LIVE_PARAMS
+    /* The count of the speed (0) and controller (1) live change that a new
+     * configuration superseded before the interrupt took it: the interrupt
+     * takes it and applies nothing (fw_request_withdraw). */
+    volatile uint32_t withdrawn[2];
+#endif
+} fw_from_main_t;
+
+/* fw_to_main_t: written by the interrupt only, read by the main loop
+ * (volatile loads). A request is taken once taken[k] == req[k]. */
+typedef struct {
+    volatile uint32_t taken[FW_REQ_N]; /* requests taken, per kind */
+    volatile uint32_t taken_sum;       /* their sum */
+    volatile uint32_t tm_head;         /* telemetry records published */
+    volatile uint32_t tm_drop;         /* records before it belong to an earlier stream */
+    volatile uint32_t tm_dropped;      /* records not published: the ring was full */
+} fw_to_main_t;
+
 /* Corner of the mean-torque trim in field weakening (pipeline.c): the DRR
  * EMA's, thesis sec. 5.3.2, as FST's f_i. */
 #define FW_TRIM_HZ 50.0
@@ -282,10 +335,8 @@ typedef struct {
     q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */
     q24_t trim;           /* mean-torque trim in field weakening, Q24 pu (pipeline.c) */
     q24_t trim_k;         /* its gain per period, 1 - exp(-2 pi FW_TRIM_HZ / fs), Q24 */
-    fw_ref_mode_t ref_mode;
-    q24_t torque_ref;     /* Q24 pu (torque mode) */
-    q24_t torque_ref_lim; /* torque_ref clamped to +-torque_ref_max (fw_set_torque_ref) */
-    q24_t speed_ref;      /* Q24 pu electrical (speed mode) */
+    fw_from_main_t ml;    /* the main loop's requests and references (written there only) */
+    fw_to_main_t isr;     /* what the interrupt tells the main loop (written there only) */
     q24_t torque_ref_max; /* Q24 pu, clamp of the torque reference */
     q24_t torque_ref_min; /* Q24 pu, fx_neg(torque_ref_max) (set with it) */
     /* The medium-rate task (medium.c) and the hand-over (fw_mid_in_t). */
@@ -339,36 +390,28 @@ typedef struct {
     cm_t cm;
     const char *cm_what; /* quantity the commissioning limits could not represent */
     uint8_t cm_gates;    /* gates enabled by a commissioning step */
-    /* commands from the main loop, applied at the next period start; req_any
-       is set after the flag (and cleared by the interrupt before it reads
-       them), so that one test per period covers all four */
-    volatile uint8_t req_arm, req_disarm, req_clear, req_cm, req_any;
-    bool busy; /* re-entry flag */
-    uint32_t period;
+    bool busy;           /* re-entry flag */
+    uint32_t period;     /* periods so far (interrupt; the main loop reads it for the watchdog) */
     /* Telemetry ring: the interrupt writes each period's record into slot
-     * tm_head and publishes it (tm_head + 1) once in
-     * tm_every periods; the main loop takes records from tm_tail
-     * (fw_tm_peek / fw_tm_release). Single producer, single consumer: the
-     * interrupt never writes a slot in [tm_tail, tm_head). */
+     * isr.tm_head and publishes it (tm_head + 1) once in tm_every periods;
+     * the main loop takes records from ml.tm_tail (fw_tm_peek /
+     * fw_tm_release). Single producer, single consumer: the interrupt never
+     * writes a slot in [tm_tail, tm_head). */
     fw_telemetry_t tm_ring[FW_TM_RING];
     fw_telemetry_t *tm_slot;       /* &tm_ring[tm_head mod FW_TM_RING], kept with tm_head */
     const fw_telemetry_t *tm_last; /* the last complete record */
-    volatile uint32_t tm_head;     /* records published (interrupt) */
-    volatile uint32_t tm_tail;     /* records taken (main loop) */
-    volatile uint32_t tm_every;    /* publish one record in tm_every periods; 0: none */
-    uint32_t tm_count;             /* periods until the next publication */
-    uint32_t tm_dropped;           /* records not published: ring full */
+    uint32_t tm_every;             /* interrupt: publish one record in tm_every periods; 0: none */
+    uint32_t tm_count;             /* interrupt: periods until the next publication */
     ctrl_diag_t why;               /* why the core refused the last configuration (fw_explain) */
     /* PM-flux tracking (fw_config_t.psi_adapt, estimation/psi_track.h); last,
      * so that its size moves no other field's offset (code size). */
     ctrl_psi_track_t psi_track;
     /* Live changes (fw_speed_retune, fw_tunable_set while running), after it
      * for the same reason: the main loop fills the speed PI's new gains or
-     * the controller's state for its new configuration, then sets the
-     * request; the interrupt takes the change at its next period's start
-     * (fw_apply_commands) and clears the request. The main loop writes
-     * neither while its request is set. */
-    volatile uint8_t req_speed_tune, req_ctrl_tune;
+     * the controller's state for its new configuration, then requests it
+     * (FW_REQ_SPEED_TUNE, FW_REQ_CTRL_TUNE); the interrupt takes the change at
+     * its next period's start (fw_apply_commands). The main loop writes
+     * neither while its request is pending (fw_tune_pending). */
 #if PMSM_LIVE_PARAMS
     ctrl_speed_pi_t speed_pi_next;
     union {
@@ -423,9 +466,32 @@ void fw_isr(fw_t *fw);
 void fw_cmd_arm(fw_t *fw);
 void fw_cmd_disarm(fw_t *fw);
 void fw_cmd_clear(fw_t *fw);
+/* Main loop: request k, its data stored before it (a release fence), the
+ * sum counted last (fw_from_main_t). */
+void fw_request(fw_t *fw, fw_req_t k);
+/* A request made and not yet taken by the interrupt. */
+bool fw_cmd_pending(const fw_t *fw, fw_req_t k);
+#if PMSM_LIVE_PARAMS
+/* Main loop: the live change k (FW_REQ_SPEED_TUNE or FW_REQ_CTRL_TUNE) not
+ * taken yet is superseded: the interrupt will take it and apply nothing. Its
+ * data may be rewritten after this returns. */
+void fw_request_withdraw(fw_t *fw, fw_req_t k);
+/* A live change of kind k requested, not withdrawn and not taken yet. */
+bool fw_tune_pending(const fw_t *fw, fw_req_t k);
+#endif
 void fw_watchdog_kick(fw_t *fw);
 void fw_set_torque_ref(fw_t *fw, q24_t torque_pu); /* selects torque mode */
 void fw_set_speed_ref(fw_t *fw, q24_t omega_e_pu); /* selects speed mode */
+/* The references as the main loop set them (fw_from_main_t). */
+fw_ref_mode_t fw_ref_mode(const fw_t *fw);
+q24_t fw_torque_ref(const fw_t *fw);
+q24_t fw_speed_ref(const fw_t *fw);
+/* Main loop: the speed loop's torque reference of the medium task's last run
+ * (the slot it reads is rewritten only two runs later; one aligned word). */
+q24_t fw_speed_loop_torque(const fw_t *fw);
+/* Main loop: the interrupt's period count (for the watchdog, the telemetry's
+ * time). */
+uint32_t fw_period_count(const fw_t *fw);
 /* SI helpers (pipeline_config.c; not for the ISR). */
 void fw_set_torque_ref_nm(fw_t *fw, double nm);
 void fw_set_speed_ref_rpm(fw_t *fw, double rpm); /* clamped to +-speed_info.speed_ref_max_rpm */
@@ -443,11 +509,14 @@ uint32_t fw_fault(const fw_t *fw);
 /* The record of the last period (zeroes before the first; NULL for NULL). */
 const fw_telemetry_t *fw_telemetry(const fw_t *fw);
 /* Main loop: publish one record in every `every` periods into the ring, the
- * first at the next period (0: stop); records not yet taken are dropped. */
+ * first at the period that takes the request (0: stop); records of the
+ * earlier stream not yet taken are dropped. */
 void fw_tm_stream(fw_t *fw, uint32_t every);
+/* Records not published because the main loop was a full ring behind. */
+uint32_t fw_tm_dropped(const fw_t *fw);
 /* Main loop: the oldest published record not yet taken, or NULL; it stays
  * valid until fw_tm_release(). */
-const fw_telemetry_t *fw_tm_peek(const fw_t *fw);
+const fw_telemetry_t *fw_tm_peek(fw_t *fw);
 void fw_tm_release(fw_t *fw);
 /*
  * Main-loop side, configuration time (double allowed; pipeline_config.c).

@@ -18,15 +18,6 @@
 
 #define FW_CALIB_DEFAULT 256u
 
-/* Orders the main loop's writes of a live change before its request: the
- * interrupt takes the change when it sees the request. */
-static inline void fw_publish_barrier(void)
-{
-#if defined(__GNUC__)
-    __asm__ volatile("" ::: "memory");
-#endif
-}
-
 void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl_desc_t *ctrl)
 {
     if (c == NULL) {
@@ -162,8 +153,7 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
                             const void *ctrl_cfg)
 {
 #if PMSM_LIVE_PARAMS
-    fw->req_speed_tune = 0u; /* superseded by the gains set here */
-    fw_publish_barrier();
+    fw_request_withdraw(fw, FW_REQ_SPEED_TUNE); /* superseded by the gains set here */
 #endif
     const hal_info_t *in = &fw->info;
     if (ctrl_params_init_diag(&fw->params, &fw->bases, fw->machine, in->pwm_freq_hz, &fw->why) !=
@@ -395,7 +385,7 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
     }
     memset(fw, 0, sizeof *fw);
     fw->tm_last = &fw->tm_ring[0];
-    fw->tm_slot = &fw->tm_ring[fw->tm_head & (FW_TM_RING - 1u)];
+    fw->tm_slot = &fw->tm_ring[0];
     fw->hal = hal;
     hal_gate_enable(hal, false);
     hal_info_get(hal, &fw->info);
@@ -436,7 +426,6 @@ int fw_init(fw_t *fw, hal_t *hal, const fw_config_t *cfg)
                        : (q24_t)(((uint64_t)in->pwm_cmp_max << 24) / in->period_counts);
     fw->off_q8[0] = fw->off_q8[1] = fw->off_q8[2] = (int32_t)fw->adc_zero * 256;
     fw->calib_samples = cfg->calib_samples;
-    fw->ref_mode = FW_REF_TORQUE;
     memset(&fw->applied, 0, sizeof fw->applied);
     fw_state_init(&fw->sm);
     return FW_OK;
@@ -447,7 +436,7 @@ int fw_commission_start(fw_t *fw, const uint8_t *steps, uint8_t n, uint8_t *miss
     if (fw == NULL || steps == NULL) {
         return FW_EINVAL;
     }
-    if (fw->sm.state != FW_STATE_READY || fw->req_cm != 0u) {
+    if (fw_state(fw) != FW_STATE_READY || fw_cmd_pending(fw, FW_REQ_CM)) {
         return FW_EBUSY;
     }
     if (fw->cm_what != NULL) {
@@ -456,8 +445,7 @@ int fw_commission_start(fw_t *fw, const uint8_t *steps, uint8_t n, uint8_t *miss
     if (cm_prepare(&fw->cm, steps, n, missing) != CM_E_NONE) {
         return FW_ENOENT;
     }
-    fw->req_cm = 1u;
-    fw->req_any = 1u;
+    fw_request(fw, FW_REQ_CM); /* after fw->cm is set up (release) */
     return FW_OK;
 }
 
@@ -469,14 +457,9 @@ void fw_commission_results(const fw_t *fw, cm_si_t *out)
     }
 }
 
-int fw_commission_apply(fw_t *fw)
+/* fw_commission_apply's rewrite (the interrupt held off). */
+static int fw_commission_adopt(fw_t *fw)
 {
-    if (fw == NULL) {
-        return FW_EINVAL;
-    }
-    if (fw->sm.state != FW_STATE_READY || fw_gates_on_or_pending(fw)) {
-        return FW_EBUSY; /* an arm taken next period would gate half-set data */
-    }
     cm_si_t r;
     fw_commission_results(fw, &r);
     ctrl_machine_t m = fw->machine_own;
@@ -519,9 +502,25 @@ int fw_commission_apply(fw_t *fw)
     return FW_OK;
 }
 
+int fw_commission_apply(fw_t *fw)
+{
+    if (fw == NULL) {
+        return FW_EINVAL;
+    }
+    if (fw_state(fw) != FW_STATE_READY || fw_gates_on_or_pending(fw)) {
+        return FW_EBUSY; /* an arm taken next period would gate half-set data */
+    }
+    /* Everything below rewrites what the interrupt reads in every state
+     * (conversion, protections, the encoder's tracking): with it held off. */
+    hal_ctrl_hold(fw->hal, true);
+    const int rc = fw_commission_adopt(fw);
+    hal_ctrl_hold(fw->hal, false);
+    return rc;
+}
+
 bool fw_commission_poll(fw_t *fw)
 {
-    if (fw == NULL || fw->cm.apply == 0u || fw->sm.state != FW_STATE_READY) {
+    if (fw == NULL || fw->cm.apply == 0u || fw_state(fw) != FW_STATE_READY) {
         return false;
     }
     fw->cm.apply = 0u;
@@ -535,8 +534,7 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     /* A live change the interrupt has not taken yet is superseded (cfg holds
      * it): withdrawn before the state is written, so that the interrupt no
      * longer touches the state. */
-    fw->req_ctrl_tune = 0u;
-    fw_publish_barrier();
+    fw_request_withdraw(fw, FW_REQ_CTRL_TUNE);
 #endif
     union {
         max_align_t align;
@@ -610,7 +608,7 @@ int fw_speed_retune(fw_t *fw, double bw_hz, double pm_deg, double kp, double ki)
     (void)ki;
     return FW_EBUSY;
 #else
-    if (fw->req_speed_tune != 0u) {
+    if (fw_tune_pending(fw, FW_REQ_SPEED_TUNE)) {
         return FW_EBUSY;
     }
     /* In fw->cfg (the interrupt reads none of these), back on a refusal. */
@@ -630,9 +628,7 @@ int fw_speed_retune(fw_t *fw, double bw_hz, double pm_deg, double kp, double ki)
         return rc;
     }
     fw->speed_info = si;
-    fw_publish_barrier();
-    fw->req_speed_tune = 1u;
-    fw->req_any = 1u;
+    fw_request(fw, FW_REQ_SPEED_TUNE); /* after the gains (a release fence) */
     return FW_OK;
 #endif
 }
@@ -656,7 +652,7 @@ int fw_tunable_set(fw_t *fw, const char *name, double value)
         while (i < d->n_tunables && strcmp(d->tunables[i].name, name) != 0) {
             i++;
         }
-        if (i < d->n_tunables && (!fw_tunable_is_live(fw, i) || fw->req_ctrl_tune != 0u)) {
+        if (i < d->n_tunables && (!fw_tunable_is_live(fw, i) || fw_tune_pending(fw, FW_REQ_CTRL_TUNE))) {
             return FW_EBUSY;
         }
     }
@@ -688,9 +684,7 @@ int fw_tunable_set(fw_t *fw, const char *name, double value)
         return FW_ECTRL;
     }
     memcpy(fw->ctrl_cfg.bytes, c.bytes, CTRL_CFG_MAX);
-    fw_publish_barrier();
-    fw->req_ctrl_tune = 1u;
-    fw->req_any = 1u;
+    fw_request(fw, FW_REQ_CTRL_TUNE); /* after the state (a release fence) */
     return FW_OK;
 #endif
 }

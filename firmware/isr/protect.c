@@ -44,7 +44,6 @@ void fw_protect_reset(fw_protect_t *p)
     p->enc_move_dist = 0u;
     p->enc_move_still = 0u;
     p->enc_primed = 0u;
-    p->wdg_count = 0u;
     p->follow_ref = 0;
     p->follow_min = INT32_MAX;
     p->follow_count = 0u;
@@ -68,13 +67,6 @@ uint32_t fw_protect_encoder_prime(fw_protect_t *p, uint32_t count)
         return FW_FAULT_NONE;
     }
     return fw_protect_encoder_check(p, count);
-}
-
-void fw_protect_watchdog_kick(fw_protect_t *p)
-{
-    if (p != NULL) {
-        p->wdg_count = 0u;
-    }
 }
 
 /* Speed following (criterion in protect.h). */

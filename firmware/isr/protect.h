@@ -29,9 +29,10 @@
  *  - deadline: the ISR entered while the previous one was still running
  *    (re-entry flag) or its duration measured with hal_cycles exceeded the
  *    period (cycle budget from hal_info_t.cycle_clock_hz).
- *  - watchdog: a counter incremented every period and cleared by the main
- *    loop (fw_watchdog_kick); more than wdg_periods periods without a kick
- *    is a fault.
+ *  - watchdog: the periods since the main loop's last kick (fw_watchdog_kick
+ *    stamps the interrupt's period count; the interrupt subtracts, so each
+ *    side writes only its own count); more than wdg_periods of them is a
+ *    fault.
  *  - overspeed: |estimated electrical speed| > omega_max, checked while
  *    running right after the estimator. Level: the machine's maximum speed
  *    (fw_speed_max_rpm: declared, or where the back-EMF meets the DC link) x
@@ -122,7 +123,6 @@ typedef struct {
     /* 0: nothing, 1: enc_last valid, 2: enc_last_delta valid (fast form),
      * 3: the same with a negative enc_jump_max (every move is a jump). */
     uint8_t enc_primed;
-    uint32_t wdg_count; /* periods since the last kick */
     /* deadline_cycles and wdg_periods with 0 ("off") as UINT32_MAX, which no
      * uint32_t exceeds: one compare each. */
     uint32_t deadline_lim, wdg_lim;
@@ -154,10 +154,8 @@ int fw_protect_config(fw_protect_cfg_t *cfg, const ctrl_machine_t *m, const ctrl
  * configuration only through fw_protect_init. CTRL_OK, or CTRL_EINVAL (p
  * unchanged) for i_max outside [0, FW_PROTECT_I_MAX_LIM]. */
 int fw_protect_init(fw_protect_t *p, const fw_protect_cfg_t *cfg);
-/* Forget the encoder history (on arm) and the watchdog count. */
+/* Forget the encoder history (on arm, on a fault clear). */
 void fw_protect_reset(fw_protect_t *p);
-
-void fw_protect_watchdog_kick(fw_protect_t *p);
 
 /* ---- The checks, inlined into the interrupt. ---- */
 
@@ -314,15 +312,11 @@ static inline uint32_t fw_protect_overspeed(const fw_protect_t *p, q24_t omega_e
 uint32_t fw_protect_speed_follow(fw_protect_t *p, q24_t speed_ref, q24_t omega, q24_t t,
                                  q24_t t_max);
 
-static inline uint32_t fw_protect_watchdog_tick(fw_protect_t *p)
+/* since: periods since the main loop's last kick (modulo 2^32: the fault
+ * latches long before it wraps). */
+static inline uint32_t fw_protect_watchdog_tick(const fw_protect_t *p, uint32_t since)
 {
-    if (p->wdg_count < UINT32_MAX) {
-        p->wdg_count++;
-    }
-    if (p->wdg_count > p->wdg_lim) {
-        return FW_FAULT_WATCHDOG;
-    }
-    return FW_FAULT_NONE;
+    return since > p->wdg_lim ? FW_FAULT_WATCHDOG : FW_FAULT_NONE;
 }
 
 #endif /* FIRMWARE_PROTECT_H */

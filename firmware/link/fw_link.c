@@ -7,6 +7,7 @@
 
 #include "controller.h"
 #include "ctrl_units.h"
+#include "fw_stack.h"
 #include "transforms.h"
 #include "vectors.h"
 
@@ -38,7 +39,7 @@ static void op_get_status(void *ctx, cmd_status_t *st)
     st->ctrl = fw->ctrl != NULL ? fw->ctrl->name : "";
     st->fault = fw_fault(fw);
     st->fault_name = fw_fault_name(st->fault);
-    st->mode = fw->ref_mode == FW_REF_SPEED ? CMD_MODE_SPEED : CMD_MODE_TORQUE;
+    st->mode = fw_ref_mode(fw) == FW_REF_SPEED ? CMD_MODE_SPEED : CMD_MODE_TORQUE;
     /* The last period's record: the estimate while running, the
      * commissioning step's (cm_monitor) while it runs, else none (0: the
      * record's "no estimate") - never the last run's estimate after a stop. */
@@ -46,11 +47,15 @@ static void op_get_status(void *ctx, cmd_status_t *st)
     st->speed_rpm = fw_link_rpm(fw, r->omega_e);
     st->torque_nm = ctrl_q24_to_double(r->torque) * fw->bases.torque_nm;
     st->torque_ref_nm = ctrl_q24_to_double(fw->torque_ref_now) * fw->bases.torque_nm;
-    st->speed_ref_rpm = fw_link_rpm(fw, fw->speed_ref);
+    st->speed_ref_rpm = fw_link_rpm(fw, fw_speed_ref(fw));
     st->torque_max_nm = ctrl_q24_to_double(fw->torque_ref_max) * fw->bases.torque_nm;
     st->speed_max_rpm = l->speed_max_rpm;
     st->tel_mask = l->tel.mask;
     st->tel_every = l->tel.every;
+    if (l->stack_hi != NULL) {
+        st->stack_size = (uint32_t)((uintptr_t)l->stack_hi - (uintptr_t)l->stack_lo);
+        st->stack_used = fw_stack_used(l->stack_lo, l->stack_hi);
+    }
 }
 
 static bool op_ctrl_at(void *ctx, size_t index, const char **name, const char **title)
@@ -239,7 +244,8 @@ static int op_param_set(void *ctx, const char *name, double value)
          * (where some parameters are live and others not; without live
          * parameters the state alone says it). */
         const size_t n = fw_link_state_text(l);
-        const bool pending = (l->fw->req_speed_tune | l->fw->req_ctrl_tune) != 0u;
+        const bool pending = fw_tune_pending(l->fw, FW_REQ_SPEED_TUNE) ||
+                             fw_tune_pending(l->fw, FW_REQ_CTRL_TUNE);
         (void)snprintf(l->state_text + n, sizeof l->state_text - n, ": %s%s",
                        pending ? "the last live change is not taken yet" : name,
                        pending ? "" : " changes with the gates off only");
@@ -629,11 +635,17 @@ void fw_link_set_params(fw_link_t *l, const fw_link_param_t *params, size_t n, v
     }
 }
 
-void fw_link_rx(fw_link_t *l, uint8_t byte)
+void fw_link_set_stack(fw_link_t *l, const uint32_t *lo, const uint32_t *hi)
 {
-    if (l != NULL) {
-        cmd_feed_byte(&l->cmd, byte);
+    if (l != NULL && lo != NULL && hi > lo) {
+        l->stack_lo = lo;
+        l->stack_hi = hi;
     }
+}
+
+bool fw_link_rx(fw_link_t *l, uint8_t byte)
+{
+    return l != NULL && cmd_feed_byte(&l->cmd, byte);
 }
 
 /* A telemetry sample from an interrupt record (main loop): |psi_s| (4.3)
@@ -651,7 +663,7 @@ static void fw_link_sample(const fw_t *fw, const fw_telemetry_t *r, tel_sample_t
     s->torque = r->torque;
     s->torque_ref = r->torque_ref;
     s->speed = r->omega_e;
-    s->speed_ref = fw->speed_ref;
+    s->speed_ref = fw_speed_ref(fw);
     s->vector = (int32_t)r->vec;
     s->duty = r->duty;
     s->vdc = r->vdc;

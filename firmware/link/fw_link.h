@@ -79,6 +79,7 @@ struct fw_link {
     int (*table_set)(fw_link_t *l, const char *name, double value);
     bool state_note; /* state_text is the detail of the err 8 just returned (op_param_set) */
     bool why_note;   /* why_text is the detail of the err 10 just returned */
+    const uint32_t *stack_lo, *stack_hi; /* the painted main stack (fw_link_set_stack) */
 };
 
 void fw_link_init(fw_link_t *l, fw_t *fw, fw_link_write_fn write, void *write_ctx);
@@ -94,6 +95,9 @@ static inline void fw_link_set_hold(fw_link_t *l, const char *why)
 {
     l->hold = why;
 }
+/* The main stack [lo, hi), painted at start-up (fw_stack.h): "status" then
+ * gives its high-water mark (stack_used=, stack_size=). */
+void fw_link_set_stack(fw_link_t *l, const uint32_t *lo, const uint32_t *hi);
 /* For an application parameter's set (main loop) that fails because the core
  * refused the configuration: the reason (fw_t.why before the application
  * restores its previous data), sent as the detail of "err 10 failed". */
@@ -104,8 +108,11 @@ void fw_link_set_why_text(fw_link_t *l, const char *why);
  * offsets the calibration measured (Q8 counts, rounded to counts) and the
  * window it judges them by (hal_info_t). snprintf's result. */
 int fw_link_offsets_text(const fw_t *fw, char *buf, size_t cap);
-/* Main loop: one received byte. */
-void fw_link_rx(fw_link_t *l, uint8_t byte);
+/* Main loop: one received byte. True when it ended a command line, which
+ * has been answered: a main loop feeds the bytes up to there, then serves
+ * its watchdogs before the next line (a queue of commands, each up to a
+ * flash page erase long, would otherwise run back to back past them). */
+bool fw_link_rx(fw_link_t *l, uint8_t byte);
 /* Main loop: META frame after "tel start", then a sample frame for each
  * record the interrupt published (fw_tm_stream). */
 void fw_link_poll(fw_link_t *l);

@@ -313,7 +313,7 @@ static void cmd_status_cmd(cmd_t *c)
         cmd_err(c, CMD_E_UNSUPPORTED, NULL);
         return;
     }
-    cmd_ok_list(c, 10);
+    cmd_ok_list(c, st.stack_size != 0u ? 12u : 10u);
     cmd_item_str(c, "state=", st.state);
     cmd_item_str(c, "armed=", st.armed ? "1" : "0");
     cmd_item_str(c, "ctrl=", st.ctrl);
@@ -334,6 +334,16 @@ static void cmd_status_cmd(cmd_t *c)
     cmd_out_str(c, " every=");
     cmd_out_u32(c, st.tel_every);
     cmd_out_flush(c);
+    if (st.stack_size != 0u) {
+        cmd_item_begin(c);
+        cmd_out_str(c, "stack_used=");
+        cmd_out_u32(c, st.stack_used);
+        cmd_out_flush(c);
+        cmd_item_begin(c);
+        cmd_out_str(c, "stack_size=");
+        cmd_out_u32(c, st.stack_size);
+        cmd_out_flush(c);
+    }
 }
 
 static void cmd_ctrl(cmd_t *c, const cmd_tok_t *tok, size_t n)
@@ -1167,10 +1177,10 @@ static void cmd_echo_out(cmd_t *c, const char *s, size_t n)
     }
 }
 
-void cmd_feed_byte(cmd_t *c, uint8_t byte)
+bool cmd_feed_byte(cmd_t *c, uint8_t byte)
 {
     if (c == NULL) {
-        return;
+        return false;
     }
     if (byte == '\r' || byte == '\n') {
         const bool had = (c->len != 0u || c->overflow || c->bad_char);
@@ -1188,7 +1198,7 @@ void cmd_feed_byte(cmd_t *c, uint8_t byte)
         c->overflow = false;
         c->bad_char = false;
         c->line[0] = '\0';
-        return;
+        return had;
     }
     if (byte == 0x08u || byte == 0x7Fu) {
         /* erase one character; a discarded line stays discarded */
@@ -1197,21 +1207,22 @@ void cmd_feed_byte(cmd_t *c, uint8_t byte)
             c->line[c->len] = '\0';
             cmd_echo_out(c, "\b \b", 3);
         }
-        return;
+        return false;
     }
     if (c->overflow || c->bad_char) {
-        return;
+        return false;
     }
     if (byte != '\t' && (byte < 0x20u || byte > 0x7Eu)) {
         c->bad_char = true;
-        return;
+        return false;
     }
     if (c->len >= CMD_LINE_MAX) {
         c->overflow = true;
-        return;
+        return false;
     }
     c->line[c->len++] = (char)byte;
     c->line[c->len] = '\0';
     const char ch = (byte == '\t') ? ' ' : (char)byte; /* echo printable only */
     cmd_echo_out(c, &ch, 1);
+    return false;
 }

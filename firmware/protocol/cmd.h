@@ -66,6 +66,9 @@ typedef struct {
     double speed_max_rpm;   /* |ref speed| limit accepted by "ref speed" (> 0) */
     uint32_t tel_mask;      /* telemetry signal mask, 0 = stopped */
     uint32_t tel_every;     /* telemetry decimation */
+    /* main stack: reserved bytes (0: not measured, the items are left out)
+     * and the high-water mark since reset (fw_stack.h) */
+    uint32_t stack_size, stack_used;
 } cmd_status_t;
 
 /* When a parameter can be written (cmd_param_info_t.access). */
@@ -196,8 +199,10 @@ typedef struct {
 
 void cmd_init(cmd_t *c, const cmd_ops_t *ops, void *ctx);
 
-/* Feed one received byte; a complete line is executed immediately. */
-void cmd_feed_byte(cmd_t *c, uint8_t byte);
+/* Feed one received byte; a complete line is executed immediately. Returns
+ * true when the byte ended a line that was answered (executed or refused):
+ * the main loop serves its watchdogs then, before the next line. */
+bool cmd_feed_byte(cmd_t *c, uint8_t byte);
 
 /* Execute one line (without terminator; len <= CMD_LINE_MAX, printable
  * characters only). Used by cmd_feed_byte; exposed for scripted use. */

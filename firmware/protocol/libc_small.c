@@ -9,9 +9,17 @@
  *   - strcmp, strlen, strcpy and strncpy as byte loops: newlib's are unrolled
  *     or word-wise for speed (strcmp 0.7 KB; the other three 0.5 KB), and the
  *     image handles strings only in the command path and at start-up, never
- *     per period.
+ *     per period;
+ *   - memcpy and memset word by word where both ends are word-aligned, byte
+ *     by byte otherwise: newlib-nano's unrolled ones took 470 B; the running
+ *     period copies no block through them (its copies are a few words, inline),
+ *     the configuration and the arming period do (a copy of 1 KB: some
+ *     1 300 cycles here).
+ * Built with -fno-tree-loop-distribute-patterns: GCC would otherwise turn
+ * these loops into calls of memset and memcpy, themselves.
  */
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -70,6 +78,41 @@ char *strncpy(char *restrict dst, const char *restrict src, size_t n)
     }
     for (; i < n; i++) {
         dst[i] = '\0';
+    }
+    return dst;
+}
+
+/* A word that may alias any object (GCC's may_alias): the copies below read
+ * and write other types' bytes through it. */
+typedef uint32_t __attribute__((may_alias)) libc_word_t;
+
+__attribute__((noinline)) void *memcpy(void *restrict dst, const void *restrict src, size_t n)
+{
+    unsigned char *d = dst;
+    const unsigned char *s = src;
+    if ((((uintptr_t)d | (uintptr_t)s) & 3u) == 0u) {
+        for (; n >= 4u; n -= 4u, d += 4, s += 4) {
+            *(libc_word_t *)(void *)d = *(const libc_word_t *)(const void *)s;
+        }
+    }
+    for (; n != 0u; n--) {
+        *d++ = *s++;
+    }
+    return dst;
+}
+
+__attribute__((noinline)) void *memset(void *dst, int c, size_t n)
+{
+    unsigned char *d = dst;
+    const unsigned char b = (unsigned char)c;
+    if (((uintptr_t)d & 3u) == 0u) {
+        const uint32_t w = 0x01010101u * b;
+        for (; n >= 4u; n -= 4u, d += 4) {
+            *(libc_word_t *)(void *)d = w;
+        }
+    }
+    for (; n != 0u; n--) {
+        *d++ = b;
     }
     return dst;
 }

@@ -32,7 +32,8 @@ endif()
 # link whatever the archives' order.
 if(NOT PMSM_TARGET STREQUAL "host" AND NOT TARGET pmsm_libc_small)
   add_library(pmsm_libc_small OBJECT ${CMAKE_CURRENT_LIST_DIR}/libc_small.c)
-  set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/libc_small.c PROPERTIES COMPILE_OPTIONS "-Os")
+  set_source_files_properties(${CMAKE_CURRENT_LIST_DIR}/libc_small.c PROPERTIES COMPILE_OPTIONS
+                              "-Os;-fno-tree-loop-distribute-patterns")
   target_link_libraries(pmsm_libc_small PUBLIC pmsm_fw_proto)
   pmsm_strict(pmsm_libc_small)
 endif()

@@ -43,7 +43,8 @@ typedef enum {
     TEL_SIG_CM_STEP,     /* commissioning step running (cm_step_id_t, 0 none) */
     TEL_SIG_CM_PROGRESS, /* its progress, per mille */
     TEL_SIG_TORQUE_MAX,  /* |torque| limit of the period (current, voltage, MTPV) */
-    TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fieldweak_limit_t) + 4 clipped + 8 flux weakened */
+    TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fieldweak_limit_t) + 4 clipped + 8 flux weakened
+                            + 16 torque not following its reference (torque_follow.h) */
     TEL_SIG_COUNT
 } tel_sig_t;
 

@@ -321,7 +321,9 @@ settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, u
             return SETTINGS_E_VALUE;
         }
     }
-    *s = t;
+    if (s != NULL) {
+        *s = t;
+    }
     *seq = (uint32_t)settings_get(buf + 8, 4u);
     return SETTINGS_OK;
 }

@@ -119,9 +119,9 @@ size_t settings_record_size(void);
  * (such a record would never load). */
 size_t settings_encode(const settings_t *s, uint32_t seq, uint8_t *buf, size_t cap);
 
-/* Parse and check the record at buf (n bytes available). On SETTINGS_OK *s and
- * *seq hold it; otherwise they are untouched. *format (if not NULL) receives
- * the format version read from the header (0 when there is none). */
+/* Parse and check the record at buf (n bytes available). On SETTINGS_OK *s (s
+ * may be NULL: a check only) and *seq hold it; otherwise they are untouched. *format (if not NULL)
+ * receives the format version read from the header (0 when there is none). */
 settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, uint32_t *seq,
                                   uint16_t *format);
 

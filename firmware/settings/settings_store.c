@@ -88,14 +88,14 @@ int settings_store_save(const settings_flash_t *f, uint8_t *buf, size_t cap, con
     if (rc != 0) {
         return rc;
     }
-    /* read back through the same checks the next boot applies */
-    settings_t back;
+    /* read back through the same checks the next boot applies (the record
+     * itself not kept: no second settings_t on the stack) */
     uint32_t seq_back = 0;
     rc = f->read(f->ctx, page, 0u, buf, len);
     if (rc != 0) {
         return rc;
     }
-    if (settings_decode(buf, len, &back, &seq_back, NULL) != SETTINGS_OK || seq_back != seq) {
+    if (settings_decode(buf, len, NULL, &seq_back, NULL) != SETTINGS_OK || seq_back != seq) {
         return SETTINGS_STORE_E_VERIFY;
     }
     if (seq_out != NULL) {

@@ -206,6 +206,19 @@ void board_irq_enable(void)
     __asm__ volatile("cpsie i" ::: "memory");
 }
 
+bool board_timer0_irq_mask(void)
+{
+    const bool on = (NVIC_ISER0 & (1u << TIMER0_IRQ)) != 0u;
+    NVIC_ICER0 = 1u << TIMER0_IRQ;
+    __asm__ volatile("dsb\n\tisb" ::: "memory"); /* masked before the caller goes on */
+    return on;
+}
+
+void board_timer0_irq_unmask(void)
+{
+    NVIC_ISER0 = 1u << TIMER0_IRQ;
+}
+
 void board_idle(void)
 {
     __asm__ volatile("nop" ::: "memory");

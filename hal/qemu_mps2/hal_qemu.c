@@ -116,6 +116,20 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
     }
 }
 
+void hal_ctrl_hold(hal_t *h, bool hold)
+{
+    if (h == NULL) {
+        return;
+    }
+    if (hold) {
+        if (h->hold_depth++ == 0u) {
+            h->hold_was_on = board_timer0_irq_mask();
+        }
+    } else if (h->hold_depth != 0u && --h->hold_depth == 0u && h->hold_was_on) {
+        board_timer0_irq_unmask();
+    }
+}
+
 void hal_gate_enable(hal_t *h, bool enable)
 {
     if (h != NULL) {

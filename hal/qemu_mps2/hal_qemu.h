@@ -38,6 +38,8 @@ struct hal {
     uint32_t ticks_per_kinstr; /* Timer1 ticks of 1000 emulated instructions */
     uint64_t periods;          /* hal_qemu_period_begin calls */
     bool primed;               /* a period has been sampled */
+    uint32_t hold_depth;       /* hal_ctrl_hold's nesting */
+    bool hold_was_on;          /* Timer0's interrupt was enabled at the outermost hold */
     int plant_rc;              /* first plant error (PLANT_OK while fine) */
 };
 

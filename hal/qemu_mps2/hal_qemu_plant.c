@@ -13,6 +13,7 @@
 #define hal_trip_active hal_qemu_sim_trip_active
 #define hal_trip_clear hal_qemu_sim_trip_clear
 #define hal_cycles hal_qemu_sim_cycles
+#define hal_ctrl_hold hal_qemu_sim_ctrl_hold
 #include "../sim/hal_sim.c"
 #undef hal
 #undef hal_info_get
@@ -23,6 +24,7 @@
 #undef hal_trip_active
 #undef hal_trip_clear
 #undef hal_cycles
+#undef hal_ctrl_hold
 
 #include "hal_qemu_plant.h"
 

@@ -16,6 +16,7 @@
 #ifndef HAL_QEMU_MPS2_H
 #define HAL_QEMU_MPS2_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -73,6 +74,10 @@ void board_pendsv_pend(void);
 /* Interrupt masking (PRIMASK). */
 void board_irq_disable(void);
 void board_irq_enable(void);
+/* Timer0's interrupt alone (NVIC ICER/ISER): masked, returning whether it
+ * was enabled; enabled again. */
+bool board_timer0_irq_mask(void);
+void board_timer0_irq_unmask(void);
 
 /* One pass of the idle loop: a busy-wait instruction, never `wfi` (under QEMU's
  * -icount sleep=off, wfi loses timer interrupts: QEMU.md). */

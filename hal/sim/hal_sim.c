@@ -332,6 +332,14 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
     }
 }
 
+void hal_ctrl_hold(hal_t *h, bool hold)
+{
+    /* no interrupt: the caller runs the periods; the depth for the tests */
+    if (h != NULL) {
+        h->hold_depth = hold ? h->hold_depth + 1u : (h->hold_depth != 0u ? h->hold_depth - 1u : 0u);
+    }
+}
+
 void hal_gate_enable(hal_t *h, bool enable)
 {
     if (h == NULL) {

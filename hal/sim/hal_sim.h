@@ -123,6 +123,7 @@ struct hal {
     hal_pwm_t shadow, active;
     bool gates_on, gate_enable_pending;
     bool trip;
+    uint32_t hold_depth; /* hal_ctrl_hold's nesting (no interrupt to hold here) */
     hal_adc_raw_t adc;
     hal_encoder_raw_t enc;
     uint64_t rng;

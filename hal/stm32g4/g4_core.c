@@ -83,4 +83,14 @@ void g4_nvic_enable(uint32_t irq)
 void g4_nvic_disable(uint32_t irq)
 {
     g4_wr(G4_NVIC + G4_NVIC_ICER(irq / 32u), 1u << (irq % 32u));
+#if !defined(G4_MEM_ARRAYS)
+    /* masked before the next instruction (ARMv7-M ARM B3.4: the write's
+     * effect is guaranteed only after a DSB and an ISB) */
+    __asm__ volatile("dsb\n\tisb" ::: "memory");
+#endif
+}
+
+bool g4_nvic_enabled(uint32_t irq)
+{
+    return (g4_rd(G4_NVIC + G4_NVIC_ISER(irq / 32u)) & (1u << (irq % 32u))) != 0u;
 }

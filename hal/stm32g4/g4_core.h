@@ -35,6 +35,17 @@ static inline uint32_t g4_cycles(void)
 {
     return g4_rd(G4_DWT + G4_DWT_CYCCNT);
 }
+/* The stack pointer now (the main stack in thread mode). */
+static inline uint32_t *g4_sp(void)
+{
+#if defined(G4_MEM_ARRAYS)
+    return (uint32_t *)0; /* the register model has no stack of its own */
+#else
+    uint32_t *sp;
+    __asm__ volatile("mov %0, sp" : "=r"(sp));
+    return sp;
+#endif
+}
 /* Busy-waits at least n core cycles. */
 void g4_delay_cycles(uint32_t n);
 /* Waits until (*reg & mask) == want; false after timeout_cycles core cycles. */
@@ -44,6 +55,7 @@ bool g4_wait_bits(uintptr_t reg, uint32_t mask, uint32_t want, uint32_t timeout_
 void g4_nvic_set_priority(uint32_t irq, uint32_t prio);
 void g4_nvic_enable(uint32_t irq);
 void g4_nvic_disable(uint32_t irq);
+bool g4_nvic_enabled(uint32_t irq);
 
 /* PendSV, the software-triggered exception (the firmware's medium-rate task):
  * its priority 0 .. 15 (SHPR3), and pending it (ICSR.PENDSVSET); it runs when

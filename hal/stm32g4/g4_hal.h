@@ -64,6 +64,8 @@ struct hal {
     volatile uint32_t break_acked; /* break_n at the last accepted clear */
     volatile uint32_t system_n;    /* system breaks seen (not clearable) */
     volatile bool board_trip;      /* G4_TRIP_BOARD */
+    uint8_t hold_depth;            /* hal_ctrl_hold's nesting (main loop) */
+    bool hold_was_on;              /* ADC1_2 was enabled at the outermost hold */
     uint16_t vinp_zero[3];         /* comparator plus inputs at zero current, ADC counts */
     uint32_t dac_code[2];          /* DAC3 channel 1, 2 thresholds */
     double trip_current_a;

@@ -353,3 +353,16 @@ double g4_hal_temp_c(const g4_board_t *b, int32_t counts)
     }
     return b->temp_t0_c + (v - b->temp_v0) / b->temp_dv_dt;
 }
+
+/* The control interrupt is ADC1_2's (the injected sequence's end). */
+void hal_ctrl_hold(hal_t *h, bool hold)
+{
+    if (hold) {
+        if (h->hold_depth++ == 0u) {
+            h->hold_was_on = g4_nvic_enabled(G4_IRQ_ADC1_2);
+            g4_nvic_disable(G4_IRQ_ADC1_2);
+        }
+    } else if (h->hold_depth != 0u && --h->hold_depth == 0u && h->hold_was_on) {
+        g4_nvic_enable(G4_IRQ_ADC1_2);
+    }
+}

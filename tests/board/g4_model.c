@@ -193,7 +193,17 @@ uint32_t g4_trace_read(uintptr_t reg)
     return v;
 }
 
+static void g4_model_write(uintptr_t reg, uint32_t value);
+
 void g4_trace_write(uintptr_t reg, uint32_t value)
+{
+    g4_model_write(reg, value);
+    if (g4_model.on_write != NULL) {
+        g4_model.on_write(reg, value);
+    }
+}
+
+static void g4_model_write(uintptr_t reg, uint32_t value)
 {
     uint32_t *c = g4_model_cell(reg);
     if (g4_model.n_log < G4_MODEL_LOG_MAX) {

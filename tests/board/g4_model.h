@@ -37,6 +37,8 @@ typedef struct {
      * interrupt inside a read-modify-write); one shot. */
     uintptr_t irq_on_read;
     void (*irq)(void);
+    /* Called after every register write (NULL: none): a test's probe. */
+    void (*on_write)(uintptr_t reg, uint32_t value);
     /* state the model keeps */
     bool rcr_before_cen;
     bool rcr_written;

@@ -12,3 +12,20 @@ set_tests_properties(esc1_flash PROPERTIES LABELS "board")
 add_test(NAME esc1_image_printf
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_printf.py ${PMSM_ESC1_ELF})
 set_tests_properties(esc1_image_printf PROPERTIES LABELS "board")
+# The static stack check (tools/stack_check.py): every entry point's worst
+# depth from the image's call graph and its -fstack-usage frames, the
+# priority levels nested, within 75 % of the reserved stack; the control
+# interrupt's code free of FPU instructions.
+set(PMSM_ESC1_STACK_CFG ${PROJECT_SOURCE_DIR}/firmware/apps/esc1/stack_check.json)
+add_test(NAME esc1_stack
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/stack_check.py --elf ${PMSM_ESC1_ELF}
+                 --config ${PMSM_ESC1_STACK_CFG} --su-dir ${CMAKE_BINARY_DIR}/firmware/apps/esc1
+                 --su-dir ${CMAKE_BINARY_DIR}/hal --verbose)
+set_tests_properties(esc1_stack PROPERTIES LABELS "board")
+# The same check fails when the worst case passes the limit: here a limit
+# below the image's share (the check's own failure path, which CI relies on).
+add_test(NAME esc1_stack_limit_fails
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/stack_check.py --elf ${PMSM_ESC1_ELF}
+                 --config ${PMSM_ESC1_STACK_CFG} --su-dir ${CMAKE_BINARY_DIR}/firmware/apps/esc1
+                 --su-dir ${CMAKE_BINARY_DIR}/hal --limit 0.30)
+set_tests_properties(esc1_stack_limit_fails PROPERTIES LABELS "board" WILL_FAIL TRUE)

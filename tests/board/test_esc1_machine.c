@@ -23,6 +23,7 @@
 #include "ctrl_params.h"
 #include "esc1_app.h"
 #include "esc1_report.h"
+#include "fw_stack.h"
 #include "g4_clock.h"
 #include "g4_core.h"
 #include "g4_flash.h"
@@ -265,6 +266,25 @@ static void calibrate_at(uint32_t code)
     }
 }
 
+/* Phase W's offset is range-checked as U's and V's are (the board has all
+ * three; the commissioning steps use W's current): W at mid-scale, 505
+ * counts off the board's zero, faults the calibration. */
+static void test_calibration_checks_phase_w(void)
+{
+    esc1_start();
+    g4_model_put(G4_ADC1 + G4_ADC_JDR1, 2553u);
+    g4_model_put(G4_ADC2 + G4_ADC_JDR1, 2553u);
+    g4_model_put(G4_ADC1 + G4_ADC_JDR2, 2048u); /* W */
+    g4_model_put(G4_ADC2 + G4_ADC_JDR2, 1433u);
+    for (uint32_t k = 0; k < 2u * esc.fc.calib_samples && fw_state(&esc.fw) != FW_STATE_READY &&
+                         fw_state(&esc.fw) != FW_STATE_FAULT;
+         k++) {
+        esc1_control_isr(&esc);
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_FAULT, fw_state(&esc.fw));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_CALIB, esc.fw.sm.fault_code);
+}
+
 static void test_calibration_takes_the_board_zero(void)
 {
     calibrate_at(2553u);
@@ -415,7 +435,7 @@ static void test_throttle_rearms_only_from_its_low_end(void)
     for (; ms < 1200u; ms++) {
         pulse_at(ms, 1800u);
     }
-    TEST_ASSERT_TRUE(esc.fw.torque_ref > 0);
+    TEST_ASSERT_TRUE(fw_torque_ref(&esc.fw) > 0);
     expect_prefix("ok", command("disarm"));
     for (; ms < 2500u; ms++) {
         pulse_at(ms, 1800u);
@@ -428,7 +448,7 @@ static void test_throttle_rearms_only_from_its_low_end(void)
         pulse_at(ms, 1800u);
     }
     TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&esc.fw));
-    TEST_ASSERT_EQUAL_INT32(0, esc.fw.torque_ref); /* the link's, not the stick's */
+    TEST_ASSERT_EQUAL_INT32(0, fw_torque_ref(&esc.fw)); /* the link's, not the stick's */
     TEST_ASSERT_EQUAL_UINT8(THR_WAIT_LOW, esc.thr.state);
 }
 
@@ -468,7 +488,7 @@ static void test_throttle_survives_a_power_cycle(void)
     }
     /* (1520 - 1140) / (1900 - 1140) of the torque limit, Q24 */
     const q24_t want = fx_mul((q24_t)((380ll << 24) / 760), esc.fw.torque_ref_max);
-    TEST_ASSERT_EQUAL_INT32(want, esc.fw.torque_ref);
+    TEST_ASSERT_EQUAL_INT32(want, fw_torque_ref(&esc.fw));
     expect_prefix("ok", command("disarm"));
     control_period();
 
@@ -521,6 +541,119 @@ static void test_throttle_survives_a_power_cycle(void)
     memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
 }
 
+/* Replies so far whose first word is "ok" or "err" (one per command). */
+static unsigned answers(void)
+{
+    unsigned n = 0;
+    for (size_t k = 0; k < n_reply; k++) {
+        n += strncmp(reply[k], "ok", 2) == 0 || strncmp(reply[k], "err ", 4) == 0 ? 1u : 0u;
+    }
+    return n;
+}
+
+static unsigned iwdg_refreshes(void)
+{
+    unsigned n = 0;
+    for (uint32_t k = 0; k < g4_model.n_log; k++) {
+        n += g4_model.log[k].reg == G4_IWDG + G4_IWDG_KR &&
+                     g4_model.log[k].value == G4_IWDG_KR_REFRESH
+                 ? 1u
+                 : 0u;
+    }
+    return n;
+}
+
+/* Lines that arrive together (a pasted script, a console that does not wait)
+ * run one per pass of the main loop, the watchdogs served after each: three
+ * "config show" (each a flash read; "config erase" is two page erases of up
+ * to 24.5 ms) do not run back to back past the independent watchdog. */
+static void test_main_loop_serves_the_watchdog_between_commands(void)
+{
+    calibrate_at(2553u);
+    esc.ms_cycles = 170000u;
+    esc.temp_period = 0xFFFFFFFFu;
+    esc.t_temp = g4_cycles();
+    static const char lines[] = "status\rfault\rstatus\r";
+    for (const char *c = lines; *c != '\0'; c++) {
+        esc.uart.rx[esc.uart.rx_head & (ESC1_UART_RX_SIZE - 1u)] = (uint8_t)*c;
+        esc.uart.rx_head++;
+    }
+    n_reply = 0;
+    g4_model.n_log = 0;
+    for (unsigned pass = 1; pass <= 3u; pass++) {
+        esc.isr_count++; /* the control interrupt runs */
+        esc1_loop_once(&esc);
+        TEST_ASSERT_EQUAL_UINT_MESSAGE(pass, answers(), "one command line per pass");
+        TEST_ASSERT_EQUAL_UINT_MESSAGE(pass, iwdg_refreshes(), "the watchdog after each");
+    }
+    TEST_ASSERT_EQUAL_UINT32(esc.uart.rx_head, esc.uart.rx_tail);
+    /* in order: status (11 lines), fault, status */
+    TEST_ASSERT_EQUAL_STRING("ok 10", reply[0]);
+    TEST_ASSERT_NOT_NULL(strstr(reply[11], "none"));
+    TEST_ASSERT_EQUAL_STRING("ok 10", reply[12]);
+}
+
+/* "status" gives the main stack's high-water mark once the application has
+ * told the link where its painted stack lies. */
+static void test_status_gives_the_stack_high_water_mark(void)
+{
+    calibrate_at(2553u);
+    static uint32_t stack[256];
+    fw_stack_paint(stack, stack + 256);
+    stack[200] = 0u; /* the deepest word written: 56 words below the top */
+    fw_link_set_stack(&esc.link, stack, stack + 256);
+    const size_t n = command_lines("status");
+    TEST_ASSERT_EQUAL_STRING("ok 12", reply[0]);
+    TEST_ASSERT_EQUAL_UINT(13u, n);
+    TEST_ASSERT_EQUAL_STRING("  stack_used=224", reply[11]);
+    TEST_ASSERT_EQUAL_STRING("  stack_size=1024", reply[12]);
+}
+
+/* "ident apply" rewrites what the control interrupt reads (conversion,
+ * protections, the encoder's tracking: fw_setup_machine) with the interrupt
+ * masked, as the board's own reconfiguration does: fw_t unchanged until the
+ * NVIC's ICER masks ADC1_2, and again from the ISER that lets it run. */
+static fw_t fw_at_mask, fw_at_unmask;
+static int hold_mask = -1, hold_unmask = -1;
+static void watch_nvic(uintptr_t reg, uint32_t value)
+{
+    if ((value & (1u << G4_IRQ_ADC1_2)) == 0u) {
+        return;
+    }
+    if (reg == G4_NVIC + G4_NVIC_ICER(0u) && hold_mask < 0) {
+        hold_mask = (int)g4_model.n_log;
+        memcpy(&fw_at_mask, &esc.fw, sizeof esc.fw);
+    } else if (reg == G4_NVIC + G4_NVIC_ISER(0u) && hold_mask >= 0) {
+        hold_unmask = (int)g4_model.n_log;
+        memcpy(&fw_at_unmask, &esc.fw, sizeof esc.fw);
+    }
+}
+
+static void test_ident_apply_holds_the_control_interrupt(void)
+{
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    g4_model_put(G4_NVIC + G4_NVIC_ISER(0u), 1u << G4_IRQ_ADC1_2); /* running */
+    /* an identified encoder offset to adopt */
+    esc.fw.cm.res.have = CM_HAVE_ENC;
+    esc.fw.cm.res.enc_dir = 1;
+    esc.fw.cm.res.enc_off = 0x40000000u;
+    esc.fw.cm.res.bases = esc.fw.bases;
+    static fw_t before;
+    memcpy(&before, &esc.fw, sizeof esc.fw);
+    hold_mask = hold_unmask = -1;
+    g4_model.on_write = watch_nvic;
+    expect_prefix("ok ident applied", command("ident apply"));
+    g4_model.on_write = NULL;
+    TEST_ASSERT_TRUE_MESSAGE(hold_mask >= 0, "ADC1_2 masked during ident apply");
+    TEST_ASSERT_TRUE_MESSAGE(hold_unmask > hold_mask, "and enabled again after it");
+    TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&before, &fw_at_mask, sizeof before,
+                                     "nothing rewritten before the mask");
+    TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&fw_at_unmask, &esc.fw, sizeof before,
+                                     "nothing rewritten after the interrupt runs again");
+    TEST_ASSERT_EQUAL_UINT32(0x40000000u, esc.fw.enc_offset); /* and it was adopted */
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -530,10 +663,14 @@ int main(void)
     RUN_TEST(test_config_carries_the_board_dead_time);
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
+    RUN_TEST(test_calibration_checks_phase_w);
     RUN_TEST(test_throttle_arms_and_disarms_the_drive);
     RUN_TEST(test_throttle_rearms_only_from_its_low_end);
     RUN_TEST(test_link_reconfig_refused_while_gates_on);
     RUN_TEST(test_bringup_sense_says_the_offsets);
     RUN_TEST(test_throttle_survives_a_power_cycle);
+    RUN_TEST(test_main_loop_serves_the_watchdog_between_commands);
+    RUN_TEST(test_status_gives_the_stack_high_water_mark);
+    RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     return UNITY_END();
 }

@@ -117,7 +117,7 @@ static void test_telemetry_frames(void)
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok tel", 6));
     lt.zeros = 0;
     periods(100);
-    TEST_ASSERT_EQUAL_UINT32(0u, run.fw.tm_dropped);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_tm_dropped(&run.fw));
     TEST_ASSERT_EQUAL_UINT32(2u * (1u + 10u), (uint32_t)lt.zeros);
     send("tel stop");
     lt.zeros = 0;

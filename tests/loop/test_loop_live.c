@@ -129,10 +129,10 @@ static void test_speed_loop_live_is_bumpless(void)
     send("param set speed.bw_hz 15");
     TEST_ASSERT_EQUAL_STRING("ok speed.bw_hz 15\r\n", lt.out);
     const double e_star =
-        ctrl_q24_to_double(fx_sat32((int64_t)run_b.fw.speed_ref - run_b.fw.estimate.omega_e));
+        ctrl_q24_to_double(fx_sat32((int64_t)fw_speed_ref(&run_b.fw) - run_b.fw.estimate.omega_e));
     const uint32_t done = run_b.fw.mid_done;
     both_period(); /* takes the change, triggers the run */
-    TEST_ASSERT_EQUAL_UINT8(0u, run_b.fw.req_speed_tune);
+    TEST_ASSERT_FALSE(fw_cmd_pending(&run_b.fw, FW_REQ_SPEED_TUNE));
     TEST_ASSERT_EQUAL_UINT32(done + 1u, run_b.fw.mid_done);
     TEST_ASSERT_EQUAL_UINT32(run_a.fw.mid_done, run_b.fw.mid_done);
     const fw_mid_in_t *in = &run_b.fw.mid_in[run_b.fw.mid_done & 1u];
@@ -191,7 +191,7 @@ static void test_foc_gain_live_is_bumpless(void)
     send(line);
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "ok wc", 5));
     both_period();
-    TEST_ASSERT_EQUAL_UINT8(0u, run_b.fw.req_ctrl_tune);
+    TEST_ASSERT_FALSE(fw_cmd_pending(&run_b.fw, FW_REQ_CTRL_TUNE));
     double worst = 0.0;
     double naive = 0.0;
     const ctrl_foc_pi_t *pold[2] = {&old.pi_d, &old.pi_q};

@@ -261,12 +261,11 @@ static void test_protect_checks(void)
     TEST_ASSERT_EQUAL_UINT32(FW_FAULT_ENC_STUCK, fw_protect_encoder(&p, c));
     TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_deadline(&p, 1000u));
     TEST_ASSERT_EQUAL_UINT32(FW_FAULT_DEADLINE, fw_protect_deadline(&p, 1001u));
-    for (int k = 0; k < 10; k++) {
-        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_watchdog_tick(&p));
+    /* watchdog: 10 periods since the last kick allowed, 11 not */
+    for (uint32_t k = 0; k <= 10u; k++) {
+        TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_watchdog_tick(&p, k));
     }
-    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_WATCHDOG, fw_protect_watchdog_tick(&p));
-    fw_protect_watchdog_kick(&p);
-    TEST_ASSERT_EQUAL_UINT32(0u, fw_protect_watchdog_tick(&p));
+    TEST_ASSERT_EQUAL_UINT32(FW_FAULT_WATCHDOG, fw_protect_watchdog_tick(&p, 11u));
     for (uint32_t f = 0; f < (uint32_t)FW_FAULT_COUNT; f++) {
         TEST_ASSERT_NOT_NULL(fw_fault_name(f));
         TEST_ASSERT_TRUE(strcmp(fw_fault_name(f), "unknown") != 0);
@@ -305,20 +304,20 @@ static void test_telemetry_ring(void)
         }
     }
     TEST_ASSERT_EQUAL_UINT32(20u, taken);
-    TEST_ASSERT_EQUAL_UINT32(0u, fw->tm_dropped);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_tm_dropped(fw));
     /* nobody reads: the ring fills to FW_TM_RING - 1, the rest is dropped */
     fw_tm_stream(fw, 1u);
     for (uint32_t k = 0; k < FW_TM_RING + 5u; k++) {
         TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
     }
-    TEST_ASSERT_EQUAL_UINT32(FW_TM_RING - 1u, fw->tm_head - fw->tm_tail);
-    TEST_ASSERT_EQUAL_UINT32(6u, fw->tm_dropped);
+    TEST_ASSERT_EQUAL_UINT32(FW_TM_RING - 1u, fw->isr.tm_head - fw->ml.tm_tail);
+    TEST_ASSERT_EQUAL_UINT32(6u, fw_tm_dropped(fw));
     fw_tm_stream(fw, 0u);
     TEST_ASSERT_NULL(fw_tm_peek(fw));
     TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run));
     TEST_ASSERT_NULL(fw_tm_peek(fw));
     fw_tm_release(fw); /* nothing to release: no change */
-    TEST_ASSERT_EQUAL_UINT32(fw->tm_head, fw->tm_tail);
+    TEST_ASSERT_EQUAL_UINT32(fw->isr.tm_head, fw->ml.tm_tail);
 }
 
 static void test_init_rejects(void)

@@ -50,6 +50,12 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
     }
 }
 
+void hal_ctrl_hold(hal_t *h, bool hold)
+{
+    (void)h; /* the replay calls the periods itself */
+    (void)hold;
+}
+
 void hal_gate_enable(hal_t *h, bool enable)
 {
     if (h != NULL) {

@@ -87,7 +87,7 @@ int main(int argc, char **argv)
         }
         if (phase == 2 && after == 0u) {
             fw_set_torque_ref_nm(&run.fw, GEN_TORQUE_NM);
-            tref = run.fw.torque_ref;
+            tref = fw_torque_ref(&run.fw);
             fw_cmd_arm(&run.fw);
             cmd |= PIL_IDENT_TORQUE | PIL_IDENT_ARM;
         }

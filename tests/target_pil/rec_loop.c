@@ -40,7 +40,7 @@ void rec_loop_isr(rec_loop_t *loop, double torque_nm, pil_in_t *in)
         fw_cmd_arm(&loop->fw);
         cmd = PIL_CMD_TORQUE | PIL_CMD_ARM;
         loop->armed = 1;
-        loop->torque_ref_armed = loop->fw.torque_ref;
+        loop->torque_ref_armed = fw_torque_ref(&loop->fw);
     }
     hal_sim_period_begin(hal);
     in->adc[0] = hal->adc.i_a;

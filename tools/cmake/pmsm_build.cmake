@@ -18,6 +18,23 @@ if(PMSM_SANITIZE AND PMSM_TARGET STREQUAL "host")
   add_link_options(-fsanitize=address,undefined)
 endif()
 
+# pmsm_no_fpu(<source>...): the code of the PWM-period interrupt (the control
+# core's per-sample files, the pipeline, the commissioning steps, a board's
+# interrupt HAL) without the FPU's registers on the hard-float Cortex-M4
+# (-mgeneral-regs-only): GCC otherwise moves and spills 64-bit integers
+# through d7, the interrupt then counts as FPU code, and its preemption of
+# FPU code stacks the FP context (lazy stacking: 17 words, and the extended
+# frame for every interrupt above it). These files are float-free (the
+# control core's is checked on the Cortex-M0+: control_float_free_cm0); a
+# float in them is now a compile error on these targets. Call it in the
+# directory that defines the targets of the files (source properties are
+# per directory).
+function(pmsm_no_fpu)
+  if(PMSM_TARGET STREQUAL "cm4" OR PMSM_TARGET STREQUAL "stm32g4")
+    set_property(SOURCE ${ARGN} APPEND PROPERTY COMPILE_OPTIONS -mgeneral-regs-only)
+  endif()
+endfunction()
+
 # pmsm_qemu_firmware(<executable target>)
 #   Makes a cm4 executable a QEMU mps2-an386 image: links the board support
 #   (startup, linker script, syscalls, UART, timers), names it <target>.elf, writes

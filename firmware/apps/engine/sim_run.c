@@ -109,10 +109,10 @@ static void sim_limit_add(sim_run_t *r)
 
 double sim_run_speed_ref_now(const sim_run_t *r)
 {
-    if (r->fw.ref_mode != FW_REF_SPEED) {
+    if (fw_ref_mode(&r->fw) != FW_REF_SPEED) {
         return NAN;
     }
-    return ctrl_q24_to_double(r->fw.speed_ref) * r->fw.bases.w_rad_s /
+    return ctrl_q24_to_double(fw_speed_ref(&r->fw)) * r->fw.bases.w_rad_s /
            (double)r->fw.params.pole_pairs * 60.0 / (2.0 * CTRL_PI);
 }
 

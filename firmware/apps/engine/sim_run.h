@@ -110,7 +110,7 @@ typedef struct {
     /* Speed loop and overspeed (fw_config_t; from the machine file by default). */
     double speed_bw_hz, speed_pm_deg;     /* sizing (0 = firmware defaults) */
     double speed_kp, speed_ki;            /* explicit gains, N*m s/rad, N*m/rad (0 = sized) */
-    double overspeed_rpm;                 /* 0 = 1.05 x rated speed */
+    double overspeed_rpm;                 /* 0 = 1.05 x the machine's maximum speed (protect.h) */
     uint32_t torque_follow_fault_windows; /* fw_config_t's (0: warning only) */
     bool stop_on_fault;                   /* end the run at a fault (default false) */
     bool psi_adapt;                       /* fw_config_t.psi_adapt (default true) */

@@ -31,6 +31,23 @@
 #define ESC1_IWDG_MS 100u /* independent watchdog time-out */
 
 typedef struct {
+    /* The main loop's small fields first: near the start of the struct
+     * their accesses take short offsets (fw_t alone is 8 KB). */
+    volatile uint32_t isr_count;
+    uint32_t last_isr;            /* isr_count at the last watchdog refresh */
+    uint32_t reset_csr;           /* RCC_CSR at start-up (b.reset) */
+    uint32_t thr_losses;          /* signal losses so far (the main loop reports each) */
+    uint32_t now_ms;              /* main loop's millisecond clock */
+    uint32_t ms_cycle;            /* cycle count at its last tick */
+    uint32_t ms_cycles;           /* core cycles per millisecond */
+    uint32_t t_temp, temp_period; /* the temperature's last reading, its period (cycles) */
+    uint32_t thr_losses_told;     /* throttle losses reported */
+    bool offsets_told;            /* the calibration's offsets reported */
+    bool blink;                   /* the LED's phase on a fault */
+    bool temp_check;              /* board over-temperature trip enabled */
+    double temp_c;                /* last board temperature (NaN: sensor open/short) */
+    q24_t thr_tref;               /* speed mode: the torque when the signal was lost, Q24 pu */
+    thr_t thr;                    /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
     hal_t hal;
     fw_t fw;
     fw_link_t link;
@@ -39,17 +56,6 @@ typedef struct {
     uint32_t encoder_cpr;
     g4_hal_cfg_t hc;
     esc1_uart_t uart;
-    volatile uint32_t isr_count;
-    uint32_t last_isr;   /* isr_count at the last watchdog refresh */
-    uint32_t reset_csr;  /* RCC_CSR at start-up (b.reset) */
-    thr_t thr;           /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
-    q24_t thr_tref;      /* speed mode: the torque when the signal was lost, Q24 pu */
-    uint32_t thr_losses; /* signal losses so far (the main loop reports each) */
-    uint32_t now_ms;     /* main loop's millisecond clock */
-    uint32_t ms_cycle;   /* cycle count at its last tick */
-    uint32_t ms_cycles;  /* core cycles per millisecond */
-    bool temp_check;     /* board over-temperature trip enabled */
-    double temp_c;       /* last board temperature (NaN: sensor open/short) */
 #if defined(ESC1_SETTINGS)
     fw_settings_t settings; /* the record in flash (esc1_settings.c) */
     union {
@@ -113,5 +119,15 @@ void esc1_throttle_poll(esc1_t *s);
 
 /* The parameter table for fw_link_set_params. */
 void esc1_params_attach(esc1_t *s);
+
+/* One pass of the main loop (esc1_loop.c): the received bytes up to one
+ * command line (answered), telemetry out, esc1_service, the break
+ * interrupt's re-arm, the reports, the temperature and the LED (every
+ * temp_period cycles). */
+void esc1_loop_once(esc1_t *s);
+/* The watchdogs (the firmware's kick; the independent one refreshed while
+ * the control interrupt runs), the millisecond clock, the throttle; also the
+ * serial writer's idle hook. */
+void esc1_service(void *ctx);
 
 #endif /* FIRMWARE_APPS_ESC1_ESC1_APP_H */

@@ -8,18 +8,21 @@
  * with the gates never enabled and says so on USART2 once a second. Then
  * the board HAL (gates off, op-amps, ADCs calibrated, comparator thresholds,
  * TIM1 with break, encoder, TIM1 started and its phase checked), fw_init with
- * the compiled-in machine, the command link, the interrupts, the independent
- * watchdog.
+ * the compiled-in machine, the command link, the interrupts, the settings,
+ * the independent watchdog's running time-out (it runs from the reset
+ * handler's first instruction with a longer one, refreshed between these
+ * steps).
  *
  * Interrupts (priority: lower number first):
  *   0 TIM1_BRK_TIM15  break: the hardware has cleared MOE; latch the cause
  *   1 ADC1_2          end of the injected sequence: fw_isr_fast
  *   2 USART2          byte rings
  *   3 PendSV          the medium-rate task (fw_medium), pended by fw_isr_fast
- * Main loop: received bytes -> command interpreter, telemetry frames out,
- * firmware watchdog kick, the break interrupt re-armed after a long break, board temperature every
- * 100 ms, independent watchdog refreshed only while the control interrupt keeps running (also while
- * a reply waits for transmit space: esc1_service).
+ * Main loop (esc1_loop.c): one received command line at a time, telemetry
+ * frames out, the firmware watchdog's kick and the independent watchdog
+ * (refreshed only while the control interrupt keeps running; also while a
+ * reply waits for transmit space: esc1_service) after every line, the break
+ * interrupt re-armed after a long break, the board temperature every 100 ms.
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +32,7 @@
 #include "controller.h"
 #include "esc1_app.h"
 #include "esc1_report.h"
+#include "fw_stack.h"
 #include "g4_boot.h"
 #include "g4_clock.h"
 #include "g4_core.h"
@@ -39,6 +43,9 @@
 /* Everything lives in one instance; the interrupt handlers take no argument,
  * so it is reachable at file scope. */
 static esc1_t esc1;
+
+/* The main stack (stm32g431cb.ld). */
+extern uint32_t __stack_bottom__[], __stack_top__[];
 
 void ADC1_2_IRQHandler(void);
 void TIM1_BRK_TIM15_IRQHandler(void);
@@ -77,14 +84,13 @@ static void esc1_write(void *ctx, const uint8_t *bytes, size_t len)
     esc1_uart_write((esc1_uart_t *)ctx, bytes, len);
 }
 
-/* Start-up failed: gates off for good, the reason on the serial link once a
- * second by polled output (the USART interrupt may not be enabled; it is
- * masked so that the ring does not interleave). The watchdog is never
- * refreshed here: after a clock, board or fw_init failure it has not been
- * started (unless the IWDG_SW option byte starts it in hardware), and after
- * a failed watchdog start it runs (g4_iwdg_start writes the start key
- * first), so the chip resets within its time-out and says it again at every
- * start; a halted board is not kept looking alive. */
+/* Start-up failed: gates off for good, the reason on the serial link by
+ * polled output (the USART interrupt may not be enabled; it is masked so
+ * that the ring does not interleave). The watchdog, running since the reset
+ * handler's first instruction, is never refreshed here: the chip resets
+ * within its start-up time-out (0.48 .. 0.56 s) and says it again at every
+ * start, the report's first line "reset: watchdog"; a halted board is not
+ * kept looking alive. */
 static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_cpu_hz)
 {
     g4_tim1_gates_off_now();
@@ -95,46 +101,12 @@ static void esc1_halt(esc1_t *s, const char *what, const char *why, uint32_t f_c
     }
 }
 
-/* The main loop's liveness: the firmware watchdog's kick, the independent
- * watchdog refreshed only while the control interrupt keeps running, the
- * millisecond clock and the throttle. Also called while the serial writer
- * waits for space, so that neither a watchdog nor the throttle's 100 ms
- * loss time-out sees a long reply as a hang. */
-static void esc1_service(void *ctx)
-{
-    esc1_t *s = ctx;
-    fw_watchdog_kick(&s->fw);
-    const uint32_t n = s->isr_count;
-    if (n != s->last_isr) {
-        s->last_isr = n;
-        g4_iwdg_refresh();
-    }
-    while (g4_cycles() - s->ms_cycle >= s->ms_cycles) {
-        s->ms_cycle += s->ms_cycles;
-        s->now_ms++;
-    }
-    esc1_throttle_poll(s);
-}
-
-/* Board temperature every 100 ms; over-temperature or a broken sensor latch
- * the board trip (gates off; the firmware latches hw_trip). */
-static void esc1_temperature(esc1_t *s)
-{
-    const int32_t counts = g4_hal_temp_counts(&s->hal);
-    s->temp_c = g4_hal_temp_c(s->hal.board, counts);
-    if (!s->temp_check) {
-        g4_hal_trip_board(&s->hal, false);
-        return;
-    }
-    if (isnan(s->temp_c) || s->temp_c > s->hal.board->temp_trip_c) {
-        g4_hal_trip_board(&s->hal, true);
-    } else if (s->temp_c < s->hal.board->temp_trip_c - 10.0) {
-        g4_hal_trip_board(&s->hal, false); /* 10 C hysteresis */
-    }
-}
-
 int main(void)
 {
+    /* The stack below this frame painted: its high-water mark since reset in
+     * "status" and the start-up report (fw_stack.h). 16 words left for the
+     * painting's own call. */
+    fw_stack_paint(__stack_bottom__, g4_sp() - 16u);
     esc1_t *s = &esc1;
     const g4_board_t *b = &g4_board_esc1;
     g4_cycle_counter_init();
@@ -149,6 +121,9 @@ int main(void)
     const uint32_t f_cpu = clk == G4_OK ? b->sysclk_hz : G4_HSI_HZ;
     (void)esc1_uart_init(&s->uart, f_cpu, b->baud);
     esc1_report_startup(&s->uart, b, &boot, clk);
+    /* The watchdog runs from reset with its start-up time-out (g4_startup.c):
+     * refreshed after each step of the start-up, each far shorter. */
+    g4_iwdg_refresh();
     if (clk != G4_OK) {
         esc1_halt(s, "clock", g4_strerror(clk), f_cpu);
     }
@@ -162,15 +137,18 @@ int main(void)
     s->hc.encoder_cpr = s->encoder_cpr;
     s->hc.trip_current_a = esc1_hw_trip_a(b, &s->machine);
     const int hrc = g4_hal_init(&s->hal, b, &s->hc);
+    g4_iwdg_refresh();
     if (hrc != G4_OK) {
         esc1_halt(s, "board init", g4_strerror(hrc), f_cpu);
     }
     esc1_config_default(&s->fc, b, &s->machine, ctrl_find(ESC1_CTRL));
     const int frc = fw_init(&s->fw, &s->hal, &s->fc);
+    g4_iwdg_refresh();
     if (frc != FW_OK) {
         esc1_halt(s, "fw_init", fw_strerror(frc), f_cpu);
     }
     fw_link_init(&s->link, &s->fw, esc1_write, &s->uart);
+    fw_link_set_stack(&s->link, __stack_bottom__, __stack_top__);
     esc1_params_attach(s);
     esc1_throttle_init(s, f_cpu);
 
@@ -184,7 +162,10 @@ int main(void)
 #if defined(ESC1_SETTINGS)
     /* the saved settings (or the defaults), said on the link */
     esc1_settings_start(s);
+    g4_iwdg_refresh();
 #endif
+    esc1_report_stack(&s->uart, fw_stack_used(__stack_bottom__, __stack_top__),
+                      (uint32_t)((uintptr_t)__stack_top__ - (uintptr_t)__stack_bottom__));
 
     uint32_t pr, rlr;
     if (g4_iwdg_config(ESC1_IWDG_MS, 32000u, &pr, &rlr) != G4_OK ||
@@ -192,53 +173,14 @@ int main(void)
         esc1_halt(s, "watchdog", "LSI not ready", f_cpu);
     }
 
-    bool offsets_told = false;
-    uint32_t thr_losses_told = 0u;
     s->ms_cycles = f_cpu / 1000u;
     s->ms_cycle = g4_cycles();
     s->last_isr = s->isr_count;
     s->uart.idle = esc1_service;
     s->uart.idle_ctx = s;
-    uint32_t t_temp = g4_cycles();
-    const uint32_t temp_period = f_cpu / 10u;
+    s->t_temp = g4_cycles();
+    s->temp_period = f_cpu / 10u;
     for (;;) {
-        int c;
-        while ((c = esc1_uart_getc(&s->uart)) >= 0) {
-            fw_link_rx(&s->link, (uint8_t)c);
-        }
-        fw_link_poll(&s->link);
-        esc1_service(s);
-        /* The break interrupt, masked by a long break, back on once the
-         * comparators are low (the trip stays latched until a clear). */
-        (void)g4_hal_break_rearm(&s->hal);
-        if (s->thr_losses != thr_losses_told) {
-            thr_losses_told = s->thr_losses;
-            esc1_uart_puts(&s->uart, s->thr.cause == THR_CAUSE_NO_PULSE
-                                         ? "esc1: throttle: no pulse for 100 ms; torque to "
-                                           "zero, gates off\r\n"
-                                         : "esc1: throttle: no valid pulse for 100 ms; torque "
-                                           "to zero, gates off\r\n");
-        }
-        /* Once the offset calibration has ended (ready, or its fault): the
-         * measured offsets, which the fault alone would not show. */
-        const fw_state_id_t st_now = fw_state(&s->fw);
-        if (!offsets_told && st_now != FW_STATE_BOOT && st_now != FW_STATE_CALIB) {
-            char line[80];
-            offsets_told = true;
-            if (fw_link_offsets_text(&s->fw, line, sizeof line) > 0) {
-                esc1_uart_puts(&s->uart, "esc1: ");
-                esc1_uart_puts(&s->uart, line);
-                esc1_uart_puts(&s->uart, "\r\n");
-            }
-        }
-        if (g4_cycles() - t_temp >= temp_period) {
-            t_temp += temp_period;
-            esc1_temperature(s);
-            /* LED: on while running, blinking (5 Hz) on a fault. */
-            const fw_state_id_t st = fw_state(&s->fw);
-            static bool blink;
-            blink = !blink;
-            g4_gpio_write(b->led, st == FW_STATE_RUNNING || (st == FW_STATE_FAULT && blink));
-        }
+        esc1_loop_once(s);
     }
 }

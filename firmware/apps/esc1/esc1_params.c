@@ -346,7 +346,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     /* fw_init clears fw_t, so the controller in use is kept here for the
      * restore (else a refused machine left the firmware without one). */
     const ctrl_desc_t *ctrl = s->fw.ctrl;
-    g4_nvic_disable(G4_IRQ_ADC1_2);
+    hal_ctrl_hold(&s->hal, true);
     s->machine = *m;
     s->encoder_cpr = encoder_cpr;
     s->hal.info.encoder_counts_per_rev = encoder_cpr;
@@ -373,7 +373,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     } else {
         s->link.speed_max_rpm = 1.2 * s->machine.speed_rated_rpm;
     }
-    g4_nvic_enable(G4_IRQ_ADC1_2);
+    hal_ctrl_hold(&s->hal, false);
     /* In its range but refused by the core (e.g. a per-unit value outside its
      * Q format): "err 10 failed <quantity> = <value> outside [<min>, <max>]",
      * the previous data in force. */

@@ -42,9 +42,7 @@ void esc1_throttle_poll(esc1_t *s)
     if (t->state == THR_ARMED) {
         if (speed) {
             fw_set_speed_ref_rpm(fw, (double)o.ref / FX_ONE * fw->speed_info.speed_ref_max_rpm);
-            /* the medium task's last output (its slot is rewritten only two
-             * runs later; one aligned word) */
-            s->thr_tref = fw->mid_out[fw->mid_done & 1u].speed_tref;
+            s->thr_tref = fw_speed_loop_torque(fw); /* the medium task's last */
         } else {
             fw_set_torque_ref(fw, fx_mul(o.ref, fw->torque_ref_max));
         }

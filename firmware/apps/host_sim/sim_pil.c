@@ -405,9 +405,9 @@ static int sim_pil_setup(void *ctx, sim_run_t *r, const fw_config_t *fc, char *e
     p->cycle_clock_hz = rd.cycle_clock_hz;
     p->fs_hz = c->fs_hz;
     p->seq = 0u;
-    p->last_mode = r->fw.ref_mode;
-    p->last_torque = r->fw.torque_ref;
-    p->last_speed = r->fw.speed_ref;
+    p->last_mode = fw_ref_mode(&r->fw);
+    p->last_torque = fw_torque_ref(&r->fw);
+    p->last_speed = fw_speed_ref(&r->fw);
     clock_gettime(CLOCK_MONOTONIC, &p->t0);
     return 0;
 }
@@ -423,18 +423,19 @@ static int sim_pil_send_period(void *ctx, sim_run_t *r)
     s.trip = hal_trip_active(&r->hal);
     /* The main loop's commands since the last period, read from the host
      * firmware's request state (pipeline.h). */
-    s.cmd = (uint8_t)((fw->req_arm ? PIL_CMD_ARM : 0u) | (fw->req_disarm ? PIL_CMD_DISARM : 0u) |
-                      (fw->req_clear ? PIL_CMD_CLEAR : 0u) |
+    s.cmd = (uint8_t)((fw_cmd_pending(fw, FW_REQ_ARM) ? PIL_CMD_ARM : 0u) |
+                      (fw_cmd_pending(fw, FW_REQ_DISARM) ? PIL_CMD_DISARM : 0u) |
+                      (fw_cmd_pending(fw, FW_REQ_CLEAR) ? PIL_CMD_CLEAR : 0u) |
                       (r->cfg.kick_watchdog ? PIL_CMD_KICK : 0u));
-    if (fw->ref_mode == FW_REF_TORQUE &&
-        (p->last_mode != FW_REF_TORQUE || fw->torque_ref != p->last_torque)) {
+    if (fw_ref_mode(fw) == FW_REF_TORQUE &&
+        (p->last_mode != FW_REF_TORQUE || fw_torque_ref(fw) != p->last_torque)) {
         s.cmd |= PIL_CMD_TORQUE;
-        s.torque_ref = fw->torque_ref;
+        s.torque_ref = fw_torque_ref(fw);
     }
-    if (fw->ref_mode == FW_REF_SPEED &&
-        (p->last_mode != FW_REF_SPEED || fw->speed_ref != p->last_speed)) {
+    if (fw_ref_mode(fw) == FW_REF_SPEED &&
+        (p->last_mode != FW_REF_SPEED || fw_speed_ref(fw) != p->last_speed)) {
         s.cmd |= PIL_CMD_SPEED;
-        s.speed_ref = fw->speed_ref;
+        s.speed_ref = fw_speed_ref(fw);
     }
     uint8_t pl[64];
     const size_t n = pil_sample_pack(&s, pl, sizeof pl);
@@ -489,9 +490,9 @@ static int sim_pil_receive(void *ctx, sim_run_t *r)
         hal_trip_clear(&r->hal);
     }
     hal_gate_enable(&r->hal, (a.flags & PIL_OUT_GATES) != 0u);
-    p->last_mode = r->fw.ref_mode;
-    p->last_torque = r->fw.torque_ref;
-    p->last_speed = r->fw.speed_ref;
+    p->last_mode = fw_ref_mode(&r->fw);
+    p->last_torque = fw_torque_ref(&r->fw);
+    p->last_speed = fw_speed_ref(&r->fw);
     p->periods++;
     if (a.state == (uint8_t)FW_STATE_RUNNING) {
         p->run_n++;
