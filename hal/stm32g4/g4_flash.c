@@ -17,7 +17,11 @@ void g4_fault_handler(void);
 /* Core cycles a BSY wait may take (g4_flash_set_clock; 0: not given). */
 static uint32_t g4_flash_bsy_cycles;
 
-/* Set by the NMI when a read of the settings pages met ECCD. */
+/* A read of the settings pages in progress (g4_flash_read): the NMI takes an
+ * uncorrectable ECC error as that read's by it, as ST's EEPROM emulation
+ * decides by the read it has in progress. */
+static volatile uint32_t g4_flash_reading;
+/* Set by the NMI when it took the read's ECC error. */
 static volatile uint32_t g4_flash_eccd;
 
 static const char *const g4_flash_sr_names[16] = {
@@ -184,11 +188,15 @@ int g4_flash_program(unsigned p, uint32_t off, uint32_t lo, uint32_t hi)
     return rc;
 }
 
-/* ECCD is rc_w1; ECCIE kept, ECCC (a corrected error) left alone. */
-static void g4_flash_eccd_clear(void)
+/* ECCD and ECCC are rc_w1 (RM0440 sec. 3.7, FLASH_ECCR); ECCIE kept. Both
+ * cleared: ADDR_ECC is not updated while either is set, so an old corrected
+ * error (ECCC, which nothing else clears) would keep the address of a new
+ * one from being recorded. */
+static void g4_flash_ecc_clear(void)
 {
     const uint32_t eccr = g4_rd(G4_FLASH + G4_FLASH_ECCR);
-    g4_wr(G4_FLASH + G4_FLASH_ECCR, (eccr & G4_FLASH_ECCR_ECCIE) | G4_FLASH_ECCR_ECCD);
+    g4_wr(G4_FLASH + G4_FLASH_ECCR,
+          (eccr & G4_FLASH_ECCR_ECCIE) | G4_FLASH_ECCR_ECCD | G4_FLASH_ECCR_ECCC);
 }
 
 int g4_flash_read(unsigned p, uint32_t off, uint8_t *buf, size_t n)
@@ -197,34 +205,51 @@ int g4_flash_read(unsigned p, uint32_t off, uint8_t *buf, size_t n)
         return G4_FLASH_E_ADDR;
     }
     const uintptr_t base = G4_FLASH_SETTINGS_BASE + p * G4_FLASH_PAGE_SIZE;
+    g4_flash_ecc_clear(); /* this read's error gets its own address */
     g4_flash_eccd = 0u;
+    g4_flash_reading = 1u;
+    int rc = 0;
     for (size_t i = 0; i < n; i += 4u) {
         const uint32_t w = g4_rd(base + off + i);
-        /* the NMI handler cleared ECCD and noted it; where no NMI runs (the
-         * register model) ECCD itself says it */
         if (g4_flash_eccd != 0u || (g4_rd(G4_FLASH + G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD) != 0u) {
-            g4_flash_eccd_clear();
-            g4_flash_eccd = 0u;
-            return G4_FLASH_E_ECC;
+            /* The NMI takes it (and clears ECCD) as soon as the core gets to
+             * it: waited for, a little, with the read still marked in
+             * progress, so that a late NMI does not take it for a fault. */
+            for (unsigned k = 0; k < 64u && g4_flash_eccd == 0u; k++) {
+            }
+            rc = G4_FLASH_E_ECC;
+            break;
         }
         const size_t k = n - i < 4u ? n - i : 4u;
         for (size_t b = 0; b < k; b++) {
             buf[i + b] = (uint8_t)(w >> (8u * b));
         }
     }
-    return 0;
+    g4_flash_reading = 0u;
+    if (rc != 0) {
+        g4_flash_ecc_clear(); /* no NMI came (none reaches the register model) */
+        g4_flash_eccd = 0u;
+    }
+    return rc;
 }
 
 bool g4_flash_nmi_ecc(void)
 {
     const uint32_t eccr = g4_rd(G4_FLASH + G4_FLASH_ECCR);
+    if (g4_flash_reading == 0u || (eccr & G4_FLASH_ECCR_ECCD) == 0u ||
+        (eccr & G4_FLASH_ECCR_SYSF_ECC) != 0u) {
+        return false; /* no settings read, another NMI source, the system flash */
+    }
+    /* During the read the only data read from the bank is the settings
+     * pages; an address elsewhere is an instruction fetch's (the code's own
+     * error: a fault). With ECCC also set the address is the corrected
+     * error's, which the read's flag has to cover. */
     const uint32_t at = eccr & G4_FLASH_ECCR_ADDR_MASK;
     const uint32_t lo = G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE;
-    if ((eccr & G4_FLASH_ECCR_ECCD) == 0u || (eccr & G4_FLASH_ECCR_SYSF_ECC) != 0u || at < lo ||
-        at >= lo + 2u * G4_FLASH_PAGE_SIZE) {
+    if ((eccr & G4_FLASH_ECCR_ECCC) == 0u && (at < lo || at >= lo + 2u * G4_FLASH_PAGE_SIZE)) {
         return false;
     }
-    g4_flash_eccd_clear();
+    g4_flash_ecc_clear();
     g4_flash_eccd = 1u;
     return true;
 }

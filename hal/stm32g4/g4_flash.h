@@ -119,10 +119,14 @@ int g4_flash_erase(unsigned p);
 int g4_flash_program(unsigned p, uint32_t off, uint32_t lo, uint32_t hi);
 int g4_flash_read(unsigned p, uint32_t off, uint8_t *buf, size_t n);
 
-/* The NMI's ECC case: an uncorrectable ECC error (FLASH_ECCR.ECCD) while
- * reading the settings pages raises the NMI (RM0440 sec. 3.3.9); this clears
- * ECCD, notes it for g4_flash_read and returns true. False for any other
- * NMI (the caller then takes the fault path). */
+/* The NMI's ECC case: an uncorrectable ECC error (FLASH_ECCR.ECCD) raises
+ * the NMI (RM0440 sec. 3.3.9). It is a settings read's error when a read of
+ * the settings pages is in progress (g4_flash_read marks it), ECCD is set and
+ * its address lies in the settings pages (or cannot be told: ECCC set, the
+ * address then a corrected error's); this clears ECCD and ECCC, notes it for
+ * the read and returns true. False for anything else (no read in progress,
+ * an instruction fetch's error, the system flash, another NMI source): the
+ * caller then takes the fault path. */
 bool g4_flash_nmi_ecc(void);
 /* The NMI (NMI_Handler on the target): gates off, then g4_flash_nmi_ecc, or
  * the fault path (g4_fault_handler of g4_startup.c) for any other cause. */

@@ -7,7 +7,9 @@
  * TIMx_EGR.BG (software break: the hardware clears MOE and drives the outputs
  * to their idle, inactive level), written as the handler's first instructions
  * without touching the stack (a fault may come from a broken stack); then MOE
- * is cleared and the core waits for the independent watchdog. If the handler
+ * is cleared and the core waits for the independent watchdog, which the reset
+ * handler starts as its first instruction (so a fault before the application
+ * is up is a reset, not a silent halt). If the handler
  * itself faults, the core locks up, and SYSCFG_CFGR2.CLL (set by the
  * application) routes the lockup to the TIM1 system break as well.
  *
@@ -109,7 +111,9 @@ __attribute__((used)) void g4_fault_halt(void)
     g4_clr(G4_TIM1 + G4_TIM_BDTR, G4_TIM_BDTR_MOE);
     g4_board_fault_hook();
     for (;;) {
-        /* The independent watchdog resets the chip (gates off from reset). */
+        /* The independent watchdog, running since the reset handler's first
+         * instruction (and not stoppable), resets the chip: gates off from
+         * reset, "reset: watchdog" in the next start-up report. */
     }
 }
 
@@ -134,6 +138,15 @@ void _fini(void)
 
 void Reset_Handler(void)
 {
+    /* The independent watchdog first (RM0440 IWDG: the key 0xCCCC starts it
+     * with its reset prescaler /4 and reload 0xFFF, 4096 x 4 / f_LSI = 482 ..
+     * 555 ms at the data sheet's 29.5 .. 34 kHz), frozen while a debugger
+     * halts the core: a fault or a hang anywhere from here on ends in a reset
+     * (the fault handlers wait for it) and a "reset: watchdog" report, never
+     * in a silent halt. The application refreshes it between its start-up
+     * steps and then sets its own time-out (g4_iwdg_start). */
+    g4_wr(G4_IWDG + G4_IWDG_KR, G4_IWDG_KR_START);
+    g4_set(G4_DBGMCU + G4_DBGMCU_APB1FZR1, G4_DBGMCU_APB1FZR1_IWDG_STOP);
     /* FPU (CP10, CP11) full access before any floating-point instruction. */
     g4_set(G4_SCB + G4_SCB_CPACR, 0xFu << 20);
     __asm__ volatile("dsb\n\tisb" ::: "memory");

@@ -61,6 +61,15 @@ static struct {
     unsigned moe_off_seq;    /* seq of the first write clearing TIM1_BDTR.MOE, 0: none */
     unsigned flash_reg_seq;  /* seq of the first flash register access, 0: none */
     unsigned faults;         /* calls of the fault path (g4_fault_handler) */
+    /* The NMI (RM0440 sec. 3.3.9): a read of a torn double word sets ECCD
+     * (its address only while neither ECCC nor ECCD is set) and runs
+     * g4_flash_nmi at once, unless no_nmi; fetch_error: the next settings
+     * read meets an instruction fetch's ECCD instead (address in the code). */
+    bool no_nmi;
+    bool fetch_error;
+    bool eccc_first; /* a corrected error in the code just before the torn read */
+    unsigned nmi_runs;
+    bool nmi_gates_first; /* the last NMI cleared MOE before its first flash register access */
 } fm;
 
 #define NOW g4_mem_dwt[G4_DWT_CYCCNT / 4u]
@@ -81,6 +90,32 @@ static void model_reset(void)
     fm.poll_cycles = 8u;
     fm.erase_cycles = fm.prog_cycles = 3u * fm.poll_cycles;
     g4_flash_set_clock(MODEL_HZ);
+}
+
+void g4_flash_nmi(void);
+
+/* ECCD with an address (kept while ECCC or ECCD is already set), then the
+ * NMI as the core takes it. */
+static void model_ecc_nmi(uint32_t addr)
+{
+    if (fm.eccc_first) {
+        fm.eccc_first = false;
+        REG(G4_FLASH_ECCR) |= G4_FLASH_ECCR_ECCC | 0x1000u; /* its address is kept */
+    }
+    const uint32_t eccr = REG(G4_FLASH_ECCR);
+    uint32_t v = eccr | G4_FLASH_ECCR_ECCD;
+    if ((eccr & (G4_FLASH_ECCR_ECCC | G4_FLASH_ECCR_ECCD)) == 0u) {
+        v = (v & ~G4_FLASH_ECCR_ADDR_MASK) | (addr & G4_FLASH_ECCR_ADDR_MASK);
+    }
+    REG(G4_FLASH_ECCR) = v;
+    if (fm.no_nmi) {
+        return;
+    }
+    fm.nmi_runs++;
+    fm.moe_off_seq = fm.flash_reg_seq = 0u;
+    g4_mem_tim1[G4_TIM_BDTR / 4u] |= G4_TIM_BDTR_MOE; /* gates on when it strikes */
+    g4_flash_nmi();
+    fm.nmi_gates_first = fm.moe_off_seq != 0u && fm.moe_off_seq < fm.flash_reg_seq;
 }
 
 /* The fault path of g4_startup.c, counted. */
@@ -278,13 +313,14 @@ uint32_t g4_trace_read(uintptr_t reg)
     }
     if (in_settings(reg)) {
         const size_t w = (reg - (uintptr_t)g4_mem_flash_settings) / 4u;
-        if (fm.ecc_bad[w / 2u] != 0u) {
-            REG(G4_FLASH_ECCR) =
-                (REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCIE) | G4_FLASH_ECCR_ECCD |
-                ((G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + (uint32_t)(w * 4u)) &
-                 G4_FLASH_ECCR_ADDR_MASK);
+        const uint32_t v = g4_mem_flash_settings[w];
+        if (fm.fetch_error) {
+            fm.fetch_error = false;
+            model_ecc_nmi(0x1000u); /* the code's own double word */
+        } else if (fm.ecc_bad[w / 2u] != 0u) {
+            model_ecc_nmi(G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + (uint32_t)(w * 4u));
         }
-        return g4_mem_flash_settings[w];
+        return v;
     }
     const uintptr_t off = reg - (uintptr_t)g4_mem_flash;
     if (off == G4_FLASH_SR) {
@@ -456,24 +492,78 @@ static void test_bad_addresses(void)
     TEST_ASSERT_EQUAL_UINT(0u, fm.n); /* nothing written */
 }
 
+/* An uncorrectable ECC error in a settings read: the NMI (run by the model as
+ * the core takes it) turns the gates off first, takes it as the read's error
+ * (a read is in progress), clears ECCD and ECCC; the read says ECCD. */
 static void test_ecc_read_and_nmi(void)
 {
     fm.ecc_bad[3] = 1u; /* page 62, bytes 24..31 */
     uint8_t b[64];
     TEST_ASSERT_EQUAL_INT(0, g4_flash_read(0u, 0u, b, 24u));
     TEST_ASSERT_EQUAL_INT(G4_FLASH_E_ECC, g4_flash_read(0u, 0u, b, sizeof b));
-    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD); /* cleared */
-    /* the NMI: ECCD in a settings page is handled, elsewhere it is a fault */
-    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | (G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + 24u);
-    TEST_ASSERT_TRUE(g4_flash_nmi_ecc());
-    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD);
-    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | 0x1000u; /* in the code */
-    TEST_ASSERT_FALSE(g4_flash_nmi_ecc());
-    REG(G4_FLASH_ECCR) = 0u; /* another NMI source */
-    TEST_ASSERT_FALSE(g4_flash_nmi_ecc());
+    TEST_ASSERT_EQUAL_UINT(1u, fm.nmi_runs);
+    TEST_ASSERT_TRUE_MESSAGE(fm.nmi_gates_first, "flash read before gates off");
+    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
+    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & (G4_FLASH_ECCR_ECCD | G4_FLASH_ECCR_ECCC));
     /* the page erased: readable again */
     TEST_ASSERT_EQUAL_INT(0, g4_flash_erase(0u));
     TEST_ASSERT_EQUAL_INT(0, g4_flash_read(0u, 0u, b, sizeof b));
+}
+
+/* An old corrected error elsewhere (ECCC set, never cleared by anything
+ * else) keeps FLASH_ECCR's address (RM0440: ADDR_ECC is not updated while
+ * ECCC or ECCD is set): the read clears it first, so its own error has its
+ * address; and were it set during the read, the read in progress still
+ * decides. A decision by the address alone took the fault path: a settings
+ * read's ECC error halted the board. */
+static void test_ecc_with_an_old_corrected_error(void)
+{
+    fm.ecc_bad[3] = 1u;
+    uint8_t b[64];
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCC | 0x1000u; /* corrected, in the code, long ago */
+    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_ECC, g4_flash_read(0u, 0u, b, sizeof b));
+    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
+    TEST_ASSERT_EQUAL_UINT(1u, fm.nmi_runs);
+    /* a corrected error (an instruction fetch's) during the read, right
+     * before the torn double word: the address is the corrected one's, and
+     * the read in progress decides */
+    fm.eccc_first = true;
+    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_ECC, g4_flash_read(0u, 0u, b, sizeof b));
+    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
+    TEST_ASSERT_EQUAL_UINT(2u, fm.nmi_runs);
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCC | 0x1000u;
+    fm.ecc_bad[3] = 0u;
+    TEST_ASSERT_EQUAL_INT(0, g4_flash_read(0u, 0u, b, sizeof b));
+    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCC); /* cleared */
+}
+
+/* The NMI is a fault unless a settings read is in progress: an ECC error at
+ * a settings address with no read (the address alone does not make it the
+ * store's), an instruction fetch's error during a read (its address in the
+ * code), any other NMI source. */
+static void test_ecc_nmi_outside_a_read_is_a_fault(void)
+{
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | (G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + 24u);
+    TEST_ASSERT_FALSE(g4_flash_nmi_ecc());
+    REG(G4_FLASH_ECCR) = 0u; /* another NMI source (clock security) */
+    TEST_ASSERT_FALSE(g4_flash_nmi_ecc());
+    uint8_t b[16];
+    fm.fetch_error = true;
+    (void)g4_flash_read(0u, 0u, b, sizeof b);
+    TEST_ASSERT_EQUAL_UINT(1u, fm.nmi_runs);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, fm.faults, "an instruction fetch's ECC error is a fault");
+}
+
+/* Where no NMI comes (a register model without one), the read waits a
+ * moment for it, then reports the error itself and clears the flags. */
+static void test_ecc_without_nmi(void)
+{
+    fm.no_nmi = true;
+    fm.ecc_bad[2] = 1u;
+    uint8_t b[32];
+    TEST_ASSERT_EQUAL_INT(G4_FLASH_E_ECC, g4_flash_read(0u, 0u, b, sizeof b));
+    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD);
+    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
 }
 
 /* BSY never clears: the driver gives up after G4_FLASH_BSY_MS of core
@@ -507,24 +597,16 @@ static void test_no_clock_refused(void)
     TEST_ASSERT_EQUAL_UINT(0u, fm.n);
 }
 
-/* The NMI turns the gates off (TIM1_BDTR.MOE cleared) before it reads any
- * flash register; a settings-page ECC error returns, any other NMI takes the
- * fault path. */
+/* Any other NMI: the gates off (TIM1_BDTR.MOE cleared) before the NMI reads
+ * any flash register, then the fault path. */
 static void test_nmi_gates_off_first(void)
 {
     g4_mem_tim1[G4_TIM_BDTR / 4u] = G4_TIM_BDTR_MOE | G4_TIM_BDTR_BKE;
-    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | (G4_FLASH_SETTINGS_PAGE * G4_FLASH_PAGE_SIZE + 8u);
+    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | 0x1000u; /* in the code: a fault */
     g4_flash_nmi();
     TEST_ASSERT_TRUE_MESSAGE(fm.moe_off_seq != 0u, "MOE not cleared");
     TEST_ASSERT_TRUE_MESSAGE(fm.moe_off_seq < fm.flash_reg_seq, "flash read before gates off");
     TEST_ASSERT_EQUAL_HEX32(G4_TIM_BDTR_BKE, g4_mem_tim1[G4_TIM_BDTR / 4u]);
-    TEST_ASSERT_EQUAL_HEX32(0u, REG(G4_FLASH_ECCR) & G4_FLASH_ECCR_ECCD);
-    TEST_ASSERT_EQUAL_UINT(0u, fm.faults);
-    g4_mem_tim1[G4_TIM_BDTR / 4u] = G4_TIM_BDTR_MOE;
-    fm.moe_off_seq = fm.flash_reg_seq = 0u;
-    REG(G4_FLASH_ECCR) = G4_FLASH_ECCR_ECCD | 0x1000u; /* in the code: a fault */
-    g4_flash_nmi();
-    TEST_ASSERT_TRUE(fm.moe_off_seq != 0u && fm.moe_off_seq < fm.flash_reg_seq);
     TEST_ASSERT_EQUAL_UINT(1u, fm.faults);
 }
 
@@ -631,6 +713,9 @@ int main(void)
     RUN_TEST(test_already_unlocked_no_keys);
     RUN_TEST(test_bad_addresses);
     RUN_TEST(test_ecc_read_and_nmi);
+    RUN_TEST(test_ecc_with_an_old_corrected_error);
+    RUN_TEST(test_ecc_nmi_outside_a_read_is_a_fault);
+    RUN_TEST(test_ecc_without_nmi);
     RUN_TEST(test_busy_timeout);
     RUN_TEST(test_no_clock_refused);
     RUN_TEST(test_nmi_gates_off_first);
