@@ -96,7 +96,7 @@ static inline void fw_link_set_hold(fw_link_t *l, const char *why)
     l->hold = why;
 }
 /* The main stack [lo, hi), painted at start-up (fw_stack.h): "status" then
- * gives its high-water mark (stack_used=, stack_size=). */
+ * gives its high-water mark (stack_used=<bytes> size=<bytes>). */
 void fw_link_set_stack(fw_link_t *l, const uint32_t *lo, const uint32_t *hi);
 /* For an application parameter's set (main loop) that fails because the core
  * refused the configuration: the reason (fw_t.why before the application

@@ -313,7 +313,7 @@ static void cmd_status_cmd(cmd_t *c)
         cmd_err(c, CMD_E_UNSUPPORTED, NULL);
         return;
     }
-    cmd_ok_list(c, st.stack_size != 0u ? 12u : 10u);
+    cmd_ok_list(c, st.stack_size != 0u ? 11u : 10u);
     cmd_item_str(c, "state=", st.state);
     cmd_item_str(c, "armed=", st.armed ? "1" : "0");
     cmd_item_str(c, "ctrl=", st.ctrl);
@@ -338,9 +338,7 @@ static void cmd_status_cmd(cmd_t *c)
         cmd_item_begin(c);
         cmd_out_str(c, "stack_used=");
         cmd_out_u32(c, st.stack_used);
-        cmd_out_flush(c);
-        cmd_item_begin(c);
-        cmd_out_str(c, "stack_size=");
+        cmd_out_str(c, " size=");
         cmd_out_u32(c, st.stack_size);
         cmd_out_flush(c);
     }

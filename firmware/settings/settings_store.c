@@ -138,7 +138,7 @@ size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap)
             p++;
         }
         if (p == 2u) {
-            n = snprintf(out, cap, "settings: no record in flash, compiled-in defaults");
+            n = snprintf(out, cap, "settings: no record in flash,");
         } else {
             /* an older or newer format is named first */
             for (unsigned q = 0; q < 2u; q++) {
@@ -149,13 +149,18 @@ size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap)
             if (scan->status[p] == SETTINGS_E_OLD || scan->status[p] == SETTINGS_E_NEW) {
                 n = snprintf(out, cap,
                              "settings: page %u: record format %u (this firmware reads %u to "
-                             "%u), refused; compiled-in defaults",
+                             "%u), refused;",
                              p, (unsigned)scan->format[p], SETTINGS_FORMAT_MIN, SETTINGS_FORMAT);
             } else {
                 n = snprintf(out, cap,
-                             "settings: page %u: %s, no valid record; compiled-in defaults", p,
+                             "settings: page %u: %s, no valid record;", p,
                              settings_status_name(scan->status[p]));
             }
+        }
+        /* what runs instead, once for the three cases (flash) */
+        if (n >= 0 && (size_t)n < cap) {
+            const int m = snprintf(out + n, cap - (size_t)n, " compiled-in defaults");
+            n = m < 0 ? m : n + m;
         }
     }
     return n < 0 ? 0u : ((size_t)n < cap ? (size_t)n : cap - 1u);

@@ -90,3 +90,8 @@ void f4_nvic_disable(uint32_t irq)
 {
     f4_wr(F4_NVIC + F4_NVIC_ICER(irq / 32u), 1u << (irq % 32u));
 }
+
+bool f4_nvic_enabled(uint32_t irq)
+{
+    return (f4_rd(F4_NVIC + F4_NVIC_ISER(irq / 32u)) & (1u << (irq % 32u))) != 0u;
+}

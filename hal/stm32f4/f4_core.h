@@ -61,6 +61,7 @@ bool f4_wait_bits(uintptr_t reg, uint32_t mask, uint32_t want, uint32_t timeout_
 void f4_nvic_set_priority(uint32_t irq, uint32_t prio);
 void f4_nvic_enable(uint32_t irq);
 void f4_nvic_disable(uint32_t irq);
+bool f4_nvic_enabled(uint32_t irq);
 
 /* PendSV (the firmware's medium-rate task): priority 0 .. 15 (SHPR3), and
  * pending it (ICSR.PENDSVSET). */

@@ -134,6 +134,19 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
     f4_wr(F4_TIM1 + F4_TIM_CCR(3u), pwm->cmp[2] < m ? pwm->cmp[2] : m);
 }
 
+/* The control interrupt is the ADCs' (the injected sequence's end). */
+void hal_ctrl_hold(hal_t *h, bool hold)
+{
+    if (hold) {
+        if (h->hold_depth++ == 0u) {
+            h->hold_was_on = f4_nvic_enabled(F4_IRQ_ADC);
+            f4_nvic_disable(F4_IRQ_ADC);
+        }
+    } else if (h->hold_depth != 0u && --h->hold_depth == 0u && h->hold_was_on) {
+        f4_nvic_enable(F4_IRQ_ADC);
+    }
+}
+
 void hal_gate_enable(hal_t *h, bool enable)
 {
     if (enable && !hal_trip_active(h)) {

@@ -79,6 +79,8 @@ struct hal {
     volatile uint32_t break_n, break_acked;
     volatile bool board_trip;
     volatile bool cfg_lost;
+    uint8_t hold_depth; /* hal_ctrl_hold's nesting (main loop) */
+    bool hold_was_on;   /* the ADC interrupt was enabled at the outermost hold */
     volatile bool hold;
     /* gate driver */
     f4_spi_t spi;

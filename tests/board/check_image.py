@@ -16,12 +16,22 @@ Reads the ELF (section and symbol tables, parsed here) and the .bin beside it:
     separates the flash's ECC double-error NMI (a read result of the store)
     from any other NMI, sent to the fault handler (hal/stm32g4/g4_flash.c,
     tested on the host in test_g4_flash.c);
+  - the reset handler starts the independent watchdog (IWDG_KR = 0xCCCC,
+    RM0440 IWDG) before it calls anything (the data and bss set-up, main):
+    a fault or a hang anywhere after the reset vector ends in a watchdog
+    reset, not in a silent halt (read from its disassembly, the registers'
+    values followed through literal loads and immediates);
   - the .hex and .map files exist beside the .elf.
 Exit 0 when all hold; prints each check.
 """
 import os
+import re
 import struct
+import subprocess
 import sys
+
+IWDG_KR = 0x40003000
+IWDG_START = 0xCCCC
 
 FLASH = 0x08000000
 SRAM_TOP = 0x20000000 + 32 * 1024
@@ -59,6 +69,48 @@ def elf_symbols(data, secs_list, secs):
         if name and (info & 0xF) == 2:  # STT_FUNC
             syms.setdefault(name, value)
     return syms
+
+
+def word_at(data, secs, addr):
+    for s in secs.values():
+        if s["type"] == 1 and s["addr"] <= addr < s["addr"] + s["size"]:
+            return struct.unpack_from("<I", data, s["offset"] + addr - s["addr"])[0]
+    return None
+
+
+def iwdg_started_first(elf, data, secs):
+    """True when Reset_Handler stores 0xCCCC to IWDG_KR before its first call."""
+    out = subprocess.run(["arm-none-eabi-objdump", "-d", "--no-show-raw-insn", elf],
+                         capture_output=True, text=True, check=True).stdout
+    body = re.search(r"<Reset_Handler>:\n(.*?)\n\n", out, re.S)
+    if body is None:
+        return False
+    regs = {}
+    for line in body.group(1).splitlines():
+        m = re.match(r"\s*[0-9a-f]+:\s+(\S+)\s*(.*)", line)
+        if not m:
+            continue
+        op, args = m.group(1), m.group(2).split("@")
+        ops = args[0].strip()
+        note = args[1] if len(args) > 1 else ""
+        dst = ops.split(",")[0].strip()
+        if op.startswith("bl") or op.startswith("blx"):
+            return False  # a call before the watchdog's start
+        lit = re.search(r"\(([0-9a-f]+) <", note)
+        imm = re.search(r"#(-?\d+)$", ops)
+        if op.startswith("ldr") and lit and "[pc" in ops:
+            regs[dst] = word_at(data, secs, int(lit.group(1), 16))
+        elif op.split(".")[0] in ("mov", "movw", "movs") and imm:
+            regs[dst] = int(imm.group(1)) & 0xFFFFFFFF
+        elif op.startswith("str"):
+            m2 = re.match(r"(\w+), \[(\w+)(?:, #(-?\d+))?\]$", ops)
+            if m2 and regs.get(m2.group(1)) == IWDG_START and \
+                    regs.get(m2.group(2)) is not None and \
+                    regs[m2.group(2)] + int(m2.group(3) or 0) == IWDG_KR:
+                return True
+        elif dst in regs:
+            regs.pop(dst)  # any other write: its value no longer known
+    return False
 
 
 def main():
@@ -112,6 +164,8 @@ def main():
     others = [i for i in range(16, N_VECTORS) if i not in used and i != 16 + 25 and i != 16 + 30]
     check(all(words[i] == ((fault or 0) | 1) for i in others),
           "unused IRQ vectors -> gates-off fault handler")
+    check(iwdg_started_first(elf, data, secs),
+          "Reset_Handler starts the independent watchdog (IWDG_KR = 0xCCCC) before any call")
     base = elf[:-4] if elf.endswith(".elf") else elf
     binf = base + ".bin"
     check(os.path.exists(binf) and open(binf, "rb").read(8) == struct.pack("<II", *words[:2]),

@@ -3,7 +3,8 @@
  * (docs/architecture.md, "State shared between the contexts"; pipeline.h,
  * fw_from_main_t and fw_to_main_t), checked around every period of closed-loop
  * runs that go through what the main loop does to a drive: references in
- * torque and speed mode, telemetry started, restarted and stopped, disarm,
+ * torque and speed mode, live changes (the speed loop's gains, a
+ * controller's tunable), telemetry started, restarted and stopped, disarm,
  * arm, a fault and its clear, commissioning steps that drive the legs and the
  * controller (bringup gates, bringup run), the link's status.
  *
@@ -187,6 +188,17 @@ static void test_running_and_telemetry(void)
     periods(30);
     expect_ok("ref speed 600");
     periods(200);
+    /* live changes while running (pipeline.h): the speed loop's gains and a
+     * tunable of the controller, each a request the interrupt takes */
+    const fw_config_t *cfg = &run.fw.cfg;
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_speed_retune(&run.fw, 0.8 * run.fw.speed_info.bandwidth_hz,
+                                                 cfg->speed_pm_deg, 0.0, 0.0));
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_tunable_set(&run.fw, "lambda", 0.5));
+    TEST_ASSERT_TRUE(fw_cmd_pending(&run.fw, FW_REQ_CTRL_TUNE));
+    periods(2);
+    TEST_ASSERT_FALSE(fw_cmd_pending(&run.fw, FW_REQ_SPEED_TUNE));
+    TEST_ASSERT_FALSE(fw_cmd_pending(&run.fw, FW_REQ_CTRL_TUNE));
+    periods(100);
     expect_ok("tel start i_a i_b every 1"); /* a new stream drops the last one's records */
     periods(30);
     expect_ok("status");

@@ -132,9 +132,7 @@ void board_app_throttle_poll(board_app_t *a)
     if (t->state == THR_ARMED) {
         if (speed) {
             fw_set_speed_ref_rpm(fw, (double)o.ref / FX_ONE * fw->speed_info.speed_ref_max_rpm);
-            /* the medium task's last output (its slot is rewritten only two
-             * runs later; one aligned word) */
-            a->thr_tref = fw->mid_out[fw->mid_done & 1u].speed_tref;
+            a->thr_tref = fw_speed_loop_torque(fw); /* the medium task's last */
         } else {
             fw_set_torque_ref(fw, fx_mul(o.ref, fw->torque_ref_max));
         }

@@ -48,13 +48,13 @@ typedef struct {
     double temp_c;                /* last board temperature (NaN: sensor open/short) */
     q24_t thr_tref;               /* speed mode: the torque when the signal was lost, Q24 pu */
     thr_t thr;                    /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
+    ctrl_machine_t machine; /* the machine data the firmware runs with */
+    uint32_t encoder_cpr;
+    g4_hal_cfg_t hc;
     hal_t hal;
     fw_t fw;
     fw_link_t link;
     fw_config_t fc;
-    ctrl_machine_t machine; /* the machine data the firmware runs with */
-    uint32_t encoder_cpr;
-    g4_hal_cfg_t hc;
     esc1_uart_t uart;
 #if defined(ESC1_SETTINGS)
     fw_settings_t settings; /* the record in flash (esc1_settings.c) */

@@ -67,10 +67,9 @@ void esc1_loop_once(esc1_t *s)
     if (s->thr_losses != s->thr_losses_told) {
         s->thr_losses_told = s->thr_losses;
         esc1_uart_puts(&s->uart, s->thr.cause == THR_CAUSE_NO_PULSE
-                                     ? "esc1: throttle: no pulse for 100 ms; torque to "
-                                       "zero, gates off\r\n"
-                                     : "esc1: throttle: no valid pulse for 100 ms; torque "
-                                       "to zero, gates off\r\n");
+                                     ? "esc1: throttle: no pulse"
+                                     : "esc1: throttle: no valid pulse");
+        esc1_uart_puts(&s->uart, " for 100 ms; torque to zero, gates off\r\n");
     }
     /* Once the offset calibration has ended (ready, or its fault): the
      * measured offsets, which the fault alone would not show. */

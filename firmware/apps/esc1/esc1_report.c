@@ -39,7 +39,7 @@ void esc1_report_stack(esc1_uart_t *u, uint32_t used, uint32_t size)
 {
     char line[80];
     const int n = snprintf(line, sizeof line,
-                           "esc1: stack: %lu of %lu B used since reset (high-water mark)\r\n",
+                           "esc1: stack: %lu of %lu B used (high-water mark)\r\n",
                            (unsigned long)used, (unsigned long)size);
     if (n > 0) {
         esc1_uart_puts(u, line);

@@ -364,7 +364,9 @@ int main(void)
     for (;;) {
         int c;
         while ((c = board_uart_getc(&a->uart)) >= 0) {
-            fw_link_rx(&a->link, (uint8_t)c);
+            if (fw_link_rx(&a->link, (uint8_t)c)) {
+                break; /* one command line per pass: the watchdogs after each */
+            }
         }
         fw_link_poll(&a->link);
         board_app_service(a);
