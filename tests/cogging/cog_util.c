@@ -96,6 +96,7 @@ void cog_ripple(const sim_machine_t *m, const char *ctrl, const int16_t *table, 
         }
     }
     TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    sim_run_free(&r);
     out->speed_sd_rpm = sqrt(fmax(s2 / (double)n - (s1 / (double)n) * (s1 / (double)n), 0.0));
     out->speed_cog_rpm = cog_harmonics(fc, fs, pc.cog_n, n);
 
@@ -128,6 +129,7 @@ void cog_ripple(const sim_machine_t *m, const char *ctrl, const int16_t *table, 
         }
     }
     TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    sim_run_free(&r);
     out->torque_sd_nm = sqrt(fmax(s2 / (double)n - (s1 / (double)n) * (s1 / (double)n), 0.0));
     out->torque_cog_nm = cog_harmonics(fc, fs, pc.cog_n, n);
 }
@@ -154,6 +156,7 @@ int cog_calibrate(const sim_machine_t *m, double rpm, double bw_hz, int16_t *tab
     if (!id.finished || id.err != CM_E_NONE) {
         printf("cogging calibration: %s (%d %d %d)\n", cm_err_name(id.err), (int)fw->cm.detail[0],
                (int)fw->cm.detail[1], (int)fw->cm.detail[2]);
+        sim_run_free(&r);
         return id.err != CM_E_NONE ? id.err : -1;
     }
     *peak_nm = fw->cm.detail[0] / 16777216.0 * fw->bases.torque_nm;
@@ -162,5 +165,6 @@ int cog_calibrate(const sim_machine_t *m, double rpm, double bw_hz, int16_t *tab
     const int16_t *t = fw_cogging_table(fw, &n);
     TEST_ASSERT_NOT_NULL(t);
     memcpy(table, t, sizeof(int16_t) * CTRL_COG_N);
+    sim_run_free(&r);
     return 0;
 }
