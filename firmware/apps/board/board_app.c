@@ -30,6 +30,7 @@ int board_app_start(board_app_t *a, const board_app_port_t *port, hal_t *hal)
     a->temp_c = NAN;
     a->ms_ticks = port->ticks_hz / 1000u;
     a->ms_tick = port->ticks();
+    a->isr_watch_ticks = (uint32_t)((uint64_t)BOARD_ISR_WATCH_US * port->ticks_hz / 1000000u);
     board_app_config_default(a, &a->fc, &a->machine, ctrl_find(port->ctrl));
     const int rc = fw_init(&a->fw, hal, &a->fc);
     fw_link_init(&a->link, &a->fw, board_app_write, &a->uart);
@@ -56,6 +57,11 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
     /* fw_init clears fw_t: the controller in use kept for the restore */
     const ctrl_desc_t *ctrl = a->fw.ctrl;
     a->port->control_irq(false);
+    /* fw_init blocks the main loop for longer than the run window (the
+     * board's documentation gives its count), the interrupt masked. */
+    if (a->port->watchdog_long != NULL) {
+        a->port->watchdog_long(a, true);
+    }
     a->machine = *m;
     a->encoder_cpr = encoder_cpr;
     /* every board back-end keeps the hal.h description it reports in its
@@ -85,6 +91,9 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
     } else {
         a->link.speed_max_rpm = 1.2 * a->machine.speed_rated_rpm;
     }
+    if (a->port->watchdog_long != NULL) {
+        a->port->watchdog_long(a, false);
+    }
     a->port->control_irq(true);
     return rc == FW_OK ? CMD_OK : CMD_E_FAILED;
 }
@@ -97,6 +106,11 @@ void board_app_service(void *ctx)
     if (n != a->last_isr || a->link.hold != NULL) {
         a->last_isr = n;
         a->port->watchdog_refresh();
+    }
+    if (a->port->isr_stalled != NULL &&
+        board_isr_watch_check(&a->isr_watch, n, a->port->ticks(), a->port->gates_on(),
+                              a->isr_watch_ticks)) {
+        a->port->isr_stalled(a);
     }
     while (a->port->ticks() - a->ms_tick >= a->ms_ticks) {
         a->ms_tick += a->ms_ticks;

@@ -24,6 +24,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "board_isr_watch.h"
 #include "board_uart.h"
 #include "controller.h"
 #include "ctrl_params.h"
@@ -52,6 +53,16 @@ typedef struct {
     /* one new throttle pulse since the last call: width and period, us */
     bool (*throttle_read)(board_app_t *a, uint32_t *width_us, uint32_t *period_us);
     void (*watchdog_refresh)(void);
+    /* The watchdog's long window (on) while the main loop blocks without the
+     * control interrupt (the firmware's re-initialisation), its run window
+     * again (off); NULL: none. */
+    void (*watchdog_long)(const board_app_t *a, bool on);
+    /* The gate outputs on as the hardware has them, and what the main loop
+     * does when the control interrupt has stopped with them on
+     * (board_isr_watch): gates off and held, the reason said. NULL: not
+     * watched. */
+    bool (*gates_on)(void);
+    void (*isr_stalled)(board_app_t *a);
     /* a free-running clock (the main loop's milliseconds) and its rate */
     uint32_t (*ticks)(void);
     uint32_t ticks_hz;
@@ -68,6 +79,8 @@ struct board_app {
     board_uart_t uart;
     volatile uint32_t isr_count; /* control interrupts so far */
     uint32_t last_isr;           /* isr_count at the last watchdog refresh */
+    board_isr_watch_t isr_watch; /* the interrupt's progress with the gates on */
+    uint32_t isr_watch_ticks;    /* BOARD_ISR_WATCH_US in port->ticks() */
     uint32_t reset_flags;        /* the reset cause's flags (b.reset) */
     thr_t thr;                   /* the throttle ([throttle] settings in thr.cfg) */
     q24_t thr_tref;              /* speed mode: the torque when the signal was lost, Q24 pu */

@@ -90,5 +90,7 @@ void f405_settings_start(f405_t *s);
  * or why there is none. */
 void f405_report_startup(f405_t *s, uint32_t csr);
 void f405_report_line(f405_t *s, const char *a, const char *b, const char *c);
+/* The watchdog's window for a time-out (the values above reach one). */
+void f405_watchdog_set(const f405_t *s, uint32_t ms);
 
 #endif /* FIRMWARE_APPS_F405_F405_APP_H */

@@ -44,6 +44,7 @@
 #include "f4_core.h"
 #include "f4_regs.h"
 #include "f4_startup.h"
+#include "f4_tim.h"
 #include F405_BOARD_HEADER
 
 _Static_assert(offsetof(f405_t, app) == 0, "the link's context is the f405_t");
@@ -189,6 +190,35 @@ static uint32_t f405_ticks(void)
     return f4_ticks(F405_BOARD.tick_tim);
 }
 
+/* Around the firmware's re-initialisation (24.9 M instructions, at least
+ * 148 ms at 168 MHz: docs/f405.md) the erase's window, then the run window. */
+static void f405_watchdog_long(const board_app_t *a, bool on)
+{
+    f405_watchdog_set((const f405_t *)a, on ? F405_IWDG_ERASE_MS : F405_IWDG_RUN_MS);
+}
+
+static bool f405_gates_on(void)
+{
+    return (f4_rd(F4_TIM1 + F4_TIM_BDTR) & F4_TIM_BDTR_MOE) != 0u;
+}
+
+/* The control interrupt stopped with the gates on: off at once (break
+ * event, MOE cleared, EN_GATE low), held off for good with the reason. */
+static void f405_isr_stalled(board_app_t *a)
+{
+    f405_t *s = (f405_t *)a;
+    f4_tim1_gates_off_now();
+    s->hal.hold = true;
+    f4_hal_gate_pins_safe(s->board);
+    if (a->link.hold == NULL) {
+        (void)snprintf(s->hold_why, sizeof s->hold_why,
+                       "gates held off: control interrupt stopped (no period for %u ms)",
+                       (unsigned)(BOARD_ISR_WATCH_US / 1000u));
+        f405_report_line(s, s->hold_why, "", "");
+        fw_link_set_hold(&a->link, s->hold_why);
+    }
+}
+
 static const board_app_port_t f405_port = {
     .tag = f405_tag,
     .machine = &f405_default_machine,
@@ -199,6 +229,9 @@ static const board_app_port_t f405_port = {
     .set_trip = NULL, /* the DRV8301's VDS level is the board's, not the machine's */
     .throttle_read = f405_throttle_read,
     .watchdog_refresh = f4_iwdg_refresh,
+    .watchdog_long = f405_watchdog_long,
+    .gates_on = f405_gates_on,
+    .isr_stalled = f405_isr_stalled,
     .ticks = f405_ticks,
     .ticks_hz = 1000000u,
 };
@@ -305,6 +338,7 @@ int main(void)
     /* 4. */
     const f4_hal_cfg_t hc = {F405_FS_HZ, F405_ENCODER_CPR};
     s->hal_rc = f4_hal_init(&s->hal, b, &hc, &s->clk);
+    f4_iwdg_refresh(); /* between the start-up's long steps */
     if (s->hal.drv_rc == DRV8301_OK) {
         char line[96];
         (void)snprintf(line, sizeof line, "DRV8301 configured (control 1 0x%x, control 2 0x%x)",
@@ -313,6 +347,7 @@ int main(void)
     }
     /* 5. */
     const int frc = board_app_start(a, &f405_port, &s->hal);
+    f4_iwdg_refresh();
     if (frc != FW_OK) {
         f405_report_line(s, "fw_init failed: ", fw_strerror(frc), "");
         if (s->hal_rc == F4_OK) {

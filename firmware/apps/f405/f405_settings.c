@@ -20,8 +20,7 @@
 #include "f4_flash.h"
 #include "f4_periph.h"
 
-/* The watchdog's window for a time-out (f405_app.h's values reach one). */
-static void f405_watchdog_set(const f405_t *s, uint32_t ms)
+void f405_watchdog_set(const f405_t *s, uint32_t ms)
 {
     uint32_t pr, rlr;
     if (stm32_iwdg_config(ms, F4_LSI_TYP_HZ, &pr, &rlr) == STM32_OK) {
