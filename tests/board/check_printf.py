@@ -44,8 +44,19 @@ def image_strings(data, secs, map_text):
         if sec is None:
             continue
         off = sec["offset"] + addr - sec["addr"]
-        out += [x for x in data[off:off + size].split(b"\0") if x]
+        out += [x for x in map(text_tail, data[off:off + size].split(b"\0")) if x]
     return out
+
+
+def text_tail(s):
+    """A literal ends at its NUL: the printable UTF-8 text that ends `s`. With
+    link-time optimisation GCC may place a constant table in a string section
+    too, with no NUL before the next literal; its bytes are no format."""
+    u = s.decode("utf-8", "replace")
+    i = len(u)
+    while i > 0 and u[i - 1] != "\ufffd" and (u[i - 1].isprintable() or u[i - 1] in "\t\r\n"):
+        i -= 1
+    return u[i:].encode()
 
 
 def main():
