@@ -8,7 +8,6 @@
 
 #include <math.h>
 #include <stddef.h>
-#include <string.h>
 
 #include "cm_internal.h"
 
@@ -123,8 +122,26 @@ void cm_cogging_begin(cm_t *cm)
     c->fin = 0u;
     c->mean_sum[0] = c->mean_sum[1] = 0;
     cm->detail[0] = cm->detail[1] = cm->detail[2] = 0;
-    memset(c->sum, 0, sizeof c->sum);
-    memset(c->cnt, 0, sizeof c->cnt);
+    /* The sums are cleared during the hold (cm_cog_clear), not here: begin
+     * runs in the interrupt, and clearing their 12 KiB at once costs more
+     * than a whole period's budget (a deadline fault). */
+    c->clr = 0u;
+}
+
+/* CM_COG_CLEAR_PER_PERIOD bins' sums and counts to 0 from c->clr on;
+ * true once every bin is clear. */
+static bool cm_cog_clear(cm_cog_t *c)
+{
+    uint32_t end = c->clr + CM_COG_CLEAR_PER_PERIOD;
+    if (end > CTRL_COG_N) {
+        end = CTRL_COG_N;
+    }
+    for (uint32_t i = c->clr; i < end; i++) {
+        c->sum[i] = 0;
+        c->cnt[i] = 0u;
+    }
+    c->clr = end;
+    return end == CTRL_COG_N;
 }
 
 enum { COG_HOLD, COG_ACCEL, COG_LEAD, COG_MEASURE, COG_DECEL, COG_CONVERT, COG_CENTRE };
@@ -194,7 +211,8 @@ int cm_cogging_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
         if (cm->t == 0u) {
             c->pos_ref = c->pos * 65536; /* hold where the rotor is */
         }
-        if (cm->t >= c->n_settle) {
+        /* the sweep measures once the sums are clear and the rotor settled */
+        if (cm_cog_clear(c) && cm->t >= c->n_settle) {
             cm_next(cm);
         }
         break;

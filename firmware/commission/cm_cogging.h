@@ -52,8 +52,14 @@ typedef struct {
 
 #define CM_COG_RPM_DEFAULT 3.0
 #define CM_COG_BW_DEFAULT 50.0
-#define CM_COG_BINS_PER_PERIOD 16u /* bins converted per period at the end of a direction */
-#define CM_COG_CNT_MAX 4095u       /* samples kept per bin and direction (sum < 2^28) */
+/* bins converted per period at the end of a direction (one or two 64-bit
+ * divisions each: 16 divisions cost about 30 % of a 20 kHz period's budget
+ * on the Cortex-M4) */
+#define CM_COG_BINS_PER_PERIOD 4u
+#define CM_COG_CNT_MAX 4095u /* samples kept per bin and direction (sum < 2^28) */
+/* bins' sums cleared per period of the first hold (all 12 KiB at once cost
+ * more than a 20 kHz period's budget on the Cortex-M4) */
+#define CM_COG_CLEAR_PER_PERIOD 64u
 
 /* A gain as mantissa and shift: y = round(x m / 2^s). */
 typedef struct {
@@ -93,6 +99,7 @@ typedef struct cm_cog {
     q24_t integ;         /* integral part, pu torque */
     int8_t dir;          /* +1 forward, -1 backward */
     uint32_t fin;        /* next bin of the conversion */
+    uint32_t clr;        /* next bin of the sums' clearing (the first hold) */
     int64_t mean_sum[2]; /* sums of the directions' means (Q15 rated) */
 } cm_cog_t;
 
