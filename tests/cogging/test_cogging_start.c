@@ -30,29 +30,43 @@ void tearDown(void)
 #define START_S 0.40
 #define START_MEAN_S 0.10 /* the speed's mean over the run's last 0.1 s */
 
+/* The stress file (stiction 15 %, cogging 10 %, Coulomb friction, passive load). */
+static void start_machine(sim_machine_t *m)
+{
+    char err[256];
+    char path[512];
+    snprintf(path, sizeof path, "%s/nonideal/thesis_spmsm_stress.ini", PMSM_MACHINES_DIR);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, m, err, sizeof err), err);
+}
+
+/* A sensorless start of foc on the free rotor to START_RPM in speed mode. */
+static void start_config(sim_run_cfg_t *c, const sim_machine_t *m, const ctrl_desc_t *d,
+                         double duration_s)
+{
+    sim_run_config_default(c, m, d);
+    c->fs_hz = d->fs_default_hz;
+    c->hal.pwm_freq_hz = c->fs_hz;
+    c->free_mech = true;
+    c->speed_mode = true;
+    c->speed_ref_rpm = START_RPM;
+    c->duration_s = duration_s;
+    c->calib_samples = 64u;
+    c->sensorless = true;
+    c->stop_on_fault = true;
+}
+
 static void test_start_36_angles(void)
 {
     static sim_machine_t m;
     char err[256];
-    char path[512];
-    snprintf(path, sizeof path, "%s/nonideal/thesis_spmsm_stress.ini", PMSM_MACHINES_DIR);
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+    start_machine(&m);
     const ctrl_desc_t *d = ctrl_find("foc");
     TEST_ASSERT_NOT_NULL(d);
     int ok = 0, named = 0;
     for (int k = 0; k < START_N; k++) {
         static sim_run_cfg_t c;
         static sim_run_t r;
-        sim_run_config_default(&c, &m, d);
-        c.fs_hz = d->fs_default_hz;
-        c.hal.pwm_freq_hz = c.fs_hz;
-        c.free_mech = true;
-        c.speed_mode = true;
-        c.speed_ref_rpm = START_RPM;
-        c.duration_s = START_S;
-        c.calib_samples = 64u;
-        c.sensorless = true;
-        c.stop_on_fault = true;
+        start_config(&c, &m, d, START_S);
         c.theta0_e_rad = 2.0 * 3.14159265358979323846 * (double)k / START_N;
         TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
         bool handed = false;
@@ -97,23 +111,12 @@ static void test_start_blocked_named(void)
 {
     static sim_machine_t m;
     char err[256];
-    char path[512];
-    snprintf(path, sizeof path, "%s/nonideal/thesis_spmsm_stress.ini", PMSM_MACHINES_DIR);
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_machine_load(path, &m, err, sizeof err), err);
+    start_machine(&m);
     const ctrl_desc_t *d = ctrl_find("foc");
     static sim_run_cfg_t c;
     static sim_run_t r;
-    sim_run_config_default(&c, &m, d);
-    c.fs_hz = d->fs_default_hz;
-    c.hal.pwm_freq_hz = c.fs_hz;
-    c.free_mech = true;
-    c.speed_mode = true;
-    c.speed_ref_rpm = START_RPM;
+    start_config(&c, &m, d, 1.5);
     c.load_passive_nm = 2.8;
-    c.duration_s = 1.5;
-    c.calib_samples = 64u;
-    c.sensorless = true;
-    c.stop_on_fault = true;
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
     TEST_ASSERT_EQUAL_INT(0, sim_run_all(&r, err, sizeof err));
     printf("blocked start: fault %s at %.3f s, rotor at %.1f r/min\n",
