@@ -162,12 +162,16 @@ class BadInputTest(unittest.TestCase):
         with 'target went away', exit 3; --port 99999 with --web a traceback)."""
         console = os.path.join(os.path.dirname(os.path.abspath(__file__)), "console")
         cases = (
-            (["--timeout", "-1"], "--timeout: '-1' is out of range: allowed (0, 3600] s"),
+            (["--timeout", "-1"], "--timeout: '-1' is out of range: allowed a decimal number "
+             "in (0, 3600] s"),
             (["--timeout", "nan"], "--timeout: 'nan' is out of range"),
-            (["--duration", "-5"], "--duration: '-5' is out of range: allowed [0, "),
-            (["--shift", "99"], "--shift: '99' is out of range: allowed [0, 10]"),
-            (["--baud", "fast"], "--baud: 'fast' is not a whole number: allowed [50, "),
-            (["--port", "99999", "--web"], "--port: '99999' is out of range: allowed [0, 65535]"),
+            (["--duration", "-5"], "--duration: '-5' is out of range: allowed a decimal number "
+             "in [0, "),
+            (["--shift", "99"], "--shift: '99' is out of range: allowed a whole number in [0, 10]"),
+            (["--baud", "fast"], "--baud: 'fast' is not a whole number: allowed a whole number "
+             "in [50, "),
+            (["--port", "99999", "--web"], "--port: '99999' is out of range: allowed a whole "
+             "number in [0, 65535]"),
             (["--tcp", "localhost"], "--tcp: 'localhost': expected HOST:PORT with the port in "
              "[1, 65535]"))
         for args, want in cases:

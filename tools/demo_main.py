@@ -27,6 +27,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
+from argtypes import whole_in  # noqa: E402
 
 # Debian packages (tools/setup's names) and what shows each is there.
 NEEDS = (
@@ -124,25 +125,9 @@ def clock(s):
     return "%d min %02d s" % (s // 60, s % 60) if s >= 60 else "%d s" % s
 
 
-def whole_in(lo, hi, what):
-    """An argparse type: a whole number in [lo, hi]; the error names value and range
-    (argparse adds the option and exits with status 2)."""
-    def parse(text):
-        try:
-            v = int(text)
-        except ValueError:
-            v = None
-        if v is None or not lo <= v <= hi:
-            raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [%d, %d] (%s)"
-                                             % (text, "out of range" if v is not None else
-                                                "not a whole number", lo, hi, what))
-        return v
-    return parse
-
-
 def main():
     ap = argparse.ArgumentParser(prog="demo", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seed", type=whole_in(0, SEED_MAX, "the simulator's ADC noise seed"),
+    ap.add_argument("--seed", type=whole_in(0, SEED_MAX),
                     help="ADC noise seed of every run, [0, 2^53]")
     ap.add_argument("--jobs", type=whole_in(1, MAX_JOBS, "simulations at once"),
                     help="simulations at once, [1, %d]" % MAX_JOBS)

@@ -23,7 +23,7 @@ class BadInput(unittest.TestCase):
         """Before anything is set up or built: a time-out of 20 s would show it started."""
         demo = os.path.join(os.path.dirname(os.path.abspath(__file__)), "demo")
         for args, want in ((["--jobs", "0"], "--jobs: '0' is out of range: allowed a whole "
-                            "number in [1, 1024]"),
+                            "number in [1, 1024] simulations at once"),
                            (["--jobs", "two"], "--jobs: 'two' is not a whole number: allowed a "
                             "whole number in [1, 1024]"),
                            (["--seed", "-1"], "--seed: '-1' is out of range: allowed a whole "

@@ -44,6 +44,7 @@ import zlib
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import study_worker  # noqa: E402
+from argtypes import whole_in  # noqa: E402
 
 ROOT = os.path.dirname(HERE)
 DESCRIPTION_VERSION = 1  # part of every key: bump when the meaning of a description changes
@@ -727,23 +728,10 @@ class Engine:
 MAX_JOBS = 1024
 
 
-def _workers(text):
-    """--jobs: a whole number in [1, MAX_JOBS] (0 read as 'the CPU count' before)."""
-    try:
-        v = int(text)
-    except ValueError:
-        v = None
-    if v is None or not 1 <= v <= MAX_JOBS:
-        raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [1, %d] workers"
-                                         % (text, "out of range" if v is not None else
-                                            "not a whole number", MAX_JOBS))
-    return v
-
-
 def add_arguments(ap, jobs_default=None):
     """The engine's options on a tool's command line."""
     g = ap.add_argument_group("execution (tools/study_engine.py, docs/studies.md)")
-    g.add_argument("--jobs", type=_workers, default=jobs_default,
+    g.add_argument("--jobs", type=whole_in(1, MAX_JOBS, "workers"), default=jobs_default,
                    help="workers of the local dask cluster, [1, %d] (default: the CPU count)"
                    % MAX_JOBS)
     g.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",

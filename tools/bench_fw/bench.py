@@ -25,6 +25,8 @@ import sys
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from argtypes import whole_in  # noqa: E402
 FW = os.path.join(ROOT, "tools", "bench_fw")
 SPEEDS = (750, 2250)
 TORQUE_NM = 1.8
@@ -323,22 +325,6 @@ def stats(v):
     return {"mean": round(statistics.fmean(v), 1), "max": max(v), "min": min(v), "n": len(v)}
 
 
-def whole_in(lo, hi, what):
-    """An argparse type: a whole number in [lo, hi], refused (exit status 2) with the
-    value and the range before anything is built."""
-    def parse(text):
-        try:
-            v = int(text)
-        except ValueError:
-            v = None
-        if v is None or not lo <= v <= hi:
-            raise argparse.ArgumentTypeError("'%s' is %s: allowed a whole number in [%d, %d] %s"
-                                             % (text, "out of range" if v is not None else
-                                                "not a whole number", lo, hi, what))
-        return v
-    return parse
-
-
 def main():
     ap = argparse.ArgumentParser(prog="bench", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench.json"))
@@ -361,7 +347,7 @@ def main():
                     help="the firmware without its encoder (fw_config_t.sensorless): recorded at "
                          "5 %% of rated speed (the forced start's final speed), so that the forced "
                          "start, the handover (about 1100 periods) and the observer are counted")
-    ap.add_argument("--jobs", type=whole_in(1, 1024, "at once"), default=2)
+    ap.add_argument("--jobs", type=whole_in(1, 1024, "jobs at once"), default=2)
     ap.add_argument("--cm0-build", default=os.environ.get(
         "BENCH_CM0_BUILD", os.path.join(ROOT, "build", "cm0")))
     ap.add_argument("--cm0-periods", type=whole_in(1, 1700, "periods"), default=1000,
