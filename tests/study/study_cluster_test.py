@@ -34,27 +34,15 @@ import tempfile
 import time
 import zlib
 
+from study_testutil import STALL_S, free_port, stored, watch
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 STUDY = os.path.join(ROOT, "tools", "study")
 SPEC = os.path.join(HERE, "cluster40.toml")
 N_RUNS = 40
 KILL_AFTER = 6  # stored results before the kill: the study is under way
-# A study, a process's start or the scheduler's answer that shows no progress for this
-# long is stuck. On two idle cores a result arrives every second or so and the whole
-# test takes about 30 s; on the shared machine loaded twenty-fold, a run took 2.5 s
-# and the report after the last result about 20 s: the limit is ten times that, and
-# it counts from the last sign of progress, not from the start.
-STALL_S = 240
 PY = "/usr/bin/python3"
-
-
-def free_port():
-    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-    s.close()
-    return port
 
 
 def die_with_parent():
@@ -110,38 +98,6 @@ def rows(store):
         db.close()
 
 
-def count(store):
-    if not os.path.exists(store):
-        return 0
-    db = sqlite3.connect(store)
-    try:
-        return db.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
-    except sqlite3.OperationalError:
-        return 0
-    finally:
-        db.close()
-
-
-def watch(proc, store, log, on_progress=None):
-    """Wait for proc to end while it makes progress: a new result in store, or its log
-    growing. on_progress(results), if given, is called at every poll. Returns (exit
-    status, or None if it was stuck for STALL_S and killed; seconds it took)."""
-    t0 = t_last = time.monotonic()
-    last = None
-    while proc.poll() is None:
-        now = time.monotonic()
-        n = count(store)
-        size = os.path.getsize(log) if os.path.exists(log) else 0
-        if (n, size) != last:
-            last, t_last = (n, size), now
-        elif now - t_last > STALL_S:
-            return None, now - t0
-        if on_progress is not None:
-            on_progress(n)
-        time.sleep(0.05)
-    return proc.returncode, time.monotonic() - t0
-
-
 def verdict(rc, took):
     return (f"exit {rc}, {took:.0f} s" if rc is not None else
             f"stuck: no new result nor output for {STALL_S} s, killed after {took:.0f} s")
@@ -168,7 +124,7 @@ def main():
         os.makedirs(out, exist_ok=True)
         p = procs.start(name, [PY, STUDY, SPEC, "--sim", sim, "--out", out, "--progress", "text",
                                "--store", store] + list(extra))
-        rc, took = watch(p, store, procs.path(name), on_progress)
+        rc, took = watch(p, store, [procs.path(name)], on_progress)
         procs.kill(name)  # if it was stuck
         return rc, took, procs.log(name)
 
@@ -226,7 +182,7 @@ def main():
                 # its tasks, each a chunk of runs named by its first run's key
                 kill["in_flight"] = {k[len("pmsm-runs-"):].rsplit("-", 1)[0]
                                      for k in proc[names[victim]]}
-                kill["at"] = count(store)
+                kill["at"] = stored(store)
                 procs.kill(victim)
                 kill["victim"] = victim
                 print(f"     killed {victim} ({names[victim]}) after {kill['at']} results, "

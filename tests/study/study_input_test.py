@@ -16,7 +16,6 @@ usage: study_input_test.py SIM
 import os
 import shutil
 import signal
-import socket
 import sqlite3
 import subprocess
 import sys
@@ -29,6 +28,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 STUDY = os.path.join(ROOT, "tools", "study")
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 import study_spec  # noqa: E402
+from study_testutil import STALL_S, free_port, watch  # noqa: E402
 PY = "/usr/bin/python3"
 SIM = None
 
@@ -76,24 +76,6 @@ psi_pm = { dist = "uniform", lo = -0.05, hi = 0.05 }
 """
 
 
-# A study that shows no progress (a new stored result, a line of output) for this long
-# is stuck (study_cluster_test.py: the same limit); a slow machine only takes longer.
-STALL_S = 240
-
-
-def stored(store):
-    """Results in store so far (0 before it exists)."""
-    if not store or not os.path.exists(store):
-        return 0
-    db = sqlite3.connect(store)
-    try:
-        return db.execute("SELECT COUNT(*) FROM runs").fetchone()[0]
-    except sqlite3.OperationalError:
-        return 0
-    finally:
-        db.close()
-
-
 def study(path, *args):
     """tools/study on path with args (stdout, stderr, exit status), given up only when
     it is stuck: no new result in its store and no output for STALL_S."""
@@ -102,17 +84,12 @@ def study(path, *args):
     with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
         p = subprocess.Popen([PY, STUDY, path, "--sim", SIM, "--progress", "text"] + args,
                              stdout=out, stderr=err, text=True, start_new_session=True)
-        last, t_last = None, time.monotonic()
-        while p.poll() is None:
-            now = (os.fstat(out.fileno()).st_size, os.fstat(err.fileno()).st_size, stored(store))
-            if now != last:
-                last, t_last = now, time.monotonic()
-            elif time.monotonic() - t_last > STALL_S:
-                os.killpg(p.pid, signal.SIGKILL)
-                p.wait()
-                raise AssertionError(f"tools/study {' '.join(args)}: stuck, no new result nor "
-                                     f"output for {STALL_S} s")
-            time.sleep(0.05)
+        rc, _took = watch(p, store, [out, err])
+        if rc is None:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            raise AssertionError(f"tools/study {' '.join(args)}: stuck, no new result nor "
+                                 f"output for {STALL_S} s")
         out.seek(0)
         err.seek(0)
         return subprocess.CompletedProcess(p.args, p.returncode, out.read(), err.read())
@@ -198,10 +175,7 @@ class BadInput(Base):
                      r"FILE: not a valid TOML file: .*at line 9, column 10")
 
     def test_unreachable_scheduler(self):
-        s = socket.socket()
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-        s.close()  # nothing listens there
+        port = free_port()  # nothing listens there
         p = self.write(GOOD)
         t0 = time.monotonic()
         r = study(p, "--scheduler", f"tcp://127.0.0.1:{port}", "--connect-timeout", "2",
@@ -249,17 +223,15 @@ class Results(Base):
         proc = subprocess.Popen([PY, STUDY, p, "--sim", SIM, "--out", out, "--jobs", "1",
                                  "--progress", "none"], stdout=subprocess.DEVNULL,
                                 stderr=subprocess.DEVNULL, start_new_session=True)
-        n, t_last = 0, time.monotonic()
+        killed = []
+
+        def kill_at_3(n):
+            if n >= 3 and not killed:
+                os.killpg(proc.pid, signal.SIGKILL)
+                killed.append(n)
+
         try:
-            # until 3 results are stored; given up if none comes for STALL_S
-            while proc.poll() is None and time.monotonic() - t_last < STALL_S:
-                k = stored(store)
-                if k != n:
-                    n, t_last = k, time.monotonic()
-                if n >= 3:
-                    os.killpg(proc.pid, signal.SIGKILL)
-                    break
-                time.sleep(0.02)
+            watch(proc, store, on_progress=kill_at_3)  # given up if no result for STALL_S
         finally:
             if proc.poll() is None:
                 os.killpg(proc.pid, signal.SIGKILL)
