@@ -100,12 +100,10 @@ def build(args):
              **CM4_TARGET}
     if args.cm0:
         cm0 = args.cm0_build
-        # The micro:bit's 16 KiB of RAM cannot hold anti-cogging's table and its
-        # calibration's sums (about 16 KiB, docs/anticogging.md): left out, as on
-        # the B-G431B-ESC1; it is not in the per-period path the bench counts.
+        # (anti-cogging is left out by the cm0 target's default: the micro:bit's RAM
+        # cannot hold its sums, control/CMakeLists.txt)
         configure(cm0, {"CMAKE_BUILD_TYPE": "Release", "CMAKE_C_FLAGS_RELEASE": "-O2 -g",
-                        "CMAKE_CXX_FLAGS_RELEASE": "-O2 -g", "PMSM_TARGET": "cm0",
-                        "PMSM_COGGING": "OFF"},
+                        "CMAKE_CXX_FLAGS_RELEASE": "-O2 -g", "PMSM_TARGET": "cm0"},
                   toolchain=os.path.join(ROOT, "tools", "cmake", "arm-none-eabi-cm0.cmake"),
                   update=True)
         log("building cm0 (bench_cm0) in " + cm0)
