@@ -11,6 +11,11 @@
 # pmsm_add_expect_fail_test(NAME n TARGET t PATTERNS regex ...)
 #   Runs the already defined test executable t, which must exit non-zero with output
 #   matching every regex (used to test that failures are reported).
+# pmsm_test_alone(test ...)
+#   RUN_SERIAL for tests that talk to an image running in QEMU (a console session):
+#   QEMU runs unpaced (-icount sleep=off), so the emulated time between two commands
+#   the PC sends is the host's spare CPU, and a test beside them starves it (a speed
+#   not yet settled, a calibration not yet begun when the next command comes).
 set(PMSM_UNITY_DIR ${CMAKE_CURRENT_LIST_DIR}/../../tests/unity)
 set(PMSM_QEMU_RUN ${CMAKE_CURRENT_LIST_DIR}/../qemu-run)
 set(PMSM_QEMU_TEST_TIMEOUT 120 CACHE STRING "Wall-time limit (s) of one QEMU test run")
@@ -84,4 +89,8 @@ function(pmsm_add_expect_fail_test)
     list(APPEND labels qemu)
   endif()
   set_tests_properties(${T_NAME} PROPERTIES LABELS "${labels}")
+endfunction()
+
+function(pmsm_test_alone)
+  set_tests_properties(${ARGN} PROPERTIES RUN_SERIAL TRUE)
 endfunction()
