@@ -4,6 +4,8 @@
  * next one, on that interrupt's inputs. */
 #include "pipeline.h"
 
+#include <stdatomic.h>
+
 /* The speed loop of one run: the PI on the speed error, its output clamped
  * to the configured torque limit; the speed-following protection on it. */
 static q24_t fw_mid_speed(fw_t *fw, const fw_mid_in_t *in, uint8_t *fault)
@@ -59,6 +61,7 @@ void fw_medium(fw_t *fw)
     if (fw == NULL || fw->mid_done == fw->mid_req) {
         return; /* nothing requested */
     }
+    atomic_signal_fence(memory_order_acquire); /* the slot after its count */
     const uint32_t done = fw->mid_done + 1u;
     const fw_mid_in_t *const in = &fw->mid_in[done & 1u];
     fw_mid_out_t *const out = &fw->mid_out[done & 1u];
@@ -71,6 +74,7 @@ void fw_medium(fw_t *fw)
         fw_mid_psi(fw, &in->psi, out);
     }
     if (in->run == 0u) {
+        atomic_signal_fence(memory_order_release); /* the slot before its count */
         fw->mid_done = done;
         return;
     }
@@ -110,5 +114,7 @@ void fw_medium(fw_t *fw)
     if (in->first != 0u) {
         fw_mid_first_step(fw, in, out); /* before the run counts as ended */
     }
+    /* the slot before its count: the interrupt may preempt the task here */
+    atomic_signal_fence(memory_order_release);
     fw->mid_done = done;
 }

@@ -1069,6 +1069,7 @@ const fw_telemetry_t *fw_tm_peek(fw_t *fw)
 void fw_tm_release(fw_t *fw)
 {
     if (fw != NULL && fw->ml.tm_tail != fw->isr.tm_head) {
+        FW_RELEASE(); /* the record read before its slot is handed back */
         fw->ml.tm_tail = fw->ml.tm_tail + 1u;
     }
 }

@@ -477,6 +477,7 @@ static int fw_commission_adopt(fw_t *fw)
         m.inertia_kgm2 = r.inertia_kgm2;
     }
     const ctrl_machine_t old = fw->machine_own;
+    const double old_torque_nm = fw->bases.torque_nm;
     const fx_angle_t old_off = fw->enc_offset;
     const uint32_t old_neg = fw->enc_neg;
     const bool enc = (r.have & CM_HAVE_ENC) != 0u;
@@ -495,6 +496,12 @@ static int fw_commission_adopt(fw_t *fw)
         return rc;
     }
     cm_rebase(&fw->cm, &fw->bases, enc);
+    /* The torque reference keeps its N m in the new torque base, clamped
+     * to the new limit (the interrupt is held off: no fence needed). */
+    const q24_t tref = ctrl_q24_from_double(ctrl_q24_to_double(fw->ml.torque_ref) * old_torque_nm /
+                                            fw->bases.torque_nm);
+    fw->ml.torque_ref = tref;
+    fw->ml.torque_ref_lim = fx_clamp(tref, fw->torque_ref_min, fw->torque_ref_max);
     /* The encoder position restarts from the counter in the new direction. */
     fw->enc_primed = false;
     fw->enc_index_valid = false;
@@ -652,7 +659,8 @@ int fw_tunable_set(fw_t *fw, const char *name, double value)
         while (i < d->n_tunables && strcmp(d->tunables[i].name, name) != 0) {
             i++;
         }
-        if (i < d->n_tunables && (!fw_tunable_is_live(fw, i) || fw_tune_pending(fw, FW_REQ_CTRL_TUNE))) {
+        if (i < d->n_tunables &&
+            (!fw_tunable_is_live(fw, i) || fw_tune_pending(fw, FW_REQ_CTRL_TUNE))) {
             return FW_EBUSY;
         }
     }

@@ -1,6 +1,8 @@
 /* Cortex-M4 core services (g4_core.h). */
 #include "g4_core.h"
 
+#include <stdatomic.h>
+
 const char *g4_strerror(int rc)
 {
     switch (rc) {
@@ -77,6 +79,11 @@ void g4_pendsv_set_priority(uint32_t prio)
 
 void g4_nvic_enable(uint32_t irq)
 {
+    /* What the main loop stored for the handler (a reconfiguration under
+     * hal_ctrl_hold) before the handler can run: a compiler barrier, as the
+     * volatile register store orders only volatile accesses. The core keeps
+     * its own stores in order for its interrupts. */
+    atomic_signal_fence(memory_order_release);
     g4_wr(G4_NVIC + G4_NVIC_ISER(irq / 32u), 1u << (irq % 32u));
 }
 
@@ -88,6 +95,8 @@ void g4_nvic_disable(uint32_t irq)
      * effect is guaranteed only after a DSB and an ISB) */
     __asm__ volatile("dsb\n\tisb" ::: "memory");
 #endif
+    /* ... and nothing after it moved before it by the compiler. */
+    atomic_signal_fence(memory_order_acquire);
 }
 
 bool g4_nvic_enabled(uint32_t irq)

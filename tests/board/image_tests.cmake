@@ -29,3 +29,12 @@ add_test(NAME esc1_stack_limit_fails
                  --config ${PMSM_ESC1_STACK_CFG} --su-dir ${CMAKE_BINARY_DIR}/firmware/apps/esc1
                  --su-dir ${CMAKE_BINARY_DIR}/hal --limit 0.30)
 set_tests_properties(esc1_stack_limit_fails PROPERTIES LABELS "board" WILL_FAIL TRUE)
+# The signal fences of the state shared between the contexts
+# (docs/architecture.md), checked in the source, and the check's own failure
+# path: each rule fails with its fences removed.
+add_test(NAME fence_check COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/fence_check.py
+                                  ${PROJECT_SOURCE_DIR})
+add_test(NAME fence_check_self_test
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/fence_check.py --self-test
+                 ${PROJECT_SOURCE_DIR})
+set_tests_properties(fence_check fence_check_self_test PROPERTIES LABELS "board")

@@ -174,6 +174,40 @@ static void test_bringup_fail_and_ini(void)
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, "err 8", 5));
 }
 
+/* "ident apply" with a flux linkage 25 % above the configured one raises the
+ * torque base by 1.25^2 (T_base = 1.5 p psi^2 / Ld, ctrl_params.h): a torque
+ * reference keeps its N m in the new base, and one above the limit is
+ * clamped to the new limit (the old per-unit clamp would be 1.5625 times
+ * it). */
+static void test_apply_rebases_the_torque_reference(void)
+{
+    fw_t *fw = &run.fw;
+    const double lim_nm = fw->cfg.speed_out_max_nm;
+    char err[256];
+    for (int over = 0; over <= 1; over++) {
+        if (over != 0) { /* a fresh run: the configured machine again */
+            sim_run_free(&run);
+            TEST_ASSERT_EQUAL_INT_MESSAGE(
+                0, sim_ident_setup(&run, &spm, &spm, ctrl_find("m2ptfc"), 1.0, 1u, err, sizeof err),
+                err);
+        }
+        const double want_nm = over != 0 ? 2.0 * lim_nm : 0.5 * lim_nm;
+        fw_set_torque_ref_nm(fw, want_nm);
+        const double tb0 = fw->bases.torque_nm;
+        fw->cm.res.have = CM_HAVE_FLUX;
+        fw->cm.res.bases = fw->bases;
+        fw->cm.res.psi = ctrl_q24_from_double(1.25); /* psi_base = the configured psi_pm */
+        TEST_ASSERT_EQUAL_INT(FW_OK, fw_commission_apply(fw));
+        const double tb = fw->bases.torque_nm;
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * tb0, 1.5625 * tb0, tb);
+        TEST_ASSERT_TRUE(fw->ml.torque_ref_lim <= fw->torque_ref_max);
+        const double got_nm = ctrl_q24_to_double(fw->ml.torque_ref_lim) * tb;
+        /* one Q24 step of the new base */
+        const double want = over != 0 ? lim_nm : want_nm;
+        TEST_ASSERT_DOUBLE_WITHIN(2.0 * tb / 16777216.0, want, got_nm);
+    }
+}
+
 /* A motor with friction and a passive load (the stress file): after a run at
  * 500 r/min and a disarm it stops within milliseconds; "status" then says
  * so, and no torque. */
@@ -214,5 +248,6 @@ int main(void)
     RUN_TEST(test_ident_commands);
     RUN_TEST(test_bringup_fail_and_ini);
     RUN_TEST(test_status_after_stop);
+    RUN_TEST(test_apply_rebases_the_torque_reference);
     return UNITY_END();
 }

@@ -4,8 +4,10 @@
  * Start-up: DWT cycle counter, core lockup -> TIM1 break, reset flags and
  * option bytes read, clock (HSE 8 MHz -> PLL 170 MHz, boost mode), USART2,
  * the start-up report by polled output (reset cause, boot option bytes,
- * clock result: esc1_report.h); on a clock failure the board stays on HSI16
- * with the gates never enabled and says so on USART2 once a second. Then
+ * clock result: esc1_report.h); on a clock failure (as on any start-up
+ * failure: esc1_halt) the gates are never enabled, the reason is said on
+ * USART2 once a second, and the watchdog resets the chip within its start-up
+ * time-out, which says it again. Then
  * the board HAL (gates off, op-amps, ADCs calibrated, comparator thresholds,
  * TIM1 with break, encoder, TIM1 started and its phase checked), fw_init with
  * the compiled-in machine, the command link, the interrupts, the settings,

@@ -1,6 +1,7 @@
 /* USART2 byte rings (esc1_uart.h). */
 #include "esc1_uart.h"
 
+#include <stdatomic.h>
 #include <string.h>
 
 #include "board_esc1.h"
@@ -30,7 +31,9 @@ int esc1_uart_getc(esc1_uart_t *u)
     if (t == u->rx_head) {
         return -1;
     }
+    atomic_signal_fence(memory_order_acquire); /* the byte after its count */
     const int c = u->rx[t & (ESC1_UART_RX_SIZE - 1u)];
+    atomic_signal_fence(memory_order_release); /* read before its slot is handed back */
     u->rx_tail = t + 1u;
     return c;
 }
@@ -50,7 +53,9 @@ void esc1_uart_write(esc1_uart_t *u, const uint8_t *bytes, size_t len)
                 }
             }
         }
+        atomic_signal_fence(memory_order_acquire); /* the slot freed before it is written */
         u->tx[u->tx_head & (ESC1_UART_TX_SIZE - 1u)] = bytes[i];
+        atomic_signal_fence(memory_order_release); /* the byte before its count */
         u->tx_head++;
         /* The interrupt sends while bytes are queued. */
         g4_set(G4_USART2 + G4_USART_CR1, G4_USART_CR1_TXEIE);
@@ -84,7 +89,9 @@ void esc1_uart_irq(esc1_uart_t *u)
     if ((isr & G4_USART_ISR_RXNE) != 0u) {
         const uint8_t c = (uint8_t)g4_rd(G4_USART2 + G4_USART_RDR); /* clears RXNE */
         if (u->rx_head - u->rx_tail < ESC1_UART_RX_SIZE) {
+            atomic_signal_fence(memory_order_acquire);
             u->rx[u->rx_head & (ESC1_UART_RX_SIZE - 1u)] = c;
+            atomic_signal_fence(memory_order_release); /* the byte before its count */
             u->rx_head++;
         } else {
             u->rx_dropped++;
@@ -93,7 +100,9 @@ void esc1_uart_irq(esc1_uart_t *u)
     if ((isr & G4_USART_ISR_TXE) != 0u &&
         (g4_rd(G4_USART2 + G4_USART_CR1) & G4_USART_CR1_TXEIE) != 0u) {
         if (u->tx_tail != u->tx_head) {
+            atomic_signal_fence(memory_order_acquire); /* the byte after its count */
             g4_wr(G4_USART2 + G4_USART_TDR, u->tx[u->tx_tail & (ESC1_UART_TX_SIZE - 1u)]);
+            atomic_signal_fence(memory_order_release);
             u->tx_tail++;
         } else {
             g4_clr(G4_USART2 + G4_USART_CR1, G4_USART_CR1_TXEIE);

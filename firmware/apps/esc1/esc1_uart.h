@@ -2,7 +2,10 @@
  * USART2 of the B-G431B-ESC1 (ST-LINK virtual COM port): interrupt-driven
  * byte rings between the USART interrupt and the main loop. The main loop
  * owns the transmit side (whole lines and frames, PROTOCOL.md), the interrupt
- * moves bytes.
+ * moves bytes. Each count has one writer; a byte is stored before its count
+ * behind a release signal fence and read after the other side's count behind
+ * an acquire fence (docs/architecture.md, "State shared between the
+ * contexts").
  */
 #ifndef FIRMWARE_APPS_ESC1_ESC1_UART_H
 #define FIRMWARE_APPS_ESC1_ESC1_UART_H
