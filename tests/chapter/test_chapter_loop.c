@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "ctrl_units.h"
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -38,41 +39,11 @@ void tearDown(void)
 {
 }
 
-static void load_machine(const char *file, sim_machine_t *m)
-{
-    char path[512];
-    char err[256];
-    snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
-    if (sim_machine_load(path, m, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
-}
-
-static void cfg_for(sim_run_cfg_t *c, const sim_machine_t *m, const char *name)
-{
-    const ctrl_desc_t *d = ctrl_find(name);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, name);
-    sim_run_config_default(c, m, d);
-    c->fs_hz = d->fs_default_hz;
-    c->hal.pwm_freq_hz = c->fs_hz;
-    c->calib_samples = 64u;
-}
-
 static void test_foc_spmsm_750(void)
 {
-    sim_machine_t m;
-    load_machine("thesis_spmsm.ini", &m);
     sim_run_cfg_t c;
-    cfg_for(&c, &m, "foc");
-    c.speed_rpm = 750.0;
-    c.torque_ref_nm = 1.8;
-    c.duration_s = 0.1;
-    c.win_start_s = 0.05;
-    c.win_end_s = 0.1;
-    char err[256];
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
+    loop_cfg(&c, "foc", 750.0, 1.8, 0.1, 0.05);
+    loop_start(&run, &c);
     const double iq_ref = 1.8 / (1.5 * 4.0 * 0.09427);
     double sum_eq = 0.0;
     double sum_d = 0.0;
@@ -112,19 +83,15 @@ typedef struct {
 
 static ripple_t chapter_case(const char *name)
 {
-    sim_machine_t m;
-    load_machine("chapter_ipmsm.ini", &m);
+    const sim_machine_t m = loop_machine_file("chapter_ipmsm.ini");
     sim_run_cfg_t c;
-    cfg_for(&c, &m, name);
+    /* the window after the speed loop's recovery from the load at t = 0 */
+    loop_cfg_machine(&c, &m, name, 0u, W_RPM, 0.0, 0.3, 0.15);
     TEST_ASSERT_EQUAL_UINT32(10000u, c.fs_hz); /* S1: 100 us */
     c.free_mech = true;
-    c.speed_rpm = W_RPM;
     c.load_nm = 2.0;
     c.speed_mode = true;
     c.speed_ref_rpm = W_RPM;
-    c.duration_s = 0.3;
-    c.win_start_s = 0.15; /* after the speed loop's recovery from the load at t = 0 */
-    c.win_end_s = 0.3;
     FILE *tr = tmpfile();
     TEST_ASSERT_NOT_NULL(tr);
     c.trace = tr;

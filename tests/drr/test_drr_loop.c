@@ -32,39 +32,13 @@
 #define T_LOAD 1.8
 
 static sim_run_t run;
-static sim_machine_t machine;
 
 void setUp(void)
 {
-    static int loaded;
-    if (!loaded) {
-        char err[256];
-        if (sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &machine, err, sizeof err) !=
-            0) {
-            TEST_FAIL_MESSAGE(err);
-        }
-        loaded = 1;
-    }
 }
 
 void tearDown(void)
 {
-}
-
-static void drr_cfg(sim_run_cfg_t *c, const char *name, double rpm, double tref, double dur,
-                    double win0)
-{
-    const ctrl_desc_t *d = ctrl_find(name);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, name);
-    sim_run_config_default(c, &machine, d);
-    c->fs_hz = d->fs_default_hz;
-    c->hal.pwm_freq_hz = c->fs_hz;
-    c->speed_rpm = rpm;
-    c->torque_ref_nm = tref;
-    c->duration_s = dur;
-    c->win_start_s = win0;
-    c->win_end_s = dur;
-    c->calib_samples = 64u;
 }
 
 typedef struct {
@@ -76,11 +50,9 @@ static res_t steady(const char *name, double rpm, double tref)
     sim_run_cfg_t c;
     /* 30 ms to settle (the EMA (5.4) time constant is 1/(lambda fs) = 3.3 ms),
      * then a 40 ms window: 2 and 6 electrical periods at 750 and 2250 r/min. */
-    drr_cfg(&c, name, rpm, tref, 0.07, 0.03);
+    loop_cfg(&c, name, rpm, tref, 0.07, 0.03);
+    loop_start(&run, &c);
     char err[256];
-    if (sim_run_init(&run, &c, err, sizeof err) != 0) {
-        TEST_FAIL_MESSAGE(err);
-    }
     if (sim_run_all(&run, err, sizeof err) != 0) {
         sim_run_free(&run);
         TEST_FAIL_MESSAGE(err);
@@ -161,7 +133,7 @@ static void test_baselines_run(void)
 static void test_reversal(void)
 {
     sim_run_cfg_t c;
-    drr_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
+    loop_cfg(&c, "drr", 0.0, 0.0, 0.3, 0.0);
     /* 20 ms of backward motoring: gamma is still settling after the 4 N*m step. */
     const loop_reversal_t r = loop_reversal(&run, &c,
                                             "at 0 torque_ref=0 load=1.6\n"

@@ -61,12 +61,7 @@ static const sim_machine_t *machine(const char *file)
             return &m[i];
         }
         if (loaded[i] == NULL) {
-            char path[512];
-            char err[256];
-            snprintf(path, sizeof path, "%s/%s", PMSM_MACHINES_DIR, file);
-            if (sim_machine_load(path, &m[i], err, sizeof err) != 0) {
-                TEST_FAIL_MESSAGE(err);
-            }
+            m[i] = loop_machine_file(file);
             loaded[i] = file;
             return &m[i];
         }
@@ -78,25 +73,16 @@ static const sim_machine_t *machine(const char *file)
 /* Controller configuration buffer: alive for the whole run. */
 static unsigned char ctrl_cfg[CTRL_CFG_MAX];
 
-/* Dynamometer run (torque mode) like loop_cfg(), for any machine; the
- * controller is configured with psi_ref_wb (< 0: the machine file's). */
+/* Dynamometer run (torque mode, loop_cfg_machine()); the controller is
+ * configured with psi_ref_wb (< 0: the machine file's) and k's tunable. */
 static void mpc_cfg(sim_run_cfg_t *c, const sim_machine_t *m, const mpc_ctrl_t *k, double rpm,
                     double tref, double duration, double win_start, double psi_ref_wb)
 {
-    const ctrl_desc_t *d = ctrl_find(k->name);
-    TEST_ASSERT_NOT_NULL_MESSAGE(d, k->name);
-    sim_run_config_default(c, m, d);
+    loop_cfg_machine(c, m, k->name, k->fs, rpm, tref, duration, win_start);
     if (psi_ref_wb >= 0.0) {
         c->ctrl_machine.psi_ref_wb = psi_ref_wb;
     }
-    c->fs_hz = k->fs != 0u ? k->fs : d->fs_default_hz;
-    c->hal.pwm_freq_hz = c->fs_hz;
-    c->speed_rpm = rpm;
-    c->torque_ref_nm = tref;
-    c->duration_s = duration;
-    c->win_start_s = win_start;
-    c->win_end_s = duration;
-    c->calib_samples = 64u;
+    const ctrl_desc_t *d = ctrl_find(k->name);
     TEST_ASSERT_TRUE(d->cfg_size <= sizeof ctrl_cfg);
     d->cfg_default(ctrl_cfg, &c->ctrl_machine);
     if (k->tunable != NULL) {
