@@ -11,6 +11,9 @@
 # pmsm_add_expect_fail_test(NAME n TARGET t PATTERNS regex ...)
 #   Runs the already defined test executable t, which must exit non-zero with output
 #   matching every regex (used to test that failures are reported).
+# pmsm_libfuzzer(<out_var>)
+#   out_var = clang (clang-14 or clang) when it builds a libFuzzer target
+#   (-fsanitize=fuzzer links), else empty: the short fuzz runs are added only then.
 # pmsm_test_alone(test ...)
 #   RUN_SERIAL for tests that talk to an image running in QEMU (a console session):
 #   QEMU runs unpaced (-icount sleep=off), so the emulated time between two commands
@@ -93,4 +96,23 @@ endfunction()
 
 function(pmsm_test_alone)
   set_tests_properties(${ARGN} PROPERTIES RUN_SERIAL TRUE)
+endfunction()
+
+function(pmsm_libfuzzer out_var)
+  set(${out_var} "" PARENT_SCOPE)
+  find_program(PMSM_CLANG NAMES clang-14 clang)
+  if(NOT PMSM_CLANG)
+    return()
+  endif()
+  get_property(probed GLOBAL PROPERTY PMSM_LIBFUZZER_RC SET)
+  if(NOT probed)  # once per configure
+    execute_process(
+      COMMAND sh -c "printf 'int LLVMFuzzerTestOneInput(const unsigned char*d,unsigned long n){(void)d;(void)n;return 0;}' | ${PMSM_CLANG} -fsanitize=fuzzer -x c - -o /dev/null"
+      RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
+    set_property(GLOBAL PROPERTY PMSM_LIBFUZZER_RC ${rc})
+  endif()
+  get_property(rc GLOBAL PROPERTY PMSM_LIBFUZZER_RC)
+  if(rc EQUAL 0)
+    set(${out_var} ${PMSM_CLANG} PARENT_SCOPE)
+  endif()
 endfunction()
