@@ -129,15 +129,7 @@ def trace_style(name, npts, lw):
 
 def sim_binary(override):
     """The simulator (built once through tools/sim) and the controller list."""
-    if override:
-        exe = override
-    else:
-        r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            sys.exit(f"compare: tools/sim failed:\n{r.stderr}")
-        bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
-        exe = os.path.join(bdir, "firmware", "sim")
+    exe = override or se.tools_sim("compare")[0]
     r = subprocess.run([exe, "--list-controllers"], capture_output=True, text=True)
     if r.returncode != 0:
         sys.exit(f"compare: {exe} --list-controllers failed:\n{r.stderr}")

@@ -30,7 +30,6 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import sys
 import tempfile
 import time
@@ -62,14 +61,10 @@ DPI = 90
 
 
 def sim_binary():
-    r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"fieldweak_studies: tools/sim failed:\n{r.stderr}")
-    bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
-    names = [ln.split("\t")[0] for ln in r.stdout.splitlines() if "\t" in ln]
-    fs = {ln.split("\t")[0]: int(ln.split("\t")[1]) for ln in r.stdout.splitlines() if "\t" in ln}
-    return os.path.join(bdir, "firmware", "sim"), names, fs
+    exe, listing = se.tools_sim("fieldweak_studies")
+    names = [ln.split("\t")[0] for ln in listing.splitlines() if "\t" in ln]
+    fs = {ln.split("\t")[0]: int(ln.split("\t")[1]) for ln in listing.splitlines() if "\t" in ln}
+    return exe, names, fs
 
 
 SIM = None

@@ -24,7 +24,6 @@ stored in OUT/runs.sqlite, a rerun computes only what is missing.
 """
 import argparse
 import os
-import subprocess
 import sys
 import time
 
@@ -60,12 +59,7 @@ SEEDS = [1, 2, 3, 4]
 
 
 def sim_binary():
-    r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.exit(f"filters: tools/sim failed:\n{r.stderr}")
-    bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
-    return os.path.join(bdir, "firmware", "sim")
+    return se.tools_sim("filters")[0]
 
 
 def job(build, ctrl, filt, duration, settle, sense=None, machine=None, tag="",

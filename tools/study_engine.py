@@ -77,17 +77,25 @@ class Build:
         return f"Build({self.path}, {self.sha[:12]})"
 
 
+def tools_sim(tool):
+    """./tools/sim --list-controllers, which builds the host-release simulator when it
+    is stale: (the simulator it built, its controller list: a line each, name TAB
+    default rate TAB ...). Exits naming tool when tools/sim fails."""
+    import subprocess
+    r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        sys.exit(f"{tool}: tools/sim failed:\n{r.stderr}")
+    # where tools/sim builds it
+    bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
+    return os.path.join(bdir, "firmware", "sim"), r.stdout
+
+
 def default_build():
     """The simulator: $PMSM_SIM_EXE, else ./tools/sim's (host-release, built if needed)."""
     exe = os.environ.get("PMSM_SIM_EXE")
     if not exe:
-        import subprocess
-        r = subprocess.run([os.path.join(ROOT, "tools", "sim"), "--list-controllers"],
-                           capture_output=True, text=True)
-        if r.returncode != 0:
-            sys.exit(f"study: tools/sim failed:\n{r.stderr}")
-        bdir = os.environ.get("PMSM_SIM_BUILD_DIR", os.path.join(ROOT, "build", "host-release"))
-        exe = os.path.join(bdir, "firmware", "sim")
+        exe, _listing = tools_sim("study")
     return Build(exe)
 
 
