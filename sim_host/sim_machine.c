@@ -12,6 +12,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sim_num.h"
+
 /* K_LIST: reals (each in the range) separated by blanks or commas, their
  * count in k_lists; K_PROFILE: points x:y (load_profile). */
 typedef enum { K_TEXT, K_INT, K_REAL, K_PATH, K_LIST, K_PROFILE } key_kind_t;
@@ -283,10 +285,8 @@ static int handler(void *user, const char *section, const char *name, const char
         if (K->kind == K_PROFILE) {
             return parse_profile(c, K, value, (plant_profile_t *)(void *)dst);
         }
-        char *end;
-        errno = 0;
-        const double v = strtod(value, &end);
-        if (end == value || *end != '\0' || errno != 0 || !isfinite(v)) {
+        double v;
+        if (sim_num_parse(value, &v) != 0) {
             snprintf(c->msg, sizeof c->msg, "[%s] %s = '%s' is not a number", section, name, value);
             return 0;
         }

@@ -7,17 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int sim_num(const char *s, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
+#include "sim_num.h"
 
 static int sim_fail(char *err, size_t errlen, const char *name, int line, const char *msg,
                     const char *tok)
@@ -60,7 +50,7 @@ int sim_scenario_parse(sim_scenario_t *s, FILE *f, const char *name, char *err, 
         e->line = line;
         if (strcmp(tok, "at") == 0) {
             tok = strtok_r(NULL, " \t\r\n", &save);
-            if (tok == NULL || sim_num(tok, &e->level) != 0 || e->level < 0.0) {
+            if (tok == NULL || sim_num_parse(tok, &e->level) != 0 || e->level < 0.0) {
                 return sim_fail(err, errlen, name, line, "expected a time >= 0 after 'at'", tok);
             }
             if (e->level < t_prev) {
@@ -71,10 +61,10 @@ int sim_scenario_parse(sim_scenario_t *s, FILE *f, const char *name, char *err, 
         } else if (strcmp(tok, "when") == 0) {
             tok = strtok_r(NULL, " \t\r\n", &save);
             if (tok != NULL && strncmp(tok, "speed>=", 7) == 0 &&
-                sim_num(tok + 7, &e->level) == 0) {
+                sim_num_parse(tok + 7, &e->level) == 0) {
                 e->trig = SIM_TRIG_SPEED_GE;
             } else if (tok != NULL && strncmp(tok, "speed<=", 7) == 0 &&
-                       sim_num(tok + 7, &e->level) == 0) {
+                       sim_num_parse(tok + 7, &e->level) == 0) {
                 e->trig = SIM_TRIG_SPEED_LE;
             } else {
                 return sim_fail(err, errlen, name, line,
@@ -86,7 +76,7 @@ int sim_scenario_parse(sim_scenario_t *s, FILE *f, const char *name, char *err, 
         while ((tok = strtok_r(NULL, " \t\r\n", &save)) != NULL) {
             char *eq = strchr(tok, '=');
             double v = 0.0;
-            if (eq == NULL || sim_num(eq + 1, &v) != 0) {
+            if (eq == NULL || sim_num_parse(eq + 1, &v) != 0) {
                 return sim_fail(err, errlen, name, line, "expected KEY=NUMBER, got", tok);
             }
             *eq = '\0';

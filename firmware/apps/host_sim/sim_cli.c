@@ -20,6 +20,7 @@
 #include "controller.h"
 #include "sim_diag.h"
 #include "sim_ident.h"
+#include "sim_num.h"
 #include "sim_pil.h"
 #include "sim_replay.h"
 #include "sim_run.h"
@@ -254,19 +255,6 @@ static const cli_opt_t *opt_find(const char *name)
     return NULL;
 }
 
-/* A whole-string finite number. */
-static int parse_number(const char *s, double *out)
-{
-    char *end = NULL;
-    errno = 0;
-    const double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno != 0 || !isfinite(v)) {
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
 static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
 {
     void *dst = (char *)c + o->off;
@@ -280,7 +268,7 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
     case K_REAL:
     case K_UINT: {
         double x;
-        if (parse_number(v, &x) != 0) {
+        if (sim_num_parse(v, &x) != 0) {
             return die("%s expects a number in [%g, %g]%s%s, got '%s'", o->name, o->lo, o->hi,
                        o->unit[0] ? " " : "", o->unit, v);
         }
@@ -306,7 +294,7 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
         }
         memcpy(a, v, (size_t)(colon - v));
         a[colon - v] = '\0';
-        if (parse_number(a, &sp->start) != 0 || parse_number(colon + 1, &sp->end) != 0) {
+        if (sim_num_parse(a, &sp->start) != 0 || sim_num_parse(colon + 1, &sp->end) != 0) {
             return die("%s expects START:END in seconds, 0 <= START < END <= the duration, "
                        "got '%s'",
                        o->name, v);
@@ -329,7 +317,7 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
             if (comma != NULL) {
                 *comma = '\0';
             }
-            if (parse_number(p, &abc->v[k]) != 0) {
+            if (sim_num_parse(p, &abc->v[k]) != 0) {
                 return die("%s expects three numbers %s, got '%s'", o->name, o->metavar, v);
             }
             if (abc->v[k] < o->lo || abc->v[k] > o->hi) {
@@ -356,7 +344,7 @@ static int parse_value(const cli_opt_t *o, const char *v, cli_t *c)
                 return die("--set %s given twice", st->name);
             }
         }
-        if (parse_number(eq + 1, &st->value) != 0) {
+        if (sim_num_parse(eq + 1, &st->value) != 0) {
             return die("--set %s expects a number, got '%s' (its unit and range: --list-tunables "
                        "CONTROLLER)",
                        st->name, eq + 1);
