@@ -2,9 +2,9 @@
  * PM-flux tracking: with the encoder and the controller's psi_pm off by
  * +-20 %, the PM flux from the voltage model (fw_config_t.psi_adapt, default
  * on) keeps the steady-state torque error of m2ptfc and drr within 3 % of
- * 1.8 N*m at 750 and 2250 r/min (the drive's torque-accuracy bound for parameter errors). Without it the current
- * model carries the error into the torque: 0.2-0.4 N*m at 750 r/min
- * (checked, so that the test can fail for the right reason).
+ * 1.8 N*m at 750 and 2250 r/min (the drive's torque-accuracy bound for parameter errors). Without
+ * it the current model carries the error into the torque: 0.2-0.4 N*m at 750 r/min (checked, so
+ * that the test can fail for the right reason).
  *
  * Why the bound holds: the encoder-mode observer is a complementary filter
  * with corner w_c = 5 % of rated speed; its PM-flux estimate psi_d - Ld i_d
@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "loop_util.h"
 #include "sim_run.h"
 #include "unity.h"
 
@@ -28,23 +29,10 @@ void tearDown(void)
 
 static double run_sse(const char *ctrl, double rpm, double psi_scale, bool adapt)
 {
-    static sim_machine_t m;
     char err[256];
-    TEST_ASSERT_EQUAL_INT_MESSAGE(
-        0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &m, err, sizeof err), err);
-    const ctrl_desc_t *d = ctrl_find(ctrl);
-    TEST_ASSERT_NOT_NULL(d);
     static sim_run_cfg_t c;
-    sim_run_config_default(&c, &m, d);
-    c.ctrl_machine.psi_pm_wb = m.psi_pm_wb * psi_scale;
-    c.fs_hz = d->fs_default_hz;
-    c.hal.pwm_freq_hz = c.fs_hz;
-    c.speed_rpm = rpm;
-    c.torque_ref_nm = 1.8;
-    c.duration_s = 0.25;
-    c.win_start_s = 0.1;
-    c.win_end_s = 0.25;
-    c.calib_samples = 64u;
+    loop_cfg(&c, ctrl, rpm, 1.8, 0.25, 0.1);
+    c.ctrl_machine.psi_pm_wb = loop_spmsm()->psi_pm_wb * psi_scale;
     c.psi_adapt = adapt;
     static sim_run_t r;
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
