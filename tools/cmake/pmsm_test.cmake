@@ -11,9 +11,11 @@
 # pmsm_add_expect_fail_test(NAME n TARGET t PATTERNS regex ...)
 #   Runs the already defined test executable t, which must exit non-zero with output
 #   matching every regex (used to test that failures are reported).
-# pmsm_libfuzzer(<out_var>)
-#   out_var = clang (clang-14 or clang) when it builds a libFuzzer target
-#   (-fsanitize=fuzzer links), else empty: the short fuzz runs are added only then.
+# pmsm_add_fuzz_test(NAME n SECONDS s [LABELS l ...])
+#   The short run of the calling folder's libFuzzer targets: test n runs
+#   fuzz/run_fuzz.sh OUTDIR CLANG s (labels "fuzz" and l, 180 s time-out), added
+#   only when clang (clang-14 or clang) links a libFuzzer target; probed once per
+#   configure.
 # pmsm_test_alone(test ...)
 #   RUN_SERIAL for tests that talk to an image running in QEMU (a console session):
 #   QEMU runs unpaced (-icount sleep=off), so the emulated time between two commands
@@ -98,21 +100,26 @@ function(pmsm_test_alone)
   set_tests_properties(${ARGN} PROPERTIES RUN_SERIAL TRUE)
 endfunction()
 
-function(pmsm_libfuzzer out_var)
-  set(${out_var} "" PARENT_SCOPE)
+function(pmsm_add_fuzz_test)
+  cmake_parse_arguments(F "" "NAME;SECONDS" "LABELS" ${ARGN})
   find_program(PMSM_CLANG NAMES clang-14 clang)
   if(NOT PMSM_CLANG)
     return()
   endif()
   get_property(probed GLOBAL PROPERTY PMSM_LIBFUZZER_RC SET)
-  if(NOT probed)  # once per configure
+  if(NOT probed)
     execute_process(
       COMMAND sh -c "printf 'int LLVMFuzzerTestOneInput(const unsigned char*d,unsigned long n){(void)d;(void)n;return 0;}' | ${PMSM_CLANG} -fsanitize=fuzzer -x c - -o /dev/null"
       RESULT_VARIABLE rc OUTPUT_QUIET ERROR_QUIET)
     set_property(GLOBAL PROPERTY PMSM_LIBFUZZER_RC ${rc})
   endif()
   get_property(rc GLOBAL PROPERTY PMSM_LIBFUZZER_RC)
-  if(rc EQUAL 0)
-    set(${out_var} ${PMSM_CLANG} PARENT_SCOPE)
+  if(NOT rc EQUAL 0)
+    return()
   endif()
+  add_test(NAME ${F_NAME}
+           COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/run_fuzz.sh
+                   ${CMAKE_CURRENT_BINARY_DIR}/fuzz ${PMSM_CLANG} ${F_SECONDS})
+  set(labels fuzz ${F_LABELS})
+  set_tests_properties(${F_NAME} PROPERTIES LABELS "${labels}" TIMEOUT 180)
 endfunction()
