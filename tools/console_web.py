@@ -129,6 +129,11 @@ class LinkWorker(threading.Thread):
         self.inflight = None              # (line, origin, lines, expected, deadline)
         self.last_poll = 0.0
         self.state = None
+        # A commissioning step was started: its status is polled until a
+        # `status` shows the drive out of the commissioning state, then once
+        # more (a step may start and end between two polls of `status`, or
+        # end between the last one in the state and the next).
+        self.cm_watch = False
 
     # ---- called from the asyncio side
     def submit(self, line, origin):
@@ -179,9 +184,6 @@ class LinkWorker(threading.Thread):
                 if now - self.last_poll >= POLL_PERIOD_S:
                     self.last_poll = now
                     line, origin = "status", "poll"
-                    if self.state in CM_STATES:
-                        self.q.put(("ident status", "poll"))
-                        self.q.put(("bringup status", "poll"))
             if line is not None:
                 self.tr.write(line.encode("ascii", "replace") + b"\n")
                 self.inflight = [line, origin, [], None, now + self.timeout]
@@ -237,9 +239,15 @@ class LinkWorker(threading.Thread):
                 return
         self.inflight = None
         ok = lines[0].startswith("ok")
+        if ok and origin != "poll" and energises(line) and line.split()[0] in ("ident", "bringup"):
+            self.cm_watch = True
         if origin == "poll" and line == "status" and ok:
             st = parse_status(lines[1:])
             self.state = st.get("state", self.state)
+            if self.state in CM_STATES or self.cm_watch:
+                self.cm_watch = self.state in CM_STATES
+                self.q.put(("ident status", "poll"))
+                self.q.put(("bringup status", "poll"))
             self.emit({"type": "status", "status": st, "counters": self.counters()})
             return
         self.emit({"type": "reply", "origin": origin, "line": line, "ok": ok, "lines": lines})

@@ -4,6 +4,7 @@ chromedriver, W3C WebDriver over HTTP; Debian's chromium and chromium-driver)
 against the emulated target (QEMU, the interactive image).
 
 usage: console_web_test.py INTERACTIVE.elf [--screenshot PNG]
+       console_web_test.py --sim SIM_INTERACTIVE --machine MACHINE.ini [--screenshot PNG]
 
 A person's session, checked from the page's own data (window.consoleState,
 what the page plots and shows):
@@ -39,12 +40,40 @@ what the page plots and shows):
     stopped within the page time-out;
   - QEMU killed: the page says "target gone"; the server neither crashes nor
     stops serving.
+
+With --sim, the commissioning end to end on the same firmware built for the
+PC with the machine file's plant (sim_interactive --pace 0: the plant as fast
+as the PC runs it; the QEMU image needs about 15 minutes of wall time for
+the anti-cogging sweep's 40 s of motor time), clicked through as a user:
+  - "run step…" vbus (confirmed): its result (vbus_v) shown when it ends;
+  - "run all…" (confirmed): while it runs the results table is empty and says
+    so (not the step's value of before); when it passes the page shows `ident
+    result`'s values, each checked against the machine file: Rs within 2 %,
+    Ld and Lq 5 %, psi_pm 2 %, the encoder's offset 2 deg electrical, its
+    direction exact, the measured counts within the firmware's own 3 % check
+    and the counts the drive then uses (the parameter tree's enc.cpr) exact,
+    inertia 10 %, viscous and Coulomb friction (with the passive load, which
+    the firmware cannot tell from Coulomb friction) 15 %;
+  - "calibrate…" (confirmed): the feed-forward's state reads "calibrating"
+    while it runs, the status line ends in `pass step=cogging` with the
+    table's peak and the friction, the feed-forward reads off (a table
+    present); "feed-forward on" makes it read on;
+  - speed mode at 30 r/min, armed: the page's speed ripple measurement (the
+    plotted speed's standard deviation over 2 s) with the feed-forward off,
+    then on: at most 0.6 of it with the table. The speed the page plots is
+    the firmware's estimate, whose quantisation alone makes about 6.7 r/min
+    on this machine (measured with its cogging set to 0), so the total falls
+    by about half while the cogging's own share falls by about 90 %; the
+    ctest `cogging` checks the 80 % on the true speed. With the
+    feed-forward's sign reversed the ripple grows and this fails.
 """
 import argparse
 import asyncio
 import base64
 import json
 import os
+import re
+import shlex
 import shutil
 import signal
 import socket
@@ -440,11 +469,274 @@ def check_firmware_page(wd, usb):
     wd.click('button[data-tab="tab-cmd"]')
 
 
+# ---- the commissioning session on the host interactive build (--sim)
+
+# Bounds of the identification against the machine file (relative, except the
+# offset in electrical degrees): the accuracy the identification is specified to.
+IDENT_BOUNDS = {"rs_ohm": 0.02, "ld_mh": 0.05, "lq_mh": 0.05, "psi_pm_wb": 0.02,
+                "inertia_kgm2": 0.10, "friction_nms": 0.15, "coulomb_nm": 0.15}
+OFFSET_BOUND_DEG = 2.0
+CPR_CHECK = 0.03       # the firmware's own counts check (enc_cpr: 3 %)
+RIPPLE_RPM = 30.0      # the speed of the ripple measurement (docs/anticogging.md)
+RIPPLE_RATIO = 0.6     # the ripple with the table at most this share of the one without
+
+
+def machine_truth(path):
+    """The machine file's values in ident result's keys and units."""
+    import configparser
+    cp_ = configparser.ConfigParser(inline_comment_prefixes=(";", "#"))
+    cp_.read(path)
+    m, mech = cp_["machine"], cp_["mechanics"]
+    sens = cp_["sensors"] if cp_.has_section("sensors") else {}
+    load = float(mech.get("load_nm", 0)) if mech.get("load_kind", "none") == "passive" else 0.0
+    return {
+        "rs_ohm": float(m["rs_ohm"]), "ld_mh": float(m["ld_mh"]), "lq_mh": float(m["lq_mh"]),
+        "psi_pm_wb": float(m["psi_pm_wb"]), "inertia_kgm2": float(mech["inertia_kgm2"]),
+        "friction_nms": float(mech.get("friction_nms", 0)),
+        # ident's coulomb_nm: Coulomb friction and a passive load (PROTOCOL.md)
+        "coulomb_nm": float(mech.get("coulomb_nm", 0)) + load,
+        "encoder_offset_deg": float(sens.get("encoder_offset_deg", 0)),
+        "encoder_direction": int(sens.get("encoder_direction", 1)),
+        "encoder_counts": 4 * int(sens.get("encoder_lines", 2500)),
+        "cogging_nm": float(mech.get("cogging_nm", 0)),
+    }
+
+
+def cm_state(wd):
+    return wd.js("return {cm: consoleState.cm, run: consoleState.cmRun, starts: consoleState.cmStarts, results: "
+                 "consoleState.results, cog: consoleState.cog, rows: document.querySelectorAll("
+                 "'#cm-results tr').length, note: document.getElementById('cm-results-note')"
+                 ".textContent, cogText: document.getElementById('cog-status').textContent, "
+                 "line: document.getElementById('cm-status').textContent}")
+
+
+def run_cm(wd, button, what, timeout):
+    """Click a commissioning button, confirm, follow the run to its end; returns
+    the end state, every state seen meanwhile and the wall time it took."""
+    n0 = cm_state(wd)["starts"]
+    wd.click(button)
+    if wd.js("return document.getElementById('modal').classList.contains('hidden')"):
+        raise Fail("%s did not ask for a confirmation" % button)
+    wd.click("#modal-ok")
+    seen = []
+
+    def ended():
+        c = cm_state(wd)
+        seen.append(c)
+        return c if c["starts"] > n0 and c["run"] is None and c["cm"] and c["cm"]["verdict"] in (
+            "pass", "fail", "stopped") and c["line"].startswith("ident: ") else None
+    t0 = time.monotonic()
+    end = wait_for("%s to end on the page" % what, ended, timeout, 0.1)
+    return end, seen, time.monotonic() - t0
+
+
+def check_identification(wd, truth):
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-cm"]')
+    # One step first (the DC link's): its result is on the page when "run all" starts.
+    wd.js("document.getElementById('cm-step').value = 'vbus'")
+    end, _, _ = run_cm(wd, "#cm-step-run", "the step vbus", 60)
+    first = wait_for("the step's result", lambda: (lambda c: c if c["results"] and
+                     c["results"]["ended"] else None)(cm_state(wd)), 30)
+    if end["cm"]["verdict"] != "pass" or "vbus_v" not in first["results"]["rows"] or \
+            not first["note"].startswith("measured by the identification that ended: pass step=vbus"):
+        raise Fail("ident step vbus on the page: %r" % first)
+    print("  ident step vbus: %s; shown: vbus_v %s V" % (end["cm"]["text"],
+                                                       first["results"]["rows"]["vbus_v"]["text"]))
+    end, seen, dt = run_cm(wd, 'button[data-cm="ident run"]', "the identification", 300)
+    if end["cm"]["verdict"] != "pass" or end["cm"]["step"] != "flux":
+        raise Fail("identification: %r" % end["cm"])
+    running = [c for c in seen if c["run"] is not None]
+    stale = [c for c in running if c["rows"] or c["results"] is not None]
+    if not running or stale or not all(c["note"].startswith("running") for c in running):
+        raise Fail("while the identification ran the page showed earlier results: %r" % (
+            stale[:1] or running[:1] or seen[:2]))
+    res = wait_for("the results of the identification", lambda: (lambda c: c if c["results"] and
+                   c["results"]["ended"] else None)(cm_state(wd)), 30)
+    rows = {r[0]: r[1] for r in wd.js(
+        "return [...document.querySelectorAll('#cm-results tr')].map((tr) => "
+        "[tr.dataset.key, tr.children[1].textContent, tr.children[2].textContent])")}
+    if not res["note"].startswith("measured by the identification that ended: pass step=flux"):
+        raise Fail("results note: %r" % res["note"])
+    print("  identification: passed in %.1f s of wall time; %d running views without a value; "
+          "results shown: %s" % (dt, len(running), res["note"]))
+    bad = []
+    print("    %-20s %12s %12s %9s %9s" % ("quantity", "page", "machine", "error", "bound"))
+    for k, rel in IDENT_BOUNDS.items():
+        if k not in rows:
+            bad.append("%s not shown" % k)
+            continue
+        v, t = float(rows[k]), truth[k]
+        err = (v - t) / t
+        print("    %-20s %12.6g %12.6g %+8.2f%% %8.0f%%" % (k, v, t, 100 * err, 100 * rel))
+        if not abs(err) <= rel:
+            bad.append("%s %g vs %g (%.2f %%, bound %g %%)" % (k, v, t, 100 * err, 100 * rel))
+    off = (float(rows.get("encoder_offset_deg", "nan")) - truth["encoder_offset_deg"] + 180) % 360 - 180
+    print("    %-20s %12s %12g %+8.2f° %8.0f°" % ("encoder_offset_deg", rows.get(
+        "encoder_offset_deg"), truth["encoder_offset_deg"], off, OFFSET_BOUND_DEG))
+    if not abs(off) <= OFFSET_BOUND_DEG:
+        bad.append("encoder offset %s deg vs %g" % (rows.get("encoder_offset_deg"),
+                                                    truth["encoder_offset_deg"]))
+    if rows.get("encoder_direction") != str(truth["encoder_direction"]):
+        bad.append("encoder direction %r vs %d" % (rows.get("encoder_direction"),
+                                                   truth["encoder_direction"]))
+    counts = float(rows.get("encoder_counts", "nan"))
+    print("    %-20s %12g %12d %+8.2f%% %8.0f%% (measured; the firmware's check)" % (
+        "encoder_counts", counts, truth["encoder_counts"],
+        100 * (counts / truth["encoder_counts"] - 1), 100 * CPR_CHECK))
+    if not abs(counts / truth["encoder_counts"] - 1) <= CPR_CHECK:
+        bad.append("encoder counts %g vs %d" % (counts, truth["encoder_counts"]))
+    # The counts the drive uses from now on: the parameter tree's enc.cpr.
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-params"]')
+    wd.js("consoleState.params = []; pmsm.command('param list', {quiet: true});")
+    cpr = wait_for("enc.cpr in the parameter tree", lambda: wd.js(
+        "const r = document.querySelector('tr[data-param=\"enc.cpr\"] input');"
+        "return r ? r.value : null"), 30)
+    print("    %-20s %12s %12d (the drive's, exact)" % ("enc.cpr", cpr, truth["encoder_counts"]))
+    if float(cpr) != truth["encoder_counts"]:
+        bad.append("enc.cpr %s vs %d" % (cpr, truth["encoder_counts"]))
+    if bad:
+        raise Fail("identification results on the page: " + "; ".join(bad))
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-cm"]')
+
+
+def check_cogging(wd, truth):
+    end, seen, dt = run_cm(wd, 'button[data-cm="ident cogging"]', "the anti-cogging calibration",
+                           600)
+    c = end["cm"]
+    if c["verdict"] != "pass" or c["step"] != "cogging":
+        raise Fail("anti-cogging calibration: %r" % c)
+    running = [x for x in seen if x["run"] is not None]
+    if not running or any(x["cogText"] != "calibrating…" or x["cog"] is not None for x in running):
+        raise Fail("while the calibration ran the feed-forward read %r" % (
+            [x["cogText"] for x in running[:3]] or seen[:1]))
+    peak = float(re.search(r"cogging_peak=([\d.eE+-]+)N\*m", c["text"]).group(1))
+    fric = float(re.search(r"friction=([\d.eE+-]+)N\*m", c["text"]).group(1))
+    st = wait_for("the feed-forward's state after the calibration",
+                  lambda: (lambda x: x if x["cog"] else None)(cm_state(wd)), 30)
+    if st["cog"] != "off" or st["cogText"] != "feed-forward off":
+        raise Fail("after the calibration the feed-forward reads %r (%r)" % (st["cog"], st["cogText"]))
+    print("  anti-cogging: calibrated in %.1f s of wall time: %s (the file's cogging %.3g N*m "
+          "peak of the fundamental); %d running views said calibrating; then %s" % (
+              dt, c["text"], truth["cogging_nm"], len(running), st["cogText"]))
+    return peak, fric
+
+
+def ripple(wd):
+    """The page's speed ripple measurement: click, wait for its row."""
+    n0 = wd.js("return consoleState.ripple.length")
+    wd.click("#ripple-measure")
+    r = wait_for("the ripple measurement", lambda: wd.js(
+        "return consoleState.ripple.length > arguments[0] ? consoleState.ripple.slice(-1)[0] : null",
+        n0), 120, 0.2)
+    if r.get("error"):
+        raise Fail("ripple measurement: %s" % r["error"])
+    return r
+
+
+def check_ripple(wd, st):
+    wd.js("document.getElementById('mode').value = 'speed';")
+    wd.type("#ref", "%g" % RIPPLE_RPM)
+    wd.click("#ref-set")
+    wd.click("#arm")
+    wd.click("#modal-ok")
+    wait_for("state=running", lambda: (st() or {}).get("state") == "running", 30)
+    time.sleep(2.0)  # the speed settled (the plant runs several times real time)
+    off = ripple(wd)
+    wd.click('button[data-cm="cogging on"]')
+    wait_for("the feed-forward on", lambda: cm_state(wd)["cog"] == "on", 30)
+    time.sleep(1.0)
+    on = ripple(wd)
+    shown = wd.js("return [...document.querySelectorAll('#ripple tr')].slice(-2).map((tr) => "
+                  "tr.textContent)")
+    print("  speed ripple at %g r/min (%s): feed-forward off: mean %.2f, sd %.2f r/min; on: mean "
+          "%.2f, sd %.2f r/min (%.0f %%); shown: %s" % (
+              RIPPLE_RPM, off["ctrl"], off["mean"], off["sd"], on["mean"], on["sd"],
+              100 * on["sd"] / off["sd"], " | ".join(shown)))
+    if off["cog"] != "off" or on["cog"] != "on" or \
+            not all(abs(x["mean"] - RIPPLE_RPM) <= 0.05 * RIPPLE_RPM for x in (off, on)):
+        raise Fail("ripple measurements in the wrong conditions: %r, %r" % (off, on))
+    if not on["sd"] <= RIPPLE_RATIO * off["sd"]:
+        raise Fail("speed ripple with the table %.2f r/min, without %.2f: more than %g of it" % (
+            on["sd"], off["sd"], RIPPLE_RATIO))
+    wd.click("#stop")
+    wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready", 30)
+
+
+def sim_main(a):
+    chromium = shutil.which("chromium")
+    driver = shutil.which("chromedriver")
+    if not chromium or not driver:
+        raise Fail("chromium and chromedriver are needed (tools/setup installs chromium, "
+                   "chromium-driver)")
+    truth = machine_truth(a.machine)
+    tmp = tempfile.mkdtemp(prefix="console-web-sim-")
+    url_file = os.path.join(tmp, "url")
+    target = "%s --machine %s --pace 0" % (shlex.quote(a.sim), shlex.quote(a.machine))
+    t_start = time.monotonic()
+    server = subprocess.Popen([CONSOLE, "--web", "--exec", target, "--port", "0",
+                               "--page-timeout", str(PAGE_TIMEOUT_S), "--url-file", url_file],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    dport = free_port()
+    cd = subprocess.Popen([driver, "--port=%d" % dport], stdout=subprocess.DEVNULL,
+                          stderr=subprocess.DEVNULL)
+    wd = WebDriver(dport)
+    try:
+        def served():
+            if server.poll() is not None:
+                raise Fail("the console server exited (%s) before it served" % server.returncode)
+            return os.path.exists(url_file) and open(url_file).read().strip()
+        url = wait_for("the server's URL", served, 60)
+        wait_for("chromedriver", lambda: http_status("http://127.0.0.1:%d/status" % dport) == 200, 30)
+        wd.start(chromium)
+        wd.get(url)
+        st = lambda: wd.js("return window.consoleState ? {role: consoleState.role, state: "
+                           "consoleState.status.state, meta: consoleState.meta && "
+                           "consoleState.meta.signals} : null")
+        wait_for("the page to control", lambda: (st() or {}).get("role") == "control", 30)
+        wait_for("the drive ready", lambda: (st() or {}).get("state") == "ready", 60)
+        wait_for("telemetry with speed", lambda: "speed" in ((st() or {}).get("meta") or []), 60)
+        print("  host interactive build (%s, plant as fast as it runs): connected, controlling, "
+              "ready, streaming" % os.path.basename(a.machine))
+        check_identification(wd, truth)
+        check_cogging(wd, truth)
+        check_ripple(wd, st)
+        if a.screenshot:
+            wd.screenshot(a.screenshot)
+    finally:
+        wd.quit() if wd.sid else None
+        cd.terminate()
+        if server.poll() is None:
+            server.send_signal(signal.SIGTERM)
+        try:
+            out, _ = server.communicate(timeout=20)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            out, _ = server.communicate()
+        print("---- console server output\n" + out.strip())
+        shutil.rmtree(tmp, ignore_errors=True)
+    if server.returncode != 0:
+        raise Fail("the console server exited with %d" % server.returncode)
+    print("console_web (host interactive build): all checks passed in %.0f s" % (
+        time.monotonic() - t_start))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("elf")
+    ap.add_argument("elf", nargs="?")
+    ap.add_argument("--sim", metavar="PROGRAM",
+                    help="the host interactive build: the commissioning session instead")
+    ap.add_argument("--machine", help="--sim: its machine file (the truth the results meet)")
     ap.add_argument("--screenshot", help="also save a screenshot of the running page here")
     a = ap.parse_args()
+    if a.sim:
+        if not a.machine:
+            ap.error("--sim needs --machine")
+        return sim_main(a)
+    if not a.elf:
+        ap.error("the interactive image (or --sim PROGRAM --machine FILE) is required")
 
     chromium = shutil.which("chromium")
     driver = shutil.which("chromedriver")

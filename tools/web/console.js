@@ -13,7 +13,7 @@ const DEFAULT_SIGNALS = ['speed', 'speed_ref', 'torque', 'torque_ref', 'i_d', 'i
 const S = {
   ws: null, connected: false, role: null, page: null, gone: null, target: '',
   status: {}, counters: { frames: 0, bad: 0, lost: 0 }, meta: null, signals: [],
-  ctrls: [], cm: null, replies: [], autostarted: false,
+  ctrls: [], replies: [], autostarted: false,
   recording: null, history: [], histPos: 0,
 };
 window.consoleState = S;
@@ -156,8 +156,6 @@ function onReply(m) {
   for (const fn of replyHooks) fn(m);
   if (!m.ok) return;
   const w = m.line.split(/\s+/);
-  if (/^ident (run|resume|step|cogging)\b/.test(m.line)) S.cmWhich = 'ident status';
-  else if (/^bringup (?!status\b)\S/.test(m.line)) S.cmWhich = 'bringup status';
   if (m.line === 'tel list') {
     S.signals = listLines(m).map((l) => {
       const p = l.trim().split(/\s+/);
@@ -169,19 +167,11 @@ function onReply(m) {
     buildCtrls();
   } else if ((w[0] === 'ctrl' && w[1] === 'select') || m.line === 'ident apply') {
     command('ctrl list', { quiet: true });
-  } else if (m.line === 'ident status' || m.line === 'bringup status') {
-    // Both describe the one commissioning engine (the server polls both while
-    // it runs): the page shows the one of what was started.
-    if (m.line === (S.cmWhich || 'ident status')) onCmStatus(m.line, first);
-  } else if (m.line === 'ident result') {
-    buildResults(listLines(m));
-  } else if (w[0] === 'cogging') {
-    $('cog-status').textContent = first.replace(/^ok\s+/, '');
   }
 }
 
 // Replies the page asks for itself: not echoed in the command log.
-const QUIET = new Set(['tel list', 'ctrl list', 'param list']);
+const QUIET = new Set(['tel list', 'ctrl list', 'param list', 'ident result', 'cogging status']);
 
 // ---------------------------------------------------------------- building the panels
 function buildSignals() {
@@ -205,32 +195,6 @@ function buildCtrls() {
     const o = document.createElement('option');
     o.value = o.textContent = c.name; o.selected = c.sel;
     sel.appendChild(o);
-  }
-}
-
-function onCmStatus(which, first) {
-  // 'ok running step=rs progress=40% ...' / 'ok pass step=...' / 'ok fail step=... error=...'
-  const w = first.split(/\s+/);
-  const verdict = w[1] || '';
-  const step = (first.match(/step=(\S+)/) || [])[1] || '';
-  if (verdict === 'idle' && S.cm && S.cm.which !== which) return;
-  const prog = +((first.match(/progress=([\d.]+)/) || [])[1] || (verdict === 'pass' ? 100 : 0));
-  S.cm = { which, verdict, step, progress: prog, text: first.replace(/^ok\s+/, '') };
-  $('cm-bar').style.width = Math.min(100, prog) + '%';
-  $('cm-status').textContent = which.split(' ')[0] + ': ' + S.cm.text;
-  $('cm-status').style.color = verdict === 'fail' ? '#b71c1c' : verdict === 'pass' ? '#2e7d32' : '';
-}
-
-function buildResults(lines) {
-  const tb = $('cm-results').tBodies[0];
-  tb.textContent = '';
-  for (const l of lines) {
-    const p = l.trim().split(/\s+/);
-    const tr = document.createElement('tr');
-    for (const c of [p[0], p[1], p[2] === '-' ? '' : p[2]]) {
-      const td = document.createElement('td'); td.textContent = c || ''; tr.appendChild(td);
-    }
-    tb.appendChild(tr);
   }
 }
 
@@ -331,9 +295,6 @@ function wire() {
     if (rec) download('pmsm-telemetry.csv', new Blob([csvText(rec)], { type: 'text/csv' }));
   };
   $('png').onclick = () => plotPng((b) => download('pmsm-plot.png', b));
-  for (const b of document.querySelectorAll('[data-cm]')) b.onclick = () => command(b.dataset.cm);
-  $('cm-step-run').onclick = () => command('ident step ' + $('cm-step').value);
-  $('bu-run').onclick = () => command('bringup ' + $('bu-step').value);
   for (const b of document.querySelectorAll('.tabs button')) {
     b.onclick = () => {
       for (const x of document.querySelectorAll('.tabs button')) x.classList.toggle('on', x === b);
