@@ -45,6 +45,7 @@
 #include "fw_settings.h"
 #include "pipeline.h"
 #include "settings_flash_model.h"
+#include "sim_num.h"
 #include "sim_run.h"
 
 #define SLICE_S 1.0e-3  /* plant time between two passes of the main loop */
@@ -140,10 +141,9 @@ static int usage(const char *why)
 /* A number option in [lo, hi]; 0 or -1 with the message printed. */
 static int number_opt(const char *name, const char *text, double lo, double hi, double *out)
 {
-    char *end = NULL;
-    const double v = text != NULL ? strtod(text, &end) : NAN;
-    if (text == NULL || end == text || *end != '\0' || !(v >= lo && v <= hi)) {
-        fprintf(stderr, "sim_interactive: %s %s outside [%g, %g]\n", name,
+    double v = NAN;
+    if (text == NULL || sim_num_parse(text, &v) != 0 || !(v >= lo && v <= hi)) {
+        fprintf(stderr, "sim_interactive: %s %s: expected a number in [%g, %g]\n", name,
                 text != NULL ? text : "(missing)", lo, hi);
         return -1;
     }
