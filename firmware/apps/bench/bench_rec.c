@@ -25,6 +25,7 @@
 #include "plant.h"
 #include "rec_loop.h"
 #include "sim_machine.h"
+#include "sim_num.h"
 #include "sim_run.h"
 
 _Static_assert(BENCH_CMD_TORQUE == PIL_CMD_TORQUE && BENCH_CMD_ARM == PIL_CMD_ARM,
@@ -176,13 +177,11 @@ static int cmd_record(int argc, char **argv)
         } else if (strcmp(a, "--ctrl") == 0) {
             only = v;
         } else if (strcmp(a, "--speed") == 0) {
-            speed = strtod(v, &end);
-            if (*end != '\0' || !(speed >= 0.0) || speed > 20000.0) {
+            if (sim_num_parse(v, &speed) != 0 || !(speed >= 0.0) || speed > 20000.0) {
                 return die("--speed expects 0 .. 20000 r/min, got ", v);
             }
         } else if (strcmp(a, "--torque") == 0) {
-            torque = strtod(v, &end);
-            if (*end != '\0' || !(torque >= 0.0) || torque > 10000.0) {
+            if (sim_num_parse(v, &torque) != 0 || !(torque >= 0.0) || torque > 10000.0) {
                 return die("--torque expects 0 .. 10000 N*m, got ", v);
             }
         } else if (strcmp(a, "--sensorless") == 0) {
