@@ -28,6 +28,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 from argtypes import whole_in  # noqa: E402
+from study_engine import MAX_JOBS  # noqa: E402  (--jobs goes to every study; standard library only)
 
 # Debian packages (tools/setup's names) and what shows each is there.
 NEEDS = (
@@ -43,7 +44,6 @@ NEEDS = (
     ("qemu-system-arm", ("cmd", "qemu-system-arm")),
 )
 SEED_MAX = 2 ** 53  # ./tools/sim --seed: a whole number a double holds exactly
-MAX_JOBS = 1024
 BENCH_ARGS = ["--no-cm0", "--no-callgrind", "--reps", "3", "--hotspots", ""]
 BENCH_BUILDS = (("host-release", ("bench_rec", "bench_host")), ("cm4", ("bench_cm4_all",)))
 
