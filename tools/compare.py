@@ -978,7 +978,7 @@ def main():
       + (f", and {an['_runs']} for the [analyses](#analyses-of-three-findings) in "
          f"{an_wall:.0f} s. " if an else ". ") +
       "Thesis SPMSM "
-      f"(`sim_host/machines/thesis_spmsm.ini`), Vdc 220 V, no dead time, ideal switches, "
+      "(`sim_host/machines/thesis_spmsm.ini`), Vdc 220 V, no dead time, ideal switches, "
       "ADC noise 0.5 count, 2500-line encoder. Indices (thesis Appendix B): T_rip = standard "
       "deviation of the torque, ψ_rip of |ψs|, T_sse = mean(T_ref − T), f_av = mean per-leg "
       "switching frequency, THD_I of phase a up to 10 kHz; from the plant's true signals on a "

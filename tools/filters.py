@@ -264,7 +264,6 @@ def main():
         if len(traces_of[c]) == 3:
             wave_plot(traces_of[c], os.path.join(fdir, f"{c}_waveforms.png"), c)
             spectra_plot(traces_of[c], os.path.join(fdir, f"{c}_spectra.png"), c)
-    traces = traces_of["hdtc"]
     s1_freq_plot(os.path.join(fdir, "s1_responses.png"))
     bands = {c: {filt: band_rms(d["torque"], d["t"][1] - d["t"][0]) for filt, d in tr.items()}
              for c, tr in traces_of.items()}
