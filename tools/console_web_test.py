@@ -57,7 +57,8 @@ the anti-cogging sweep's 40 s of motor time), clicked through as a user:
   - "calibrate…" (confirmed): the feed-forward's state reads "calibrating"
     while it runs, the status line ends in `pass step=cogging` with the
     table's peak and the friction, the feed-forward reads off (a table
-    present); "feed-forward on" makes it read on;
+    present), the results are still the identification's, named so;
+    "feed-forward on" makes it read on;
   - speed mode at 30 r/min, armed: the page's speed ripple measurement (the
     plotted speed's standard deviation over 2 s) with the feed-forward off,
     then on: at most 0.6 of it with the table. The speed the page plots is
@@ -618,6 +619,9 @@ def check_cogging(wd, truth):
                   lambda: (lambda x: x if x["cog"] else None)(cm_state(wd)), 30)
     if st["cog"] != "off" or st["cogText"] != "feed-forward off":
         raise Fail("after the calibration the feed-forward reads %r (%r)" % (st["cog"], st["cogText"]))
+    # the identification's results still under their own run's name
+    if not st["note"].startswith("measured by the identification that ended: pass step=flux"):
+        raise Fail("after the calibration the results read: %r" % st["note"])
     print("  anti-cogging: calibrated in %.1f s of wall time: %s (the file's cogging %.3g N*m "
           "peak of the fundamental); %d running views said calibrating; then %s" % (
               dt, c["text"], truth["cogging_nm"], len(running), st["cogText"]))

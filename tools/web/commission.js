@@ -48,8 +48,12 @@
       // The run ended: its results (what it measured, also after a failure),
       // and the feed-forward's state (a calibration leaves a new table).
       S.cmRun = null;
-      S.cmEnded = S.cm.text;
-      if (which === 'ident status') P.command('ident result', { quiet: true });
+      // The anti-cogging step measures the table, not the motor: the
+      // identification's results stay as they were, under their own run's name.
+      if (which === 'ident status' && !run.line.startsWith('ident cogging')) {
+        S.cmEnded = S.cm.text;
+        P.command('ident result', { quiet: true });
+      }
       P.command('cogging status', { quiet: true });
     }
   }
@@ -69,7 +73,7 @@
       }
       tb.appendChild(tr);
     }
-    const running = S.cmRun !== null;
+    const running = S.cmRun !== null && !S.cmRun.line.startsWith('ident cogging');
     S.results = { ended: running ? null : (S.cmEnded || null), running, rows };
     setResultsNote(!lines.length ? 'nothing measured yet' : running
       ? 'measured so far (the identification is still running)'

@@ -9,6 +9,11 @@ const TOKEN = new URLSearchParams(location.search).get('token') || '';
 const HEARTBEAT_MS = 250;
 const KEEP_S = 120;           // firmware seconds of telemetry kept for the plots
 const DEFAULT_SIGNALS = ['speed', 'speed_ref', 'torque', 'torque_ref', 'i_d', 'i_q'];
+// Streamed by default too where the image has them (`tel list`): the sensorless
+// start's state and the injection's angle error (an image with the injection).
+const DEFAULT_IF_PRESENT = ['sl_state', 'angle_err'];
+// Signals the page shows in other units than the firmware's SI ones.
+const DISPLAY = { angle_err: { unit: 'deg', k: 180 / Math.PI } };  // electrical degrees
 
 const S = {
   ws: null, connected: false, role: null, page: null, gone: null, target: '',
@@ -109,6 +114,8 @@ function onMessage(m) {
     case 'meta': onMeta(m); break;
     case 'samples':
       S.counters = m.counters;
+      toDisplay(m.rows);
+      lastSensorless(m.rows);
       if (charts.series) charts.series.push(m.rows);
       if (S.recording) for (const r of m.rows) S.recording.rows.push(r);
       break;
@@ -128,8 +135,49 @@ function onGone(reason) {
 }
 
 function onMeta(m) {
-  S.meta = m;
-  charts.setSeries(new Series(m.signals, m.units, KEEP_S, m.scales));
+  // The page's units (DISPLAY): the samples are converted as they arrive, so the
+  // plots, the cursor, the recordings and their CSV all say the same.
+  const d = m.signals.map((n) => DISPLAY[n] || null);
+  S.meta = Object.assign({}, m, {
+    units: m.units.map((u, i) => (d[i] ? d[i].unit : u)),
+    scales: m.scales.map((sc, i) => (d[i] ? sc * d[i].k : sc)),
+  });
+  S.displayK = d.some((x) => x) ? d.map((x) => (x ? x.k : 1)) : null;
+  charts.setSeries(new Series(m.signals, S.meta.units, KEEP_S, S.meta.scales));
+}
+
+// The sensorless start's state of the last sample (telemetry sl_state, firmware/PROTOCOL.md):
+// bits 0-1 the angle's source, 2-4 the start's phase, 5-6 where the polarity came from.
+const SL_MODE = ['forced angle', 'observer', 'initial-angle pulses', 'injection'];
+const SL_PHASE = ['', 'angle mod π', 'polarity pulse', 'angle mod π again', 'lock',
+  'saturation pulses'];
+const SL_POL = ['polarity not yet known', 'polarity from saturation', 'polarity from motion'];
+
+function lastSensorless(rows) {
+  const k = S.meta ? S.meta.signals.indexOf('sl_state') : -1;
+  if (k < 0 || !rows.length) return;
+  const v = rows[rows.length - 1][k + 1] | 0;
+  const phase = (v >> 2) & 7;
+  S.sl = { value: v, mode: SL_MODE[v & 3], phase: SL_PHASE[phase] === undefined ? 'phase ' + phase
+    : SL_PHASE[phase], pol: SL_POL[(v >> 5) & 3] || 'polarity source ' + ((v >> 5) & 3),
+  t: rows[rows.length - 1][0] };
+}
+
+// Shown only while the gates are on in sensorless mode (est.sensorless > 0, from the
+// parameter tree) and sl_state streams: never a stopped drive's last state.
+function sensorlessText() {
+  const st = S.status.state;
+  const p = (S.params || []).find((x) => x.name === 'est.sensorless');
+  if (!S.sl || !p || !(+p.value > 0) || (st !== 'running' && st !== 'commission')) return null;
+  if (!S.meta || S.meta.signals.indexOf('sl_state') < 0) return null;
+  return 'sensorless: ' + S.sl.mode + (S.sl.phase ? ' · ' + S.sl.phase : '') + ' · ' + S.sl.pol;
+}
+
+function toDisplay(rows) {
+  const K = S.displayK;
+  if (!K) return rows;
+  for (const r of rows) for (let i = 0; i < K.length; i++) r[i + 1] *= K[i];
+  return rows;
 }
 
 function maybeAutostart() {
@@ -177,7 +225,7 @@ const QUIET = new Set(['tel list', 'ctrl list', 'param list', 'ident result', 'c
 function buildSignals() {
   const box = $('signals');
   box.textContent = '';
-  const active = S.meta ? S.meta.signals : DEFAULT_SIGNALS;
+  const active = S.meta ? S.meta.signals : DEFAULT_SIGNALS.concat(DEFAULT_IF_PRESENT);
   for (const s of S.signals) {
     const lab = document.createElement('label');
     const cb = document.createElement('input');
@@ -200,7 +248,8 @@ function buildCtrls() {
 
 function telStart() {
   const names = [...document.querySelectorAll('#signals input:checked')].map((c) => c.value);
-  const use = names.length ? names : DEFAULT_SIGNALS;
+  const have = new Set(S.signals.map((x) => x.name));
+  const use = names.length ? names : DEFAULT_SIGNALS.concat(DEFAULT_IF_PRESENT.filter((n) => have.has(n)));
   command('tel start ' + use.join(' ') + ' every ' + $('every').value.trim());
 }
 
@@ -220,12 +269,18 @@ function render() {
   f.className = 'chip ' + (fault && !fault.startsWith('0') ? 'bad' : '');
   const warns = Object.keys(st).filter((k) => k.startsWith('warn')).map((k) => k + '=' + st[k])
     .filter((s) => !/=(0|none)$/.test(s));
+  const sl = sensorlessText();
+  $('st-sl').textContent = sl || '';
+  $('st-sl').className = 'chip' + (sl ? (S.sl.value & 3) === 3 ? ' ok' : '' : ' hidden');
   $('st-warn').textContent = warns.join(' ');
   $('st-warn').className = 'chip warn' + (warns.length ? '' : ' hidden');
   $('st-speed').textContent = st.speed_rpm || '—';
   $('st-speedref').textContent = st.speed_ref_rpm || '—';
   $('st-torque').textContent = st.torque_nm || '—';
-  $('st-torqueref').textContent = st.torque_ref_nm || '—';
+  // status's torque_ref_nm is the last controlled period's reference: with the
+  // gates off (after a run or a calibration) it would be a stale number.
+  const gatesOn = st.state === 'running' || st.state === 'commission';
+  $('st-torqueref').textContent = gatesOn ? st.torque_ref_nm || '—' : '—';
   $('c-frames').textContent = S.counters.frames;
   $('c-lost').textContent = S.counters.lost;
   $('c-bad').textContent = S.counters.bad;

@@ -17,6 +17,7 @@
   const GROUPS = {
     m: 'machine', enc: 'encoder', inv: 'inverter', est: 'estimation', speed: 'speed loop',
     lim: 'limits', prot: 'protections', throttle: 'throttle', thr: 'throttle', b: 'board',
+    hfi: 'high-frequency injection (sensorless at standstill: est.sensorless 2)',
   };
   const CTRL_GROUP = '';  // names without a dot: the selected controller's tunables
 
