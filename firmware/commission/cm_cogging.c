@@ -288,6 +288,7 @@ int cm_cogging_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
             const int64_t fr = cm_cog_div(c->mean_sum[0] - c->mean_sum[1], 2 * (int64_t)CTRL_COG_N);
             cm->detail[1] = fx_round_sat(fr * c->map.torque_rated, 15u);
             cm->detail[2] = (int32_t)CTRL_COG_N;
+            c->cal_cpr = cpr;
             c->valid = 1u;
             return CM_DONE;
         }

@@ -73,6 +73,7 @@ typedef struct cm_cog {
     ctrl_cogging_t map;
     uint8_t valid;    /* the table holds a completed calibration */
     uint32_t enc_neg; /* the encoder direction it was measured with (fw_t.enc_neg) */
+    uint32_t cal_cpr; /* the encoder counts per revolution it was measured with */
     /* per direction: Q16 pu torque sums and samples per bin */
     int32_t sum[CTRL_COG_N];
     uint16_t cnt[CTRL_COG_N];

@@ -282,6 +282,14 @@ typedef struct {
      * encoder and its protections unused, psi_adapt off (the observer's
      * correction needs the configured psi_pm). Default off. */
     bool sensorless;
+#if CM_MECH
+    /* The shaft's friction (Coulomb with the passive load, N*m; viscous,
+     * N*m*s): the machine's mechanics beside its inertia, which "ident apply"
+     * adopts from the identification (cm_flux.c) and the settings record
+     * keeps; 0 = none known. Kept and reported, not yet used by a
+     * controller; an image without the mechanics' identification has none. */
+    double coulomb_nm, viscous_nms;
+#endif
 #if CTRL_COGGING
     /* Anti-cogging calibration's sweep (cm_cogging.h; zeroes: its defaults). */
     cm_cog_config_t cog;
@@ -588,7 +596,8 @@ void fw_commission_results(const fw_t *fw, cm_si_t *out);
  *   encoder's counts and direction, FW_EINVAL sensorless: no mechanical
  *   angle) or off; taken at the next period.
  * fw_cogging_load: n entries of Q15 of the rated torque against the encoder
- *   position (cogging_ff.h), n = CTRL_COG_N (else FW_ERANGE); gates off
+ *   position (cogging_ff.h), measured with the encoder's present counts
+ *   (the caller checked), n = CTRL_COG_N (else FW_ERANGE); gates off
  *   (FW_EBUSY); the feed-forward stays as it was (off after a load that
  *   replaces a table in use).
  * fw_cogging_table: the table and its entries (NULL when there is none).

@@ -473,8 +473,17 @@ static int fw_commission_adopt(fw_t *fw)
     if ((r.have & CM_HAVE_FLUX) != 0u) {
         m.psi_pm_wb = r.psi_wb;
     }
+#if CM_MECH
+    const double old_fric[2] = {fw->cfg.coulomb_nm, fw->cfg.viscous_nms};
+#endif
     if (cm_si_has(&r, CM_HAVE_MECH)) {
         m.inertia_kgm2 = r.inertia_kgm2;
+#if CM_MECH
+        /* friction: a negative fit (noise about none) is none */
+        fw->cfg.coulomb_nm = isfinite(r.coulomb_nm) && r.coulomb_nm > 0.0 ? r.coulomb_nm : 0.0;
+        fw->cfg.viscous_nms =
+            isfinite(r.friction_nms) && r.friction_nms > 0.0 ? r.friction_nms : 0.0;
+#endif
     }
     const ctrl_machine_t old = fw->machine_own;
     const double old_torque_nm = fw->bases.torque_nm;
@@ -490,6 +499,10 @@ static int fw_commission_adopt(fw_t *fw)
     if (rc != FW_OK) {
         /* Back to the configuration that worked before. */
         fw->machine_own = old;
+#if CM_MECH
+        fw->cfg.coulomb_nm = old_fric[0];
+        fw->cfg.viscous_nms = old_fric[1];
+#endif
         fw->enc_offset = old_off;
         fw->enc_neg = old_neg;
         (void)fw_setup_machine(fw, &fw->cfg, fw->ctrl, NULL);
@@ -737,7 +750,7 @@ int fw_cogging_enable(fw_t *fw, bool on)
     if (fw->cfg.sensorless) {
         return FW_EINVAL;
     }
-    if (fw->cog.valid == 0u || fw->cog.map.cpr != fw->enc_cpr) {
+    if (fw->cog.valid == 0u || fw->cog.cal_cpr != fw->enc_cpr) {
         return FW_ENOENT;
     }
     fw->cog_on = 1u;
@@ -755,7 +768,8 @@ int fw_cogging_load(fw_t *fw, const int16_t *table, uint32_t n)
     if (fw_gates_on_or_pending(fw)) {
         return FW_EBUSY;
     }
-    memcpy(fw->cog.table, table, sizeof fw->cog.table);
+    memmove(fw->cog.table, table, sizeof fw->cog.table); /* table may be fw->cog.table */
+    fw->cog.cal_cpr = fw->enc_cpr;
     fw->cog.valid = 1u;
     return FW_OK;
 }

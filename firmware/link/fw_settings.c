@@ -11,7 +11,11 @@
 #include "cmd.h"
 #include "cmd_num.h"
 #include "controller.h"
+#include "ctrl_units.h"
 #include "fw_link.h"
+#if CTRL_COGGING
+#include "settings_table.h"
+#endif
 
 static void fw_settings_name(char *dst, const char *src)
 {
@@ -75,6 +79,10 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
     s->speed_out_max_nm = c->speed_out_max_nm;
     s->speed_loop_hz = c->speed_loop_hz;
     s->overspeed_rpm = c->overspeed_rpm;
+#if CM_MECH
+    s->coulomb_nm = c->coulomb_nm;
+    s->viscous_nms = c->viscous_nms;
+#endif
     fw_settings_thr_capture(s, NULL);
     cm_si_t r;
     fw_commission_results(fw, &r);
@@ -87,6 +95,10 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
     s->id_enc_offset_deg = fw_settings_finite(r.enc_offset_deg);
     s->id_enc_dir = (int8_t)(r.enc_dir > 0 ? 1 : (r.enc_dir < 0 ? -1 : 0));
     s->id_enc_cpr = r.enc_cpr;
+#if CM_MECH
+    s->id_coulomb_nm = fw_settings_finite(r.coulomb_nm);
+    s->id_viscous_nms = fw_settings_finite(r.friction_nms);
+#endif
 }
 
 void fw_settings_thr_capture(settings_t *s, const thr_config_t *c)
@@ -134,6 +146,42 @@ int fw_settings_thr_config(const settings_t *s, thr_config_t *c, char *why, size
     return FW_EINVAL;
 }
 
+#if CM_MECH
+/* The record's friction into c: none up to what the rated torque overcomes
+ * (a drive that cannot move its own shaft is a wrong record). */
+static int fw_settings_friction(const settings_t *s, fw_config_t *c, char *why, size_t cap)
+{
+    /* friction: none up to what the rated torque overcomes (a drive that
+     * cannot move its own shaft is a wrong record) */
+    const double t_r = s->torque_rated_nm;
+    const double w_r = s->speed_rated_rpm * (CTRL_TWO_PI / 60.0);
+    const char *bad = NULL;
+    double val = 0.0, hi = 0.0;
+    if (!(s->coulomb_nm >= 0.0 && s->coulomb_nm <= t_r)) {
+        bad = "m.coulomb_nm";
+        val = s->coulomb_nm;
+        hi = t_r;
+    } else if (!(s->viscous_nms >= 0.0 && s->viscous_nms * w_r <= t_r)) {
+        bad = "m.viscous_nms";
+        val = s->viscous_nms;
+        hi = w_r > 0.0 ? t_r / w_r : 0.0;
+    }
+    if (bad != NULL) {
+        char vt[24], ht[24]; /* no float conversion in printf (the tunables below) */
+        if (cmd_num_format(vt, sizeof vt, val, 7u) == 0u ||
+            cmd_num_format(ht, sizeof ht, hi, 7u) == 0u) {
+            strcpy(vt, "?");
+            strcpy(ht, "?");
+        }
+        (void)snprintf(why, cap, "%s = %s outside [0, %s]", bad, vt, ht);
+        return FW_EINVAL;
+    }
+    c->coulomb_nm = s->coulomb_nm;
+    c->viscous_nms = s->viscous_nms;
+    return FW_OK;
+}
+#endif
+
 int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, void *cfg_buf,
                        char *why, size_t cap)
 {
@@ -173,6 +221,13 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
     c->speed_out_max_nm = s->speed_out_max_nm;
     c->speed_loop_hz = s->speed_loop_hz;
     c->overspeed_rpm = s->overspeed_rpm;
+#if CM_MECH
+    /* friction (an image without the mechanics' identification keeps none:
+     * the record's stay in the record) */
+    if (fw_settings_friction(s, c, why, cap) != FW_OK) {
+        return FW_EINVAL;
+    }
+#endif
     memset(cfg_buf, 0, CTRL_CFG_MAX);
     if (ctrl_cfg_default(d, cfg_buf, m) != CTRL_OK) {
         (void)snprintf(why, cap, "controller %s: no default configuration", d->name);
@@ -192,8 +247,113 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
     return FW_OK;
 }
 
+#if CTRL_COGGING
+/* The number x as text (no float conversion in printf). */
+static const char *fw_settings_num(char *buf, size_t cap, double x)
+{
+    return cmd_num_format(buf, cap, x, 6u) != 0u ? buf : "?";
+}
+
+/* Why the table of header h was not measured on what fw runs now; NULL: it was. */
+static const char *fw_settings_tab_mismatch(const fw_t *fw, const settings_tab_hdr_t *h, char *why,
+                                            size_t cap)
+{
+    char a[16], b[16]; /* 6 significant digits */
+    const int dir = fw->enc_neg != 0u ? -1 : 1;
+    /* the offset's difference, electrical: 2 degrees is the identification's
+     * bound; beyond it the encoder moved on the shaft, and the table with it */
+    const int32_t d = (int32_t)(fw->enc_offset - h->enc_offset);
+    const uint32_t ad = d < 0 ? 0u - (uint32_t)d : (uint32_t)d;
+    const double t_r = fw->machine_own.torque_rated_nm;
+    if (h->n_log2 != CTRL_COG_N_LOG2) {
+        (void)snprintf(why, cap, "%lu entries, this image's table %lu",
+                       (unsigned long)1u << h->n_log2, (unsigned long)CTRL_COG_N);
+    } else if (h->enc_cpr != fw->enc_cpr) {
+        (void)snprintf(why, cap, "encoder %lu counts per revolution, the table's %lu",
+                       (unsigned long)fw->enc_cpr, (unsigned long)h->enc_cpr);
+    } else if (h->enc_dir != dir) {
+        (void)snprintf(why, cap, "encoder direction %d, the table's %d", dir, h->enc_dir);
+    } else if (h->pole_pairs != fw->machine_own.pole_pairs) {
+        (void)snprintf(why, cap, "pole pairs %d, the table's %ld", fw->machine_own.pole_pairs,
+                       (long)h->pole_pairs);
+    } else if (!(fabs(h->torque_rated_nm - t_r) <= 1e-9 * t_r)) {
+        (void)snprintf(why, cap, "rated torque %s N*m, the table's %s",
+                       fw_settings_num(a, sizeof a, t_r),
+                       fw_settings_num(b, sizeof b, h->torque_rated_nm));
+    } else if (ad > FW_SETTINGS_TAB_OFFSET_MAX) {
+        (void)snprintf(why, cap, "encoder offset %s deg electrical from the table's (> 2)",
+                       fw_settings_num(a, sizeof a, (double)ad * (360.0 / 4294967296.0)));
+    } else {
+        return NULL;
+    }
+    return why;
+}
+
+/* The table saved with the record of page st->scan.page (fw_settings_boot). */
+static void fw_settings_tab_boot(fw_settings_t *st)
+{
+    fw_t *fw = st->fw;
+    st->tab_msg[0] = '\0';
+    if (fw == NULL || !settings_tab_fits(&st->flash, CTRL_COG_N_LOG2)) {
+        return;
+    }
+    const unsigned page = (unsigned)st->scan.page;
+    settings_tab_hdr_t h;
+    uint16_t fmt = 0;
+    /* straight into the drive's table: it has none since the record's
+     * configuration (fw_init), and stays without one (valid 0) unless the
+     * table passes */
+    const settings_status_t ts =
+        settings_tab_load(&st->flash, page, st->scan.seq[page], st->buf, sizeof st->buf, &h,
+                          fw->cog.table, CTRL_COG_N, &fmt);
+    char why[FW_SETTINGS_MSG_MAX - 41u]; /* the message's own words: 41 */
+    if (ts == SETTINGS_E_EMPTY) {
+        return;
+    }
+    if (ts == SETTINGS_E_OLD || ts == SETTINGS_E_NEW) {
+        (void)snprintf(why, sizeof why, "format %u (this firmware reads %u)", (unsigned)fmt,
+                       SETTINGS_TAB_FORMAT);
+    } else if (ts != SETTINGS_OK) {
+        (void)snprintf(why, sizeof why, "%s", settings_status_name(ts));
+    } else if (fw_settings_tab_mismatch(fw, &h, why, sizeof why) == NULL) {
+        if (fw_cogging_load(fw, fw->cog.table, CTRL_COG_N) == FW_OK) {
+            const bool on = h.ff_on != 0u && fw_cogging_enable(fw, true) == FW_OK;
+            (void)snprintf(st->tab_msg, sizeof st->tab_msg,
+                           "cogging table (%lu entries) applied, feed-forward %s",
+                           (unsigned long)CTRL_COG_N,
+                           on ? "on" : (h.ff_on != 0u ? "off (sensorless)" : "off"));
+            return;
+        }
+        (void)snprintf(why, sizeof why, "%s", "gates on");
+    }
+    (void)snprintf(st->tab_msg, sizeof st->tab_msg, "cogging table refused: %s; feed-forward off",
+                   why);
+}
+
+/* The drive's table as a record to save; false: none. */
+static bool fw_settings_tab_capture(const fw_t *fw, settings_tab_t *t)
+{
+    t->entries = fw_cogging_table(fw, NULL);
+    if (t->entries == NULL) {
+        return false;
+    }
+    t->hdr.seq = 0u; /* the store's */
+    t->hdr.enc_cpr = fw->cog.cal_cpr;
+    t->hdr.enc_offset = fw->enc_offset;
+    t->hdr.enc_dir = fw->enc_neg != 0u ? -1 : 1;
+    t->hdr.n_log2 = (uint8_t)CTRL_COG_N_LOG2;
+    t->hdr.ff_on = fw->cog_on != 0u ? 1u : 0u;
+    t->hdr.pole_pairs = fw->machine_own.pole_pairs;
+    t->hdr.torque_rated_nm = fw->machine_own.torque_rated_nm;
+    return true;
+}
+#endif
+
 bool fw_settings_boot(fw_settings_t *st)
 {
+#if CTRL_COGGING
+    st->tab_msg[0] = '\0';
+#endif
     const settings_status_t rc =
         settings_store_load(&st->flash, st->buf, sizeof st->buf, &st->rec, &st->scan);
     if (rc != SETTINGS_OK) {
@@ -204,6 +364,9 @@ bool fw_settings_boot(fw_settings_t *st)
     why[0] = '\0';
     if (st->apply(st->ctx, &st->rec, why, sizeof why) == CMD_OK) {
         (void)settings_load_message(&st->scan, st->msg, sizeof st->msg);
+#if CTRL_COGGING
+        fw_settings_tab_boot(st);
+#endif
         return true;
     }
     (void)st->apply_default(st->ctx);
@@ -258,11 +421,27 @@ static int fw_settings_command(fw_settings_t *st, fw_t *fw, const char *what, co
             st->capture(st->ctx, &s);
         }
         uint32_t seq = 0;
+#if CTRL_COGGING
+        /* the table in its own record of the same page, where the page holds it */
+        settings_tab_t tab;
+        const bool have = fw_settings_tab_capture(fw, &tab);
+        const bool fits = settings_tab_fits(&st->flash, CTRL_COG_N_LOG2);
+        rc = settings_store_save_with(&st->flash, st->buf, sizeof st->buf, &s,
+                                      have && fits ? settings_tab_program : NULL, &tab, &seq);
+        if (rc == SETTINGS_STORE_OK) {
+            (void)snprintf(st->msg, sizeof st->msg, "saved record %lu%s", (unsigned long)seq,
+                           !have  ? ""
+                           : fits ? " with the cogging table"
+                                  : "; the cogging table not kept: the flash page is too small");
+            return CMD_OK;
+        }
+#else
         rc = settings_store_save(&st->flash, st->buf, sizeof st->buf, &s, &seq);
         if (rc == SETTINGS_STORE_OK) {
             (void)snprintf(st->msg, sizeof st->msg, "saved record %lu", (unsigned long)seq);
             return CMD_OK;
         }
+#endif
     } else {
         rc = settings_store_erase(&st->flash, st->buf, sizeof st->buf);
         if (rc == SETTINGS_STORE_OK) {

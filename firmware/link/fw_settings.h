@@ -21,9 +21,16 @@
 #include "throttle.h"
 
 #define FW_SETTINGS_MSG_MAX 112u
+/* A saved anti-cogging table is refused when the encoder's offset moved by
+ * more than 2 degrees electrical (2^-32 turn): the identification's bound. */
+#define FW_SETTINGS_TAB_OFFSET_MAX 23860929u
 
 typedef struct {
     settings_flash_t flash;
+    /* The drive whose anti-cogging table (pipeline.h) is kept with the
+     * record, in its own record (settings_table.h) where the flash's pages
+     * hold it; NULL: none (the record alone). */
+    fw_t *fw;
     uint8_t buf[SETTINGS_REC_MAX]; /* work area of the store */
     settings_t rec;                /* the record last read ("config show") */
     settings_scan_t scan;          /* what the last read found */
@@ -38,6 +45,13 @@ typedef struct {
     void (*capture)(void *ctx, settings_t *s);
     void *ctx;
     char msg[FW_SETTINGS_MSG_MAX]; /* the last operation's message */
+#if CTRL_COGGING
+    /* The table's part of the last start-up: "" (none saved), "cogging
+     * table (2048 entries) applied, feed-forward on", or why it was refused
+     * ("cogging table refused: encoder 4096 counts per revolution, the
+     * table's 16384; feed-forward off"). */
+    char tab_msg[FW_SETTINGS_MSG_MAX];
+#endif
 } fw_settings_t;
 
 /* The firmware's configuration as a record: machine, encoder, inverter,
@@ -67,7 +81,13 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
 /* Start-up: the newest valid record applied through st->apply, else the
  * defaults (st->apply_default when a record was refused). st->msg says which
  * ("settings: record 3 (page 1) applied", "settings: no record in flash,
- * compiled-in defaults", ...). Returns true when a record was applied. */
+ * compiled-in defaults", ...). Returns true when a record was applied.
+ * Then, in an image with anti-cogging and st->fw set, the table saved with
+ * that record: loaded when it was measured on what the record configured
+ * (the table's entries, the encoder's counts, direction and offset within
+ * 2 degrees electrical, the pole pairs and the rated torque that scales it),
+ * its feed-forward on if it was on when saved; else refused, the reason in
+ * st->tab_msg, and the drive runs without it. */
 bool fw_settings_boot(fw_settings_t *st);
 
 #endif /* FIRMWARE_FW_SETTINGS_H */

@@ -26,8 +26,9 @@ typedef struct {
 #define SF_F64(key, field) SF(key, field, ST_F64, 0, 0)
 #define SF_U32(key, field) SF(key, field, ST_U32, 0, 0) /* every value */
 
-/* The body of format 1, in order. The tunables are listed separately by
- * settings_item_at (their names are data). */
+/* The body, in order: formats 1 and 2 have the fields up to id.enc_cpr,
+ * format 3 the friction after them (settings_nfields). The tunables are
+ * listed separately by settings_item_at (their names are data). */
 static const settings_field_t settings_fields[] = {
     SF("m.p", pole_pairs, ST_I32, 1, 1000),
     SF_F64("m.rs_ohm", rs_ohm),
@@ -74,8 +75,20 @@ static const settings_field_t settings_fields[] = {
     SF_F64("id.enc_offset_deg", id_enc_offset_deg),
     SF("id.enc_dir", id_enc_dir, ST_I8, -1, 1),
     SF_U32("id.enc_cpr", id_enc_cpr),
+    /* format 3 */
+    SF_F64("m.coulomb_nm", coulomb_nm),
+    SF_F64("m.viscous_nms", viscous_nms),
+    SF_F64("id.coulomb_nm", id_coulomb_nm),
+    SF_F64("id.viscous_nms", id_viscous_nms),
 };
 #define SETTINGS_NFIELDS (sizeof settings_fields / sizeof settings_fields[0])
+#define SETTINGS_NFIELDS_F2 (SETTINGS_NFIELDS - 4u) /* formats 1 and 2 */
+
+/* The fields a record of format fmt (SETTINGS_FORMAT_MIN .. SETTINGS_FORMAT) has. */
+static size_t settings_nfields(unsigned fmt)
+{
+    return fmt >= 3u ? SETTINGS_NFIELDS : SETTINGS_NFIELDS_F2;
+}
 
 static const uint8_t settings_type_size[] = {1u, 1u, 2u, 4u, 4u, 8u, SETTINGS_NAME_MAX};
 
@@ -96,42 +109,51 @@ const char *settings_status_name(settings_status_t st)
     return (unsigned)st < (unsigned)SETTINGS_E_COUNT ? settings_status_names[st] : "?";
 }
 
-uint32_t settings_crc32(const uint8_t *data, size_t n)
+uint32_t settings_crc32_update(uint32_t crc, const uint8_t *data, size_t n)
 {
     /* bitwise: no 1 KB table in flash; a record is checked once per boot */
-    uint32_t crc = 0xFFFFFFFFu;
     for (size_t i = 0; i < n; i++) {
         crc ^= data[i];
         for (unsigned b = 0; b < 8u; b++) {
             crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
         }
     }
-    return ~crc;
+    return crc;
 }
 
-static size_t settings_body_size(void)
+uint32_t settings_crc32(const uint8_t *data, size_t n)
+{
+    return ~settings_crc32_update(SETTINGS_CRC_INIT, data, n);
+}
+
+static size_t settings_body_size(unsigned fmt)
 {
     size_t n = 0;
-    for (size_t i = 0; i < SETTINGS_NFIELDS; i++) {
+    for (size_t i = 0; i < settings_nfields(fmt); i++) {
         n += (size_t)settings_type_size[settings_fields[i].type] * settings_fields[i].count;
     }
     return n;
 }
 
-size_t settings_record_size(void)
+static size_t settings_record_size_of(unsigned fmt)
 {
     /* header, body, CRC, rounded up to whole double words */
-    return (SETTINGS_HDR_SIZE + settings_body_size() + 4u + 7u) & ~(size_t)7u;
+    return (SETTINGS_HDR_SIZE + settings_body_size(fmt) + 4u + 7u) & ~(size_t)7u;
 }
 
-static void settings_put(uint8_t *p, uint64_t v, unsigned n)
+size_t settings_record_size(void)
+{
+    return settings_record_size_of(SETTINGS_FORMAT);
+}
+
+void settings_put(uint8_t *p, uint64_t v, unsigned n)
 {
     for (unsigned i = 0; i < n; i++) {
         p[i] = (uint8_t)(v >> (8u * i));
     }
 }
 
-static uint64_t settings_get(const uint8_t *p, unsigned n)
+uint64_t settings_get(const uint8_t *p, unsigned n)
 {
     uint64_t v = 0;
     for (unsigned i = 0; i < n; i++) {
@@ -192,7 +214,7 @@ size_t settings_encode(const settings_t *s, uint32_t seq, uint8_t *buf, size_t c
     settings_put(buf + 4, SETTINGS_FORMAT, 2u);
     settings_put(buf + 6, len, 2u);
     settings_put(buf + 8, seq, 4u);
-    settings_put(buf + 12, settings_body_size(), 4u);
+    settings_put(buf + 12, settings_body_size(SETTINGS_FORMAT), 4u);
     uint8_t *p = buf + SETTINGS_HDR_SIZE;
     const uint8_t *base = (const uint8_t *)s;
     for (size_t i = 0; i < SETTINGS_NFIELDS; i++) {
@@ -272,14 +294,15 @@ settings_status_t settings_decode(const uint8_t *buf, size_t n, settings_t *s, u
     if (fmt > SETTINGS_FORMAT) {
         return SETTINGS_E_NEW;
     }
-    if (len != settings_record_size() || settings_get(buf + 12, 4u) != settings_body_size()) {
+    if (len != settings_record_size_of(fmt) ||
+        settings_get(buf + 12, 4u) != settings_body_size(fmt)) {
         return SETTINGS_E_LENGTH;
     }
     settings_t t;
     memset(&t, 0, sizeof t);
     const uint8_t *p = buf + SETTINGS_HDR_SIZE;
     uint8_t *base = (uint8_t *)&t;
-    for (size_t i = 0; i < SETTINGS_NFIELDS; i++) {
+    for (size_t i = 0; i < settings_nfields(fmt); i++) {
         const settings_field_t *f = &settings_fields[i];
         const unsigned sz = settings_type_size[f->type];
         for (unsigned k = 0; k < f->count; k++) {

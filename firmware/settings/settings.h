@@ -19,12 +19,20 @@
  *      0xFFFFFFFF) of every byte before it
  * A record of another format version is refused with its version named
  * (settings_decode: SETTINGS_E_OLD / SETTINGS_E_NEW). This firmware writes
- * format 2 and reads formats 1 and 2, which have the same layout: format 1's
- * writers never stored the throttle input (its four fields hold zeroes, which
- * no throttle check accepts), so a format-1 record is read with thr_stored = 0
- * and its throttle fields cleared, and the firmware keeps the throttle's
- * defaults (fw_settings_thr_config). A later format adds its migration from
- * the earlier ones in settings_decode.
+ * format 3 and reads formats 1 to 3. A format appends its fields at the end
+ * of the body (settings.c: the fields each format has), and a record of an
+ * earlier format is read with the fields it lacks zero:
+ *   format 1: the layout of format 2, but its writers never stored the
+ *             throttle input (its four fields hold zeroes, which no throttle
+ *             check accepts): read with thr_stored = 0 and its throttle
+ *             fields cleared; the firmware keeps the throttle's defaults
+ *             (fw_settings_thr_config);
+ *   format 2: no friction (m.coulomb_nm, m.viscous_nms, id.coulomb_nm,
+ *             id.viscous_nms read as 0: none known).
+ * A later format appends its fields and its entry in settings.c's table.
+ *
+ * The anti-cogging table is a record of its own in the same flash page
+ * (settings_table.h): 4 KiB does not fit this record's page on every board.
  */
 #ifndef FIRMWARE_SETTINGS_SETTINGS_H
 #define FIRMWARE_SETTINGS_SETTINGS_H
@@ -34,7 +42,7 @@
 #include <stdint.h>
 
 #define SETTINGS_MAGIC 0x53534D50u /* "PMSS" in memory order */
-#define SETTINGS_FORMAT 2u         /* written; read: SETTINGS_FORMAT_MIN .. SETTINGS_FORMAT */
+#define SETTINGS_FORMAT 3u         /* written; read: SETTINGS_FORMAT_MIN .. SETTINGS_FORMAT */
 #define SETTINGS_FORMAT_MIN 1u     /* format 1: no throttle input stored (thr_stored = 0) */
 #define SETTINGS_HDR_SIZE 16u
 #define SETTINGS_NAME_MAX 16u     /* controller and tunable names, NUL included */
@@ -89,6 +97,11 @@ typedef struct {
     double id_rs_ohm, id_ld_h, id_lq_h, id_psi_wb, id_inertia_kgm2, id_enc_offset_deg;
     int8_t id_enc_dir;
     uint32_t id_enc_cpr;
+    /* format 3: friction. The drive's (fw_config_t.coulomb_nm, viscous_nms:
+     * "ident apply" adopts the identified ones, as the inertia above) and the
+     * identification's (informational, as id_* above); 0: none known. */
+    double coulomb_nm, viscous_nms;       /* Coulomb (and passive load), N*m; viscous, N*m*s */
+    double id_coulomb_nm, id_viscous_nms; /* idem, as identified */
 } settings_t;
 
 /* Why a record was not accepted (settings_decode). */
@@ -107,9 +120,16 @@ typedef enum {
 
 const char *settings_status_name(settings_status_t st);
 
-/* CRC-32 (IEEE 802.3) of n bytes; crc: SETTINGS_CRC_INIT or a previous
- * result without the final xor (settings_crc32 applies it). */
+/* CRC-32 (IEEE 802.3) of n bytes. */
 uint32_t settings_crc32(const uint8_t *data, size_t n);
+/* The same in pieces: crc = SETTINGS_CRC_INIT, then each piece in order
+ * through settings_crc32_update; the CRC is ~crc at the end. */
+#define SETTINGS_CRC_INIT 0xFFFFFFFFu
+uint32_t settings_crc32_update(uint32_t crc, const uint8_t *data, size_t n);
+
+/* n <= 8 little-endian bytes at p: written from v / read. */
+void settings_put(uint8_t *p, uint64_t v, unsigned n);
+uint64_t settings_get(const uint8_t *p, unsigned n);
 
 /* Record length in bytes for this format (a multiple of 8). */
 size_t settings_record_size(void);

@@ -15,11 +15,17 @@ static uint32_t sfm_rand(sfm_t *m)
     return x;
 }
 
-void sfm_init(sfm_t *m, uint32_t seed)
+void sfm_init_size(sfm_t *m, uint32_t seed, uint32_t page_size)
 {
     memset(m, 0, sizeof *m);
     memset(m->mem, 0xFF, sizeof m->mem);
+    m->page_size = page_size <= SFM_PAGE_MAX ? page_size & ~7u : SFM_PAGE_MAX;
     m->rng = seed != 0u ? seed : 0x9E3779B9u;
+}
+
+void sfm_init(sfm_t *m, uint32_t seed)
+{
+    sfm_init_size(m, seed, SFM_PAGE_SIZE);
 }
 
 void sfm_cut(sfm_t *m, uint32_t n, sfm_cut_t mode)
@@ -69,7 +75,7 @@ static bool sfm_begin(sfm_t *m, bool *torn)
 static int sfm_read(void *ctx, unsigned page, uint32_t off, uint8_t *buf, size_t n)
 {
     sfm_t *m = (sfm_t *)ctx;
-    if (page > 1u || off > SFM_PAGE_SIZE || n > SFM_PAGE_SIZE - off) {
+    if (page > 1u || off > m->page_size || n > m->page_size - off) {
         return SFM_E_ADDR;
     }
     for (size_t i = off / 8u; i * 8u < off + n; i++) {
@@ -93,7 +99,7 @@ static int sfm_erase(void *ctx, unsigned page)
     }
     if (torn) {
         /* interrupted: each double word erased, untouched, or half-way (ECC) */
-        for (unsigned i = 0; i < SFM_DW; i++) {
+        for (unsigned i = 0; i < m->page_size / 8u; i++) {
             const uint32_t r = sfm_rand(m) % 3u;
             if (r == 0u) {
                 memset(&m->mem[page][8u * i], 0xFF, 8u);
@@ -107,15 +113,15 @@ static int sfm_erase(void *ctx, unsigned page)
         }
         return SFM_E_POWER;
     }
-    memset(m->mem[page], 0xFF, SFM_PAGE_SIZE);
-    memset(m->ecc_bad[page], 0, SFM_DW);
+    memset(m->mem[page], 0xFF, m->page_size);
+    memset(m->ecc_bad[page], 0, m->page_size / 8u);
     return m->off ? SFM_E_POWER : 0;
 }
 
 static int sfm_program(void *ctx, unsigned page, uint32_t off, const uint8_t dw[8])
 {
     sfm_t *m = (sfm_t *)ctx;
-    if (page > 1u || (off & 7u) != 0u || off >= SFM_PAGE_SIZE) {
+    if (page > 1u || (off & 7u) != 0u || off >= m->page_size) {
         return SFM_E_ADDR;
     }
     uint8_t *at = &m->mem[page][off];
@@ -148,7 +154,7 @@ void sfm_flash(sfm_t *m, settings_flash_t *f)
 {
     memset(f, 0, sizeof *f);
     f->ctx = m;
-    f->page_size = SFM_PAGE_SIZE;
+    f->page_size = m->page_size;
     f->read = sfm_read;
     f->erase = sfm_erase;
     f->program = sfm_program;

@@ -69,6 +69,13 @@ settings_status_t settings_store_load(const settings_flash_t *f, uint8_t *buf, s
 int settings_store_save(const settings_flash_t *f, uint8_t *buf, size_t cap, const settings_t *s,
                         uint32_t *seq_out)
 {
+    return settings_store_save_with(f, buf, cap, s, NULL, NULL, seq_out);
+}
+
+int settings_store_save_with(const settings_flash_t *f, uint8_t *buf, size_t cap,
+                             const settings_t *s, settings_store_writer_t write, const void *wctx,
+                             uint32_t *seq_out)
+{
     if (s == NULL || !settings_store_args(f, buf, cap)) {
         return SETTINGS_STORE_E_ARGS;
     }
@@ -82,6 +89,9 @@ int settings_store_save(const settings_flash_t *f, uint8_t *buf, size_t cap, con
         return SETTINGS_STORE_E_ENCODE;
     }
     int rc = f->erase(f->ctx, page);
+    if (rc == 0 && write != NULL) {
+        rc = write(wctx, f, page, seq, buf + len, cap - len); /* buf: the record so far */
+    }
     for (size_t off = 0; rc == 0 && off < len; off += 8u) {
         rc = f->program(f->ctx, page, (uint32_t)off, buf + off);
     }
@@ -152,8 +162,7 @@ size_t settings_load_message(const settings_scan_t *scan, char *out, size_t cap)
                              "%u), refused;",
                              p, (unsigned)scan->format[p], SETTINGS_FORMAT_MIN, SETTINGS_FORMAT);
             } else {
-                n = snprintf(out, cap,
-                             "settings: page %u: %s, no valid record;", p,
+                n = snprintf(out, cap, "settings: page %u: %s, no valid record;", p,
                              settings_status_name(scan->status[p]));
             }
         }

@@ -24,7 +24,10 @@
 
 #include "settings.h"
 
-/* A flash device with two pages of page_size bytes (numbered 0 and 1 here). */
+/* A flash device with two pages of page_size bytes (numbered 0 and 1 here):
+ * the settings record at offset 0, the anti-cogging table's record at
+ * SETTINGS_TAB_OFFSET where the page holds it (settings_table.h: the F405's
+ * 16 KiB sectors, not the G4's 2 KiB pages). */
 typedef struct {
     void *ctx;
     uint32_t page_size; /* bytes, a multiple of 8 and >= SETTINGS_REC_MAX */
@@ -67,6 +70,17 @@ settings_status_t settings_store_load(const settings_flash_t *f, uint8_t *buf, s
  * SETTINGS_STORE_OK, a SETTINGS_STORE_E_* code or a negative device code. */
 int settings_store_save(const settings_flash_t *f, uint8_t *buf, size_t cap, const settings_t *s,
                         uint32_t *seq_out);
+
+/* The same with another record in the page (the anti-cogging table,
+ * settings_table.h): write(wctx, f, page, seq, buf, cap) programs it into
+ * the freshly erased page before the settings record, so that the page only
+ * counts (its settings record complete) once both are; its code, when not
+ * 0, ends the save (the previous page still the newest). write NULL: none. */
+typedef int (*settings_store_writer_t)(const void *wctx, const settings_flash_t *f, unsigned page,
+                                       uint32_t seq, uint8_t *buf, size_t cap);
+int settings_store_save_with(const settings_flash_t *f, uint8_t *buf, size_t cap,
+                             const settings_t *s, settings_store_writer_t write, const void *wctx,
+                             uint32_t *seq_out);
 
 /* Erase both pages (older record first). */
 int settings_store_erase(const settings_flash_t *f, uint8_t *buf, size_t cap);

@@ -70,7 +70,11 @@ static inline void sgen_settings(uint32_t *x, settings_t *s)
                    &s->id_lq_h,
                    &s->id_psi_wb,
                    &s->id_inertia_kgm2,
-                   &s->id_enc_offset_deg};
+                   &s->id_enc_offset_deg,
+                   &s->coulomb_nm,
+                   &s->viscous_nms,
+                   &s->id_coulomb_nm,
+                   &s->id_viscous_nms};
     for (unsigned i = 0; i < sizeof d / sizeof d[0]; i++) {
         *d[i] = sgen_double(x);
     }

@@ -276,7 +276,7 @@ static void test_other_format_refused_with_message(void)
     char msg[160];
     settings_load_message(&scan, msg, sizeof msg);
     TEST_ASSERT_NOT_NULL(
-        strstr(msg, "page 1: record format 0 (this firmware reads 1 to 2), refused"));
+        strstr(msg, "page 1: record format 0 (this firmware reads 1 to 3), refused"));
     TEST_ASSERT_NOT_NULL(strstr(msg, "compiled-in defaults"));
 }
 

@@ -162,7 +162,7 @@ static void test_other_formats_refused(void)
     settings_t s;
     sgen_settings(&x, &s);
     const size_t len = settings_encode(&s, 9u, rec, sizeof rec);
-    const uint16_t formats[] = {0u, 3u, 0x7FFFu, 0xFFFFu};
+    const uint16_t formats[] = {0u, 4u, 0x7FFFu, 0xFFFFu};
     for (unsigned i = 0; i < sizeof formats / sizeof formats[0]; i++) {
         memcpy(rec2, rec, len);
         rec2[4] = (uint8_t)formats[i];
@@ -185,9 +185,29 @@ static void test_other_formats_refused(void)
     assert_refused(rec2, len, SETTINGS_E_LENGTH);
 }
 
+/* A record of this format rewritten as one of format 1 or 2: the same
+ * fields up to id.enc_cpr, without format 3's friction (its last 4 doubles),
+ * as those firmwares wrote it. Returns its length. */
+static size_t as_format(uint8_t *r, size_t len, uint8_t fmt)
+{
+    const size_t body3 = (size_t)r[12] | ((size_t)r[13] << 8);
+    const size_t body = body3 - 4u * 8u;
+    const size_t n = (SETTINGS_HDR_SIZE + body + 4u + 7u) & ~(size_t)7u;
+    TEST_ASSERT_TRUE(n < len);
+    memset(r + SETTINGS_HDR_SIZE + body, 0xFF, len - SETTINGS_HDR_SIZE - body);
+    r[4] = fmt;
+    r[6] = (uint8_t)n;
+    r[7] = (uint8_t)(n >> 8);
+    r[12] = (uint8_t)body;
+    r[13] = (uint8_t)(body >> 8);
+    recrc(r, n);
+    return n;
+}
+
 /* Format 1 (the first firmware's, which never wrote the throttle input: its
- * fields held zeroes) is read with the same layout, its throttle fields
- * cleared and marked as not stored, and not listed; format 2 keeps them. */
+ * fields held zeroes) is read with format 2's layout, its throttle fields
+ * cleared and marked as not stored, and not listed; format 2 keeps them.
+ * Both are read without friction (format 3's): zero, the rest kept. */
 static void test_format1_read_without_throttle(void)
 {
     uint32_t x = 8u;
@@ -195,16 +215,33 @@ static void test_format1_read_without_throttle(void)
     sgen_settings(&x, &s);
     s.thr_mode = 1u;
     s.thr_low_us = 1100u;
-    const size_t len = settings_encode(&s, 4u, rec, sizeof rec);
-    TEST_ASSERT_EQUAL_UINT8(2u, rec[4]);
+    size_t len = settings_encode(&s, 4u, rec, sizeof rec);
+    TEST_ASSERT_EQUAL_UINT8(3u, rec[4]);
     settings_t d;
     uint32_t seq = 0;
     uint16_t fmt = 0;
     TEST_ASSERT_EQUAL_INT(SETTINGS_OK, settings_decode(rec, len, &d, &seq, &fmt));
     TEST_ASSERT_EQUAL_UINT8(1u, d.thr_stored);
     TEST_ASSERT_EQUAL_UINT16(1100u, d.thr_low_us);
-    rec[4] = 1u;
-    recrc(rec, len);
+    TEST_ASSERT_EQUAL_MEMORY(&s.coulomb_nm, &d.coulomb_nm, sizeof s.coulomb_nm);
+    TEST_ASSERT_EQUAL_MEMORY(&s.id_viscous_nms, &d.id_viscous_nms, sizeof s.id_viscous_nms);
+    /* format 2: throttle kept, friction none */
+    memcpy(rec2, rec, len);
+    const size_t len2 = as_format(rec2, len, 2u);
+    memset(&d, 0xA5, sizeof d);
+    TEST_ASSERT_EQUAL_INT(SETTINGS_OK, settings_decode(rec2, len2, &d, &seq, &fmt));
+    TEST_ASSERT_EQUAL_UINT16(2u, fmt);
+    TEST_ASSERT_EQUAL_UINT8(1u, d.thr_stored);
+    TEST_ASSERT_EQUAL_UINT16(1100u, d.thr_low_us);
+    TEST_ASSERT_TRUE(d.coulomb_nm == 0.0 && d.viscous_nms == 0.0);
+    TEST_ASSERT_TRUE(d.id_coulomb_nm == 0.0 && d.id_viscous_nms == 0.0);
+    TEST_ASSERT_EQUAL_UINT32(s.id_enc_cpr, d.id_enc_cpr); /* the last field of format 2 */
+    /* format 2's length with format 3's: refused */
+    rec2[4] = 3u;
+    recrc(rec2, len2);
+    assert_refused(rec2, len2, SETTINGS_E_LENGTH);
+    /* format 1 */
+    len = as_format(rec, len, 1u);
     memset(&d, 0xA5, sizeof d);
     TEST_ASSERT_EQUAL_INT(SETTINGS_OK, settings_decode(rec, len, &d, &seq, &fmt));
     TEST_ASSERT_EQUAL_UINT16(1u, fmt);
@@ -212,6 +249,7 @@ static void test_format1_read_without_throttle(void)
     TEST_ASSERT_EQUAL_UINT8(0u, d.thr_stored);
     TEST_ASSERT_EQUAL_UINT8(0u, d.thr_mode);
     TEST_ASSERT_EQUAL_UINT16(0u, d.thr_low_us);
+    TEST_ASSERT_TRUE(d.coulomb_nm == 0.0 && d.id_viscous_nms == 0.0);
     TEST_ASSERT_EQUAL_MEMORY(&s.rs_ohm, &d.rs_ohm, sizeof s.rs_ohm); /* the rest kept */
     TEST_ASSERT_EQUAL_STRING(s.ctrl, d.ctrl);
     settings_item_t it;

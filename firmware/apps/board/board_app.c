@@ -256,6 +256,7 @@ void board_app_settings_start(board_app_t *a, const settings_flash_t *flash)
     st->apply_default = board_app_settings_default;
     st->capture = board_app_settings_capture;
     st->ctx = a;
+    st->fw = &a->fw; /* the anti-cogging table beside the record (F405 sectors) */
     (void)fw_settings_boot(st);
     fw_link_set_settings(&a->link, st);
 #if PMSM_LIVE_PARAMS
@@ -264,4 +265,11 @@ void board_app_settings_start(board_app_t *a, const settings_flash_t *flash)
     board_uart_puts(&a->uart, a->port->tag);
     board_uart_puts(&a->uart, st->msg);
     board_uart_puts(&a->uart, "\r\n");
+#if CTRL_COGGING
+    if (st->tab_msg[0] != '\0') {
+        board_uart_puts(&a->uart, a->port->tag);
+        board_uart_puts(&a->uart, st->tab_msg);
+        board_uart_puts(&a->uart, "\r\n");
+    }
+#endif
 }

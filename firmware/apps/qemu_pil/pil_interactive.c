@@ -120,10 +120,12 @@ int main(void)
         return 2;
     }
     app.machine = app.run.fw.machine_own;
-    sfm_init(&app.flash, 1u);
+    /* the F405's 16 KiB sectors: the record and the anti-cogging table */
+    sfm_init_size(&app.flash, 1u, SFM_PAGE_MAX);
     sfm_flash(&app.flash, &app.settings.flash);
     app.settings.apply = app_settings_apply;
     app.settings.apply_default = app_settings_default;
+    app.settings.fw = &app.run.fw;
     (void)fw_settings_boot(&app.settings);
     fw_link_init(&app.link, &app.run.fw, pil_uart_write, NULL);
     fw_link_set_settings(&app.link, &app.settings);
@@ -134,6 +136,11 @@ int main(void)
            "at %u Hz; calibrating (256 periods), then 'arm' (PROTOCOL.md, 'help')\n",
            rig.name, c.load_passive_nm, desc->name, (unsigned)c.fs_hz);
     printf("%s (flash: RAM model)\n", app.settings.msg);
+#if CTRL_COGGING
+    if (app.settings.tab_msg[0] != '\0') {
+        printf("%s\n", app.settings.tab_msg);
+    }
+#endif
     pil_timer_start(&app.timer, app_isr);
     for (;;) {
         pil_poll_uart(&app.link);
