@@ -7,6 +7,7 @@
  * T_base = 1.5 p psi_base i_base.
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -89,54 +90,124 @@ void ctrl_mtpa_split(double psi_pm, double ld, double lq, double i, double *i_d,
     *i_q = sqrt(fmax(i * i - d * d, 0.0));
 }
 
-/* The MTPA point of amplitude i (pu, ctrl_mtpa_split): i_d, i_q, Te (3.10)
- * and |psi_s|. */
-static void mtpa_point(double ld, double lq, double psi_pm, double i, double *id, double *iq,
-                       double *te, double *psi)
+/*
+ * The MTPA table in integer arithmetic (the same bits on every target: no
+ * floating point, no library square root). Along the locus of amplitude i,
+ * with dL = Lq - Ld (ctrl_mtpa_split, without its cancellation):
+ *   i_d = -2 dL i^2 / (psi + sqrt(psi^2 + 8 dL^2 i^2)),  i_q = sqrt(i^2 - i_d^2),
+ *   Te = i_q (psi - dL i_d) (3.10),  |psi_s| = |(psi + Ld i_d, Lq i_q)|.
+ * Formats: i, i_d, i_q, psi Q24 pu, Ld and Lq Q27, |dL| Q29 (uint32_t
+ * magnitudes, signs apart: the inductances' rounding kept below the
+ * outputs' LSB); dL i, dL i^2 and the torque Q48 (uint64_t). Ranges
+ * (params_compute's checks; psi = Ld = 1 by the bases): i <= 16,
+ * Ld, Lq <= 8, max(Ld, Lq) i <= 31, so dL i^2 < 2^9 (Q48: < 2^57),
+ * psi^2 + 8 (dL i)^2 < 2^62 (Q48), Te <= 100 (Q48: < 2^55), |psi_s| < 32.
+ */
+typedef struct {
+    uint32_t psi;    /* Q24 */
+    uint32_t ld, lq; /* Q27 */
+    uint32_t adl;    /* |Lq - Ld|, Q29 */
+    bool neg;        /* dL > 0: i_d <= 0 */
+} mtpa_q_t;
+
+/* a * b / 2^24, rounded, for a Q48 a < 2^60 and a Q24 b < 2^29 (< 2^61):
+ * the two halves of a apart so that each product fits 64 bits. */
+static uint64_t mul_q48_q24(uint64_t a, uint32_t b)
 {
-    ctrl_mtpa_split(psi_pm, ld, lq, i, id, iq);
-    *te = *iq * (psi_pm - (lq - ld) * *id);
-    *psi = ctrl_cfg_hypot(psi_pm + ld * *id, lq * *iq);
+    return (a >> 24) * b + (((a & 0xFFFFFFu) * b + 0x800000u) >> 24);
+}
+
+/* 2 sqrt(2) in Q29 */
+#define MTPA_2SQRT2_Q29 1518500250
+
+/* The MTPA point of amplitude i (Q24): Te (Q48), |i_d|, i_q (Q24). */
+static uint64_t mtpa_point_q(const mtpa_q_t *m, uint32_t i, uint32_t *aid, uint32_t *iq)
+{
+    const uint64_t a48 = ((uint64_t)m->adl * i + 16u) >> 5; /* |dL| i, Q48 */
+    const q24_t a24 = (q24_t)((a48 + 0x800000u) >> 24);     /* < 31 pu */
+    /* sqrt(psi^2 + 8 dL^2 i^2) = |(psi, 2 sqrt(2) |dL| i)| */
+    const uint32_t s = (uint32_t)fx_mag((q24_t)m->psi, fx_mul_qn(a24, MTPA_2SQRT2_Q29, 29u));
+    const uint64_t den = (uint64_t)m->psi + s;
+    *aid = (uint32_t)((2u * mul_q48_q24(a48, i) + den / 2u) / den);
+    /* round(sqrt(i^2 - i_d^2)): up exactly when the rest exceeds r (no
+     * integer square is a half-integer's) */
+    const uint64_t i2 = (uint64_t)i * i;
+    const uint64_t d2 = (uint64_t)*aid * *aid;
+    const uint64_t q2 = i2 > d2 ? i2 - d2 : 0u;
+    const uint32_t r = fx_isqrt64(q2);
+    *iq = q2 - (uint64_t)r * r > r ? r + 1u : r;
+    /* psi - dL i_d = psi + |dL| |i_d| (opposite signs), Q48 */
+    const uint64_t f48 = ((uint64_t)m->psi << 24) + (((uint64_t)m->adl * *aid + 16u) >> 5);
+    return mul_q48_q24(f48, *iq);
+}
+
+/* |psi_s| = |(psi + Ld i_d, Lq i_q)| of an MTPA point, Q24 (the first
+ * negative beyond the characteristic current). */
+static uint32_t mtpa_psi_q(const mtpa_q_t *m, uint32_t aid, uint32_t iq)
+{
+    const q24_t d = fx_mul_qn((q24_t)aid, (int32_t)m->ld, 27u);
+    const q24_t x = m->neg ? (q24_t)m->psi - d : (q24_t)m->psi + d;
+    return (uint32_t)fx_mag(x, fx_mul_qn((q24_t)iq, (int32_t)m->lq, 27u));
 }
 
 /* The MTPA table: psi_s, i_d, i_q at CTRL_MTPA_N + 1 uniform torques up to
- * T(current_max); T(i) increases along the locus, so each point is found by
- * bisection on the current amplitude. */
+ * T(current_max). T(i) increases along the locus: each point's amplitude
+ * is found by bisection on i in Q24 steps, the closer of the two last
+ * points taken, so i is within half a step of the
+ * exact one. Its error against the exact locus in double precision is
+ * bounded in tests/core/test_params.c (test_mtpa_table_integer). */
 static int mtpa_table(ctrl_params_t *p, double ld, double lq, double psi_pm, double i_max)
 {
-    double id;
-    double iq;
-    double t_max;
-    double psi;
-    mtpa_point(ld, lq, psi_pm, i_max, &id, &iq, &t_max, &psi);
-    if (!fits(t_max) || !(t_max > 0.0) || !fits(psi)) {
+    const q24_t qpsi = ctrl_q24_from_double(psi_pm);
+    const q24_t qi = ctrl_q24_from_double(i_max);
+    /* the ranges the formats above rely on (params_compute's checks) */
+    if (qpsi <= 0 || qi <= 0 || psi_pm > 1.0 || i_max > 16.0 || !(ld > 0.0) || !(lq > 0.0) ||
+        fmax(ld, lq) > 8.0 || !(fabs(lq - ld) < 8.0) || fmax(ld, lq) * i_max > 31.0) {
         return CTRL_ERANGE;
     }
+    const mtpa_q_t m = {(uint32_t)qpsi, (uint32_t)ctrl_cfg_llround(ld * 134217728.0),
+                        (uint32_t)ctrl_cfg_llround(lq * 134217728.0),
+                        (uint32_t)ctrl_cfg_llround(fabs(lq - ld) * 536870912.0), lq > ld};
+    const uint32_t i_top = (uint32_t)qi;
+    uint32_t aid;
+    uint32_t iq;
+    const uint64_t t_max48 = mtpa_point_q(&m, i_top, &aid, &iq);
+    const uint32_t t_max = (uint32_t)((t_max48 + 0x800000u) >> 24);
+    const double t_pu = ctrl_q24_to_double((q24_t)t_max);
+    if (!fits(t_pu) || !(t_pu > 0.0) || !fits(ctrl_q24_to_double((q24_t)mtpa_psi_q(&m, aid, iq)))) {
+        return CTRL_ERANGE;
+    }
+    /* T(lo) = t_lo <= t <= T(hi) = t_hi; lo from the row before (T increases
+     * with k) */
+    uint32_t lo = 0u;
+    uint64_t t_lo = 0u;
     for (int k = 0; k <= CTRL_MTPA_N; k++) {
-        const double t = t_max * (double)k / (double)CTRL_MTPA_N;
-        double lo = 0.0;
-        double hi = i_max;
-        double tm;
-        for (int it = 0; it < 80; it++) {
-            const double mid = 0.5 * (lo + hi);
-            mtpa_point(ld, lq, psi_pm, mid, &id, &iq, &tm, &psi);
+        const uint64_t t = t_max48 * (uint64_t)k / CTRL_MTPA_N; /* < 2^61 */
+        uint32_t hi = i_top;
+        uint64_t t_hi = t_max48;
+        while (hi - lo > 1u) {
+            const uint32_t mid = lo + (hi - lo) / 2u;
+            const uint64_t tm = mtpa_point_q(&m, mid, &aid, &iq);
             if (tm < t) {
                 lo = mid;
+                t_lo = tm;
             } else {
                 hi = mid;
+                t_hi = tm;
             }
         }
-        mtpa_point(ld, lq, psi_pm, 0.5 * (lo + hi), &id, &iq, &tm, &psi);
-        p->mtpa_psi[k] = ctrl_q24_from_double(psi);
-        p->mtpa_id[k] = ctrl_q24_from_double(id);
-        p->mtpa_iq[k] = ctrl_q24_from_double(iq);
+        (void)mtpa_point_q(&m, t - t_lo <= t_hi - t ? lo : hi, &aid, &iq);
+        p->mtpa_psi[k] = (q24_t)mtpa_psi_q(&m, aid, iq);
+        p->mtpa_id[k] = m.neg ? -(q24_t)aid : (q24_t)aid;
+        p->mtpa_iq[k] = (q24_t)iq;
     }
-    const double scale = (double)CTRL_MTPA_N / t_max; /* Q16 */
-    if (!(scale * 65536.0 < 2147483647.0)) {
+    /* CTRL_MTPA_N / T_max in Q16, rounded: < 2^31 */
+    const uint64_t scale = (((uint64_t)CTRL_MTPA_N << 40) + t_max / 2u) / t_max;
+    if (scale >= 0x80000000u) {
         return CTRL_ERANGE;
     }
-    p->mtpa_t_max = ctrl_q24_from_double(t_max);
-    p->mtpa_scale = (int32_t)ctrl_cfg_llround(scale * 65536.0);
+    p->mtpa_t_max = (q24_t)t_max;
+    p->mtpa_scale = (int32_t)scale;
     return CTRL_OK;
 }
 

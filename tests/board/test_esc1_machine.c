@@ -205,6 +205,21 @@ static void test_config_carries_the_board_dead_time(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-15, dt_s, esc.fc.dead_time_s);
 }
 
+/* A reconfiguration's time with the interrupt held (fw_init, the watchdog
+ * not refreshed) is kept for the start-up report, the longest one: the
+ * model's cycle counter moves 16 per read, so a hold measured spans at
+ * least one step, and a shorter one does not lower the figure. */
+static void test_reconfiguration_time_is_kept(void)
+{
+    esc1_start();
+    esc.init_cycles = 0u;
+    TEST_ASSERT_EQUAL_INT(CMD_OK, esc1_reconfigure(&esc, &esc1_default_machine, ESC1_ENCODER_CPR));
+    TEST_ASSERT_TRUE(esc.init_cycles >= 16u);
+    esc.init_cycles = 0xFFFFFFF0u;
+    TEST_ASSERT_EQUAL_INT(CMD_OK, esc1_reconfigure(&esc, &esc1_default_machine, ESC1_ENCODER_CPR));
+    TEST_ASSERT_EQUAL_UINT32(0xFFFFFFF0u, esc.init_cycles);
+}
+
 /* Neighbours of the compiled-in gimbal motor the core cannot represent at
  * 20 kHz (docs/fixed-point.md, "The range the core takes"): each answer names
  * the quantity, its value and the range; the motor's data stay. */
@@ -660,6 +675,7 @@ int main(void)
     RUN_TEST(test_default_machine_within_the_board);
     RUN_TEST(test_core_and_every_controller_take_it);
     RUN_TEST(test_config_carries_the_board_dead_time);
+    RUN_TEST(test_reconfiguration_time_is_kept);
     RUN_TEST(test_link_refusal_names_quantity_value_range);
     RUN_TEST(test_calibration_takes_the_board_zero);
     RUN_TEST(test_calibration_checks_phase_w);

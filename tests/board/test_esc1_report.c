@@ -153,6 +153,20 @@ static void test_full_ring_wait_serves_the_watchdog(void)
     TEST_ASSERT_TRUE(idle_calls >= uart.tx_wait_cycles / 64u);
 }
 
+/* The report after the start-up, through the transmit ring: the stack's
+ * high-water mark and the longest firmware initialisation. */
+static void test_stack_and_init_time_report(void)
+{
+    esc1_report_stack(&uart, 6124u, 12288u, 1520u);
+    char text[128];
+    const uint32_t n = uart.tx_head - uart.tx_tail;
+    TEST_ASSERT_TRUE(n < sizeof text);
+    memcpy(text, uart.tx, n);
+    text[n] = '\0';
+    TEST_ASSERT_EQUAL_STRING(
+        "esc1: stack: 6124 of 12288 B used (high-water mark); fw_init 1520 us\r\n", text);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -162,5 +176,6 @@ int main(void)
     RUN_TEST(test_boot_option_bytes);
     RUN_TEST(test_boot_read);
     RUN_TEST(test_full_ring_wait_serves_the_watchdog);
+    RUN_TEST(test_stack_and_init_time_report);
     return UNITY_END();
 }

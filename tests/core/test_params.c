@@ -453,6 +453,98 @@ static void test_mtpa_ipmsm_table(void)
     TEST_ASSERT_TRUE(ctrl_mtpa_psi(&p, FX_MIN) > 0);
 }
 
+/* The exact MTPA point of amplitude i in double precision (ctrl_mtpa_split:
+ * ld = psi_pm = 1 pu by the bases): T (3.10) and |psi_s|. */
+static void mtpa_exact(double lq, double i, double *id, double *iq, double *t, double *psi)
+{
+    ctrl_mtpa_split(1.0, 1.0, lq, i, id, iq);
+    *t = *iq * (1.0 - (lq - 1.0) * *id);
+    *psi = hypot(1.0 + *id, lq * *iq);
+}
+
+/* The integer MTPA table against the exact table in double precision (each
+ * row's amplitude by 200 bisections on T(i), T increasing along the locus),
+ * over the machines params_compute accepts: Lq / Ld from 0.125 to 8, the
+ * current limit from 1/256 to 16 pu and up to Lq i_max = 31. Bound, in Q24
+ * LSB: the table's amplitude lies within 3 LSB of the exact row's (half a
+ * step of the bisection, one from the torque's rounding at i, 1.5 from the
+ * rows' torques, which follow T(i_max) rounded to Q24), so an output x is
+ * off by at most 1 (its own rounding and that of its inputs) + 3 |dx/di|,
+ * with |di_d/di|, |di_q/di| <= 1 and |d|psi_s|/di| <= max(Ld, Lq) along the
+ * locus; plus the rounding of |dL| to Q29 (2^-30 pu) times |di_d/d dL| <= i^2:
+ * i^2 / 64 LSB. T_max: 1 LSB of rounding plus that of i_q and i_d times the torque's
+ * sensitivity to them (psi - dL i_d <= 1 + 31). */
+static void test_mtpa_table_integer(void)
+{
+    const double lqs[] = {0.125, 0.5, 0.97, 1.0 + 2e-6, 1.3, 2.0, 3.5, 8.0};
+    const double imaxs[] = {1.0 / 256.0, 0.05, 0.4, 1.0, 2.5, 3.875, 9.0, 16.0};
+    int n = 0;
+    double worst[3] = {0.0, 0.0, 0.0};
+    for (size_t a = 0; a < sizeof lqs / sizeof lqs[0]; a++) {
+        for (size_t c = 0; c < sizeof imaxs / sizeof imaxs[0]; c++) {
+            const double lq = lqs[a];
+            const double i_max = imaxs[c];
+            if (fmax(1.0, lq) * i_max > 31.0) {
+                continue;
+            }
+            ctrl_machine_t m = machine_thesis_ipmsm80();
+            m.lq_h = lq * m.ld_h;
+            m.current_max_a = i_max * m.psi_pm_wb / m.ld_h;
+            m.current_rated_a = m.current_max_a;
+            m.torque_rated_nm = 1e-3 * m.torque_rated_nm;
+            ctrl_params_t p;
+            ctrl_bases_t b;
+            ctrl_diag_t why;
+            const int rc = ctrl_params_init_diag(&p, &b, &m, 20000u, &why);
+            char msg[160];
+            snprintf(msg, sizeof msg, "lq %g i_max %g: %s", lq, i_max, why.quantity);
+            double id, iq, t_max, psi;
+            mtpa_exact(lq, i_max, &id, &iq, &t_max, &psi);
+            if (t_max > 100.0) {
+                TEST_ASSERT_NOT_EQUAL_MESSAGE(CTRL_OK, rc, msg); /* does not fit Q24 */
+                continue;
+            }
+            TEST_ASSERT_EQUAL_INT_MESSAGE(CTRL_OK, rc, msg);
+            n++;
+            const double dl = fabs(lq - 1.0);
+            TEST_ASSERT_DOUBLE_WITHIN_MESSAGE((1.0 + 2.0 * (1.0 + dl * i_max)) * LSB, t_max,
+                                              d(p.mtpa_t_max), msg);
+            for (int k = 0; k <= CTRL_MTPA_N; k++) {
+                const double t = t_max * k / CTRL_MTPA_N;
+                double lo = 0.0;
+                double hi = i_max;
+                for (int it = 0; it < 200; it++) {
+                    const double mid = 0.5 * (lo + hi);
+                    double tm;
+                    mtpa_exact(lq, mid, &id, &iq, &tm, &psi);
+                    if (tm < t) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                double tm;
+                mtpa_exact(lq, 0.5 * (lo + hi), &id, &iq, &tm, &psi);
+                const double e[3] = {fabs(d(p.mtpa_id[k]) - id) / LSB,
+                                     fabs(d(p.mtpa_iq[k]) - iq) / LSB,
+                                     fabs(d(p.mtpa_psi[k]) - psi) / LSB};
+                const double in = i_max * i_max / 64.0; /* |dL|'s rounding */
+                const double bound[3] = {4.0 + in, 4.0 + in, 1.0 + 3.0 * fmax(1.0, lq) + in};
+                for (int j = 0; j < 3; j++) {
+                    worst[j] = fmax(worst[j], e[j]);
+                    snprintf(msg, sizeof msg, "lq %g i_max %g row %d output %d: %.2f LSB", lq,
+                             i_max, k, j, e[j]);
+                    TEST_ASSERT_TRUE_MESSAGE(e[j] <= bound[j], msg);
+                }
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(n >= 40);
+    printf("MTPA table, integer vs double: %d machines, worst i_d %.2f, i_q %.2f, |psi_s| %.2f "
+           "LSB\n",
+           n, worst[0], worst[1], worst[2]);
+}
+
 static void test_speed_lpf_setter(void)
 {
     const ctrl_machine_t spm = machine_thesis_spmsm();
@@ -655,6 +747,7 @@ int main(void)
     RUN_TEST(test_q24_conversion);
     RUN_TEST(test_mtpa_oracle_spmsm);
     RUN_TEST(test_mtpa_ipmsm_table);
+    RUN_TEST(test_mtpa_table_integer);
     RUN_TEST(test_speed_lpf_setter);
     RUN_TEST(test_speed_pi);
     RUN_TEST(test_speed_pi_retune);

@@ -67,8 +67,14 @@ def board_core_options(preset):
     board = next(p for p in presets if p["name"] == preset)
     skip = {"PMSM_TARGET", "PMSM_BOARD", "PMSM_ESC1_MACHINE_INI", "PMSM_ESC1_SETTINGS",
             "PMSM_F405_MACHINE_INI"}
-    return {k: v for k, v in board.get("cacheVariables", {}).items()
+    opts = {k: v for k, v in board.get("cacheVariables", {}).items()
             if k.startswith("PMSM_") and k not in skip}
+    # Options whose default follows the target (control/CMakeLists.txt): the
+    # bench builds for cm4, so the board's default is given explicitly.
+    target = board.get("cacheVariables", {}).get("PMSM_TARGET")
+    if target in ("cm0", "stm32g4"):
+        opts.setdefault("PMSM_COGGING", "OFF")
+    return opts
 
 
 def registry_all():

@@ -14,6 +14,7 @@
 #include "ctrl_params.h"
 #include "esc1_uart.h"
 #include "fw_link.h"
+#include "g4_core.h"
 #include "g4_hal.h"
 #include "pipeline.h"
 #include "throttle.h"
@@ -47,13 +48,14 @@ typedef struct {
     uint32_t ms_cycles;           /* core cycles per millisecond */
     uint32_t t_temp, temp_period; /* the temperature's last reading, its period (cycles) */
     uint32_t thr_losses_told;     /* throttle losses reported */
+    uint32_t init_cycles;         /* longest fw_init with the interrupt held, core cycles */
     bool offsets_told;            /* the calibration's offsets reported */
     bool blink;                   /* the LED's phase on a fault */
     bool temp_check;              /* board over-temperature trip enabled */
     double temp_c;                /* last board temperature (NaN: sensor open/short) */
     q24_t thr_tref;               /* speed mode: the torque when the signal was lost, Q24 pu */
     thr_t thr;                    /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
-    ctrl_machine_t machine; /* the machine data the firmware runs with */
+    ctrl_machine_t machine;       /* the machine data the firmware runs with */
     uint32_t encoder_cpr;
     g4_hal_cfg_t hc;
     fw_link_t link;
@@ -104,6 +106,17 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
  * applied, or the compiled-in defaults, with a line on the serial link saying
  * which; the "config" commands attached (esc1_settings.c). */
 void esc1_settings_start(esc1_t *s);
+
+/* The firmware's initialisation started at cycle count t0 has ended: the
+ * longest so far kept for the start-up report (against the watchdog's
+ * window: docs/bringup.md). */
+static inline void esc1_init_time(esc1_t *s, uint32_t t0)
+{
+    const uint32_t d = g4_cycles() - t0;
+    if (d > s->init_cycles) {
+        s->init_cycles = d;
+    }
+}
 #endif
 
 /* The body of the ADC1_2 interrupt (end of the injected sequence): flags

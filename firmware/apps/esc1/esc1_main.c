@@ -144,7 +144,9 @@ int main(void)
         esc1_halt(s, "board init", g4_strerror(hrc), f_cpu);
     }
     esc1_config_default(&s->fc, b, &s->machine, ctrl_find(ESC1_CTRL));
+    const uint32_t t_init = g4_cycles();
     const int frc = fw_init(&s->fw, &s->hal, &s->fc);
+    esc1_init_time(s, t_init);
     g4_iwdg_refresh();
     if (frc != FW_OK) {
         esc1_halt(s, "fw_init", fw_strerror(frc), f_cpu);
@@ -167,7 +169,8 @@ int main(void)
     g4_iwdg_refresh();
 #endif
     esc1_report_stack(&s->uart, fw_stack_used(__stack_bottom__, __stack_top__),
-                      (uint32_t)((uintptr_t)__stack_top__ - (uintptr_t)__stack_bottom__));
+                      (uint32_t)((uintptr_t)__stack_top__ - (uintptr_t)__stack_bottom__),
+                      s->init_cycles / (f_cpu / 1000000u));
 
     uint32_t pr, rlr;
     if (g4_iwdg_config(ESC1_IWDG_MS, 32000u, &pr, &rlr) != G4_OK ||

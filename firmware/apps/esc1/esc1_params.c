@@ -346,6 +346,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     /* fw_init clears fw_t, so the controller in use is kept here for the
      * restore (else a refused machine left the firmware without one). */
     const ctrl_desc_t *ctrl = s->fw.ctrl;
+    const uint32_t t0 = g4_cycles(); /* the hold's length: the start-up report */
     hal_ctrl_hold(&s->hal, true);
     s->machine = *m;
     s->encoder_cpr = encoder_cpr;
@@ -374,6 +375,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->link.speed_max_rpm = 1.2 * s->machine.speed_rated_rpm;
     }
     hal_ctrl_hold(&s->hal, false);
+    esc1_init_time(s, t0);
     /* In its range but refused by the core (e.g. a per-unit value outside its
      * Q format): "err 10 failed <quantity> = <value> outside [<min>, <max>]",
      * the previous data in force. */

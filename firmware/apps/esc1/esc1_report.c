@@ -35,12 +35,12 @@ void esc1_report_failure(esc1_uart_t *u, const char *what, const char *why)
     esc1_report_line(u, "gates off, not armable", "", "");
 }
 
-void esc1_report_stack(esc1_uart_t *u, uint32_t used, uint32_t size)
+void esc1_report_stack(esc1_uart_t *u, uint32_t used, uint32_t size, uint32_t init_us)
 {
-    char line[80];
+    char line[100];
     const int n = snprintf(line, sizeof line,
-                           "esc1: stack: %lu of %lu B used (high-water mark)\r\n",
-                           (unsigned long)used, (unsigned long)size);
+                           "esc1: stack: %lu of %lu B used (high-water mark); fw_init %lu us\r\n",
+                           (unsigned long)used, (unsigned long)size, (unsigned long)init_us);
     if (n > 0) {
         esc1_uart_puts(u, line);
     }

@@ -18,7 +18,9 @@ void esc1_report_startup(esc1_uart_t *u, const g4_board_t *b, const g4_boot_info
 /* "esc1: <what> failed: <why>", "esc1: gates off, not armable". */
 void esc1_report_failure(esc1_uart_t *u, const char *what, const char *why);
 /* After the start-up (through the transmit ring): "esc1: stack: <used> of
- * <size> B used since reset (high-water mark)". */
-void esc1_report_stack(esc1_uart_t *u, uint32_t used, uint32_t size);
+ * <size> B used (high-water mark); fw_init <us> us", the stack since reset
+ * and the longest firmware initialisation so far (the interrupt held, the
+ * watchdog not refreshed: the start-up's, a settings record's). */
+void esc1_report_stack(esc1_uart_t *u, uint32_t used, uint32_t size, uint32_t init_us);
 
 #endif /* FIRMWARE_APPS_ESC1_ESC1_REPORT_H */
