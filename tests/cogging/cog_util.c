@@ -168,3 +168,60 @@ int cog_calibrate(const sim_machine_t *m, double rpm, double bw_hz, int16_t *tab
     sim_run_free(&r);
     return 0;
 }
+
+/* rms(table - truth) / rms(truth) */
+static double cog_table_err(const int16_t *a, const int16_t *b)
+{
+    double e2 = 0.0, t2 = 0.0;
+    for (uint32_t i = 0; i < CTRL_COG_N; i++) {
+        e2 += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+        t2 += (double)b[i] * b[i];
+    }
+    return sqrt(e2 / t2);
+}
+
+static int16_t case_tab[CTRL_COG_N], case_truth[CTRL_COG_N];
+
+/* Calibrate m at rpm / bw_hz, check the table and the friction it reports
+ * (Coulomb + passive load + viscous at the sweep speed), then the ripple
+ * without and with the table. */
+void cog_case(const char *name, const sim_machine_t *m, double rpm, double bw_hz)
+{
+    double fr = 0.0, pk = 0.0, sec = 0.0;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, cog_calibrate(m, rpm, bw_hz, case_tab, &fr, &pk, &sec), name);
+    cog_table_truth(m, case_truth);
+    const double err = cog_table_err(case_tab, case_truth);
+    const double fr_true = m->coulomb_nm + (m->load_kind == SIM_LOAD_PASSIVE ? m->load_nm : 0.0) +
+                           m->friction_nms * rpm * 6.283185307179586 / 60.0;
+    printf("%s: calibration %.2f s at %.0f r/min: table error %.1f %% rms, peak %.4f N*m, "
+           "friction %.4f N*m (true %.4f)\n",
+           name, sec, rpm, 100.0 * err, pk, fr, fr_true);
+
+    cog_ripple_t a, b, z;
+    cog_ripple(m, "foc", NULL, 0.4, 0.25, &a);
+    cog_ripple(m, "foc", case_tab, 0.4, 0.25, &b);
+    /* the same motor without cogging: the speed ripple of everything else (the
+     * speed loop on the encoder's quantised speed, friction), which no table
+     * removes; independent causes add in variance */
+    sim_machine_t m0 = *m;
+    m0.cogging_nm = 0.0;
+    m0.cog_harm_n = m0.cog_harm_deg_n = 0;
+    cog_ripple(&m0, "foc", NULL, 0.4, 0.25, &z);
+    const double cog_a =
+        sqrt(fmax(a.speed_sd_rpm * a.speed_sd_rpm - z.speed_sd_rpm * z.speed_sd_rpm, 0.0));
+    const double cog_b =
+        sqrt(fmax(b.speed_sd_rpm * b.speed_sd_rpm - z.speed_sd_rpm * z.speed_sd_rpm, 0.0));
+    printf("%s: speed sd %.3f -> %.3f r/min (%.3f without cogging: the cogging's share %.3f -> "
+           "%.3f); torque sd %.4f -> %.4f N*m (%.4f without cogging), at the cogging harmonics "
+           "%.4f -> %.4f N*m\n",
+           name, a.speed_sd_rpm, b.speed_sd_rpm, z.speed_sd_rpm, cog_a, cog_b, a.torque_sd_nm,
+           b.torque_sd_nm, z.torque_sd_nm, a.torque_cog_nm, b.torque_cog_nm);
+    /* every figure printed first, then the checks: the table's error (the
+     * loop's lag at the cogging's periods: within (f / bw)^2 + 10 %), the
+     * friction, the ripple */
+    TEST_ASSERT_TRUE_MESSAGE(err < 0.25, name);
+    TEST_ASSERT_TRUE_MESSAGE(fabs(fr - fr_true) < 0.1 * fr_true, name);
+    TEST_ASSERT_TRUE_MESSAGE(cog_b < 0.2 * cog_a, name);
+    TEST_ASSERT_TRUE_MESSAGE(b.torque_sd_nm < 0.2 * a.torque_sd_nm, name);
+    TEST_ASSERT_TRUE_MESSAGE(b.torque_cog_nm < 0.2 * a.torque_cog_nm, name);
+}
