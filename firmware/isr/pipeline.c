@@ -800,7 +800,11 @@ static void fw_period_idle(fw_t *fw, fw_telemetry_t *tm, const hal_adc_raw_t *ra
     }
     fw_measure_rest(fw, raw, enc, m);
     if (fw->sm.state != FW_STATE_FAULT) {
-        const uint32_t f = fw_protect_slow(fw, m->vdc, enc->count);
+        /* Sensorless: the encoder unchecked, as while running (fw_period_running),
+         * whose periods leave its history behind: the first count after a stop
+         * read as a jump (fault 6 encoder_jump at every stop of a turning rotor). */
+        const uint32_t f = fw->cfg.sensorless ? fw_protect_vdc(&fw->prot, m->vdc)
+                                              : fw_protect_slow(fw, m->vdc, enc->count);
         if (f != FW_FAULT_NONE) {
             fw_fault_now(fw, f);
         }

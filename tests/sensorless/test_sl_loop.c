@@ -151,6 +151,49 @@ static void test_ipmsm80_m2ptfc(void)
  * the overspeed level, reached after band / a) and stayed there for 50 ms -
  * long before the overspeed trip. The same check ends the 80 kW IPMSM's runaway under 200 N*m
  * (docs/algorithms.md, "Sensorless drive"). */
+/* A stop while the rotor turns: the drive goes ready, no fault. The encoder is
+ * unused in sensorless mode; with its check back in the stopped periods, the
+ * first count after the run read as a jump (fault 6 encoder_jump at each stop). */
+static void test_stop_while_turning_no_fault(void)
+{
+    static sim_machine_t m;
+    char err[256];
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        0, sim_machine_load(PMSM_MACHINES_DIR "/thesis_spmsm.ini", &m, err, sizeof err), err);
+    const ctrl_desc_t *d = ctrl_find("foc");
+    TEST_ASSERT_NOT_NULL(d);
+    static sim_run_cfg_t c;
+    sim_run_config_default(&c, &m, d);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = true;
+    c.speed_mode = true;
+    c.speed_ref_rpm = 300.0;
+    c.duration_s = 0.6;
+    c.win_start_s = 0.0;
+    c.win_end_s = c.duration_s;
+    c.calib_samples = 64u;
+    c.sensorless = true;
+    c.arm_delay_periods = 200u; /* ready a while first: the encoder's history primed */
+    static sim_run_t r;
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, sim_run_init(&r, &c, err, sizeof err), err);
+    while (sim_run_time(&r) < 0.5) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+    }
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(&r.fw));
+    const double rpm = sim_run_speed_rpm(&r);
+    fw_cmd_disarm(&r.fw);
+    for (int k = 0; k < 2000; k++) { /* 0.1 s of the coasting rotor, gates off */
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+    }
+    printf("stop at %.0f r/min: state %s, fault %u\n", rpm, fw_state_name(fw_state(&r.fw)),
+           (unsigned)fw_fault(&r.fw));
+    TEST_ASSERT_TRUE(rpm > 200.0);
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&r.fw));
+    sim_run_free(&r);
+}
+
 static void test_runaway_trips_speed_follow(void)
 {
     static sim_machine_t m;
@@ -286,5 +329,6 @@ int main(void)
     RUN_TEST(test_ipmsm80_m2ptfc);
     RUN_TEST(test_rated_torque_low_speed);
     RUN_TEST(test_runaway_trips_speed_follow);
+    RUN_TEST(test_stop_while_turning_no_fault);
     return UNITY_END();
 }
