@@ -669,6 +669,68 @@ def check_ripple(wd, st):
     wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready", 30)
 
 
+
+# ---- the injection's view (--hfi: a salient machine on the host build)
+
+HFI_MEAN_DEG = 2.0   # |mean| of the plotted angle error estimate while it tracks
+HFI_SD_MIN_DEG = 1.0  # its spread at least this (radians shown as degrees would be 57 x less)
+HFI_MAX_DEG = 45.0   # the estimate (from sin 2e) is defined within +-45 deg electrical
+
+
+def check_hfi(wd, st):
+    """The injection on the page: its parameter group's title, its state in the
+    header while it runs (and not after STOP), its angle error in degrees."""
+    wd.js("window.scrollTo(0, 0)")
+    wd.click('button[data-tab="tab-params"]')
+    wd.js("consoleState.params = []; pmsm.command('param list', {quiet: true});")
+    title = wait_for("the hfi group in the parameter tree", lambda: wd.js(
+        "const d = document.querySelector('#ptree details[data-group=\"hfi\"]');"
+        "return d ? d.querySelector('summary').textContent : null"), 30)
+    n = wd.js("return document.querySelectorAll('#ptree details[data-group=\"hfi\"] tr[data-param]')"
+              ".length")
+    if not title.startswith("high-frequency injection") or n < 1:
+        raise Fail("the injection's parameter group: title %r, %d rows" % (title, n))
+    print("  parameter tree: group hfi titled %r, %d settings" % (title, n))
+    # foc (the injection rides on a modulated voltage), then est.sensorless 2
+    wd.js("const s = document.getElementById('ctrl'); s.value = 'foc';")
+    wd.click("#ctrl-set")
+    wait_for("foc selected", lambda: (st() or {}).get("ctrl") == "foc", 30)
+    x = set_in_box(wd, "est.sensorless", "2")
+    if x["err"] or x["msg"] != "ok est.sensorless 2":
+        raise Fail("est.sensorless 2: %r" % x)
+    wait_for("the drive ready again", lambda: (st() or {}).get("state") == "ready", 60)
+    wd.js("document.getElementById('mode').value = 'speed';")
+    wd.type("#ref", "0")
+    wd.click("#ref-set")
+    wd.click("#arm")
+    wd.click("#modal-ok")
+    wait_for("state=running", lambda: (st() or {}).get("state") == "running", 30)
+    chip = wait_for("the injection's state in the header", lambda: wd.js(
+        "const c = document.getElementById('st-sl');"
+        "return !c.classList.contains('hidden') && c.textContent.indexOf('injection') >= 0 ? "
+        "c.textContent : null"), 60, 0.1)
+    time.sleep(1.5)  # firmware seconds of tracking on the plot
+    plot = wd.js("const s = consoleState.charts.series; const k = s.names.indexOf('angle_err');"
+                 "const t1 = s.t[s.t.length - 1]; const v = [];"
+                 "for (let i = s.t.length - 1; i >= 0 && s.t[i] > t1 - 1.0; i--) v.push(s.v[k][i]);"
+                 "return {unit: s.units[k], v: v, charted: consoleState.charts.groups.some((g) => "
+                 "g.includes(k)), sl: consoleState.sl}")
+    v = plot["v"]
+    mean = sum(v) / max(1, len(v))
+    sd = (sum((x - mean) ** 2 for x in v) / max(1, len(v))) ** 0.5
+    print("  injection running: header %r; angle error plotted in %s: %d samples over 1 s, mean "
+          "%.2f, sd %.2f, largest %.1f" % (chip, plot["unit"], len(v), mean, sd,
+                                           max((abs(x) for x in v), default=float("nan"))))
+    if plot["unit"] != "deg" or not plot["charted"] or len(v) < 20 or not abs(mean) <= HFI_MEAN_DEG \
+            or not sd >= HFI_SD_MIN_DEG or not all(abs(x) <= HFI_MAX_DEG for x in v):
+        raise Fail("the angle error on the page: unit %r, charted %r, %d samples, mean %.3f, sd "
+                   "%.3f" % (plot["unit"], plot["charted"], len(v), mean, sd))
+    wd.click("#stop")
+    wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready", 30)
+    gone = wait_for("the injection's state gone from the header", lambda: wd.js(
+        "return document.getElementById('st-sl').classList.contains('hidden')"), 10)
+    print("  STOP: the header no longer shows the injection (%s)" % gone)
+
 def sim_main(a):
     chromium = shutil.which("chromium")
     driver = shutil.which("chromedriver")
@@ -697,16 +759,20 @@ def sim_main(a):
         wd.start(chromium)
         wd.get(url)
         st = lambda: wd.js("return window.consoleState ? {role: consoleState.role, state: "
-                           "consoleState.status.state, meta: consoleState.meta && "
+                           "consoleState.status.state, ctrl: consoleState.status.ctrl, meta: "
+                           "consoleState.meta && "
                            "consoleState.meta.signals} : null")
         wait_for("the page to control", lambda: (st() or {}).get("role") == "control", 30)
         wait_for("the drive ready", lambda: (st() or {}).get("state") == "ready", 60)
         wait_for("telemetry with speed", lambda: "speed" in ((st() or {}).get("meta") or []), 60)
         print("  host interactive build (%s, plant as fast as it runs): connected, controlling, "
               "ready, streaming" % os.path.basename(a.machine))
-        check_identification(wd, truth)
-        check_cogging(wd, truth)
-        check_ripple(wd, st)
+        if a.hfi:
+            check_hfi(wd, st)
+        else:
+            check_identification(wd, truth)
+            check_cogging(wd, truth)
+            check_ripple(wd, st)
         if a.screenshot:
             wd.screenshot(a.screenshot)
     finally:
@@ -733,6 +799,8 @@ def main():
     ap.add_argument("--sim", metavar="PROGRAM",
                     help="the host interactive build: the commissioning session instead")
     ap.add_argument("--machine", help="--sim: its machine file (the truth the results meet)")
+    ap.add_argument("--hfi", action="store_true",
+                    help="--sim: the injection's view instead (a salient machine)")
     ap.add_argument("--screenshot", help="also save a screenshot of the running page here")
     a = ap.parse_args()
     if a.sim:

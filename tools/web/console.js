@@ -185,6 +185,7 @@ function maybeAutostart() {
   // calibration and streams nothing; any page can change it afterwards.
   const st = S.status.state;
   if (S.autostarted || S.role !== 'control' || !st || st === 'boot' || st === 'calib') return;
+  if (!S.signals.length) return;  // `tel list` not answered yet: what the image streams
   S.autostarted = true;
   if ((S.status.tel_mask || '').startsWith('0x00000000')) telStart();
 }
