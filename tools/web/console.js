@@ -232,7 +232,8 @@ function buildSignals() {
     const cb = document.createElement('input');
     cb.type = 'checkbox'; cb.value = s.name; cb.checked = active.includes(s.name);
     lab.appendChild(cb);
-    lab.appendChild(document.createTextNode(' ' + s.name + (s.unit ? ' (' + s.unit + ')' : '')));
+    const unit = DISPLAY[s.name] ? DISPLAY[s.name].unit : s.unit;
+    lab.appendChild(document.createTextNode(' ' + s.name + (unit ? ' (' + unit + ')' : '')));
     box.appendChild(lab);
   }
 }
