@@ -38,14 +38,14 @@
 #endif
 
 /* Independent watchdog (nominal 32 kHz LSI; the window with the LSI's
- * spread in brackets): through the start-up 8 s (5.45 .. 15.1 s: the whole
+ * spread in brackets): through the start-up 2 s (1.36 .. 3.76 s: the whole
  * start-up on the fall-back HSI, 16 MHz, when the crystal does not start:
- * 29.4 M instructions, and the firmware's initialisation, 24.9 M, once more
- * when a settings record is applied: 5.09 s at CPI 1.5; ctest
+ * 5.33 M instructions, and the firmware's initialisation, 0.76 M, once more
+ * when a settings record is applied: 0.57 s at CPI 1.5; ctest
  * <board>_qemu_wdg counts them), in the main loop 100 ms
  * (68 .. 188 ms), around a settings sector's erase 2 s (1.36 .. 3.76 s:
  * above the erase's 1 s BSY time-out at the fastest LSI). */
-#define F405_IWDG_BOOT_MS 8000u
+#define F405_IWDG_BOOT_MS 2000u
 #define F405_IWDG_RUN_MS 100u
 #define F405_IWDG_ERASE_MS 2000u
 

@@ -190,8 +190,9 @@ static uint32_t f405_ticks(void)
     return f4_ticks(F405_BOARD.tick_tim);
 }
 
-/* Around the firmware's re-initialisation (24.9 M instructions, at least
- * 148 ms at 168 MHz: docs/f405.md) the erase's window, then the run window. */
+/* Around the firmware's re-initialisation (0.76 M instructions, 4.5 ..
+ * 6.8 ms at 168 MHz: docs/f405.md; a margin whatever the machine data) the
+ * erase's window, then the run window. */
 static void f405_watchdog_long(const board_app_t *a, bool on)
 {
     f405_watchdog_set((const f405_t *)a, on ? F405_IWDG_ERASE_MS : F405_IWDG_RUN_MS);
