@@ -310,7 +310,13 @@ int cm_cogging_period(cm_t *cm, const cm_in_t *in, cm_out_t *out)
     tq = fx_clamp(fx_add(tq, c->integ), fx_neg(lim), lim);
     out->torque_ref = tq;
     if (measure) {
-        const uint32_t bin = ctrl_cogging_bin(&c->map, ctrl_cogging_turn(&c->map, in->enc_pos));
+        /* the nearest entry: a bin's samples then average to its entry's
+         * angle i / n, where the feed-forward reads it (flooring them into
+         * [i, i + 1) put the table half a bin early: 23 degrees of a cogging
+         * period at 7.8 entries per period) */
+        const uint32_t half = 1u << (31u - c->map.n_log2);
+        const uint32_t bin =
+            ctrl_cogging_bin(&c->map, ctrl_cogging_turn(&c->map, in->enc_pos) + half);
         if (c->cnt[bin] < CM_COG_CNT_MAX) {
             c->sum[bin] += fx_rshift32_round(tq, 8u); /* Q16 pu, |.| <= 2^16 */
             c->cnt[bin]++;
