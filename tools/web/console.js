@@ -9,9 +9,9 @@ const TOKEN = new URLSearchParams(location.search).get('token') || '';
 const HEARTBEAT_MS = 250;
 const KEEP_S = 120;           // firmware seconds of telemetry kept for the plots
 const DEFAULT_SIGNALS = ['speed', 'speed_ref', 'torque', 'torque_ref', 'i_d', 'i_q'];
-// Streamed by default too where the image has them (`tel list`): the sensorless
-// start's state and the injection's angle error (an image with the injection).
-const DEFAULT_IF_PRESENT = ['sl_state', 'angle_err'];
+// Streamed too in sensorless mode (est.sensorless > 0) where the image has them
+// (`tel list`): the sensorless start's state and the injection's angle error.
+const SENSORLESS_SIGNALS = ['sl_state', 'angle_err'];
 // Signals the page shows in other units than the firmware's SI ones.
 const DISPLAY = { angle_err: { unit: 'deg', k: 180 / Math.PI } };  // electrical degrees
 
@@ -205,6 +205,7 @@ function onReply(m) {
   for (const fn of replyHooks) fn(m);
   if (!m.ok) return;
   const w = m.line.split(/\s+/);
+  if (m.line === 'param list') addSensorlessSignals();
   if (m.line === 'tel list') {
     S.signals = listLines(m).map((l) => {
       const p = l.trim().split(/\s+/);
@@ -226,7 +227,7 @@ const QUIET = new Set(['tel list', 'ctrl list', 'param list', 'ident result', 'c
 function buildSignals() {
   const box = $('signals');
   box.textContent = '';
-  const active = S.meta ? S.meta.signals : DEFAULT_SIGNALS.concat(DEFAULT_IF_PRESENT);
+  const active = S.meta ? S.meta.signals : defaultSignals();
   for (const s of S.signals) {
     const lab = document.createElement('label');
     const cb = document.createElement('input');
@@ -248,11 +249,34 @@ function buildCtrls() {
   }
 }
 
+function sensorlessOn() {
+  const p = (S.params || []).find((x) => x.name === 'est.sensorless');
+  return !!p && +p.value > 0;
+}
+
+// The default stream, and in sensorless mode the sensorless signals the image has.
+function defaultSignals() {
+  const have = new Set(S.signals.map((x) => x.name));
+  return DEFAULT_SIGNALS.concat(sensorlessOn() ? SENSORLESS_SIGNALS.filter((n) => have.has(n)) : []);
+}
+
 function telStart() {
   const names = [...document.querySelectorAll('#signals input:checked')].map((c) => c.value);
-  const have = new Set(S.signals.map((x) => x.name));
-  const use = names.length ? names : DEFAULT_SIGNALS.concat(DEFAULT_IF_PRESENT.filter((n) => have.has(n)));
+  const use = names.length ? names : defaultSignals();
   command('tel start ' + use.join(' ') + ' every ' + $('every').value.trim());
+}
+
+// Once the drive is sensorless (the parameter tree read again after a change, or
+// at the start), a running stream gets the sensorless signals it lacks.
+function addSensorlessSignals() {
+  if (S.role !== 'control' || !S.meta || !sensorlessOn()) return;
+  const have = new Set(S.signals.map((x) => x.name));
+  const missing = SENSORLESS_SIGNALS.filter((n) => have.has(n) && !S.meta.signals.includes(n));
+  if (!missing.length) return;
+  command('tel start ' + S.meta.signals.concat(missing).join(' ') + ' every ' + S.meta.every);
+  for (const cb of document.querySelectorAll('#signals input')) {
+    if (missing.includes(cb.value)) cb.checked = true;
+  }
 }
 
 // ---------------------------------------------------------------- header and readouts
