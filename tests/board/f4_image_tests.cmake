@@ -21,7 +21,12 @@ else()
   message(FATAL_ERROR "f4_image_tests.cmake: no checks for board '${PMSM_BOARD}'")
 endif()
 set(f405_tests ${PMSM_BOARD}_image ${PMSM_BOARD}_image_printf ${PMSM_BOARD}_flash
-    ${PMSM_BOARD}_qemu_boot ${PMSM_BOARD}_qemu_wdg)
+    ${PMSM_BOARD}_qemu_boot ${PMSM_BOARD}_qemu_wdg ${PMSM_BOARD}_isr_fpu_free)
+# The control interrupt and the medium-rate task without FPU instructions
+# (pmsm_no_fpu): no lazy stacking of the FP context when they preempt.
+add_test(NAME ${PMSM_BOARD}_isr_fpu_free
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_isr_fpu_free.py ${PMSM_F405_ELF}
+                 ADC_IRQHandler PendSV_Handler)
 add_test(NAME ${PMSM_BOARD}_image
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/check_f4_image.py ${PMSM_F405_ELF}
                  ${f405_console_irq} ${f405_nfault_irq} ${PMSM_CONTROLLERS_ALL})

@@ -30,7 +30,7 @@ endif()
 # directory that defines the targets of the files (source properties are
 # per directory).
 function(pmsm_no_fpu)
-  if(PMSM_TARGET STREQUAL "cm4" OR PMSM_TARGET STREQUAL "stm32g4")
+  if(PMSM_TARGET STREQUAL "cm4" OR PMSM_TARGET STREQUAL "stm32g4" OR PMSM_TARGET STREQUAL "stm32f4")
     set_property(SOURCE ${ARGN} APPEND PROPERTY COMPILE_OPTIONS -mgeneral-regs-only)
   endif()
 endfunction()
