@@ -37,15 +37,7 @@ int main(void)
     uint32_t ff_periods = 0;
     for (uint32_t k = 0; k < r->n; k++) {
         const pil_ident_in_t *s = &r->in[k];
-        in.adc[0] = s->adc[0];
-        in.adc[1] = s->adc[1];
-        in.adc[2] = s->adc[2];
-        in.adc[3] = s->adc[3];
-        in.cmd = 0u;
-        in.index_seen = (uint8_t)(s->flags & 1u);
-        in.trip = (uint8_t)((s->flags >> 1) & 1u);
-        in.enc_count = s->enc_count;
-        in.index_count = s->index_count;
+        pil_ident_in_replay(s, &in);
         hal_replay_set_input(&hal, &in);
         if ((s->cmd & PIL_COG_TABLE) != 0u) {
             if (fw_cogging_load(&fw, r->table, CTRL_COG_N) != FW_OK ||

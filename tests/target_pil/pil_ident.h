@@ -18,6 +18,7 @@
 
 #include "ctrl_params.h"
 #include "hal.h"
+#include "pil_data.h"
 #include "pipeline.h"
 
 #define PIL_IDENT_START 0x1u  /* fw_commission_start(the ident plan) before the ISR */
@@ -49,6 +50,20 @@ typedef struct {
 } pil_ident_rec_t;
 
 extern const pil_ident_rec_t pil_ident_rec;
+
+/* A recorded period's samples as the replay HAL's input (hal_replay.h). */
+static inline void pil_ident_in_replay(const pil_ident_in_t *s, pil_in_t *in)
+{
+    in->adc[0] = s->adc[0];
+    in->adc[1] = s->adc[1];
+    in->adc[2] = s->adc[2];
+    in->adc[3] = s->adc[3];
+    in->cmd = 0u;
+    in->index_seen = (uint8_t)(s->flags & 1u);
+    in->trip = (uint8_t)((s->flags >> 1) & 1u);
+    in->enc_count = s->enc_count;
+    in->index_count = s->index_count;
+}
 
 /* FNV-1a over one period's outputs: compare values, gate request, the
  * telemetry sample and the commissioning state. */
