@@ -27,6 +27,8 @@ SIGNALS = [
     ("sector", ""), ("state", ""), ("fault", ""), ("cycles", ""),
     ("cm_step", ""), ("cm_progress", ""),
     ("torque_max", "N*m"), ("fieldweak_limit", ""),
+    # an image with the injection (CMake option PMSM_SL_HFI) only
+    ("sl_state", ""), ("angle_err", "rad"),
 ]
 
 

@@ -123,8 +123,8 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
      * the products < 2^60, no saturation. */
     const q24_t i_a = FX_SAT(m->i_a, 30); /* [-CTRL_EST_I_LIM, CTRL_EST_I_LIM) */
     const q24_t i_b = FX_SAT(m->i_b, 30);
-    const q24_t i_alpha = i_a;
-    const q24_t i_beta =
+    q24_t i_alpha = i_a;
+    q24_t i_beta =
         fx_round_nosat((int64_t)i_a * FX_Q30_INV_SQRT3 + (int64_t)i_b * FX_Q30_2_SQRT3, 30u);
     const q24_t vdc = fx_clamp(m->vdc, 0, EST_VDC_LIM - 1); /* one USAT */
 
@@ -148,10 +148,21 @@ void ctrl_estimator_update(ctrl_estimator_t *e, const ctrl_params_t *p, const ct
     } else {
         ctrl_angle_out_t ang;
         ang.frame = NULL;
+#if CTRL_SL_HFI
+        ang.i_fund = NULL;
+#endif
         e->src->update(e->src_state.bytes, p, in, &ang);
         th = ang.theta;
         omega = ang.omega;
         fr = ang.frame;
+#if CTRL_SL_HFI
+        if (ang.i_fund != NULL) {
+            /* the source's current (an injection's ripple removed), within
+             * the same range as the measured one */
+            i_alpha = FX_SAT(ang.i_fund[0], 30);
+            i_beta = FX_SAT(ang.i_fund[1], 30);
+        }
+#endif
     }
 
     /* The one table sine/cosine of the period, unless the source formed it

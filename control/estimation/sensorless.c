@@ -23,6 +23,10 @@ void ctrl_sl_reset(ctrl_sl_t *s)
 #if CTRL_SL_INITIAL_ANGLE
     ctrl_ia_start(&s->ia);
 #endif
+#if CTRL_SL_HFI
+    s->pol_src = CTRL_SL_POL_UNKNOWN;
+    ctrl_hfi_halt(&s->hfi);
+#endif
 }
 
 /* omega_f one step towards target (at most ramp_dw). */
@@ -95,6 +99,28 @@ static void sl_observe_from(ctrl_sl_t *s, const ctrl_params_t *p, fx_angle_t the
     out->handover = 1u;
 }
 
+#if CTRL_SL_HFI
+/* The injection's tracking from angle theta (the north the polarity told, or
+ * the observer's angle below w_lo) at speed omega, its angle from this period
+ * on; the observer waits (it is started anew at the hand-over); the caller's
+ * speed loop takes over (handover) or runs on. */
+static void sl_inject_from(ctrl_sl_t *s, fx_angle_t theta, q24_t omega, q24_t torque, q24_t i_alpha,
+                           q24_t i_beta, ctrl_sl_out_t *out)
+{
+    ctrl_hfi_start(&s->hfi, theta, omega, torque, i_alpha, i_beta);
+    s->mode = CTRL_SL_INJECT;
+    s->phase = CTRL_SL_PH_NONE;
+    s->count = 0u;
+    s->w_f = omega;
+    s->reached = 1u;
+    out->mode = CTRL_SL_INJECT;
+    out->theta = theta;
+    out->omega = omega;
+    out->torque_ref = 0;
+    out->handover = 1u;
+}
+#endif
+
 /* The salient machine's start (sensorless.h): angle modulo pi, polarity
  * pulse, angle again, then the observer from the measured angle. */
 static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v_beta,
@@ -105,6 +131,45 @@ static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_
     out->torque_ref = 0;
     out->v_alpha = 0;
     out->v_beta = 0;
+#if CTRL_SL_HFI
+    if (s->phase == CTRL_SL_PH_LOCK) {
+        /* the injection settles on the measured axis; no torque */
+        out->mode = CTRL_SL_FORCED;
+        out->theta = s->hfi.theta;
+        if (++s->count >= s->lock_n) {
+            ctrl_hfi_halt(&s->hfi);
+            ctrl_hfi_pol_start(&s->hfi, s->hfi.theta);
+            s->phase = CTRL_SL_PH_SAT;
+            s->mode = CTRL_SL_DETECT;
+            s->count = 0u;
+        }
+        return;
+    }
+    if (s->phase == CTRL_SL_PH_SAT) {
+        out->mode = CTRL_SL_DETECT;
+        out->theta = s->hfi.pol_theta;
+        if (ctrl_hfi_pol_step(&s->hfi, i_alpha, i_beta, &out->v_alpha, &out->v_beta) != 0u) {
+            return;
+        }
+        const uint8_t r = s->hfi.pol_result;
+        if (r == CTRL_HFI_POL_NORTH || r == CTRL_HFI_POL_SOUTH) {
+            s->pol_src = CTRL_SL_POL_SAT;
+            const fx_angle_t north =
+                r == CTRL_HFI_POL_NORTH ? s->hfi.pol_theta : s->hfi.pol_theta + SL_HALF_TURN;
+            sl_inject_from(s, north, 0, 0, i_alpha, i_beta, out);
+            return;
+        }
+        /* no saturation to read: the polarity from the first motion, on the
+         * axis the injection found */
+        s->th1 = s->hfi.pol_theta & (SL_HALF_TURN - 1u);
+        s->theta_f = s->th1;
+        s->dir = speed_ref < 0 ? -1 : 1;
+        s->phase = CTRL_SL_PH_POL;
+        s->mode = CTRL_SL_FORCED;
+        s->count = 0u;
+        return;
+    }
+#endif
     if (s->phase == CTRL_SL_PH_POL) {
         out->mode = CTRL_SL_FORCED;
         const q24_t t = s->dir > 0 ? s->t_start : fx_neg(s->t_start);
@@ -125,6 +190,16 @@ static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_
         return;
     }
     const fx_angle_t th = ctrl_ia_angle(&s->ia);
+#if CTRL_SL_HFI
+    if (s->phase == CTRL_SL_PH_D1 && s->hfi_on != 0u) {
+        /* the injection tracks the axis found, then the saturation pulses */
+        ctrl_hfi_start(&s->hfi, th, 0, 0, i_alpha, i_beta);
+        s->phase = CTRL_SL_PH_LOCK;
+        s->mode = CTRL_SL_FORCED;
+        s->count = 0u;
+        return;
+    }
+#endif
     if (s->phase == CTRL_SL_PH_D1) {
         /* the polarity pulse on the measured axis, the way the speed is wanted */
         s->th1 = th;
@@ -154,7 +229,64 @@ static void sl_initial(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_
      * the ends of [0, pi)), or turned by pi if the rotor went backwards */
     const fx_angle_t moved = s->th1 + (fx_angle_t)(uint32_t)disp;
     const fx_angle_t north = ((disp < 0) == (s->dir < 0)) ? moved : moved + SL_HALF_TURN;
+#if CTRL_SL_HFI
+    s->pol_src = CTRL_SL_POL_MOTION;
+    if (s->hfi_on != 0u) {
+        sl_inject_from(s, north, 0, 0, i_alpha, i_beta, out);
+        return;
+    }
+#endif
     sl_observe_from(s, p, north, i_alpha, i_beta, out);
+}
+#endif
+
+#if CTRL_SL_HFI
+/* The injection's angle and speed (its tracking observer's, through the
+ * encoder speed's filter); above w_hi for hfi_low_n periods (a torque step on
+ * a load the tracking does not know moves its speed for a few ms) the
+ * hand-over to the flux observer: the injection stops (its half pulse back
+ * to the centre next) and the observer starts anew from the current model at
+ * the injection's angle and speed (no angle step; its PLL without an error,
+ * which its speed, 2 w_n e, would pass), its angle the output from the next
+ * period on. */
+static void sl_inject_track(ctrl_sl_t *s, const ctrl_params_t *p, q24_t i_alpha, q24_t i_beta,
+                            ctrl_sl_out_t *out)
+{
+    s->w_f = fx_add(s->w_f, fx_mul(p->speed_lpf_k, fx_sub(s->hfi.omega, s->w_f)));
+    out->mode = CTRL_SL_INJECT;
+    out->theta = s->hfi.theta;
+    out->theta_obs = s->hfi.theta;
+    out->torque_ref = 0;
+    out->v_alpha = 0;
+    out->v_beta = 0;
+    out->omega = s->w_f;
+    s->count = fx_abs(s->w_f) >= s->hfi_w_hi ? s->count + 1u : 0u;
+    if (s->count >= s->hfi_low_n) {
+        ctrl_hfi_stop(&s->hfi);
+        ctrl_fobs_reset(&s->obs, p, s->hfi.theta, s->w_f, i_alpha, i_beta);
+        s->obs.kappa_ts = s->kappa_ts;
+        s->mode = CTRL_SL_OBSERVER;
+        s->count = 0u;
+    }
+}
+
+/* Observer mode with the injection configured: below w_lo (the speed through
+ * the encoder speed's filter) the injection takes over again at once, at the
+ * observer's angle and that speed (the observer's angle is the one not to
+ * trust there; the hysteresis w_lo .. w_hi keeps the two from alternating),
+ * with the load its tracking learnt before (a load that lasts: through a
+ * reversal the torque is far from it, and taken as steady the tracking would
+ * lag the acceleration until it learnt it again). */
+static void sl_observer_inject(ctrl_sl_t *s, fx_angle_t th_obs, q24_t torque, q24_t i_alpha,
+                               q24_t i_beta, ctrl_sl_out_t *out)
+{
+    if (fx_abs(s->w_f) >= s->hfi_w_lo) {
+        return;
+    }
+    const int64_t load = s->hfi.load_acc;
+    sl_inject_from(s, th_obs, s->w_f, torque, i_alpha, i_beta, out);
+    s->hfi.load_acc = load;
+    out->handover = 0u; /* the speed loop runs on */
 }
 #endif
 
@@ -163,10 +295,31 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
                     ctrl_sl_out_t *out)
 {
     ctrl_fobs_t *const o = &s->obs;
-    const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
-    const q24_t w_obs = o->omega; /* ctrl_fobs_omega without the call */
+#if CTRL_SL_HFI
     out->handover = 0u;
     out->obs_frame = 0u;
+    out->i_fund = 0u;
+    if (s->hfi.on != 0u || s->hfi.pos[0] != 0 || s->hfi.pos[1] != 0) {
+        /* injecting, or its last pulses still in the samples: the current
+         * without the ripple, for the observer and the estimator */
+        ctrl_hfi_update(&s->hfi, p, v_alpha, v_beta, i_alpha, i_beta, torque_est, &i_alpha,
+                        &i_beta);
+        out->i_fund = 1u;
+        out->i_ab[0] = i_alpha;
+        out->i_ab[1] = i_beta;
+    }
+    if (s->mode == CTRL_SL_INJECT) {
+        /* the injection's angle: the observer waits */
+        sl_inject_track(s, p, i_alpha, i_beta, out);
+        return;
+    }
+    const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
+#else
+    const fx_angle_t th_obs = ctrl_fobs_update(o, p, v_alpha, v_beta, i_alpha, i_beta, 0u);
+    out->handover = 0u;
+    out->obs_frame = 0u;
+#endif
+    const q24_t w_obs = o->omega; /* ctrl_fobs_omega without the call */
     out->theta_obs = th_obs;
 
 #if CTRL_SL_INITIAL_ANGLE
@@ -184,6 +337,12 @@ void ctrl_sl_update(ctrl_sl_t *s, const ctrl_params_t *p, q24_t v_alpha, q24_t v
         out->torque_ref = 0;
         out->v_alpha = 0;
         out->v_beta = 0;
+#if CTRL_SL_HFI
+        if (s->hfi_on != 0u) {
+            sl_observer_inject(s, th_obs, torque_est, i_alpha, i_beta, out);
+            return;
+        }
+#endif
         if (fx_abs(s->w_f) >= s->w_on) {
             s->reached = 1u; /* on the filtered speed: the PLL's noise near standstill
                               * reaches w_on */
@@ -254,6 +413,9 @@ static void angle_sl_reset(void *state, const ctrl_params_t *p)
     s->out.torque_ref = 0;
     s->out.v_alpha = 0;
     s->out.v_beta = 0;
+#if CTRL_SL_HFI
+    s->out.i_fund = 0u;
+#endif
 }
 
 static void angle_sl_update(void *state, const ctrl_params_t *p, const ctrl_angle_in_t *in,
@@ -270,6 +432,11 @@ static void angle_sl_update(void *state, const ctrl_params_t *p, const ctrl_angl
     if (s->out.obs_frame != 0u) {
         out->frame = &s->sl.obs.frame;
     }
+#if CTRL_SL_HFI
+    if (s->out.i_fund != 0u) {
+        out->i_fund = s->out.i_ab;
+    }
+#endif
 }
 
 const ctrl_angle_src_t ctrl_angle_sensorless = {

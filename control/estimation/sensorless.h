@@ -58,6 +58,7 @@
 #include "ctrl_params.h"
 #include "flux_observer.h"
 #include "fx.h"
+#include "hfi.h"
 #include "initial_angle.h"
 
 /* 0: the initial angle left out (a flash-tight image, CMake option
@@ -69,12 +70,20 @@
 #define CTRL_SL_FORCED 0u   /* forced angle (start-up, low speed) */
 #define CTRL_SL_OBSERVER 1u /* the observer's angle */
 #define CTRL_SL_DETECT 2u   /* initial angle: the caller applies out.v_alpha, v_beta */
+#define CTRL_SL_INJECT 3u   /* the injection's angle (hfi.h): the caller's speed loop runs */
 
 /* Start of a salient machine (ia_on): the phases before the observer. */
 #define CTRL_SL_PH_NONE 0u /* the blind forced start (or started) */
 #define CTRL_SL_PH_D1 1u   /* angle modulo pi (initial_angle.h) */
 #define CTRL_SL_PH_POL 2u  /* polarity pulse: +t_start, -t_start, 0 on that axis */
 #define CTRL_SL_PH_D2 3u   /* angle modulo pi again: the displacement's sign */
+#define CTRL_SL_PH_LOCK 4u /* injection: the tracking settles on the measured axis */
+#define CTRL_SL_PH_SAT 5u  /* polarity by d-axis saturation pulses (hfi.h) */
+
+/* Where the polarity of the start came from (ctrl_sl_t.pol_src). */
+#define CTRL_SL_POL_UNKNOWN 0u /* not yet, or the blind forced start */
+#define CTRL_SL_POL_SAT 1u     /* d-axis saturation pulses */
+#define CTRL_SL_POL_MOTION 2u  /* the first motion (polarity pulse) */
 
 typedef struct {
     ctrl_fobs_t obs; /* the observer (CTRL_FOBS_SENSORLESS) */
@@ -111,6 +120,19 @@ typedef struct {
     q24_t w_f;          /* observer mode: the observer's speed through the encoder
                          * speed's filter (params speed_lpf_k), Q24 pu - what the
                          * speed loop gets (the PLL's own is too noisy for it) */
+#if CTRL_SL_HFI
+    uint8_t pol_src; /* CTRL_SL_POL_* of the start */
+    /* High-frequency injection at and near standstill (hfi_on; hfi.h): the
+     * start's angle modulo pi, LOCK, SAT (or the motion's polarity), then
+     * the injection's angle below w_hi (for hfi_low_n periods above it: the
+     * observer's), back below w_lo at once. */
+    ctrl_hfi_t hfi;
+    uint8_t hfi_on;     /* configured (ctrl_sl_init with an injection configuration) */
+    q24_t hfi_w_hi;     /* |speed| of the hand-over to the observer, Q24 pu */
+    q24_t hfi_w_lo;     /* |speed| under which the injection takes over again, Q24 pu */
+    uint32_t lock_n;    /* periods of LOCK */
+    uint32_t hfi_low_n; /* periods above hfi_w_hi before the observer takes over */
+#endif
 } ctrl_sl_t;
 
 /* What the sensorless angle gives at sample k. */
@@ -123,6 +145,11 @@ typedef struct {
     q24_t torque_ref;      /* forced mode: the torque reference to apply, Q24 pu */
     fx_angle_t theta_obs;  /* the observer's angle (also while forced) */
     q24_t v_alpha, v_beta; /* CTRL_SL_DETECT: the voltage to apply, Q24 pu */
+#if CTRL_SL_HFI
+    uint8_t i_fund; /* 1: i_ab is the current without the injection's ripple, for the
+                     * estimator (hfi.h) */
+    q24_t i_ab[2];  /* alpha, beta, Q24 pu */
+#endif
 } ctrl_sl_out_t;
 
 /* Back to the start: theta_f = theta0, omega_f = 0, observer not primed

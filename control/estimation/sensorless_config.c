@@ -28,6 +28,11 @@ void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m)
     c->ia_rounds = 2.0;
     c->pol_deg = 10.0;
     c->pol_min_frac = 0.25;
+#if CTRL_SL_HFI
+    c->hfi = 0u;
+    ctrl_hfi_config_default(&c->hfi_cfg, m);
+    c->hfi_low_s = 5e-3;
+#endif
 }
 
 /* The initial angle's settings (sensorless.h): the pulse amplitude that
@@ -54,7 +59,14 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
     const double ld = (double)p->ld * b->l_h / (double)FX_ONE;
     const double lq = (double)p->lq * b->l_h / (double)FX_ONE;
     const double sal = 2.0 * fabs(lq - ld) / (lq + ld);
-    n->ia_on = (c->inertia_kgm2 > 0.0 && sal >= c->ia_saliency_min) ? 1u : 0u;
+    /* the injection's start measures the axis with the pulses too, at the
+     * saliency it accepts (ctrl_hfi_init) */
+#if CTRL_SL_HFI
+    const int want = sal >= c->ia_saliency_min || c->hfi != 0u;
+#else
+    const int want = sal >= c->ia_saliency_min;
+#endif
+    n->ia_on = (c->inertia_kgm2 > 0.0 && want) ? 1u : 0u;
     if (n->ia_on == 0u) {
         return CTRL_OK;
     }
@@ -99,6 +111,47 @@ static int sl_ia_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *
     return CTRL_OK;
 #endif
 }
+
+#if CTRL_SL_HFI
+/* The injection (c->hfi): its gains (ctrl_hfi_init: refused on a machine
+ * with too little saliency), the hand-over speeds, LOCK's length (8 / w_o:
+ * the tracking's error from the pulses' angle, (1 + w t + (w t)^2 / 2)
+ * e^(-w t) at its triple pole, down to 1.4 %), the time above the upper
+ * speed before the hand-over. */
+static int sl_hfi_init(ctrl_sl_t *n, const ctrl_params_t *p, const ctrl_bases_t *b,
+                       const ctrl_sl_config_t *c, ctrl_diag_t *why)
+{
+    if (c->hfi == 0u) {
+        return CTRL_OK;
+    }
+    if (!ctrl_diag_in_range(why, "hfi", "0/1", (double)c->hfi, 0.0, 1.0)) {
+        return CTRL_EINVAL;
+    }
+    if (!CTRL_SL_INITIAL_ANGLE || n->ia_on == 0u) {
+        /* the start measures the axis with the initial angle's pulses and
+         * sizes the motion's polarity pulse from the inertia */
+        (void)ctrl_diag_in_range(why, "inertia_kgm2 (the injection's start needs it)", "kg*m^2",
+                                 c->inertia_kgm2, 1e-12, 1e6);
+        return CTRL_EINVAL;
+    }
+    if (ctrl_hfi_init(&n->hfi, p, b, &c->hfi_cfg, why) != CTRL_OK) {
+        return CTRL_EINVAL;
+    }
+    const double fs = (double)p->fs_hz;
+    if (!ctrl_diag_in_range(why, "hfi_low_s", "s", c->hfi_low_s, 1.0 / fs, 10.0)) {
+        return CTRL_EINVAL;
+    }
+    const double w_rated = (double)p->speed_rated_e / (double)FX_ONE;
+    n->hfi_on = 1u;
+    n->hfi_w_hi = ctrl_q24_from_double(c->hfi_cfg.w_hi_frac * w_rated);
+    n->hfi_w_lo = ctrl_q24_from_double(c->hfi_cfg.w_lo_frac * w_rated);
+    const double wo = (double)n->hfi.l1 / (double)FX_ONE * fs / 3.0;
+    n->lock_n = (uint32_t)ceil(8.0 * fs / wo);
+    n->hfi_low_n = (uint32_t)ceil(c->hfi_low_s * fs);
+    (void)b;
+    return CTRL_OK;
+}
+#endif
 
 int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
                  const ctrl_sl_config_t *c, ctrl_diag_t *why)
@@ -166,6 +219,11 @@ int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
     if (sl_ia_init(&n, p, b, c, why) != CTRL_OK) {
         return CTRL_EINVAL;
     }
+#if CTRL_SL_HFI
+    if (sl_hfi_init(&n, p, b, c, why) != CTRL_OK) {
+        return CTRL_EINVAL;
+    }
+#endif
     /* into [0, 2 pi) by floor (not fmod: its 0.75 KB do not fit the board's image) */
     double th = c->theta0_rad - CTRL_TWO_PI * floor(c->theta0_rad / CTRL_TWO_PI);
     if (th >= CTRL_TWO_PI) {

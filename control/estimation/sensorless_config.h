@@ -8,6 +8,7 @@
 
 #include "ctrl_params.h"
 #include "flux_observer_config.h"
+#include "hfi_config.h"
 #include "sensorless.h"
 
 typedef struct {
@@ -29,6 +30,14 @@ typedef struct {
     double ia_rounds;    /* rounds of the six pulse directions per measurement */
     double pol_deg;      /* polarity pulse: displacement of the bare rotor, electrical deg */
     double pol_min_frac; /* displacement under which the polarity is unknown, share of pol_deg */
+#if CTRL_SL_HFI
+    /* High-frequency injection at and near standstill (hfi.h; an image built
+     * with it, CMake option PMSM_SL_HFI): 0 off (the forced start and
+     * fallback), 1 on. */
+    unsigned hfi;
+    ctrl_hfi_config_t hfi_cfg;
+    double hfi_low_s; /* time above the upper hand-over speed before the hand-over, s */
+#endif
 } ctrl_sl_config_t;
 
 /*
@@ -45,9 +54,10 @@ typedef struct {
  */
 void ctrl_sl_config_default(ctrl_sl_config_t *c, const ctrl_machine_t *m);
 
-/* Validate and set everything (the observer through ctrl_fobs_init); the
- * state is reset (ctrl_sl_reset). Returns CTRL_OK or CTRL_EINVAL with *why
- * naming the field (why may be NULL) and *s untouched. */
+/* Validate and set everything (the observer through ctrl_fobs_init, the
+ * injection through ctrl_hfi_init); the state is reset (ctrl_sl_reset).
+ * Returns CTRL_OK or CTRL_EINVAL with *why naming the field (why may be
+ * NULL) and *s untouched. */
 int ctrl_sl_init(ctrl_sl_t *s, const ctrl_params_t *p, const ctrl_bases_t *b,
                  const ctrl_sl_config_t *c, ctrl_diag_t *why);
 

@@ -42,16 +42,26 @@ typedef struct {
 /* What it returns: the d-axis angle and the electrical speed at k; frame:
  * NULL (the estimator's default), or the frame at theta, which the
  * estimator then takes instead of forming it again (the same values:
- * fx_sincos is a function of the angle alone). */
+ * fx_sincos is a function of the angle alone); i_fund: NULL, or the
+ * current the estimator is to take instead of the measured one (the
+ * sensorless source's with an injection: the current without the
+ * injection's ripple, alpha and beta, Q24 pu). */
 typedef struct {
     fx_angle_t theta;                /* electrical angle of the d axis */
     q24_t omega;                     /* electrical speed, Q24 pu (positive: theta increasing) */
     const ctrl_angle_frame_t *frame; /* NULL, or the frame at theta */
+#if !defined(CTRL_SL_HFI) || CTRL_SL_HFI
+    const q24_t *i_fund; /* NULL, or {i_alpha, i_beta} */
+#endif
 } ctrl_angle_out_t;
 
 /* bytes of a source's state (estimator.h): the sensorless one, 328 with the
- * initial angle */
+ * initial angle, 600 with the injection (CTRL_SL_HFI, hfi.h) */
+#if !defined(CTRL_SL_HFI) || CTRL_SL_HFI
+#define CTRL_ANGLE_STATE_MAX 600
+#else
 #define CTRL_ANGLE_STATE_MAX 336
+#endif
 
 typedef struct ctrl_angle_src {
     const char *name;     /* "encoder", "forced", ... */

@@ -142,8 +142,10 @@ int ctrl_params_init_diag(ctrl_params_t *p, ctrl_bases_t *bases, const ctrl_mach
 
 /* The diagnosis as one line, e.g. "rated electrical speed x Ts = 1.47 rad per
  * period is outside the range the core takes, [0.001, 1] rad per period (from
- * speed_rated_rpm, pole_pairs, fs_hz)" ("ok" for CTRL_OK); returns its length
- * (truncated to cap - 1). */
+ * speed_rated_rpm, pole_pairs, fs_hz)" ("ok" for CTRL_OK); a refused choice
+ * (min > max: no range, the unit names its kind) as "controller bst refused:
+ * <depends>" (in an image with the injection, CTRL_SL_HFI, its only user);
+ * returns its length (truncated to cap - 1). */
 size_t ctrl_diag_format(const ctrl_diag_t *d, char *buf, size_t cap);
 
 /* A per-unit value -> Q24, rounded half away from zero, saturated (NaN: 0). */

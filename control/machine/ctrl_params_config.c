@@ -408,6 +408,13 @@ size_t ctrl_diag_format(const ctrl_diag_t *d, char *buf, size_t cap)
         n = snprintf(buf, cap, "ok");
     } else if (d->min == 0.0 && d->max == 0.0) {
         n = snprintf(buf, cap, "%s missing", d->quantity);
+#if CTRL_SL_HFI
+    } else if (d->min > d->max) {
+        /* not a range: a choice refused (the unit names its kind) */
+        n = snprintf(buf, cap, "%s%s%s refused: %s", d->unit != NULL ? d->unit : "",
+                     d->unit != NULL && d->unit[0] != '\0' ? " " : "", d->quantity,
+                     d->depends != NULL ? d->depends : "not accepted");
+#endif
     } else {
         const char *u = d->unit != NULL && d->unit[0] != '\0' ? " " : "";
         const char *un = d->unit != NULL ? d->unit : "";

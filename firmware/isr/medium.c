@@ -102,10 +102,18 @@ void fw_medium(fw_t *fw)
     const q24_t vdc = (q24_t)((in->vdc_sum + (int64_t)(n / 2u)) / (int64_t)n);
     /* ctrl_fieldweak_step_lazy without its inline shortcut (the same outputs,
      * field_weak.h; flash matters more than time here) */
+    q24_t w = in->omega_e;
+#if CTRL_SL_HFI
+    if (fx_abs(w) < fw->hfi_w_still) {
+        /* the injection's speed estimate at standstill scatters about 0: a
+         * torque against its sign is not braking (the braking margin of
+         * field_weak.h is for a rotor that turns away from a standing flux) */
+        w = 0;
+    }
+#endif
     ctrl_fieldweak_out_t lim;
     ctrl_fieldweak_limits_lazy(&fw->fieldweak, &fw->params,
-                               ctrl_fieldweak_vdc_filter(&fw->fieldweak, vdc), in->omega_e, t_req,
-                               &lim);
+                               ctrl_fieldweak_vdc_filter(&fw->fieldweak, vdc), w, t_req, &lim);
     fw->torque_max = lim.torque_max;
     out->torque_max = lim.torque_max;
     out->psi_ref = lim.psi_ref;

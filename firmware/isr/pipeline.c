@@ -19,6 +19,15 @@
  * same core). */
 #define FW_RELEASE() atomic_signal_fence(memory_order_release)
 
+/* The sensorless angle is its own (the observer's, or the injection's), not
+ * the start's forced one: the speed loop runs, the torque estimate is
+ * trusted. */
+#if CTRL_SL_HFI
+#define FW_SL_OWN_ANGLE(mode) ((mode) == CTRL_SL_OBSERVER || (mode) == CTRL_SL_INJECT)
+#else
+#define FW_SL_OWN_ANGLE(mode) ((mode) == CTRL_SL_OBSERVER)
+#endif
+
 static void fw_fault_now(fw_t *fw, uint32_t code)
 {
     /* Gates off before anything else, then latch the code. */
@@ -419,6 +428,31 @@ static inline void fw_sl_inputs(fw_t *fw, ctrl_angle_sl_t *sl, uint8_t mode, q24
     sl->torque_est = fw->estimate.now.torque;
 }
 
+/* The sensorless angle's state in the record: its mode, the start's phase
+ * and where its polarity came from (pipeline.h, fw_telemetry_t.sl_state),
+ * and the injection's angle error. */
+#if CTRL_SL_HFI
+static inline void fw_sl_telemetry(fw_telemetry_t *tm, const ctrl_sl_t *s, const ctrl_sl_out_t *o)
+{
+    tm->sl_state = (uint8_t)((o->mode & 3u) | ((s->phase & 7u) << 2) | ((s->pol_src & 3u) << 5));
+    tm->hfi_err = s->hfi.err;
+}
+
+/* The injection's voltage (hfi.h) added to the controller's leg duties for
+ * the inverter only: what the estimator and the observer are told was
+ * applied stays the controller's (limited as the written ones), so that they
+ * see the fundamental; a clamp (the spread left no room) is counted. */
+static FW_NOINLINE void fw_hfi_out(fw_t *fw, hal_t *hal, fw_telemetry_t *tm, ctrl_hfi_t *h,
+                                   ctrl_legs_t *legs, const ctrl_estimate_t *est)
+{
+    ctrl_legs_t w = *legs;
+    fw_legs_limit(w.duty, fw->duty_max);
+    fw->hfi_clipped += ctrl_hfi_add_to_legs(h, w.duty, fw->duty_max);
+    fw_pwm_out(fw, hal, tm, &w, est);
+    fw_legs_limit(legs->duty, fw->duty_max);
+}
+#endif
+
 /* The medium task's run of the PM-flux tracker alone (its inputs are in the
  * free slot, fw_psi_track): true. */
 static inline bool fw_mid_track_request(fw_t *fw)
@@ -507,11 +541,16 @@ static inline bool fw_control(fw_t *fw, fw_telemetry_t *tm, const ctrl_meas_t *m
     tm->psi_d = est->now.psi_d;
     tm->psi_q = est->now.psi_q;
     tm->torque = est->now.torque;
+#if CTRL_SL_HFI
+    if (sl != NULL) {
+        fw_sl_telemetry(tm, &sl->sl, &sl->out);
+    }
+#endif
     /* The torque reference without the speed loop: the sensorless start's
      * (forced angle or the initial angle's pulses: the start-up current along
      * the forced q axis, the speed loop waiting, sensorless.h), or torque
      * mode's (torque_ref clamped by fw_set_torque_ref). */
-    const uint8_t hold = sl != NULL && sl->out.mode != CTRL_SL_OBSERVER ? 1u : 0u;
+    const uint8_t hold = sl != NULL && !FW_SL_OWN_ANGLE(sl->out.mode) ? 1u : 0u;
     const q24_t tref = hold != 0u ? sl->out.torque_ref : tref0;
     q24_t t_req = tref;
     if (fw->mid_fresh == 0u) {
@@ -555,7 +594,7 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
         /* the estimate at k answers the reference applied at k-1; none to
          * trust on the sensorless start's forced angle */
         f = fw_torque_follow_step(&fw->tqf, fw->torque_ref_now, est->now.torque,
-                                  sl == NULL || sl->out.mode == CTRL_SL_OBSERVER);
+                                  sl == NULL || FW_SL_OWN_ANGLE(sl->out.mode));
     }
 #if CTRL_SL_START_CHECK
     if (f == FW_FAULT_NONE && sl != NULL) {
@@ -648,7 +687,14 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
         ctrl_svpwm_duties(sl->out.v_alpha, sl->out.v_beta, m->vdc, &out.legs);
         out.plan.n_seg = 0u;
     }
-    fw_pwm_out(fw, hal, tm, &out.legs, est);
+#if CTRL_SL_HFI
+    if (sl != NULL && sl->sl.hfi.amp[0] != 0) {
+        fw_hfi_out(fw, hal, tm, &sl->sl.hfi, &out.legs, est);
+    } else
+#endif
+    {
+        fw_pwm_out(fw, hal, tm, &out.legs, est);
+    }
     /* The duties written now act during [k+1, k+2): they are "applied" for
      * the estimator's prediction at k+1 (the compensation makes them true). */
     fw->applied = out.legs;

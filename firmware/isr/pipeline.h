@@ -77,6 +77,7 @@
 #include "flux_observer.h"
 #include "fw_state.h"
 #include "hal.h"
+#include "hfi_config.h"
 #include "protect.h"
 #include "psi_track.h"
 #include "sensorless.h"
@@ -125,6 +126,16 @@ typedef struct {
     uint32_t cycles;         /* ISR duration measured with hal_cycles */
     uint8_t cm_step;         /* commissioning step running (cm_step_id_t), 0 = none */
     uint16_t cm_progress;    /* its progress, per mille */
+#if CTRL_SL_HFI
+    /* Sensorless (fw_config_t.sensorless): bits 0-1 the angle's mode
+     * (CTRL_SL_FORCED, _OBSERVER, _DETECT, _INJECT of sensorless.h), bits 2-4
+     * the start's phase (CTRL_SL_PH_*), bits 5-6 where the polarity came from
+     * (CTRL_SL_POL_*); 0 with the encoder. In an image with the injection
+     * only (CMake option PMSM_SL_HFI): the record's size stays otherwise. */
+    uint8_t sl_state;
+    int32_t hfi_err; /* the injection's angle error estimate (rotor minus tracked), fx_angle_t
+                      * units (2^32 = one electrical turn); 0 without a demodulated sample */
+#endif
 } fw_telemetry_t;
 
 /* Records kept for the main loop (power of 2): at one record in `every`
@@ -282,6 +293,16 @@ typedef struct {
      * encoder and its protections unused, psi_adapt off (the observer's
      * correction needs the configured psi_pm). Default off. */
     bool sensorless;
+    /* High-frequency injection at and near standstill (sensorless only;
+     * control/estimation/hfi.h, docs/algorithms.md "High-frequency
+     * injection"): the start from the saliency's angle with its polarity by
+     * d-axis saturation pulses (or the first motion), the injection's angle
+     * below the hand-over speed, the observer's above. Needs a salient
+     * machine and a modulated controller (foc, m2ptfc, drr: the injection is
+     * added to their voltage); others are refused by name. hfi_cfg: each
+     * field 0 takes the machine's default (ctrl_hfi_config_default). Default
+     * off. */
+    bool hfi; /* beside sensorless: in its padding */
 #if CM_MECH
     /* The shaft's friction (Coulomb with the passive load, N*m; viscous,
      * N*m*s): the machine's mechanics beside its inertia, which "ident apply"
@@ -299,6 +320,9 @@ typedef struct {
      * than max(5 %, 2 % of rated) before the fault torque_follow; 0 (the
      * default): the telemetry warning only. */
     uint32_t torque_follow_fault_windows;
+#if CTRL_SL_HFI
+    ctrl_hfi_config_t hfi_cfg; /* last: no other field's offset moves (fw_config_t.hfi) */
+#endif
 } fw_config_t;
 
 /* The speed loop and speed limits in force (SI, for reports; set by fw_init). */
@@ -337,7 +361,7 @@ typedef struct {
     uint8_t psi_due;     /* interrupt: the tracker's correction of this period is the medium
                             task's (its step and parameters taken at the next period) */
     ctrl_legs_t applied; /* leg duties acting in [k, k+1): chosen at k-1 (or 0), before
-                          * the dead-time compensation */
+                          * the dead-time compensation (and without the injection) */
     ctrl_deadtime_t deadtime; /* compensation of the written duties (dd 0: off) */
     ctrl_refs_t refs;
     q24_t torque_ref_now; /* torque reference after the limits, before the trim, Q24 pu */
@@ -432,6 +456,10 @@ typedef struct {
      * on it since, and the bound (3 x the ramp, settle and polarity pulses'
      * periods + 0.25 s; pipeline_config.c). */
     uint32_t sl_forced_n, sl_obs_n, sl_forced_max;
+#if CTRL_SL_HFI
+    uint32_t hfi_clipped; /* periods whose injection was clamped (its legs had no room) */
+    q24_t hfi_w_still;    /* |speed| the field weakening takes as standstill (medium.c), Q24 pu */
+#endif
 #if CTRL_COGGING
     /* Anti-cogging (cogging_ff.h, cm_cogging.h): the table, which the step
      * "cogging" measures, and cog_on (main loop: fw_cogging_enable), which
@@ -533,7 +561,9 @@ void fw_tm_release(fw_t *fw);
  * step, the controller state these replace).
  * fw_select_controller: cfg NULL = desc->cfg_default(machine); on failure the
  * previous controller stays selected. fw_tunable_set re-initialises the
- * controller with the changed value (FW_ENOENT unknown name, FW_EINVAL range).
+ * controller with the changed value (FW_ENOENT unknown name, FW_EINVAL range);
+ * a name "hfi.<field>" (an image with the injection) is the injection's
+ * setting (fw_config_t.hfi_cfg, hfi_config.h), the drive set up again with it.
  */
 int fw_select_controller(fw_t *fw, const ctrl_desc_t *desc, const void *cfg);
 int fw_tunable_set(fw_t *fw, const char *name, double value);

@@ -48,6 +48,7 @@ void fw_config_default(fw_config_t *c, const ctrl_machine_t *machine, const ctrl
     c->dead_comp = true;
     c->dead_comp_band_a = 0.0;
     c->sensorless = false;
+    c->hfi = false;                      /* hfi_cfg 0: the machine's defaults */
     c->torque_follow_fault_windows = 0u; /* warning only */
 }
 
@@ -78,6 +79,40 @@ const char *fw_strerror(int code)
         return "unknown error";
     }
 }
+
+#if CTRL_SL_HFI
+/* The injection's settings: each non-zero field of set replaces the
+ * machine's default in c (fw_config_t.hfi_cfg). */
+static void fw_hfi_overlay(ctrl_hfi_config_t *c, const ctrl_hfi_config_t *set)
+{
+    double *const dst[] = {&c->ripple_frac, &c->v_inj_v,    &c->track_hz,  &c->j_kgm2,
+                           &c->h_tau_s,     &c->sal_min,    &c->w_hi_frac, &c->w_lo_frac,
+                           &c->pol_i_frac,  &c->pol_rounds, &c->pol_min};
+    const double src[] = {set->ripple_frac, set->v_inj_v,    set->track_hz,  set->j_kgm2,
+                          set->h_tau_s,     set->sal_min,    set->w_hi_frac, set->w_lo_frac,
+                          set->pol_i_frac,  set->pol_rounds, set->pol_min};
+    _Static_assert(sizeof src == sizeof(ctrl_hfi_config_t), "every field of ctrl_hfi_config_t");
+    for (size_t k = 0; k < sizeof src / sizeof src[0]; k++) {
+        if (src[k] != 0.0) {
+            *dst[k] = src[k];
+        }
+    }
+}
+
+/* The controllers the injection works with: its voltage is added to their
+ * modulated output (leg duties of a continuous voltage); a switching table's
+ * or a hysteresis controller's single vector has no room for it. */
+static bool fw_hfi_controller_ok(const ctrl_desc_t *d)
+{
+    static const char *const ok[] = {"foc", "m2ptfc", "drr"};
+    for (size_t k = 0; k < sizeof ok / sizeof ok[0]; k++) {
+        if (strcmp(d->name, ok[k]) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+#endif
 
 /* x in [0, 2) -> Q30, or -1 when it does not fit. */
 static int32_t fw_q30(double x)
@@ -177,6 +212,11 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         fw->why = d;
         return fwrc == CTRL_ERANGE ? FW_ERANGE : FW_EINVAL;
     }
+#if CTRL_SL_HFI
+    /* at standstill the injection's speed estimate scatters about 0: below 1 %
+     * of rated speed the field weakening takes standstill (medium.c) */
+    fw->hfi_w_still = cfg->hfi ? fw->params.speed_rated_e / 100 : 0;
+#endif
     fw->torque_max = 0;
     fw->trim_k = ctrl_q24_from_double(
         1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_TRIM_HZ / (double)in->pwm_freq_hz));
@@ -227,6 +267,25 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         fw->psi_band = fx_mul(fw->params.psi_pm, ctrl_q24_from_double(0.02));
         fw->psi_engaged = false;
     }
+#if CTRL_SL_HFI
+    if (cfg->hfi && !cfg->sensorless) {
+        const ctrl_diag_t d = {CTRL_EINVAL,
+                               "sensorless",
+                               "",
+                               0.0,
+                               1.0,
+                               1.0,
+                               "the injection (hfi) is a sensorless angle"};
+        fw->why = d;
+        return FW_EINVAL;
+    }
+#else
+    if (cfg->hfi) {
+        /* not built into this image (CMake option PMSM_SL_HFI): the range [0, 0] */
+        (void)ctrl_diag_in_range(&fw->why, "hfi", "", 1.0, 0.0, 0.0);
+        return FW_EINVAL;
+    }
+#endif
     if (cfg->sensorless) {
         /* The sensorless angle source with its defaults (sensorless_config.h)
          * and the inverter's dead time and drop; its PLL within the discrete
@@ -250,6 +309,10 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         }
         sc.obs.dead_time_s = obs_dead_time_s;
         sc.obs.v_fwd_v = obs_v_fwd_v;
+#if CTRL_SL_HFI
+        sc.hfi = cfg->hfi ? 1u : 0u;
+        fw_hfi_overlay(&sc.hfi_cfg, &cfg->hfi_cfg);
+#endif
         ctrl_angle_sl_t *const sl = ctrl_estimator_angle_state(&fw->est);
         if (ctrl_sl_init(&sl->sl, &fw->params, &fw->bases, &sc, &fw->why) != CTRL_OK) {
             return FW_EINVAL;
@@ -595,6 +658,21 @@ int fw_select_controller(fw_t *fw, const ctrl_desc_t *d, const void *cfg)
     if (d->state_size > CTRL_STATE_MAX || d->cfg_size > CTRL_CFG_MAX) {
         return FW_ECTRL;
     }
+#if CTRL_SL_HFI
+    if (fw->cfg.hfi && !fw_hfi_controller_ok(d)) {
+        /* named: "controller bst refused: ..." (ctrl_diag_format) */
+        const ctrl_diag_t why = {CTRL_EINVAL,
+                                 d->name,
+                                 "controller",
+                                 1.0,
+                                 1.0,
+                                 0.0,
+                                 "the injection (hfi) is added to a modulated voltage: foc, "
+                                 "m2ptfc or drr"};
+        fw->why = why;
+        return FW_ECTRL;
+    }
+#endif
     union {
         max_align_t align;
         unsigned char bytes[CTRL_CFG_MAX];
@@ -653,6 +731,37 @@ int fw_speed_retune(fw_t *fw, double bw_hz, double pm_deg, double kp, double ki)
 #endif
 }
 
+#if CTRL_SL_HFI
+/* "hfi.<field>" (hfi_config.h, ctrl_hfi_desc): the injection's settings in
+ * fw_config_t.hfi_cfg and, with the injection on, the drive set up again
+ * with them (the controller's tunables kept); refused, the previous ones stay
+ * (and fw->why says why). */
+static int fw_hfi_set(fw_t *fw, const char *name, double value)
+{
+    const ctrl_hfi_config_t old = fw->cfg.hfi_cfg;
+    const int rc = ctrl_tunable_set(&ctrl_hfi_desc, &fw->cfg.hfi_cfg, name, value);
+    if (rc != CTRL_OK) {
+        return rc == CTRL_ENOENT ? FW_ENOENT : FW_EINVAL;
+    }
+    if (!fw->cfg.hfi) {
+        return FW_OK; /* kept for when it is switched on */
+    }
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } c;
+    memcpy(c.bytes, fw->ctrl_cfg.bytes, CTRL_CFG_MAX);
+    const int s = fw_setup_machine(fw, &fw->cfg, fw->ctrl, c.bytes);
+    if (s != FW_OK) {
+        const ctrl_diag_t why = fw->why;
+        fw->cfg.hfi_cfg = old;
+        (void)fw_setup_machine(fw, &fw->cfg, fw->ctrl, c.bytes);
+        fw->why = why;
+    }
+    return s;
+}
+#endif
+
 int fw_tunable_set(fw_t *fw, const char *name, double value)
 {
     if (fw == NULL || fw->ctrl == NULL || name == NULL) {
@@ -662,6 +771,11 @@ int fw_tunable_set(fw_t *fw, const char *name, double value)
     /* With the gates on (or about to go on) only a live tunable, and not
      * while the previous live change waits for the interrupt. */
     const bool live = fw_gates_on_or_pending(fw);
+#if CTRL_SL_HFI
+    if (strncmp(name, "hfi.", 4u) == 0) { /* none live: the drive is set up again */
+        return live ? FW_EBUSY : fw_hfi_set(fw, name, value);
+    }
+#endif
 #if !PMSM_LIVE_PARAMS
     if (live) {
         return FW_EBUSY; /* as fw_select_controller */
@@ -715,6 +829,12 @@ int fw_tunable_get(const fw_t *fw, const char *name, double *value)
     if (fw == NULL || fw->ctrl == NULL || name == NULL || value == NULL) {
         return FW_EINVAL;
     }
+#if CTRL_SL_HFI
+    if (strncmp(name, "hfi.", 4u) == 0) {
+        const int h = ctrl_tunable_get(&ctrl_hfi_desc, &fw->cfg.hfi_cfg, name, value);
+        return h == CTRL_OK ? FW_OK : (h == CTRL_ENOENT ? FW_ENOENT : FW_EINVAL);
+    }
+#endif
     const int rc = ctrl_tunable_get(fw->ctrl, fw->ctrl_cfg.bytes, name, value);
     return rc == CTRL_OK ? FW_OK : (rc == CTRL_ENOENT ? FW_ENOENT : FW_EINVAL);
 }

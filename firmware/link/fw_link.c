@@ -85,7 +85,13 @@ static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
 {
     const fw_link_t *l = fw_link_of(ctx);
     const fw_t *fw = l->fw;
-    const size_t n_tun = fw->ctrl != NULL ? fw->ctrl->n_tunables : 0u;
+    const size_t n_ctrl = fw->ctrl != NULL ? fw->ctrl->n_tunables : 0u;
+#if CTRL_SL_HFI
+    /* the injection's settings after the controller's tunables ("hfi.*") */
+    const size_t n_tun = n_ctrl + ctrl_hfi_desc.n_tunables;
+#else
+    const size_t n_tun = n_ctrl;
+#endif
     if (index >= n_tun) {
         index -= n_tun;
 #if PMSM_LIVE_PARAMS
@@ -100,7 +106,12 @@ static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
         *info = l->params[index].info;
         return true;
     }
+#if CTRL_SL_HFI
+    const ctrl_tunable_t *t =
+        index < n_ctrl ? &fw->ctrl->tunables[index] : &ctrl_hfi_desc.tunables[index - n_ctrl];
+#else
     const ctrl_tunable_t *t = &fw->ctrl->tunables[index];
+#endif
     info->name = t->name;
     info->unit = t->unit;
     info->help = t->help;
@@ -683,6 +694,10 @@ static void fw_link_sample(const fw_t *fw, const fw_telemetry_t *r, tel_sample_t
     s->cm_progress = (int32_t)r->cm_progress;
     s->torque_max = r->torque_max;
     s->fieldweak_limit = (int32_t)r->fieldweak_limit;
+#if CTRL_SL_HFI
+    s->sl_state = (int32_t)r->sl_state;
+    s->angle_err = fx_rshift32_round(r->hfi_err, 8u);
+#endif
 }
 
 void fw_link_poll(fw_link_t *l)

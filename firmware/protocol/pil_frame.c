@@ -255,6 +255,7 @@ size_t pil_setup_pack(const pil_setup_t *s, uint8_t *out, size_t cap)
     w_f64(&w, s->overspeed_rpm);
     w_u8(&w, s->psi_adapt ? 1u : 0u);
     w_u8(&w, s->sensorless ? 1u : 0u);
+    w_u8(&w, s->hfi ? 1u : 0u);
     w_f64(&w, s->dead_time_s);
     w_f64(&w, s->v_fwd_v);
     w_u32(&w, s->enc_offset);
@@ -316,6 +317,7 @@ int pil_setup_unpack(const uint8_t *p, size_t n, pil_setup_t *s)
     s->overspeed_rpm = r_f64(&r);
     s->psi_adapt = r_bool(&r);
     s->sensorless = r_bool(&r);
+    s->hfi = r_bool(&r);
     s->dead_time_s = r_f64(&r);
     s->v_fwd_v = r_f64(&r);
     s->enc_offset = r_u32(&r);

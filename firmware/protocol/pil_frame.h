@@ -114,6 +114,7 @@ typedef struct {
     uint8_t speed_unit; /* ctrl_speed_unit_t */
     double overspeed_rpm;
     bool psi_adapt, sensorless;
+    bool hfi; /* fw_config_t.hfi; its settings among the sets ("hfi.<field>") */
     double dead_time_s, v_fwd_v;
     uint32_t enc_offset; /* fx_angle_t */
     int8_t enc_direction;

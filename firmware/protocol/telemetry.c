@@ -40,6 +40,14 @@ static const tel_signal_t tel_signals[TEL_SIG_COUNT] = {
             "limit: 0 current, 1 voltage, 2 MTPV, 3 flux; +4 clipped, +8 weakened, +16 torque "
             "not followed",
             TEL_KIND_INTEGER, fieldweak_limit),
+#if CTRL_SL_HFI
+    TEL_SIG("sl_state", "",
+            "sensorless: bits 0-1 mode (0 forced, 1 observer, 2 pulses, 3 injection), 2-4 start "
+            "phase, 5-6 polarity from (1 saturation, 2 motion)",
+            TEL_KIND_INTEGER, sl_state),
+    TEL_SIG("angle_err", "rad", "the injection's angle error estimate (rotor minus tracked)",
+            TEL_KIND_ANGLE, angle_err),
+#endif
 };
 
 const tel_signal_t *tel_signal_at(size_t index)

@@ -45,6 +45,11 @@ typedef enum {
     TEL_SIG_TORQUE_MAX,  /* |torque| limit of the period (current, voltage, MTPV) */
     TEL_SIG_FW_LIMIT,    /* what bounds it (ctrl_fieldweak_limit_t) + 4 clipped + 8 flux weakened
                             + 16 torque not following its reference (torque_follow.h) */
+#if CTRL_SL_HFI
+    /* an image with the injection (CMake option PMSM_SL_HFI) */
+    TEL_SIG_SL_STATE,  /* sensorless: mode, start phase, polarity's source (pipeline.h) */
+    TEL_SIG_ANGLE_ERR, /* the injection's angle error estimate (rotor minus tracked) */
+#endif
     TEL_SIG_COUNT
 } tel_sig_t;
 
@@ -59,7 +64,9 @@ typedef enum {
  *   vdc                  Q24 pu of the voltage base (V)
  *   duty                 Q24 fraction of the period (FX_ONE = 100 %)
  *   theta                theta_e >> 8: Q24 fraction of a turn, [0, 2^24)
- *   vector sector state fault cycles cm_step cm_progress fieldweak_limit   plain integers
+ *   vector sector state fault cycles cm_step cm_progress fieldweak_limit sl_state
+ *                        plain integers
+ *   angle_err            (fw_telemetry_t.hfi_err) / 2^8: Q24 fraction of a turn, signed
  */
 typedef struct {
     uint32_t tick; /* control period index k (wraps), sent in every frame */
@@ -71,6 +78,9 @@ typedef struct {
     int32_t state, fault, cycles;
     int32_t cm_step, cm_progress;
     int32_t torque_max, fieldweak_limit;
+#if CTRL_SL_HFI
+    int32_t sl_state, angle_err;
+#endif
 } tel_sample_t;
 
 /* How a raw value turns into SI. */

@@ -2,7 +2,8 @@
 #include "rec_loop.h"
 
 const char *rec_loop_init(rec_loop_t *loop, const ctrl_desc_t *d, const sim_machine_t *sm,
-                          uint32_t fs, double speed_rpm, uint32_t calib_samples, bool sensorless)
+                          uint32_t fs, double speed_rpm, uint32_t calib_samples,
+                          unsigned sensorless)
 {
     ctrl_machine_t cm;
     sim_ctrl_machine_from(sm, &cm);
@@ -21,7 +22,8 @@ const char *rec_loop_init(rec_loop_t *loop, const ctrl_desc_t *d, const sim_mach
     fw_config_t fc;
     fw_config_default(&fc, &cm, d);
     fc.calib_samples = calib_samples;
-    fc.sensorless = sensorless;
+    fc.sensorless = sensorless != 0u;
+    fc.hfi = sensorless == 2u;
     if (fw_init(&loop->fw, &loop->hal, &fc) != FW_OK) {
         return "fw_init failed for ";
     }

@@ -31,10 +31,12 @@ typedef struct {
 
 /* Sets up the loop for controller d at fs on machine sm, the plant turning at
  * speed_rpm, calib_samples of current-offset calibration, the firmware with
- * or without its encoder (fw_config_t.sensorless). Returns NULL or the
+ * its encoder (sensorless 0) or without (1: fw_config_t.sensorless; 2: with
+ * the injection too, fw_config_t.hfi). Returns NULL or the
  * failing step ("plant_init failed for "; the caller appends d->name). */
 const char *rec_loop_init(rec_loop_t *loop, const ctrl_desc_t *d, const sim_machine_t *sm,
-                          uint32_t fs, double speed_rpm, uint32_t calib_samples, bool sensorless);
+                          uint32_t fs, double speed_rpm, uint32_t calib_samples,
+                          unsigned sensorless);
 
 /* Begins one period: arms at READY with torque_nm (in->cmd = PIL_CMD_TORQUE |
  * PIL_CMD_ARM in that period), samples the ISR inputs into *in, runs the ISR

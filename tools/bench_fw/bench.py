@@ -26,7 +26,7 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
-from argtypes import whole_in  # noqa: E402
+from argtypes import number_in, whole_in  # noqa: E402
 FW = os.path.join(ROOT, "tools", "bench_fw")
 SPEEDS = (750, 2250)
 TORQUE_NM = 1.8
@@ -345,6 +345,14 @@ def main():
                     help="the firmware without its encoder (fw_config_t.sensorless): recorded at "
                          "5 %% of rated speed (the forced start's final speed), so that the forced "
                          "start, the handover (about 1100 periods) and the observer are counted")
+    ap.add_argument("--hfi", action="store_true",
+                    help="sensorless with the high-frequency injection (fw_config_t.hfi): recorded "
+                         "at 0 r/min on --machine (a salient one whose saturation tells the "
+                         "polarity on the dynamometer: thesis_ipmsm_80kw_magsat.ini), --torque; "
+                         "the start (angle, tracking's settling, saturation pulses) and the "
+                         "tracking are counted")
+    ap.add_argument("--torque", type=number_in(float, -1e5, 1e5, "N*m"), default=TORQUE_NM,
+                    help="torque reference of the recordings, N*m (default %g)" % TORQUE_NM)
     ap.add_argument("--jobs", type=whole_in(1, 1024, "jobs at once"), default=2)
     ap.add_argument("--cm0-build", default=os.environ.get(
         "BENCH_CM0_BUILD", os.path.join(ROOT, "build", "cm0")))
@@ -378,16 +386,18 @@ def main():
         speeds = SPEEDS
     if args.sensorless:
         speeds = (SENSORLESS_RPM,)
+    if args.hfi:
+        speeds = (0,)
     recdir = os.path.join(args.work, "rec")
     os.makedirs(recdir, exist_ok=True)
     log("recording %d controller(s) x %s r/min, %g N*m, %d running periods" %
-        (len(names), "/".join(map(str, speeds)), TORQUE_NM, args.periods))
+        (len(names), "/".join(map(str, speeds)), args.torque, args.periods))
 
     def record(job):
         n, s = job
         run([tools["rec"], "record", "--machine", machine, "--speed", str(s), "--torque",
-             str(TORQUE_NM), "--periods", str(args.periods), "--outdir", recdir, "--ctrl", n,
-             "--sensorless", "1" if args.sensorless else "0"])
+             str(args.torque), "--periods", str(args.periods), "--outdir", recdir, "--ctrl", n,
+             "--sensorless", "2" if args.hfi else ("1" if args.sensorless else "0")])
 
     jobs = [(n, s) for n in names for s in speeds]
     with cf.ThreadPoolExecutor(args.jobs) as ex:
@@ -536,10 +546,13 @@ def main():
         res[n]["cm4_ratio_to_m1"] = round(res[n]["cm4_instr_mean"] / res[ref]["cm4_instr_mean"], 3)
     doc = {
         "method": {
-            "scenario": "thesis SPMSM, dynamometer at %s r/min, torque reference %g N*m, "
+            "scenario": "%s, dynamometer at %s r/min, torque reference %g N*m, "
                         "controller default fs, %d running periods after arm (plus boot and "
-                        "calibration, not counted)" % ("/".join(map(str, speeds)), TORQUE_NM,
-                                                        args.periods),
+                        "calibration, not counted)%s" % (
+                            os.path.basename(machine), "/".join(map(str, speeds)), args.torque,
+                            args.periods,
+                            "; sensorless with the injection" if args.hfi else
+                            ("; sensorless" if args.sensorless else "")),
             "cm4": "QEMU mps2-an386 (Cortex-M4F, -O2 -g), recorded inputs replayed through "
                    "fw_isr_fast (the PWM-period interrupt) and, where it triggered one, "
                    "fw_medium (the medium-rate task), counted apart; exact instruction counts "

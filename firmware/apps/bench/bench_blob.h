@@ -39,7 +39,7 @@ typedef struct {
     /* hal_info_t of the recording HAL */
     uint32_t pwm_freq_hz, period_counts, encoder_counts_per_rev, cycle_clock_hz;
     uint32_t adc_bits, has_i_c;
-    uint32_t sensorless; /* fw_config_t.sensorless of the recording (0/1) */
+    uint32_t sensorless; /* fw_config_t.sensorless of the recording (0/1; 2: and .hfi) */
     uint32_t pad1;
     double adc_current_a_per_count, adc_vdc_v_per_count;
     /* ctrl_machine_t of the controller */

@@ -2,7 +2,7 @@
  * PC recorder of the interrupt-cost benchmark (tools/bench):
  *
  *   bench_rec record --machine INI --speed RPM --torque NM --periods N --outdir DIR
- *                    [--ctrl NAME] [--sensorless 0|1] [--fs HZ]
+ *                    [--ctrl NAME] [--sensorless 0|1|2] [--fs HZ]
  *       For every registered controller (or NAME): a closed loop on the PC
  *       (plant, dynamometer at RPM + hal/sim + firmware) from fw_init through
  *       calibration and arm, then N running periods at the controller's
@@ -46,7 +46,7 @@ static void put_name(char *dst, size_t n, const char *src)
 /* ---- record ------------------------------------------------------------ */
 
 static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double speed_rpm,
-                      double torque_nm, uint32_t periods, bool sensorless, uint32_t fs_hz,
+                      double torque_nm, uint32_t periods, unsigned sensorless, uint32_t fs_hz,
                       const char *outdir)
 {
     static rec_loop_t loop;
@@ -126,7 +126,7 @@ static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double spee
     h->cycle_clock_hz = info.cycle_clock_hz;
     h->adc_bits = info.adc_bits;
     h->has_i_c = info.has_i_c ? 1u : 0u;
-    h->sensorless = sensorless ? 1u : 0u;
+    h->sensorless = sensorless; /* 2: with the injection (bench_blob.h) */
     h->adc_current_a_per_count = info.adc_current_a_per_count;
     h->adc_vdc_v_per_count = info.adc_vdc_v_per_count;
     h->pole_pairs = cm.pole_pairs;
@@ -162,7 +162,7 @@ static int cmd_record(int argc, char **argv)
     const char *machine = NULL, *outdir = NULL, *only = NULL;
     double speed = 750.0, torque = 1.8;
     unsigned long periods = 2000u, fs = 0u;
-    bool sensorless = false;
+    unsigned sensorless = 0u;
     for (int i = 0; i < argc; i += 2) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -185,10 +185,10 @@ static int cmd_record(int argc, char **argv)
                 return die("--torque expects 0 .. 10000 N*m, got ", v);
             }
         } else if (strcmp(a, "--sensorless") == 0) {
-            if (strcmp(v, "0") != 0 && strcmp(v, "1") != 0) {
-                return die("--sensorless expects 0 or 1, got ", v);
+            if (strcmp(v, "0") != 0 && strcmp(v, "1") != 0 && strcmp(v, "2") != 0) {
+                return die("--sensorless expects 0, 1 or 2 (with the injection), got ", v);
             }
-            sensorless = v[0] == '1';
+            sensorless = (unsigned)(v[0] - '0');
         } else if (strcmp(a, "--fs") == 0) {
             fs = strtoul(v, &end, 10);
             if (*end != '\0' || fs < 1000u || fs > 200000u) {

@@ -59,6 +59,7 @@ int bench_replay_init(bench_replay_t *r, fw_t *fw, hal_t *hal)
     fw_config_default(&fc, &r->machine, r->desc);
     fc.calib_samples = r->hdr->calib_samples;
     fc.sensorless = r->hdr->sensorless != 0u;
+    fc.hfi = r->hdr->sensorless == 2u;
     return fw_init(fw, hal, &fc);
 }
 

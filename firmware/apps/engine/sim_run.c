@@ -345,14 +345,20 @@ static void sim_est_error_add(sim_run_t *r, double t, double th_true, double w_t
 {
     const sim_machine_t *m = &r->cfg.plant_machine;
     const double w_rated = m->speed_rated_rpm * 2.0 * CTRL_PI / 60.0 * (double)m->pole_pairs;
-    if (t < r->cfg.win_start_s || t > r->cfg.win_end_s || fw_state(&r->fw) != FW_STATE_RUNNING ||
-        fabs(w_true) < 0.1 * w_rated) {
+    if (t < r->cfg.win_start_s || t > r->cfg.win_end_s || fw_state(&r->fw) != FW_STATE_RUNNING) {
         return;
     }
     const ctrl_estimate_t *e = &r->fw.estimate;
     double d = (double)e->now.theta_e * (2.0 * CTRL_PI / 4294967296.0) - th_true;
     d -= 2.0 * CTRL_PI * floor((d + CTRL_PI) / (2.0 * CTRL_PI)); /* [-pi, pi) */
     const double deg = d * 180.0 / CTRL_PI;
+    if (fabs(w_true) < 0.1 * w_rated) {
+        /* low speed and standstill: the injection's range (sim_run_est_errors_low) */
+        r->est_lo_sum2 += deg * deg;
+        r->est_lo_max = fmax(r->est_lo_max, fabs(deg));
+        r->est_lo_n++;
+        return;
+    }
     const double w_est = ctrl_q24_to_double(e->omega_e) * r->fw.bases.w_rad_s;
     const double rpm = (w_est - w_true) / (double)m->pole_pairs * 60.0 / (2.0 * CTRL_PI);
     r->est_ang_sum2 += deg * deg;
@@ -368,6 +374,13 @@ void sim_run_est_errors(const sim_run_t *r, double *ang_rms_deg, double *ang_max
     *ang_rms_deg = r->est_n > 0u ? sqrt(r->est_ang_sum2 / n) : NAN;
     *ang_max_deg = r->est_n > 0u ? r->est_ang_max : NAN;
     *spd_rms_rpm = r->est_n > 0u ? sqrt(r->est_spd_sum2 / n) : NAN;
+}
+
+void sim_run_est_errors_low(const sim_run_t *r, double *ang_rms_deg, double *ang_max_deg)
+{
+    const double n = (double)r->est_lo_n;
+    *ang_rms_deg = r->est_lo_n > 0u ? sqrt(r->est_lo_sum2 / n) : NAN;
+    *ang_max_deg = r->est_lo_n > 0u ? r->est_lo_max : NAN;
 }
 
 bool sim_run_done(const sim_run_t *r)
@@ -445,7 +458,30 @@ static int sim_ctrl_cfg_build(const sim_run_cfg_t *c, const ctrl_machine_t *m, u
     }
     for (size_t k = 0; k < c->n_sets; k++) {
         const sim_set_t *st = &c->sets[k];
-        const int rc = ctrl_tunable_set(d, buf, st->name, st->value);
+        const bool hfi = strncmp(st->name, "hfi.", 4u) == 0; /* sim_run_fw_config's */
+        static ctrl_hfi_config_t hc;                         /* only checked here */
+        const int rc = hfi ? ctrl_tunable_set(&ctrl_hfi_desc, &hc, st->name, st->value)
+                           : ctrl_tunable_set(d, buf, st->name, st->value);
+        if (hfi && rc == CTRL_ENOENT) {
+            (void)snprintf(err, errlen,
+                           "the injection has no setting '%s' (see --list-tunables hfi)", st->name);
+            return -1;
+        }
+        if (hfi && rc != CTRL_OK) {
+            const ctrl_tunable_t *t = NULL;
+            for (size_t i = 0; i < ctrl_hfi_desc.n_tunables; i++) {
+                if (strcmp(ctrl_hfi_desc.tunables[i].name, st->name) == 0) {
+                    t = &ctrl_hfi_desc.tunables[i];
+                }
+            }
+            (void)snprintf(err, errlen, "%s = %g is out of range [%g, %g]%s%s", st->name, st->value,
+                           t != NULL ? t->min : 0.0, t != NULL ? t->max : 0.0,
+                           t != NULL && t->unit[0] != '\0' ? " " : "", t != NULL ? t->unit : "");
+            return -1;
+        }
+        if (hfi) {
+            continue;
+        }
         if (rc == CTRL_ENOENT) {
             (void)snprintf(err, errlen,
                            "controller %s has no tunable '%s' (see --list-tunables %s)", d->name,
@@ -499,6 +535,15 @@ void sim_run_fw_config(const sim_run_cfg_t *c, const ctrl_machine_t *m, fw_confi
     fc->sensorless = c->sensorless;
     fc->dead_time_s =
         c->comp_dead_time_s >= 0.0 ? c->comp_dead_time_s : c->plant_machine.dead_time_s;
+    fc->hfi = c->hfi;
+#if CTRL_SL_HFI
+    for (size_t k = 0; k < c->n_sets; k++) {
+        /* the injection's settings by name (checked by sim_ctrl_cfg_build) */
+        if (strncmp(c->sets[k].name, "hfi.", 4u) == 0) {
+            (void)ctrl_tunable_set(&ctrl_hfi_desc, &fc->hfi_cfg, c->sets[k].name, c->sets[k].value);
+        }
+    }
+#endif
     fc->v_fwd_v = c->plant_machine.v_fwd_v;
     fc->dead_comp = c->dead_comp;
     /* The firmware's encoder configuration (the control machine's [sensors]). */
@@ -1258,6 +1303,18 @@ void sim_run_write_metrics_json(FILE *f, const sim_run_t *r, const metrics_resul
     sim_json_num(f, "est_angle_err_rms_deg", ea);
     sim_json_num(f, "est_angle_err_max_deg", em);
     sim_json_num(f, "est_speed_err_rms_rpm", es);
+    sim_run_est_errors_low(r, &ea, &em);
+    sim_json_num(f, "est_angle_err_low_rms_deg", ea);
+    sim_json_num(f, "est_angle_err_low_max_deg", em);
+#if CTRL_SL_HFI
+    sim_json_num(f, "hfi_clipped_periods", (double)r->fw.hfi_clipped);
+    if (r->cfg.sensorless) {
+        /* where the start's polarity came from (sensorless.h, CTRL_SL_POL_*) */
+        static const char *const pol[4] = {"unknown", "saturation", "motion", "unknown"};
+        fprintf(f, "  \"sensorless_polarity\": \"%s\",\n",
+                pol[(fw_telemetry(&r->fw)->sl_state >> 5) & 3u]);
+    }
+#endif
     sim_json_num(f, "fault_time_s", r->fault_time_s);
     fprintf(f, "  \"scenario_fired_s\": [");
     for (size_t i = 0; r->has_scn && i < r->scn.n; i++) {

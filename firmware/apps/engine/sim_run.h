@@ -120,6 +120,7 @@ typedef struct {
      * plant's, a perfectly known inverter. A production spread sets the plant's
      * and keeps this at the nominal value. */
     double comp_dead_time_s;
+    bool hfi; /* fw_config_t.hfi (default false); its settings as sets "hfi.<field>" */
     /* Driving the periods (defaults: the host simulator). */
     bool defer_start;             /* sim_run_init stops before boot: the caller runs every period */
     bool auto_arm;                /* arm with the references above once calibrated (default) */
@@ -174,6 +175,9 @@ struct sim_run {
      * |speed| >= 10 % of rated (sim_run_est_errors). */
     double est_ang_sum2, est_ang_max, est_spd_sum2;
     uint64_t est_n;
+    /* the same below 10 % of rated speed (sim_run_est_errors_low) */
+    double est_lo_sum2, est_lo_max;
+    uint64_t est_lo_n;
     double scn_fired_s[SIM_SCN_MAX_EVENTS]; /* scenario time each event fired, NaN if not */
     unsigned char ctrl_cfg_buf[CTRL_CFG_MAX] __attribute__((aligned(16)));
     /* output filter (plant_machine.filter): cumulative statistics at the
@@ -249,6 +253,11 @@ void sim_run_free(sim_run_t *r);
  * rms speed error (mechanical r/min); NaN without such instants. */
 void sim_run_est_errors(const sim_run_t *r, double *ang_rms_deg, double *ang_max_deg,
                         double *spd_rms_rpm);
+
+/* The estimator's angle error where |speed| < 10 % of rated (standstill
+ * included: the injection's range), over the same window: rms and largest,
+ * electrical deg; NaN without such instants. */
+void sim_run_est_errors_low(const sim_run_t *r, double *ang_rms_deg, double *ang_max_deg);
 
 /* True when the run ended at a fault or the firmware is in the fault state. */
 bool sim_run_faulted(const sim_run_t *r);

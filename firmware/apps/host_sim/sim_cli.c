@@ -65,7 +65,7 @@ typedef struct {
     cli_abc_t current_gain_err;
     cli_span_t window, trace_window;
     int free_mech, help, list_controllers, continue_on_fault, no_psi_adapt, no_dead_comp,
-        sensorless;
+        sensorless, hfi;
     sim_set_t sets[SIM_MAX_SETS];
     size_t n_sets;
 } cli_t;
@@ -158,6 +158,10 @@ static const cli_opt_t k_opts[] = {
     {"--sensorless", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(sensorless),
      "no encoder: angle and speed from the stator-flux observer, forced-angle start-up "
      "(docs/algorithms.md, \"Sensorless start-up\")"},
+    {"--hfi", NULL, K_FLAG, 0, 0, "", M_LOOP, "--sensorless", NULL, F(hfi),
+     "with --sensorless: high-frequency injection at and near standstill, the observer above "
+     "(salient machines; foc, m2ptfc, drr; settings --set hfi.NAME=V, --list-tunables hfi; "
+     "docs/algorithms.md, \"High-frequency injection\")"},
     {"--continue-on-fault", NULL, K_FLAG, 0, 0, "", M_LOOP, NULL, NULL, F(continue_on_fault),
      "keep simulating after a fault (gates off) to the end; the exit status stays 3"},
     {"--list-controllers", NULL, K_FLAG, 0, 0, "", M_INFO, NULL, NULL, F(list_controllers),
@@ -503,9 +507,11 @@ static void list_controllers(void)
 
 static int list_tunables(const char *name, const sim_machine_t *m)
 {
-    const ctrl_desc_t *d = ctrl_find(name);
+    /* "hfi": the injection's settings (--set hfi.NAME=V) */
+    const bool hfi = strcmp(name, "hfi") == 0;
+    const ctrl_desc_t *d = hfi ? &ctrl_hfi_desc : ctrl_find(name);
     if (d == NULL) {
-        return die("unknown controller '%s' (see --list-controllers)", name);
+        return die("unknown controller '%s' (see --list-controllers; hfi: the injection)", name);
     }
     static union {
         max_align_t a;
@@ -516,6 +522,9 @@ static int list_tunables(const char *name, const sim_machine_t *m)
     memset(cfg.b, 0, sizeof cfg.b);
     if (d->cfg_default != NULL && d->cfg_size <= CTRL_CFG_MAX) {
         d->cfg_default(cfg.b, &cm);
+    }
+    if (hfi) {
+        ctrl_hfi_config_default((ctrl_hfi_config_t *)(void *)cfg.b, &cm);
     }
     printf("# %s: %s\n# defaults for machine %s; a computed parameter shows 0 "
            "(computed from the machine at init)\n",
@@ -616,6 +625,20 @@ static void print_metrics(FILE *f, const sim_run_t *r, const metrics_result_t *m
             "  estimator (|speed| >= 10 %% rated): angle error rms %s max %s, speed error rms %s\n",
             fmt_num(b[0], 32, "%.3f deg", ea), fmt_num(b[1], 32, "%.3f deg", em),
             fmt_num(b[2], 32, "%.2f r/min", es));
+    if (r->cfg.hfi || r->est_lo_n > 0u) {
+        sim_run_est_errors_low(r, &ea, &em);
+        fprintf(f, "  estimator (|speed| < 10 %% rated): angle error rms %s max %s",
+                fmt_num(b[0], 32, "%.3f deg", ea), fmt_num(b[1], 32, "%.3f deg", em));
+#if CTRL_SL_HFI
+        if (r->cfg.hfi) {
+            const uint8_t st = fw_telemetry(&r->fw)->sl_state;
+            static const char *const pol[4] = {"unknown", "d-axis saturation", "first motion", "?"};
+            fprintf(f, "; injection clamped in %lu periods, polarity from %s",
+                    (unsigned long)r->fw.hfi_clipped, pol[(st >> 5) & 3u]);
+        }
+#endif
+        fprintf(f, "\n");
+    }
     if (!isnan(r->fault_time_s)) {
         fprintf(f, "  fault %s at t = %.6f s\n", fw_fault_name(fw_fault(&r->fw)), r->fault_time_s);
     }
@@ -877,6 +900,7 @@ int main(int argc, char **argv)
         cfg.hal.adc_gain_err[k] = c.current_gain_err.v[k];
     }
     cfg.sensorless = c.sensorless != 0;
+    cfg.hfi = c.hfi != 0;
     if (is_given(given, "--speed-bw-hz") || is_given(given, "--speed-pm-deg")) {
         /* The command line's sizing replaces the machine file's speed loop. */
         cfg.speed_kp = cfg.speed_ki = 0.0;

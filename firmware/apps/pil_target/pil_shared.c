@@ -13,6 +13,7 @@
     X(overspeed_rpm)                                                                               \
     X(psi_adapt)                                                                                   \
     X(sensorless)                                                                                  \
+    X(hfi)                                                                                         \
     X(dead_time_s)                                                                                 \
     X(v_fwd_v)                                                                                     \
     X(enc_offset)                                                                                  \
@@ -64,6 +65,10 @@ uint16_t pil_tm_digest(const fw_telemetry_t *tm)
     }
     td_u32(b, &n, tm->theta_e);
     td_u8(b, &n, tm->fieldweak_limit);
+#if CTRL_SL_HFI
+    td_u8(b, &n, tm->sl_state);
+    td_u32(b, &n, (uint32_t)tm->hfi_err);
+#endif
     td_u8(b, &n, tm->cm_step);
     td_u32(b, &n, tm->cm_progress);
     return tel_crc16(b, n);

@@ -53,6 +53,9 @@ static void pil_on_setup(pil_target_t *t, const pil_frame_t *f)
             d->cfg_default(t->ctrl_cfg, &s->machine);
         }
         for (size_t k = 0; k < s->n_sets && rd.rc == 0; k++) {
+            if (strncmp(s->sets[k].name, "hfi.", 4u) == 0) {
+                continue; /* the injection's, into fw_config_t below */
+            }
             if (ctrl_tunable_set(d, t->ctrl_cfg, s->sets[k].name, s->sets[k].value) != CTRL_OK) {
                 rd.rc = -103;
                 (void)strncpy(rd.why, s->sets[k].name, sizeof rd.why - 1u);
@@ -64,10 +67,25 @@ static void pil_on_setup(pil_target_t *t, const pil_frame_t *f)
         fw_config_default(&fc, &s->machine, d);
         fc.ctrl_cfg = t->ctrl_cfg;
         pil_setup_to_fw_config(s, &fc);
-        hal_pil_init(&t->hal, &s->info, t->port->cycles, t->port->cycle_clock_hz);
-        rd.rc = fw_init(&t->fw, &t->hal, &fc);
-        if (rd.rc != FW_OK) {
-            (void)fw_explain(&t->fw, rd.why, sizeof rd.why);
+        for (size_t k = 0; k < s->n_sets && rd.rc == 0; k++) {
+            if (strncmp(s->sets[k].name, "hfi.", 4u) != 0) {
+                continue;
+            }
+#if CTRL_SL_HFI
+            if (ctrl_tunable_set(&ctrl_hfi_desc, &fc.hfi_cfg, s->sets[k].name, s->sets[k].value) ==
+                CTRL_OK) {
+                continue;
+            }
+#endif
+            rd.rc = -103;
+            (void)strncpy(rd.why, s->sets[k].name, sizeof rd.why - 1u);
+        }
+        if (rd.rc == 0) {
+            hal_pil_init(&t->hal, &s->info, t->port->cycles, t->port->cycle_clock_hz);
+            rd.rc = fw_init(&t->fw, &t->hal, &fc);
+            if (rd.rc != FW_OK) {
+                (void)fw_explain(&t->fw, rd.why, sizeof rd.why);
+            }
         }
     }
     t->ready = rd.rc == 0;
