@@ -54,7 +54,7 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
     s->enc_direction = fw->enc_neg != 0u ? -1 : 1;
     s->enc_offset = fw->enc_offset;
     const fw_config_t *c = &fw->cfg;
-    s->sensorless = c->sensorless ? 1u : 0u;
+    s->sensorless = c->sensorless ? (c->hfi ? 2u : 1u) : 0u;
     s->dead_time_s = c->dead_time_s;
     s->v_fwd_v = c->v_fwd_v;
     s->psi_adapt = c->psi_adapt ? 1u : 0u;
@@ -71,6 +71,19 @@ void fw_settings_capture(const fw_t *fw, settings_t *s)
             }
         }
     }
+#if CTRL_SL_HFI
+    /* the injection's settings that differ from the machine's defaults (0) */
+    for (size_t k = 0; c->hfi && k < ctrl_hfi_desc.n_tunables; k++) {
+        const char *name = ctrl_hfi_desc.tunables[k].name;
+        double v = 0.0;
+        if (s->n_tunables < SETTINGS_TUNABLES_MAX && fw_tunable_get(fw, name, &v) == FW_OK &&
+            v != 0.0) {
+            fw_settings_name(s->tunable_name[s->n_tunables], name);
+            s->tunable_value[s->n_tunables] = v;
+            s->n_tunables++;
+        }
+    }
+#endif
     s->speed_bw_hz = c->speed_bw_hz;
     s->speed_pm_deg = c->speed_pm_deg;
     s->speed_kp = c->speed_kp;
@@ -210,6 +223,7 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
     c->enc_direction = s->enc_direction;
     c->enc_offset = s->enc_offset;
     c->sensorless = s->sensorless != 0u;
+    c->hfi = s->sensorless == 2u;
     c->dead_time_s = s->dead_time_s;
     c->v_fwd_v = s->v_fwd_v;
     c->psi_adapt = s->psi_adapt != 0u;
@@ -234,6 +248,13 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
         return FW_EINVAL;
     }
     for (unsigned k = 0; k < s->n_tunables && k < SETTINGS_TUNABLES_MAX; k++) {
+#if CTRL_SL_HFI
+        if (strncmp(s->tunable_name[k], "hfi.", 4u) == 0 &&
+            ctrl_tunable_set(&ctrl_hfi_desc, &c->hfi_cfg, s->tunable_name[k],
+                             s->tunable_value[k]) == CTRL_OK) {
+            continue; /* the injection's setting (fw_config_t.hfi_cfg) */
+        }
+#endif
         if (ctrl_tunable_set(d, cfg_buf, s->tunable_name[k], s->tunable_value[k]) != CTRL_OK) {
             char v[24]; /* no float conversion in printf: the target's libc may lack it */
             if (cmd_num_format(v, sizeof v, s->tunable_value[k], 7u) == 0u) {

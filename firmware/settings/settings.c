@@ -46,7 +46,7 @@ static const settings_field_t settings_fields[] = {
     SF_U32("enc.cpr", enc_cpr),
     SF("enc.dir", enc_direction, ST_I8, -1, 1),
     SF_U32("enc.offset", enc_offset),
-    SF("est.sensorless", sensorless, ST_U8, 0, 1),
+    SF("est.sensorless", sensorless, ST_U8, 0, 2),
     SF_F64("inv.dead_time_s", dead_time_s),
     SF_F64("inv.v_fwd_v", v_fwd_v),
     SF("est.psi_adapt", psi_adapt, ST_U8, 0, 1),

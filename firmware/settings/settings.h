@@ -68,7 +68,8 @@ typedef struct {
     uint32_t enc_cpr;     /* counts per revolution */
     int8_t enc_direction; /* +1 / -1 */
     uint32_t enc_offset;  /* electrical angle at count 0, 2^-32 turn */
-    uint8_t sensorless;   /* 0/1: angle from the flux observer */
+    uint8_t sensorless;   /* 0/1: angle from the flux observer; 2: with the injection at and
+                           * near standstill (its settings among the tunables, "hfi.*") */
     /* inverter */
     double dead_time_s, v_fwd_v;
     uint8_t psi_adapt; /* 0/1: PM flux tracked from the voltage model */
