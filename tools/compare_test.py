@@ -90,6 +90,21 @@ class ReportTest(unittest.TestCase):
         for p in re.findall(r"!\[[^\]]*\]\(([^)]+)\)", self.md):
             self.assertTrue(os.path.isfile(os.path.join(self.tmp.name, p)), p)
 
+    def test_lowspeed_sensorless(self):
+        # the injection holds foc, m2ptfc and drr at 0 r/min: the angle error within
+        # the work's bounds (5 deg rms, 15 deg at most), the torque within 5 % of the
+        # reference and of the same controller with its encoder
+        sec = self.md[self.md.find("## Low-speed sensorless"):]
+        sec = sec[:sec.find("\n## ", 5)]
+        rows = re.findall(r"^\| (foc|m2ptfc|drr) \| ([\d.]+) of ([\d.]+) \| ([\d.]+) \| .+? \| "
+                          r"([\d.]+)° / ([\d.]+)° \| motion \|$", sec, re.M)
+        self.assertEqual([r[0] for r in rows], ["foc", "m2ptfc", "drr"], sec)
+        for c, t, ref, enc, rms, mx in rows:
+            self.assertLessEqual(float(rms), 5.0, c)
+            self.assertLessEqual(float(mx), 15.0, c)
+            self.assertLessEqual(abs(float(t) - float(ref)), 0.05 * float(ref), c)
+            self.assertLessEqual(abs(float(t) - float(enc)), 0.05 * float(ref), c)
+
     def test_reversal_not_commanded_is_na(self):
         # --fast runs the dynamic test for 40 ms: most controllers never reach
         # 1500 r/min, so their reversal indices must read n/a, not "no".
