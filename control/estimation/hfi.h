@@ -18,21 +18,28 @@
  *   y(k)  = sgn(k-2) (dq(k) - dq(k-1)) / 2       = h: the fundamental's change
  *                                                  (almost the same in two
  *                                                  consecutive periods) cancels
- * so y_q = -Ts V D sin 2e carries the angle error; the change the
+ * so y_q = -Ts V D sin 2e carries the angle error. The change the
  * controller's own voltage v of the period makes, Ts L^-1 v at the tracked
  * angle, is taken from dq first (a modulated controller's voltage jumps from
  * one period to the next; at the right angle the model removes it whole, off
- * by e it leaves Ts 2 D e v_d, a gain, not a noise). The tracking observer
- * drives the error to zero: the rotor's mechanics with the torque estimate
- * as its input (Lorenz's tracking observer),
- *   theta' = omega + l1 e,  omega' = p (T^ - T_L^) / J + l2 e,  (p T_L^ / J)' = -l3 e,
- * a triple pole at -w_o (l1 = 3 w_o, l2 = 3 w_o^2, l3 = w_o^3): the
- * speed follows the torque without lag and the loop only corrects for the
- * load and the model's errors, so its bandwidth (and its noise) can be low. The ripple model hm = y
- * through an EMA (time constant h_tau) gives the injection's share of the sampled current, pos(k-2)
- * hm / 2 in the injection frame (pos = +-1: the ripple's side), which the fundamental current
- * handed to the controllers has removed: no filter, hence no delay, in the controllers' current
- * path; the EMA only sets how fast the removal follows a change of the saliency.
+ * by e it leaves -2 Ts D e v_d: a gain, not a noise), and the error is
+ * weighted by the d voltage's actual change w (the injection's, what a clamp
+ * left of it, and the controller's, in units of 2 V) over the mean of w^2
+ * (at least 1): a controller alternating with the injection adds to the
+ * information instead of cancelling it. The tracking observer drives the
+ * error to zero: the rotor's mechanics with the torque estimate as its input
+ * (Lorenz's tracking observer),
+ *   theta' = omega + l1 e,  omega' = p (T^ - T_L^) / J + l2 e,
+ *   (p T_L^ / J)' = -l3 e,
+ * a triple pole at -w_o (l1 = 3 w_o, l2 = 3 w_o^2, l3 = w_o^3): the speed
+ * follows the torque without lag and the loop only corrects for the load and
+ * the model's errors, so its bandwidth (and its noise) can be low. The
+ * ripple model hm = y through an EMA (time constant h_tau) gives the
+ * injection's share of the sampled current, pos(k-2) hm / 2 in the injection
+ * frame (pos = +-1: the ripple's side), which the current handed to the
+ * controllers has removed: no filter, hence no delay, in the controllers'
+ * current path; the EMA only sets how fast the removal follows a change of
+ * the saliency.
  *
  * Polarity (the d axis modulo pi of the saliency): d-axis pulses, +v_pol for
  * n_pol periods and -v_pol back, then the same in the other direction
