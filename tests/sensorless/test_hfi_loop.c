@@ -345,13 +345,17 @@ static void test_reversal_mj5208(void)
 
 /* ---- polarity from 36 start angles ---- */
 
-static unsigned polarity_36(const char *machine, const char *ctrl, bool free_mech, uint8_t expect)
+/* 36 starts, each run to dur_s: past the start (the 80 kW IPMSM's from the
+ * first motion takes 80 ms: pulses 5, settling 46, saturation pulses 8, the
+ * polarity pulse 13, pulses 5). */
+static unsigned polarity_36(const char *machine, const char *ctrl, bool free_mech, uint8_t expect,
+                            double dur_s)
 {
     unsigned right = 0u;
     for (int a = 0; a < 36; a++) {
         const double th = (double)a * 10.0 * 3.141592653589793 / 180.0;
         const case_t k = {machine, ctrl, 20000u, free_mech,    false,  "at 0 torque_ref=0\n",
-                          0.12,    0.0,  th,     {NULL, NULL}, {0, 0}, true};
+                          dur_s,   0.0,  th,     {NULL, NULL}, {0, 0}, true};
         result_t r;
         run(&k, &r);
         const bool ok = !r.faulted && r.pol == expect && fabs(r.end_err_deg) < 15.0;
@@ -368,10 +372,11 @@ static unsigned polarity_36(const char *machine, const char *ctrl, bool free_mec
 static void test_polarity_36(void)
 {
     TEST_ASSERT_EQUAL_UINT(
-        36u, polarity_36("thesis_ipmsm_80kw.ini", "m2ptfc", true, CTRL_SL_POL_MOTION));
+        36u, polarity_36("thesis_ipmsm_80kw.ini", "m2ptfc", true, CTRL_SL_POL_MOTION, 0.1));
     TEST_ASSERT_EQUAL_UINT(
-        36u, polarity_36("thesis_ipmsm_80kw_magsat.ini", "foc", false, CTRL_SL_POL_SAT));
-    TEST_ASSERT_EQUAL_UINT(36u, polarity_36("mj5208_drone.ini", "drr", true, CTRL_SL_POL_MOTION));
+        36u, polarity_36("thesis_ipmsm_80kw_magsat.ini", "foc", false, CTRL_SL_POL_SAT, 0.08));
+    TEST_ASSERT_EQUAL_UINT(36u,
+                           polarity_36("mj5208_drone.ini", "drr", true, CTRL_SL_POL_MOTION, 0.07));
 }
 
 /* ---- refusals ---- */
