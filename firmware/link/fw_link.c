@@ -117,7 +117,7 @@ static bool op_param_at(void *ctx, size_t index, cmd_param_info_t *info)
     info->help = t->help;
     info->min = t->min;
     info->max = t->max;
-    info->access = fw_tunable_is_live(fw, index) ? CMD_PARAM_LIVE : CMD_PARAM_RW;
+    info->access = index < n_ctrl && fw_tunable_is_live(fw, index) ? CMD_PARAM_LIVE : CMD_PARAM_RW;
     return true;
 }
 

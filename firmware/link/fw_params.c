@@ -73,8 +73,13 @@ static const fw_param_t fw_params_drive_p[] = {
       "encoder direction: 1 angle grows with the count, -1 falls"),
     P("enc.offset", U_DEG, 0, 360, FW_PARAM_TURN,
       "electrical angle of the d axis at count 0 (ident step encoder measures it)"),
+#if CTRL_SL_HFI
+    P("est.sensorless", U_NONE, 0, 2, 0u,
+      "1: angle and speed from the flux observer, the encoder unused; 2: with injection at standstill"),
+#else
     P("est.sensorless", U_NONE, 0, 1, 0u,
       "1: angle and speed from the flux observer, the encoder unused"),
+#endif
     P("est.psi_adapt", U_NONE, 0, 1, 0u,
       "1: PM flux tracked from the voltage model above 10 % of rated speed"),
     P("inv.dead_time_s", U_S, 0, 1e-4, 0u, "inverter dead time (compensated; observers' voltage)"),
