@@ -27,6 +27,7 @@
 #include "fw_link.h"
 #include "fw_params.h"
 #include "fw_settings.h"
+#include "hfi_config.h"
 #include "link_text.h"
 #include "loop_util.h"
 #include "unity.h"
@@ -258,6 +259,24 @@ static void test_parameter_tree(void)
                                       t[k]->p[i].key);
         }
     }
+#if CTRL_SL_HFI
+    /* the injection's settings follow the controller's tunables, read-write
+     * (taken at the next start), and the estimator's field takes 2 */
+    n += ctrl_hfi_desc.n_tunables;
+    for (size_t i = 0; i < ctrl_hfi_desc.n_tunables; i++) {
+        char want[48];
+        (void)snprintf(want, sizeof want, "\n  %s ", ctrl_hfi_desc.tunables[i].name);
+        const char *at = strstr(lt.out, want);
+        TEST_ASSERT_NOT_NULL_MESSAGE(at, ctrl_hfi_desc.tunables[i].name);
+        const char *eol = strchr(at + 1, '\n');
+        const char *live = strstr(at, "] live ");
+        TEST_ASSERT_TRUE_MESSAGE(live == NULL || live > eol, ctrl_hfi_desc.tunables[i].name);
+        TEST_ASSERT_TRUE(at < strstr(lt.out, "  m.p "));
+    }
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  est.sensorless 0 - [0, 2] "));
+#else
+    TEST_ASSERT_NOT_NULL(strstr(lt.out, "  est.sensorless 0 - [0, 1] "));
+#endif
     char head[16];
     (void)snprintf(head, sizeof head, "ok %u\r\n", (unsigned)(run_b.fw.ctrl->n_tunables + n));
     TEST_ASSERT_EQUAL_INT(0, strncmp(lt.out, head, strlen(head)));
