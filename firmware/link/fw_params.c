@@ -75,7 +75,7 @@ static const fw_param_t fw_params_drive_p[] = {
       "electrical angle of the d axis at count 0 (ident step encoder measures it)"),
 #if CTRL_SL_HFI
     P("est.sensorless", U_NONE, 0, 2, 0u,
-      "1: angle and speed from the flux observer, the encoder unused; 2: with injection at standstill"),
+      "1: the flux observer's angle and speed, encoder unused; 2: with injection at standstill"),
 #else
     P("est.sensorless", U_NONE, 0, 1, 0u,
       "1: angle and speed from the flux observer, the encoder unused"),
