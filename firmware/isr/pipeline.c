@@ -602,8 +602,9 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
          * speed asked for is beyond the handover's (a rotor held by a load
          * or friction the start's torque cannot move falls back to the
          * forced angle again and again); forgotten once the observer has
-         * held as long. */
-        if (sl->out.mode != CTRL_SL_OBSERVER) {
+         * held as long. The injection's tracking is no start: its angle
+         * holds at any speed (docs/algorithms.md, "High-frequency injection"). */
+        if (sl->out.mode != CTRL_SL_OBSERVER && sl->out.mode != CTRL_SL_INJECT) {
             fw->sl_obs_n = 0u;
             fw->sl_forced_n += fx_abs(sl->speed_ref) >= sl->sl.w_on ? 1u : 0u;
         } else if (++fw->sl_obs_n >= fw->sl_forced_max) {
