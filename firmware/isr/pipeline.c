@@ -604,7 +604,7 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
          * forced angle again and again); forgotten once the observer has
          * held as long. The injection's tracking is no start: its angle
          * holds at any speed (docs/algorithms.md, "High-frequency injection"). */
-        if (sl->out.mode != CTRL_SL_OBSERVER && sl->out.mode != CTRL_SL_INJECT) {
+        if (!FW_SL_OWN_ANGLE(sl->out.mode)) {
             fw->sl_obs_n = 0u;
             fw->sl_forced_n += fx_abs(sl->speed_ref) >= sl->sl.w_on ? 1u : 0u;
         } else if (++fw->sl_obs_n >= fw->sl_forced_max) {

@@ -751,6 +751,9 @@ static int fw_hfi_set(fw_t *fw, const char *name, double value)
         unsigned char bytes[CTRL_CFG_MAX];
     } c;
     memcpy(c.bytes, fw->ctrl_cfg.bytes, CTRL_CFG_MAX);
+    /* fw_setup_machine rewrites what the interrupt reads in every state (as
+     * fw_commission_apply): with it held off */
+    hal_ctrl_hold(fw->hal, true);
     const int s = fw_setup_machine(fw, &fw->cfg, fw->ctrl, c.bytes);
     if (s != FW_OK) {
         const ctrl_diag_t why = fw->why;
@@ -758,6 +761,7 @@ static int fw_hfi_set(fw_t *fw, const char *name, double value)
         (void)fw_setup_machine(fw, &fw->cfg, fw->ctrl, c.bytes);
         fw->why = why;
     }
+    hal_ctrl_hold(fw->hal, false);
     return s;
 }
 #endif
