@@ -352,8 +352,8 @@ static void test_reversal_mj5208(void)
  * injection throughout (its hand-over raised to 10 %, back at 7 %), for
  * 1 s: longer than the start supervision's bound (pipeline_config.c; with
  * the injection counted as a start it ends in sl_start before 1.1 s) with
- * the speed asked for beyond the forced start's hand-over (5 %). The injection's angle is no start that does not
- * end: no fault sl_start, the speed followed. */
+ * the speed asked for beyond the forced start's hand-over (5 %). The injection's angle is no start
+ * that does not end: no fault sl_start, the speed followed. */
 static void test_creep_on_injection(void)
 {
     const case_t k = {"thesis_ipmsm_80kw.ini",
