@@ -281,8 +281,10 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
     }
 #else
     if (cfg->hfi) {
-        /* not built into this image (CMake option PMSM_SL_HFI): the range [0, 0] */
-        (void)ctrl_diag_in_range(&fw->why, "hfi", "", 1.0, 0.0, 0.0);
+        /* not built into this image (CMake option PMSM_SL_HFI): the setting
+         * that asks for it named with its range here (a range [0, 0] would
+         * read "missing", ctrl_diag_format) */
+        (void)ctrl_diag_in_range(&fw->why, "est.sensorless", "", 2.0, 0.0, 1.0);
         return FW_EINVAL;
     }
 #endif
