@@ -84,6 +84,14 @@ void fw_medium(fw_t *fw)
         fw->torque_max = fw->torque_ref_max;
         fw->mid_mode = in->ref_mode;
     }
+#if PMSM_LIVE_PARAMS
+    if (in->retune != 0u) {
+        /* a live change of the speed PI's gains (fw_apply_tune), bumpless
+         * from this run's error (speed_pi.h), here between two steps */
+        ctrl_speed_pi_retune(&fw->speed_pi, &in->retune_pi,
+                             fx_sat32((int64_t)in->speed_ref - in->omega_e));
+    }
+#endif
     out->fault = FW_FAULT_NONE;
     /* The speed loop runs in speed mode unless the sensorless start holds it;
      * otherwise its output follows the torque reference (a later switch to

@@ -236,16 +236,17 @@ static bool fw_take(fw_t *fw, fw_req_t k)
 
 #if PMSM_LIVE_PARAMS
 /* A live change the main loop published (pipeline.h): the speed PI's new
- * gains with the latest speed error (the next run's will be close to it), the
- * controller's retune from the state made for its new configuration; taken
- * and dropped when the main loop withdrew it (fw_request_withdraw). Out of
- * line: once per change. */
+ * gains handed to the medium task's next run (it applies them with that
+ * run's speed error), the controller's retune from the state made for its
+ * new configuration; taken and dropped when the main loop withdrew it
+ * (fw_request_withdraw). Out of line: once per change. */
 static FW_NOINLINE void fw_apply_tune(fw_t *fw)
 {
     if (fw_take(fw, FW_REQ_SPEED_TUNE) &&
         fw->ml.withdrawn[0] != fw->isr.taken[FW_REQ_SPEED_TUNE]) {
-        const q24_t e = fx_sat32((int64_t)fw->ml.speed_ref - fw->estimate.omega_e);
-        ctrl_speed_pi_retune(&fw->speed_pi, &fw->speed_pi_next, e);
+        /* for the medium task's next run, which steps the PI */
+        fw->speed_pi_taken = fw->speed_pi_next;
+        fw->mid_retune = 1u;
     }
     if (fw_take(fw, FW_REQ_CTRL_TUNE) && fw->ml.withdrawn[1] != fw->isr.taken[FW_REQ_CTRL_TUNE]) {
         fw->ctrl->retune(fw->ctrl_state.bytes, fw->ctrl_next.bytes);
@@ -495,6 +496,13 @@ static inline bool fw_mid_trigger(fw_t *fw, const ctrl_estimate_t *est, q24_t t_
     in->hold = hold;
     in->reset = fw->mid_reset;
     in->bump = fw->mid_bump;
+#if PMSM_LIVE_PARAMS
+    in->retune = fw->mid_retune;
+    if (fw->mid_retune != 0u) {
+        in->retune_pi = fw->speed_pi_taken;
+        fw->mid_retune = 0u;
+    }
+#endif
     fw->mid_vdc_sum = 0;
     fw->mid_n = 0u;
     fw->mid_reset = 0u;

@@ -226,6 +226,10 @@ typedef struct {
                                 that period (fw_mid_first_step) */
     uint8_t track;           /* 1: the PM-flux tracker's correction on psi (period 0 of its N) */
     ctrl_psi_track_in_t psi; /* track: the correction's inputs (psi_track.h) */
+#if PMSM_LIVE_PARAMS
+    uint8_t retune;            /* 1: the speed PI's new gains (retune_pi) before this run */
+    ctrl_speed_pi_t retune_pi; /* a live change the interrupt took (fw_apply_tune) */
+#endif
 } fw_mid_in_t;
 
 typedef struct {
@@ -450,6 +454,12 @@ typedef struct {
         max_align_t align;
         unsigned char bytes[CTRL_STATE_MAX];
     } ctrl_next;
+    /* The interrupt's: the speed PI's change it took, for the medium task's
+     * next run (fw_mid_in_t.retune), which applies it between two of its
+     * steps; the interrupt never writes speed_pi, which a step may be
+     * half-way through when it preempts. */
+    ctrl_speed_pi_t speed_pi_taken;
+    uint8_t mid_retune; /* 1: speed_pi_taken waits for the next run */
 #endif
     /* Sensorless start supervision (pipeline.c, FW_FAULT_SL_START): periods
      * off the observer with a speed asked for beyond the handover's, periods

@@ -398,6 +398,9 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
                                                 (double)fw->mid_div / (double)in->pwm_freq_hz));
     fw->mid_reset = 1u;
     fw->mid_fresh = 0u;
+#if PMSM_LIVE_PARAMS
+    fw->mid_retune = 0u; /* a change taken for the old configuration */
+#endif
     if (fw_protect_init(&fw->prot, &pc) != CTRL_OK) {
         return FW_ERANGE;
     }

@@ -164,6 +164,37 @@ static void test_speed_loop_live_is_bumpless(void)
     TEST_ASSERT_DOUBLE_WITHIN(14.0, 700.0, sim_run_speed_rpm(&run_b));
 }
 
+/* The interrupt may preempt the medium task half-way through a step of the
+ * speed PI (PendSV on the boards): so a live change of its gains is taken by
+ * the interrupt and applied by the medium task, between two of its steps.
+ * The interrupt alone (fw_isr_fast) leaves speed_pi as it was, byte for
+ * byte; the run it triggers (fw_medium) has the new gains. */
+static void test_speed_retune_applied_by_the_medium_task(void)
+{
+    sim_run_cfg_t c;
+    loop_cfg(&c, "m2ptfc", 0.0, 0.0, 1.0, 0.99);
+    c.free_mech = true;
+    c.speed_mode = true;
+    c.speed_ref_rpm = 500.0;
+    c.speed_kp = c.speed_ki = 0.0;
+    loop_start(&run_b, &c);
+    attach_tree(&run_b);
+    while (sim_run_time(&run_b) < 0.1 || run_b.fw.mid_count != 1u) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&run_b));
+    }
+    const ctrl_speed_pi_t old = run_b.fw.speed_pi;
+    send("param set speed.bw_hz 15");
+    TEST_ASSERT_EQUAL_STRING("ok speed.bw_hz 15\r\n", lt.out);
+    TEST_ASSERT_TRUE(fw_isr_fast(&run_b.fw)); /* takes the change, a run due */
+    TEST_ASSERT_FALSE(fw_cmd_pending(&run_b.fw, FW_REQ_SPEED_TUNE));
+    TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&old, &run_b.fw.speed_pi, sizeof old,
+                                     "the interrupt wrote the speed PI");
+    fw_medium(&run_b.fw);
+    TEST_ASSERT_EQUAL_INT32(run_b.fw.speed_pi_next.kp, run_b.fw.speed_pi.kp);
+    TEST_ASSERT_EQUAL_INT32(run_b.fw.speed_pi_next.ki_ts, run_b.fw.speed_pi.ki_ts);
+    TEST_ASSERT_TRUE(run_b.fw.speed_pi.kp != old.kp);
+}
+
 static void test_foc_gain_live_is_bumpless(void)
 {
     sim_run_cfg_t c;
@@ -411,6 +442,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_speed_loop_live_is_bumpless);
+    RUN_TEST(test_speed_retune_applied_by_the_medium_task);
     RUN_TEST(test_foc_gain_live_is_bumpless);
     RUN_TEST(test_parameter_tree);
     RUN_TEST(test_listing_lines_whole);
