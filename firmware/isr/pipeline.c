@@ -242,8 +242,7 @@ static bool fw_take(fw_t *fw, fw_req_t k)
  * (fw_request_withdraw). Out of line: once per change. */
 static FW_NOINLINE void fw_apply_tune(fw_t *fw)
 {
-    if (fw_take(fw, FW_REQ_SPEED_TUNE) &&
-        fw->ml.withdrawn[0] != fw->isr.taken[FW_REQ_SPEED_TUNE]) {
+    if (fw_take(fw, FW_REQ_SPEED_TUNE) && fw->ml.withdrawn[0] != fw->isr.taken[FW_REQ_SPEED_TUNE]) {
         /* for the medium task's next run, which steps the PI */
         fw->speed_pi_taken = fw->speed_pi_next;
         fw->mid_retune = 1u;

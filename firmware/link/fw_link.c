@@ -255,8 +255,8 @@ static int op_param_set(void *ctx, const char *name, double value)
          * (where some parameters are live and others not; without live
          * parameters the state alone says it). */
         const size_t n = fw_link_state_text(l);
-        const bool pending = fw_tune_pending(l->fw, FW_REQ_SPEED_TUNE) ||
-                             fw_tune_pending(l->fw, FW_REQ_CTRL_TUNE);
+        const bool pending =
+            fw_tune_pending(l->fw, FW_REQ_SPEED_TUNE) || fw_tune_pending(l->fw, FW_REQ_CTRL_TUNE);
         (void)snprintf(l->state_text + n, sizeof l->state_text - n, ": %s%s",
                        pending ? "the last live change is not taken yet" : name,
                        pending ? "" : " changes with the gates off only");
