@@ -729,7 +729,19 @@ def check_hfi(wd, st):
     wait_for("state=ready after STOP", lambda: (st() or {}).get("state") == "ready", 30)
     gone = wait_for("the injection's state gone from the header", lambda: wd.js(
         "return document.getElementById('st-sl').classList.contains('hidden')"), 10)
-    print("  STOP: the header no longer shows the injection (%s)" % gone)
+    # the samples taken after the drive was seen ready (firmware time)
+    t_ready = wd.js("const s = consoleState.charts.series; return s.t[s.t.length - 1]")
+    wait_for("0.2 s of samples after the stop", lambda: wd.js(
+        "const s = consoleState.charts.series; return s.t[s.t.length - 1] > arguments[0] + 0.2",
+        t_ready), 30)
+    after = wd.js("const s = consoleState.charts.series; const a = s.names.indexOf('angle_err');"
+                  "const b = s.names.indexOf('sl_state'); const i = s.indexAt(arguments[0]) + 1;"
+                  "return [s.v[a].slice(i), s.v[b].slice(i)]", t_ready)
+    print("  STOP: the header no longer shows the injection (%s); %d samples since: angle error "
+          "%s deg, sl_state %s" % (gone, len(after[0]), sorted(set(after[0])), sorted(set(after[1]))))
+    if not after[0] or any(after[0]) or any(after[1]):
+        raise Fail("after STOP the plots still show the injection: angle error %r, sl_state %r" % (
+            after[0], after[1]))
 
 def sim_main(a):
     chromium = shutil.which("chromium")

@@ -59,6 +59,12 @@ static void fw_tm_no_estimate(fw_telemetry_t *tm)
     tm->psi_d = tm->psi_q = 0;
     tm->torque = tm->omega_e = tm->torque_ref = tm->torque_max = 0;
     tm->fieldweak_limit = 0u;
+#if CTRL_SL_HFI
+    /* no angle source with the gates off: not the last run's (a stale angle
+     * error plotted after a stop) */
+    tm->sl_state = 0u;
+    tm->hfi_err = 0;
+#endif
 }
 
 /* Q8 counts -> Q24 pu with a Q30 gain: round(d gain / 2^14), saturated. raw
