@@ -2,7 +2,7 @@
  * The firmware's initialisation (fw_init) against the B-G431B-ESC1's
  * independent watchdog, counted on the Cortex-M4 in QEMU (cm4 build only).
  *
- * A reconfiguration on the board ("config default", "config load",
+ * A reconfiguration on the board ("config default",
  * "param set m.*", "ident apply", a settings record applied at start-up)
  * runs fw_init in the main loop with the control interrupt held off, and
  * nothing refreshes the watchdog meanwhile; a refused one runs it twice (the
