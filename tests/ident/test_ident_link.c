@@ -208,6 +208,42 @@ static void test_apply_rebases_the_torque_reference(void)
     }
 }
 
+/* "ident apply" while an arm is pending (requested, not yet taken by the
+ * interrupt) is refused by that state's name: the interrupt would gate the
+ * drive at its next period on a machine half rewritten. Nothing is adopted
+ * (fw_t byte for byte as before: not rewritten and restored), the gates
+ * stay off until the interrupt takes the arm, and it then arms on the
+ * configured machine. */
+static void test_apply_refused_while_an_arm_is_pending(void)
+{
+    fw_t *fw = &run.fw;
+    link.write = link_text_capture;
+    link.write_ctx = &lt;
+    fw->cm.res.have = CM_HAVE_FLUX;
+    fw->cm.res.bases = fw->bases;
+    fw->cm.res.psi = ctrl_q24_from_double(1.25); /* an apply would raise T_base 1.5625 x */
+    const double tb0 = fw->bases.torque_nm;
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(fw));
+    send("arm");
+    TEST_ASSERT_EQUAL_STRING("ok armed\r\n", lt.out);
+    TEST_ASSERT_TRUE(fw_gates_on_or_pending(fw));
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal)); /* the interrupt has not taken it */
+    static fw_t before;
+    memcpy(&before, fw, sizeof before);
+    send("ident apply");
+    TEST_ASSERT_EQUAL_STRING("err 8 state arm pending (ready)\r\n", lt.out);
+    TEST_ASSERT_EQUAL_INT(FW_EBUSY, fw_commission_apply(fw));
+    /* refused before anything the interrupt reads is rewritten: byte for byte */
+    TEST_ASSERT_EQUAL_MEMORY(&before, fw, sizeof before);
+    TEST_ASSERT_FALSE(hal_sim_gates_on(&run.hal));
+    TEST_ASSERT_EQUAL_DOUBLE(tb0, fw->bases.torque_nm);
+    periods(2);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_RUNNING, fw_state(fw));
+    TEST_ASSERT_EQUAL_DOUBLE(tb0, fw->bases.torque_nm);
+    send("disarm");
+    periods(2);
+}
+
 /* A motor with friction and a passive load (the stress file): after a run at
  * 500 r/min and a disarm it stops within milliseconds; "status" then says
  * so, and no torque. */
@@ -249,5 +285,6 @@ int main(void)
     RUN_TEST(test_bringup_fail_and_ini);
     RUN_TEST(test_status_after_stop);
     RUN_TEST(test_apply_rebases_the_torque_reference);
+    RUN_TEST(test_apply_refused_while_an_arm_is_pending);
     return UNITY_END();
 }
