@@ -15,6 +15,7 @@
 #include "g4_hal.h"
 #include "g4_model.h"
 #include "g4_periph.h"
+#include "g4_tim.h"
 #include "unity.h"
 
 static hal_t hal;
@@ -725,6 +726,64 @@ static void test_usart_image(void)
                   "baud rate set while the USART is disabled");
 }
 
+/* TIM2 as the throttle's capture, the PWM input mode of RM0440's TIM2/3/4/5
+ * chapter ("PWM input mode"): TI1's rising edge captures the period in CCR1
+ * and resets the counter (slave mode controller in reset mode), its falling
+ * edge captures the high time in CCR2. Register by register (RM0440 TIM2/3/4/5
+ * register descriptions; the bit positions equal ST's CMSIS device header's
+ * TIM_SMCR_SMS / TS (TS mask 0x00300070, TS[4:3] at bits 21:20),
+ * TIM_CCMR1_CC1S / IC1F / CC2S / IC2F, TIM_CCER_CC1E / CC1P / CC2E / CC2P):
+ *  - RCC_APB1ENR1.TIM2EN (bit 0) set: the timer clocked;
+ *  - SMCR: SMS[3:0] = 0100 (reset mode), TS[4:0] = 00101 (TI1FP1): 0x54;
+ *  - CCMR1 (input capture mode): CC1S = 01 (IC1 on TI1), CC2S = 10 (IC2 on
+ *    TI1 as well), IC1F = IC2F = the board's filter code (1111: f_DTS/32,
+ *    N = 8), ICxPSC = 00 (every edge): 0xF2F1;
+ *  - CCER: CC1E, CC1P = CC1NP = 0 (IC1 on the rising edge), CC2E, CC2P = 1,
+ *    CC2NP = 0 (IC2 on the falling edge): 0x31;
+ *  - PSC = 169: CK_CNT = f_CK_PSC / (PSC + 1) = 170 MHz / 170 = 1 MHz, a
+ *    microsecond per count (the timer clock is PCLK1 = SYSCLK, APB1
+ *    prescaler 1); PSC is preloaded, so UG is generated after it and before
+ *    CEN (else the first period would count at the reset's prescaler 0);
+ *  - ARR = 0xFFFFFFFF (TIM2 is 32-bit: no wrap within any period);
+ *  - CR1 = CEN last, after the mode is set.
+ * Read: CC1IF set -> width = CCR2, period = CCR1, and CC1IF, CC2IF, CC1OF,
+ * CC2OF cleared (rc_w0: the other flags are written 1, untouched). */
+static void test_tim2_capture_image(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    const uint32_t f_tim = 170000000u;
+    TEST_ASSERT_EQUAL_UINT8(15u, g4_board_esc1.throttle_filter);
+    g4_tim2_capture_init(f_tim / 1000000u - 1u, g4_board_esc1.throttle_filter);
+    const uintptr_t t = G4_TIM2;
+    TEST_ASSERT_EQUAL_HEX32(1u, reg(G4_RCC + G4_RCC_APB1ENR1) & 1u);
+    TEST_ASSERT_EQUAL_HEX32(0x00000054u, reg(t + G4_TIM_SMCR));
+    TEST_ASSERT_EQUAL_HEX32(0x0000F2F1u, reg(t + G4_TIM_CCMR1));
+    TEST_ASSERT_EQUAL_HEX32(0x00000031u, reg(t + G4_TIM_CCER));
+    TEST_ASSERT_EQUAL_UINT32(169u, reg(t + G4_TIM_PSC));
+    TEST_ASSERT_EQUAL_UINT32(1000000u, f_tim / (reg(t + G4_TIM_PSC) + 1u));
+    TEST_ASSERT_EQUAL_HEX32(0xFFFFFFFFu, reg(t + G4_TIM_ARR));
+    TEST_ASSERT_EQUAL_HEX32(0x00000001u, reg(t + G4_TIM_CR1));
+    const int cen = g4_model_find(t + G4_TIM_CR1, 1u, 1u, 0);
+    const int ug = g4_model_find(t + G4_TIM_EGR, 1u, 1u, 0);
+    assert_before(g4_model_find(t + G4_TIM_PSC, 0u, 0u, 0), ug, "PSC loaded by UG");
+    assert_before(ug, cen, "UG before the counter starts");
+    assert_before(g4_model_find(t + G4_TIM_SMCR, 0u, 0u, 0), cen, "slave mode before CEN");
+    assert_before(g4_model_find(t + G4_TIM_CCER, 0u, 0u, 0), cen, "captures enabled before CEN");
+
+    uint32_t w = 7u, per = 7u;
+    g4_model_put(t + G4_TIM_SR, 0u);
+    TEST_ASSERT_FALSE(g4_tim2_capture_read(&w, &per)); /* no rising edge yet */
+    TEST_ASSERT_EQUAL_UINT32(7u, w);
+    g4_model_put(t + G4_TIM_CCR1, 20000u); /* 50 Hz */
+    g4_model_put(t + G4_TIM_CCR2, 1500u);
+    const uint32_t flags = G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_CC1OF | G4_TIM_SR_CC2OF;
+    g4_model_put(t + G4_TIM_SR, flags | G4_TIM_SR_UIF);
+    TEST_ASSERT_TRUE(g4_tim2_capture_read(&w, &per));
+    TEST_ASSERT_EQUAL_UINT32(1500u, w);
+    TEST_ASSERT_EQUAL_UINT32(20000u, per);
+    TEST_ASSERT_EQUAL_HEX32(G4_TIM_SR_UIF, reg(t + G4_TIM_SR));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -752,5 +811,6 @@ int main(void)
     RUN_TEST(test_runtime_encoder);
     RUN_TEST(test_iwdg_sequence);
     RUN_TEST(test_usart_image);
+    RUN_TEST(test_tim2_capture_image);
     return UNITY_END();
 }
