@@ -2,12 +2,14 @@
  * The servo-style throttle decoder (firmware/throttle/throttle.h) fed by a
  * simulated pulse source: a sender at 50..490 Hz with a set width, jitter
  * (a fixed-seed generator, the same sequence on the host and in QEMU),
- * glitches, an unplugged wire and out-of-range pulses. The bounds come from
+ * glitches (through a model of the board's TIM2 capture), an unplugged wire
+ * and out-of-range pulses. The bounds come from
  * the rules the decoder implements (the ESC convention and the RC signal's
  * limits): arming after 1 s at the low end, never with the throttle high at
  * power-up; no valid pulse for 100 ms -> the reference ramps to zero over
  * 100 ms, then disarm with the cause.
  */
+#include <stdbool.h>
 #include <string.h>
 
 #include "throttle.h"
@@ -25,8 +27,26 @@ typedef struct {
     uint32_t period_us; /* 0: no pulses (wire unplugged) */
     uint32_t width_us;
     uint32_t jitter_us;    /* width +- jitter, uniform */
-    uint32_t glitch_every; /* every n-th period also carries a 0.3 us..300 us glitch (0: none) */
+    uint32_t glitch_every; /* run_capture: every n-th period also carries a 30..300 us spike */
 } sender_t;
+
+/* The board's capture (TIM2 in PWM input mode, g4_tim2_capture_init; RM0440
+ * TIM2/3/4/5 "PWM input mode", slave mode controller in reset mode): on a
+ * rising edge of TI1, CCR1 takes the counter (the period since the last
+ * rising edge), CC1IF is set and the counter restarts from 0; on a falling
+ * edge CCR2 takes the counter (the high time). The main loop reads CC1IF,
+ * CCR2 as the width and CCR1 as the period (g4_tim2_capture_read). 1 us
+ * counts; the 32-bit counter never wraps within these runs. */
+static struct {
+    uint32_t origin; /* time of the last counter reset, us */
+    uint32_t ccr1, ccr2;
+    bool cc1if;
+} tim2;
+/* The edges of the sender's period in progress: edge_at[edge_i..edge_n)
+ * still to come (rising or falling: edge_rise). */
+static uint32_t edge_at[4];
+static bool edge_rise[4];
+static unsigned edge_n, edge_i;
 
 static uint32_t rnd(void)
 {
@@ -44,6 +64,8 @@ static void reset(uint8_t mode)
     next_us = 3000u;
     seed = 12345u;
     n_arm = n_disarm = 0u;
+    memset(&tim2, 0, sizeof tim2);
+    edge_n = edge_i = 0u;
     thr_init(&thr, &c, 0u);
 }
 
@@ -52,7 +74,6 @@ static void reset(uint8_t mode)
  * (the main loop). */
 static void run(const sender_t *s, uint32_t ms)
 {
-    static uint32_t n_period;
     const uint32_t end = t_us + ms * 1000u;
     while (t_us < end) {
         t_us += 1000u;
@@ -62,15 +83,95 @@ static void run(const sender_t *s, uint32_t ms)
                 w = w - s->jitter_us + rnd() % (2u * s->jitter_us + 1u);
             }
             thr_pulse(&thr, w, s->period_us, (next_us + w) / 1000u);
-            n_period++;
-            if (s->glitch_every != 0u && n_period % s->glitch_every == 0u) {
-                /* a spike: a short pulse, and a short "period" before it */
-                thr_pulse(&thr, 1u + rnd() % 300u, 1u + rnd() % 600u, (next_us + w) / 1000u);
-            }
             next_us += s->period_us;
         }
         if (s->period_us == 0u) {
             next_us = t_us + 3000u;
+        }
+        last = thr_update(&thr, t_us / 1000u);
+        if (last.event == THR_EV_ARM) {
+            n_arm++;
+            t_arm_ms = t_us / 1000u;
+        } else if (last.event == THR_EV_DISARM) {
+            n_disarm++;
+            t_disarm_ms = t_us / 1000u;
+        }
+    }
+}
+
+static void tim2_edge(uint32_t at_us, bool rising)
+{
+    const uint32_t cnt = at_us - tim2.origin;
+    if (rising) {
+        tim2.ccr1 = cnt;
+        tim2.cc1if = true;
+        tim2.origin = at_us; /* reset mode: the trigger TI1FP1 clears the counter */
+    } else {
+        tim2.ccr2 = cnt;
+    }
+}
+
+static uint32_t n_rise, n_spike; /* rising edges of the sender, spikes, so far */
+
+#define CAPTURE_POLL_US 20u /* a main-loop pass without a command line */
+
+/* The sender's edges up to t_us into tim2. */
+static void capture_edges(const sender_t *s, uint32_t spike_at_us)
+{
+    static uint32_t n_period;
+    for (;;) {
+        if (edge_i == edge_n) { /* the next period's edges */
+            const uint32_t r = next_us;
+            edge_n = edge_i = 0u;
+            edge_at[edge_n] = r;
+            edge_rise[edge_n++] = true;
+            edge_at[edge_n] = r + s->width_us;
+            edge_rise[edge_n++] = false;
+            n_period++;
+            if (s->glitch_every != 0u && n_period % s->glitch_every == 0u) {
+                TEST_ASSERT_TRUE(spike_at_us > s->width_us && spike_at_us + 300u < s->period_us);
+                edge_at[edge_n] = r + spike_at_us;
+                edge_rise[edge_n++] = true;
+                edge_at[edge_n] = r + spike_at_us + 30u + rnd() % 271u;
+                edge_rise[edge_n++] = false;
+            }
+            next_us += s->period_us;
+        }
+        if (edge_at[edge_i] > t_us) {
+            return;
+        }
+        tim2_edge(edge_at[edge_i], edge_rise[edge_i]);
+        if (edge_rise[edge_i]) {
+            if (edge_i == 0u) {
+                n_rise++;
+            } else {
+                n_spike++;
+            }
+        }
+        edge_i++;
+    }
+}
+
+/* As run(), through the capture: the sender's edges in time order into
+ * tim2, every n-th period (s->glitch_every) with a spike rising spike_at_us
+ * after the period's rising edge (after the pulse's falling edge), 30..300 us
+ * wide. The main loop reads the capture every CAPTURE_POLL_US, as
+ * esc1_throttle_poll does on each pass, and hands it to thr_pulse; it steps
+ * the decoder every 1 ms. A spike shorter than the main loop's pass can end
+ * before the read, which then pairs the spike's own width with the period:
+ * invalid too (not modelled: these spikes outlast the pass). */
+static void run_capture(const sender_t *s, uint32_t spike_at_us, uint32_t ms)
+{
+    const uint32_t end = t_us + ms * 1000u;
+    while (t_us < end) {
+        const uint32_t step_end = t_us + 1000u;
+        while (t_us < step_end) {
+            t_us += CAPTURE_POLL_US;
+            capture_edges(s, spike_at_us);
+            if (tim2.cc1if) {
+                tim2.cc1if = false;
+                thr_pulse(&thr, tim2.ccr2, tim2.ccr1, t_us / 1000u);
+            }
         }
         last = thr_update(&thr, t_us / 1000u);
         if (last.event == THR_EV_ARM) {
@@ -166,18 +267,74 @@ static void test_reference_follows_the_width(void)
     TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
 }
 
-/* Glitches (spikes of 1..300 us with short periods) between good pulses:
- * dropped and counted; the reference and the arming are untouched. */
-static void test_glitches_are_dropped(void)
+/* A spike 2.5 ms after a rising edge (1 ms after the 1515 us pulse's
+ * falling edge), every third period of 4 ms: the capture splits that period
+ * in two, a pulse of 1515 us in a 2500 us "period" (valid: at least the
+ * 2000 us of 500 Hz) and a spike's width in the 1500 us rest (invalid). So
+ * every period still gives its valid pulse, each spike one invalid reading;
+ * the reference and the arming are untouched. */
+static void test_spike_late_in_the_period_splits_it(void)
 {
     reset(THR_MODE_TORQUE);
     arm();
     const sender_t s = {4000u, 1515u, 0u, 3u};
-    run(&s, 2000u);
-    TEST_ASSERT_TRUE(thr.n_invalid > 100u);
+    run_capture(&s, 2500u, 20u); /* the first reading spans the switch */
+    const uint32_t v0 = thr.n_valid, i0 = thr.n_invalid, r0 = n_rise, k0 = n_spike;
+    run_capture(&s, 2500u, 2000u);
+    const uint32_t rises = n_rise - r0, spikes = n_spike - k0;
+    TEST_ASSERT_UINT32_WITHIN(1u, 166u, spikes);
+    TEST_ASSERT_UINT32_WITHIN(1u, rises, thr.n_valid - v0);
+    TEST_ASSERT_UINT32_WITHIN(1u, spikes, thr.n_invalid - i0);
     TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, last.ref);
     TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
     TEST_ASSERT_EQUAL_UINT8(THR_ARMED, thr.state);
+}
+
+/* A spike less than 2 ms after a rising edge (1.8 ms: 285 us after the
+ * pulse's falling edge), every third period: the good pulse is read in a
+ * 1800 us "period", shorter than 500 Hz allows, and is lost with the spike's
+ * own reading, two invalid readings per spike and one valid pulse fewer per
+ * spike. The pulses left (one every 12 ms, inside the 100 ms time-out) keep
+ * the drive armed at the same reference. */
+static void test_spike_early_in_the_period_invalidates_the_pulse(void)
+{
+    reset(THR_MODE_TORQUE);
+    arm();
+    const sender_t s = {4000u, 1515u, 0u, 3u};
+    run_capture(&s, 1800u, 20u);
+    const uint32_t v0 = thr.n_valid, i0 = thr.n_invalid, r0 = n_rise, k0 = n_spike;
+    run_capture(&s, 1800u, 2000u);
+    const uint32_t rises = n_rise - r0, spikes = n_spike - k0;
+    TEST_ASSERT_UINT32_WITHIN(1u, 166u, spikes);
+    TEST_ASSERT_UINT32_WITHIN(1u, rises - spikes, thr.n_valid - v0);
+    TEST_ASSERT_UINT32_WITHIN(2u, 2u * spikes, thr.n_invalid - i0);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, last.ref);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_disarm);
+    TEST_ASSERT_EQUAL_UINT8(THR_ARMED, thr.state);
+}
+
+/* The same spike in every period: no reading is valid, which is a lost
+ * signal though pulses keep coming. The reference holds for the 100 ms
+ * time-out after the last valid pulse, ramps to zero over 100 ms, and the
+ * drive is disarmed with cause "invalid" (pulses, none valid). */
+static void test_repeated_spikes_read_as_signal_loss(void)
+{
+    reset(THR_MODE_TORQUE);
+    arm();
+    const sender_t good = {4000u, 1515u, 0u, 0u};
+    run_capture(&good, 0u, 100u);
+    TEST_ASSERT_EQUAL_INT32(FX_ONE / 2, last.ref);
+    const uint32_t v0 = thr.n_valid;
+    const sender_t s = {4000u, 1515u, 0u, 1u};
+    run_capture(&s, 1800u, 400u);
+    TEST_ASSERT_TRUE(thr.n_valid - v0 <= 1u); /* the period before the first spike */
+    const uint32_t t_last = thr.t_valid_ms;
+    TEST_ASSERT_EQUAL_UINT32(1u, n_disarm);
+    TEST_ASSERT_EQUAL_UINT8(THR_CAUSE_INVALID, thr.cause);
+    TEST_ASSERT_TRUE(t_disarm_ms >= t_last + THR_TIMEOUT_MS + THR_RAMP_MS &&
+                     t_disarm_ms <= t_last + THR_TIMEOUT_MS + THR_RAMP_MS + 2u);
+    TEST_ASSERT_EQUAL_INT32(0, last.ref);
+    TEST_ASSERT_TRUE(thr.n_invalid > 150u);
 }
 
 /* Wire unplugged at full throttle: the reference holds for the 100 ms
@@ -281,7 +438,9 @@ int main(void)
     RUN_TEST(test_throttle_high_at_power_up_never_arms);
     RUN_TEST(test_arming_needs_an_unbroken_second);
     RUN_TEST(test_reference_follows_the_width);
-    RUN_TEST(test_glitches_are_dropped);
+    RUN_TEST(test_spike_late_in_the_period_splits_it);
+    RUN_TEST(test_spike_early_in_the_period_invalidates_the_pulse);
+    RUN_TEST(test_repeated_spikes_read_as_signal_loss);
     RUN_TEST(test_unplugged_wire_ramps_down_and_disarms);
     RUN_TEST(test_out_of_range_pulses_are_a_loss);
     RUN_TEST(test_config_check);
