@@ -68,11 +68,15 @@ static inline void g4_pendsv_pend(void)
 
 /* Every configurable-priority exception held off (PRIMASK, CPSID i: ARMv7-M
  * ARM B1.4.3) for a few instructions that one interrupt may also run; the
- * previous PRIMASK back on unlock. The host register model runs one context:
+ * previous PRIMASK back on unlock. The traced register model keeps a
+ * PRIMASK of its own and holds its modelled interrupts off while it is set;
+ * the untraced array build (the instruction-count image) runs one context:
  * no-ops there. */
 static inline uint32_t g4_irq_lock(void)
 {
-#if defined(G4_MEM_ARRAYS)
+#if defined(G4_MEM_ARRAYS) && defined(G4_REG_TRACE)
+    return g4_trace_irq_lock();
+#elif defined(G4_MEM_ARRAYS)
     return 0u;
 #else
     uint32_t primask;
@@ -82,7 +86,9 @@ static inline uint32_t g4_irq_lock(void)
 }
 static inline void g4_irq_unlock(uint32_t primask)
 {
-#if defined(G4_MEM_ARRAYS)
+#if defined(G4_MEM_ARRAYS) && defined(G4_REG_TRACE)
+    g4_trace_irq_unlock(primask);
+#elif defined(G4_MEM_ARRAYS)
     (void)primask;
 #else
     __asm__ volatile("msr primask, %0" ::"r"(primask) : "memory");

@@ -88,6 +88,9 @@ G4_PERIPHS(G4_DECLARE_ARRAY)
 #if defined(G4_REG_TRACE)
 uint32_t g4_trace_read(uintptr_t reg);
 void g4_trace_write(uintptr_t reg, uint32_t value);
+/* PRIMASK in the model (g4_irq_lock / g4_irq_unlock, g4_core.h). */
+uint32_t g4_trace_irq_lock(void);
+void g4_trace_irq_unlock(uint32_t primask);
 static inline uint32_t g4_rd(uintptr_t reg)
 {
     return g4_trace_read(reg);

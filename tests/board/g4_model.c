@@ -185,12 +185,35 @@ uint32_t g4_trace_read(uintptr_t reg)
     const uint32_t v = *c;
     if (g4_model.irq_on_read == reg && g4_model.irq != NULL) {
         /* An interrupt taken right after this load: the caller stores what it
-         * read, modified, after the handler has run. */
+         * read, modified, after the handler has run; with PRIMASK set, held
+         * pending until it clears. */
         void (*irq)(void) = g4_model.irq;
         g4_model.irq = NULL;
-        irq();
+        if (g4_model.primask != 0u) {
+            g4_model.irq_pending = irq;
+        } else {
+            irq();
+        }
     }
     return v;
+}
+
+uint32_t g4_trace_irq_lock(void)
+{
+    const uint32_t prev = g4_model.primask;
+    g4_model.primask = 1u;
+    g4_model.n_locks++;
+    return prev;
+}
+
+void g4_trace_irq_unlock(uint32_t primask)
+{
+    g4_model.primask = primask;
+    if (primask == 0u && g4_model.irq_pending != NULL) {
+        void (*irq)(void) = g4_model.irq_pending;
+        g4_model.irq_pending = NULL;
+        irq();
+    }
 }
 
 static void g4_model_write(uintptr_t reg, uint32_t value);

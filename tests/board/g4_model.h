@@ -37,6 +37,12 @@ typedef struct {
      * interrupt inside a read-modify-write); one shot. */
     uintptr_t irq_on_read;
     void (*irq)(void);
+    /* PRIMASK (g4_irq_lock sets it, g4_irq_unlock puts the previous value
+     * back): while set, the irq above is held pending and taken at the
+     * unlock that clears it, as the core takes a pended interrupt. */
+    uint32_t primask;
+    uint32_t n_locks;          /* g4_irq_lock calls so far */
+    void (*irq_pending)(void); /* taken when PRIMASK clears */
     /* Called after every register write (NULL: none): a test's probe. */
     void (*on_write)(uintptr_t reg, uint32_t value);
     /* state the model keeps */

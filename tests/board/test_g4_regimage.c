@@ -643,6 +643,71 @@ static void test_runtime_break_rearm(void)
     TEST_ASSERT_FALSE(hal_trip_active(&hal));
 }
 
+/* Writes to TIM1_SR / TIM1_DIER made with PRIMASK clear (on_write probe). */
+static uint32_t n_unlocked_writes;
+static void probe_unlocked_trip_writes(uintptr_t r, uint32_t value)
+{
+    (void)value;
+    if ((r == G4_TIM1 + G4_TIM_SR || r == G4_TIM1 + G4_TIM_DIER) && g4_model.primask == 0u) {
+        n_unlocked_writes++;
+    }
+}
+
+/* The control interrupt's fault clear (hal_trip_clear, the re-arm's other
+ * caller), taken where it arrives; it notes where in the write log it ran. */
+static int clear_irq_at;
+static void control_irq_clear(void)
+{
+    clear_irq_at = (int)g4_model.n_log;
+    hal_trip_clear(&hal);
+}
+
+/* The main loop's re-arm of the break interrupt checks DIER and the
+ * comparators, clears the break flags and enables BIE as one step with the
+ * interrupts masked (PRIMASK, ARMv7-M ARM B1.4.3): a control interrupt
+ * arriving at its read of DIER (a fault clear that re-arms too) is taken
+ * only after the unlock, so no write of SR or DIER in the re-arm runs with
+ * PRIMASK clear, the interrupt's clear comes after the enable and, finding
+ * the interrupt armed and the inputs low, acknowledges the break. The lock
+ * nests: under an outer lock PRIMASK stays set after the re-arm and the
+ * interrupt waits for the outer unlock. */
+static void test_runtime_break_rearm_under_the_lock(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    g4_model.comp_high = true; /* a long break: the interrupt masks itself */
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF);
+    g4_hal_break_irq(&hal);
+    TEST_ASSERT_EQUAL_HEX32(0u, reg(G4_TIM1 + G4_TIM_DIER));
+    g4_model.comp_high = false;
+    n_unlocked_writes = 0u;
+    clear_irq_at = -1;
+    g4_model.on_write = probe_unlocked_trip_writes;
+    g4_model.irq_on_read = G4_TIM1 + G4_TIM_DIER;
+    g4_model.irq = control_irq_clear;
+    const uint32_t locks = g4_model.n_locks;
+    TEST_ASSERT_FALSE(g4_hal_break_rearm(&hal)); /* it was masked */
+    g4_model.on_write = NULL;
+    TEST_ASSERT_TRUE(g4_model.n_locks > locks);
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model.primask);
+    TEST_ASSERT_EQUAL_UINT32(0u, n_unlocked_writes);
+    const int enable = g4_model_find_last(G4_TIM1 + G4_TIM_DIER, G4_TIM_DIER_BIE, G4_TIM_DIER_BIE);
+    assert_before(enable, clear_irq_at, "the interrupt taken after the re-arm's unlock");
+    TEST_ASSERT_TRUE(reg(G4_TIM1 + G4_TIM_DIER) & G4_TIM_DIER_BIE);
+    TEST_ASSERT_FALSE(hal_trip_active(&hal)); /* the clear acknowledged the break */
+
+    /* nested under an outer lock */
+    g4_model.irq_on_read = G4_TIM1 + G4_TIM_DIER;
+    g4_model.irq = control_irq_clear;
+    clear_irq_at = -1;
+    const uint32_t outer = g4_irq_lock();
+    TEST_ASSERT_TRUE(g4_hal_break_rearm(&hal));
+    TEST_ASSERT_EQUAL_UINT32(1u, g4_model.primask);
+    TEST_ASSERT_EQUAL_INT(-1, clear_irq_at);
+    g4_irq_unlock(outer);
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model.primask);
+    TEST_ASSERT_TRUE(clear_irq_at >= 0);
+}
+
 /* Samples: the ESC1's amplifier inverts (sense gain -64/7), so the HAL
  * returns 4095 - code for the currents (counts rise with the phase current);
  * the DC link as is. U = ADC1_JDR1, V = ADC2_JDR1, W = ADC1_JDR2, Vbus =
@@ -807,6 +872,7 @@ int main(void)
     RUN_TEST(test_runtime_system_break_cause);
     RUN_TEST(test_runtime_break_during_clear_kept);
     RUN_TEST(test_runtime_break_rearm);
+    RUN_TEST(test_runtime_break_rearm_under_the_lock);
     RUN_TEST(test_runtime_samples_and_compare);
     RUN_TEST(test_runtime_encoder);
     RUN_TEST(test_iwdg_sequence);
