@@ -668,6 +668,76 @@ static void test_ident_apply_holds_the_control_interrupt(void)
     TEST_ASSERT_EQUAL_UINT32(0x40000000u, esc.fw.enc_offset); /* and it was adopted */
 }
 
+/* The machine in force after "ident apply" is the drive's (fw_t.machine_own,
+ * the encoder's offset and direction): "param get" reads it, and a later
+ * change of an unrelated m.* parameter or enc.cpr (a reconfiguration) keeps
+ * the identified Rs, Ld, Lq, psi_pm, the inertia set after it and the
+ * encoder calibration; the same after a settings record carrying them is
+ * loaded at power-up. Before, the board's own copy answered the pre-
+ * identification values and a reconfiguration restored them, offset 0 and
+ * direction +1 with them. */
+static void expect_machine(const ctrl_machine_t *want, double j, uint32_t off, uint32_t neg)
+{
+    const ctrl_machine_t *m = &esc.fw.machine_own;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * want->rs_ohm, want->rs_ohm, m->rs_ohm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * want->ld_h, want->ld_h, m->ld_h);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * want->lq_h, want->lq_h, m->lq_h);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * want->psi_pm_wb, want->psi_pm_wb, m->psi_pm_wb);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * j, j, m->inertia_kgm2);
+    TEST_ASSERT_EQUAL_HEX32(off, esc.fw.enc_offset);
+    TEST_ASSERT_EQUAL_HEX32(neg, esc.fw.enc_neg);
+    /* the link's answers: the same values (printed to 4 significant digits) */
+    const char *q[3] = {"param get m.rs_ohm", "param get m.psi_wb", "param get m.j_kgm2"};
+    const double v[3] = {want->rs_ohm, want->psi_pm_wb, j};
+    for (size_t k = 0; k < 3u; k++) {
+        const char *a = command(q[k]);
+        double got = 0.0;
+        TEST_ASSERT_EQUAL_INT_MESSAGE(1, sscanf(a, "ok %*s %lf", &got), a);
+        TEST_ASSERT_DOUBLE_WITHIN_MESSAGE(1e-3 * v[k], v[k], got, a);
+    }
+}
+
+static void test_identified_machine_survives_a_parameter_change(void)
+{
+    memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings); /* a new board */
+    calibrate_at(2553u);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    const ctrl_machine_t *d = &esc1_default_machine;
+    /* identified: twice the file's Rs, 1.5 x its inductances, 1.1 x its
+     * flux (pu of the bases they were taken in), the encoder a quarter turn
+     * off and counting backwards */
+    cm_results_t *r = &esc.fw.cm.res;
+    r->have = CM_HAVE_RS | CM_HAVE_LDQ | CM_HAVE_FLUX | CM_HAVE_ENC;
+    r->bases = esc.fw.bases;
+    r->rs = ctrl_q24_from_double(2.0 * d->rs_ohm / r->bases.r_ohm);
+    r->ld = ctrl_q24_from_double(1.5 * d->ld_h / r->bases.l_h);
+    r->lq = ctrl_q24_from_double(1.5 * d->lq_h / r->bases.l_h);
+    r->psi = ctrl_q24_from_double(1.1 * d->psi_pm_wb / r->bases.psi_wb);
+    r->enc_dir = -1;
+    r->enc_off = 0x40000000u;
+    expect_prefix("ok ident applied", command("ident apply"));
+    const ctrl_machine_t id = esc.fw.machine_own;
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->rs_ohm, 2.0 * d->rs_ohm, id.rs_ohm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->psi_pm_wb, 1.1 * d->psi_pm_wb, id.psi_pm_wb);
+    expect_machine(&id, d->inertia_kgm2, 0x40000000u, 0xFFFFFFFFu);
+
+    expect_prefix("ok m.j_kgm2", command("param set m.j_kgm2 6e-5"));
+    expect_machine(&id, 6e-5, 0x40000000u, 0xFFFFFFFFu);
+    TEST_ASSERT_EQUAL_STRING("ok enc.cpr 2048", command("param set enc.cpr 2048"));
+    expect_machine(&id, 6e-5, 0x40000000u, 0xFFFFFFFFu);
+
+    /* saved, the board powered off and on: the record's data in force, and
+     * kept by a change after it */
+    expect_prefix("ok saved record 1", command("config save"));
+    calibrate_at(2553u); /* power cycle */
+    TEST_ASSERT_EQUAL_STRING("settings: record 1 (page 0) applied", esc.settings.msg);
+    expect_machine(&id, 6e-5, 0x40000000u, 0xFFFFFFFFu);
+    expect_prefix("ok m.j_kgm2", command("param set m.j_kgm2 7e-5"));
+    expect_machine(&id, 7e-5, 0x40000000u, 0xFFFFFFFFu);
+    TEST_ASSERT_EQUAL_STRING("ok enc.cpr 2048 -", command("param get enc.cpr"));
+    memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -687,5 +757,6 @@ int main(void)
     RUN_TEST(test_main_loop_serves_the_watchdog_between_commands);
     RUN_TEST(test_status_gives_the_stack_high_water_mark);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
+    RUN_TEST(test_identified_machine_survives_a_parameter_change);
     return UNITY_END();
 }

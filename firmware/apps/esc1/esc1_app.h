@@ -55,7 +55,7 @@ typedef struct {
     double temp_c;                /* last board temperature (NaN: sensor open/short) */
     q24_t thr_tref;               /* speed mode: the torque when the signal was lost, Q24 pu */
     thr_t thr;                    /* throttle on the PWM pad ([throttle] settings in thr.cfg) */
-    ctrl_machine_t machine;       /* the machine data the firmware runs with */
+    ctrl_machine_t machine;       /* staged for fw_init; in force: fw.machine_own ("ident apply") */
     uint32_t encoder_cpr;
     g4_hal_cfg_t hc;
     fw_link_t link;

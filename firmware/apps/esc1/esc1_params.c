@@ -113,17 +113,19 @@ enum {
 };
 static const fw_link_param_t esc1_params[ESC1_N_PARAMS];
 
-/* Machine data and the encoder: entries M_P .. M_CPR of esc1_params. */
+/* Machine data and the encoder: entries M_P .. M_CPR of esc1_params. The
+ * machine in force is the drive's (fw_t.machine_own, which "ident apply"
+ * rewrites): read and edited there, never from a copy of the board's. */
 static int esc1_get_field(void *ctx, const fw_link_param_t *p, double *v)
 {
     esc1_t *s = esc1_of(ctx);
     const esc1_field_t f = (esc1_field_t)(p - esc1_params);
     if (f == M_P) {
-        *v = (double)s->machine.pole_pairs;
+        *v = (double)s->fw.machine_own.pole_pairs;
     } else if (f == M_CPR) {
         *v = (double)s->encoder_cpr;
     } else {
-        *v = *esc1_field(&s->machine, f);
+        *v = *esc1_field(&s->fw.machine_own, f);
     }
     return CMD_OK;
 }
@@ -132,7 +134,7 @@ static int esc1_set_field(void *ctx, const fw_link_param_t *p, double v)
 {
     esc1_t *s = esc1_of(ctx);
     const esc1_field_t f = (esc1_field_t)(p - esc1_params);
-    ctrl_machine_t m = s->machine;
+    ctrl_machine_t m = s->fw.machine_own;
     uint32_t cpr = s->encoder_cpr;
     if (f == M_P || f == M_CPR) {
         if (v != floor(v)) {
@@ -329,6 +331,17 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
     return esc1_reconfigure_cfg(s, m, encoder_cpr, NULL);
 }
 
+/* The default configuration for the machine staged in s->machine, with the
+ * encoder's calibration in force (identified, or a settings record's: the
+ * drive's enc_offset and direction), so that a machine parameter changed
+ * after it does not put back the uncalibrated 0 / +1. */
+static void esc1_config_kept(esc1_t *s, const ctrl_desc_t *ctrl, fx_angle_t off, int8_t dir)
+{
+    esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
+    s->fc.enc_offset = off;
+    s->fc.enc_direction = dir;
+}
+
 int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
                          const fw_config_t *cfg)
 {
@@ -341,8 +354,10 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     if (encoder_cpr < 4u || encoder_cpr > 0xFFFFu) {
         return CMD_E_RANGE;
     }
-    const ctrl_machine_t old = s->machine;
+    const ctrl_machine_t old = s->fw.machine_own;
     const uint32_t old_cpr = s->encoder_cpr;
+    const fx_angle_t off = s->fw.enc_offset; /* fw_init clears fw_t: kept here */
+    const int8_t dir = s->fw.enc_neg != 0u ? -1 : 1;
     /* fw_init clears fw_t, so the controller in use is kept here for the
      * restore (else a refused machine left the firmware without one). */
     const ctrl_desc_t *ctrl = s->fw.ctrl;
@@ -355,7 +370,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->fc = *cfg;
         s->fc.machine = &s->machine;
     } else {
-        esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
+        esc1_config_kept(s, ctrl, off, dir);
     }
     int rc = fw_init(&s->fw, &s->hal, &s->fc);
     if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
@@ -368,7 +383,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->machine = old;
         s->encoder_cpr = old_cpr;
         s->hal.info.encoder_counts_per_rev = old_cpr;
-        esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
+        esc1_config_kept(s, ctrl, off, dir);
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
     } else {
