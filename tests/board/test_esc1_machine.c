@@ -738,6 +738,31 @@ static void test_identified_machine_survives_a_parameter_change(void)
     memset(g4_mem_flash_settings, 0xFF, sizeof g4_mem_flash_settings);
 }
 
+/* The speed reference's limit is the drive's (fw_speed_info_t.speed_ref_max_rpm,
+ * which fw_set_speed_ref_rpm clamps to), at power-up and after every
+ * reconfiguration: a reference just inside it is taken, one just beyond it
+ * refused with the range, never taken and clamped silently. Before, a
+ * reconfiguration set the link's limit to 1.2 x rated speed. */
+static void expect_speed_limit(void)
+{
+    const double lim = esc.fw.speed_info.speed_ref_max_rpm;
+    char line[64];
+    (void)snprintf(line, sizeof line, "ref speed %.6g", 0.99 * lim);
+    expect_prefix("ok ref speed", command(line));
+    (void)snprintf(line, sizeof line, "ref speed %.6g", 1.01 * lim);
+    expect_prefix("err 4 range [-", command(line));
+}
+
+static void test_speed_reference_limit_is_the_drives(void)
+{
+    calibrate_at(2553u);
+    expect_speed_limit();
+    expect_prefix("ok m.j_kgm2", command("param set m.j_kgm2 6e-5"));
+    expect_speed_limit();
+    expect_prefix("ok m.n_rated_rpm", command("param set m.n_rated_rpm 290"));
+    expect_speed_limit();
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -758,5 +783,6 @@ int main(void)
     RUN_TEST(test_status_gives_the_stack_high_water_mark);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
+    RUN_TEST(test_speed_reference_limit_is_the_drives);
     return UNITY_END();
 }

@@ -386,9 +386,10 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         esc1_config_kept(s, ctrl, off, dir);
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
-    } else {
-        s->link.speed_max_rpm = 1.2 * s->machine.speed_rated_rpm;
     }
+    /* the drive's speed reference limit, which it clamps to (as at power-up,
+     * fw_link_init): the link refuses a reference beyond it */
+    s->link.speed_max_rpm = s->fw.speed_info.speed_ref_max_rpm;
     hal_ctrl_hold(&s->hal, false);
     esc1_init_time(s, t0);
     /* In its range but refused by the core (e.g. a per-unit value outside its
