@@ -106,6 +106,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
  * applied, or the compiled-in defaults, with a line on the serial link saying
  * which; the "config" commands attached (esc1_settings.c). */
 void esc1_settings_start(esc1_t *s);
+#endif
 
 /* The firmware's initialisation started at cycle count t0 has ended: the
  * longest so far kept for the start-up report (against the watchdog's
@@ -117,7 +118,6 @@ static inline void esc1_init_time(esc1_t *s, uint32_t t0)
         s->init_cycles = d;
     }
 }
-#endif
 
 /* The body of the ADC1_2 interrupt (end of the injected sequence): flags
  * acknowledged, the firmware's period (fw_isr_fast; PendSV pended when the
