@@ -74,7 +74,7 @@ struct board_app {
     fw_t fw;
     fw_link_t link;
     fw_config_t fc;
-    ctrl_machine_t machine; /* the machine data the firmware runs with */
+    ctrl_machine_t machine; /* staged for fw_init; in force: fw.machine_own ("ident apply") */
     uint32_t encoder_cpr;
     board_uart_t uart;
     volatile uint32_t isr_count; /* control interrupts so far */

@@ -92,11 +92,11 @@ static int board_get_field(void *ctx, const fw_link_param_t *p, double *v)
     board_app_t *a = board_app_of(ctx);
     const board_field_t f = (board_field_t)(p - board_params);
     if (f == M_P) {
-        *v = (double)a->machine.pole_pairs;
+        *v = (double)a->fw.machine_own.pole_pairs;
     } else if (f == M_CPR) {
         *v = (double)a->encoder_cpr;
     } else {
-        *v = *board_field(&a->machine, f);
+        *v = *board_field(&a->fw.machine_own, f);
     }
     return CMD_OK;
 }
@@ -105,7 +105,7 @@ static int board_set_field(void *ctx, const fw_link_param_t *p, double v)
 {
     board_app_t *a = board_app_of(ctx);
     const board_field_t f = (board_field_t)(p - board_params);
-    ctrl_machine_t m = a->machine;
+    ctrl_machine_t m = a->fw.machine_own; /* in force ("ident apply" rewrites it) */
     uint32_t cpr = a->encoder_cpr;
     if (f == M_P || f == M_CPR) {
         if (v != floor(v)) {
