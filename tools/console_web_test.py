@@ -383,7 +383,8 @@ def check_identification_start(wd):
         text = wd.js("return document.getElementById('cm-status').textContent")
         seen.append(text)
         c = wd.js("return consoleState.cm") or {}
-        return text if c.get("verdict") == "running" else None
+        # two reads: a status that arrives between them shows in the state, not yet in the text read
+        return text if c.get("verdict") == "running" and text.startswith("ident: ") else None
     text = wait_for("the identification running on the page", running, 60, 0.1)
     wd.click('button[data-cm="stop"]')
     c = wait_for("the identification stopped", lambda: (lambda c: c if c and c.get("verdict") not in
