@@ -26,9 +26,6 @@
  *             the torque reference to the torque (docs/anticogging.md); the
  *             advance omega_e (Q24 pu) * lead / 2^24 saturates to +-1/2 turn
  *             and is added to the turn modulo one turn (an angle)
- *   w_k       the look-ahead's speed filter, Q24: 1 - exp(-2 pi fc Ts); the
- *             encoder's speed (quantised to a count per period) averaged
- *             over about 1 / (2 pi fc), w_acc Q48 pu, w Q24 pu
  * Per period: one 32x32->64 multiply for the angle, two table reads, two
  * 16x16 multiplies, one 32x32->64 multiply for the scale; no division.
  */
@@ -56,9 +53,6 @@ typedef struct {
     uint64_t pos_q48;   /* round(2^48 / cpr) */
     q24_t torque_rated; /* pu */
     int32_t lead;       /* Q32 turns per pu electrical speed (0: none) */
-    int32_t w_k;        /* speed filter's gain, Q24, (0, 2^24] */
-    int64_t w_acc;      /* filtered electrical speed, Q48 pu */
-    q24_t w;            /* its Q24 value */
 } ctrl_cogging_t;
 
 /* Configuration (once): 0, or -1 when an argument is out of range (table
@@ -66,19 +60,8 @@ typedef struct {
 int ctrl_cogging_init(ctrl_cogging_t *c, const int16_t *table, uint32_t n_log2, uint32_t cpr,
                       q24_t torque_rated);
 
-/* The look-ahead and its speed filter (formats above), the filter at 0: 0,
- * or -1 when lead < 0 or w_k outside (0, 2^24] (left unchanged). */
-int ctrl_cogging_set_lead(ctrl_cogging_t *c, int32_t lead, int32_t w_k);
-
-/* One period of the look-ahead's speed filter on omega_e (Q24 pu): the
- * filtered speed, Q24 pu. |w_acc| < 2^55: each step adds < 2^31 * 2^24 and
- * the average stays within the input's range. */
-static inline q24_t ctrl_cogging_speed(ctrl_cogging_t *c, q24_t omega_e)
-{
-    c->w_acc += (int64_t)fx_sub(omega_e, c->w) * c->w_k;
-    c->w = fx_round_sat(c->w_acc, FX_QBITS);
-    return c->w;
-}
+/* The look-ahead (format above): 0, or -1 when lead < 0 (left unchanged). */
+int ctrl_cogging_set_lead(ctrl_cogging_t *c, int32_t lead);
 
 /* Q32 fraction of a revolution at encoder position pos in [0, cpr). */
 static inline uint32_t ctrl_cogging_turn(const ctrl_cogging_t *c, uint32_t pos)

@@ -628,13 +628,7 @@ bool fw_commission_poll(fw_t *fw)
  *           when Kp_q is set, else the tunable wc, else 2 pi fs / 20, as
  *           ctrl_foc_config.c); a controller of the torque itself (DTC,
  *           MPC) has none.
- * The speed it multiplies: the encoder's (a count per period at most at low
- * speed: 0 or 1 count at 30 r/min, 16384 counts, 10 kHz) averaged over
- * 1 / (2 pi FW_COG_SPEED_HZ) = 8 ms; at constant speed the average's delay
- * costs nothing, and it is tau (0.5 ms) times the speed's change in 8 ms
- * when the speed changes.
  * 0, or -1 when the lead does not fit (half a turn per rated speed). */
-#define FW_COG_SPEED_HZ 20.0
 static int fw_cogging_lead(fw_t *fw)
 {
     const double fs = (double)fw->params.fs_hz;
@@ -650,12 +644,11 @@ static int fw_cogging_lead(fw_t *fw)
     /* Q32 turns per pu electrical speed: tau w_base / (2 pi p) turns */
     const double lead =
         tau * fw->bases.w_rad_s / (CTRL_TWO_PI * (double)fw->params.pole_pairs) * 4294967296.0;
-    const q24_t w_k = ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_COG_SPEED_HZ / fs));
     if (!(lead >= 0.0) || !(lead < 2147483647.0)) {
-        (void)ctrl_cogging_set_lead(&fw->cog.map, 0, w_k);
+        (void)ctrl_cogging_set_lead(&fw->cog.map, 0);
         return -1;
     }
-    return ctrl_cogging_set_lead(&fw->cog.map, (int32_t)llround(lead), w_k);
+    return ctrl_cogging_set_lead(&fw->cog.map, (int32_t)llround(lead));
 }
 #endif
 
