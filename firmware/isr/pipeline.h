@@ -634,10 +634,7 @@ void fw_commission_results(const fw_t *fw, cm_si_t *out);
  * encoder, within the period's torque limit.
  * fw_cogging_enable: on (FW_ENOENT without a table measured with this
  *   encoder's counts and direction, FW_EINVAL sensorless: no mechanical
- *   angle, FW_ERANGE a look-ahead that does not fit) or off; taken at the
- *   next period. The table is read ahead of the position by the speed times
- *   the delay from torque reference to torque, 1.5 Ts + 1 / wc of FOC's
- *   current loop (docs/anticogging.md), set again with each controller.
+ *   angle) or off; taken at the next period.
  * fw_cogging_load: n entries of Q15 of the rated torque against the encoder
  *   position (cogging_ff.h), measured with the encoder's present counts
  *   (the caller checked), n = CTRL_COG_N (else FW_ERANGE); gates off
