@@ -9,9 +9,6 @@
  * pos / 2^17 LSB of a Q32 turn: checked, then the implementation's own turn
  * is used); index and weight from the turn by division, not shifts; the
  * interpolation in 64 bits and rounded by floor((x + 2^29) / 2^30).
- * The look-ahead: the advance floor((omega lead + 2^23) / 2^24) clamped to
- * int32_t, added to the exact turn modulo 2^32 (64-bit arithmetic), must
- * give the same bits as the plain feed-forward at that turn.
  */
 #include <stdint.h>
 
@@ -61,33 +58,6 @@ static void check_cpr(uint32_t cpr, q24_t tr, uint32_t *seed)
     }
 }
 
-/* The feed-forward at the turn pos's turn + the speed's advance. */
-static void check_ahead(uint32_t cpr, q24_t tr, int32_t lead, uint32_t *seed)
-{
-    ctrl_cogging_t c;
-    TEST_ASSERT_EQUAL_INT(0, ctrl_cogging_init(&c, t, CTRL_COG_N_LOG2, cpr, tr));
-    TEST_ASSERT_EQUAL_INT32(0, c.lead); /* none until set */
-    TEST_ASSERT_EQUAL_INT(-1, ctrl_cogging_set_lead(&c, -1));
-    TEST_ASSERT_EQUAL_INT(0, ctrl_cogging_set_lead(&c, lead));
-    for (uint32_t k = 0; k < 4000u; k++) {
-        *seed = *seed * 1664525u + 1013904223u;
-        const uint32_t pos = *seed % cpr;
-        *seed = *seed * 1664525u + 1013904223u;
-        /* speeds over the whole Q24 range, the extremes included */
-        const int32_t w =
-            k == 0u ? INT32_MAX : (k == 1u ? INT32_MIN : (int32_t)(*seed ^ 0x5a5a5a5au));
-        int64_t adv = floor_div((int64_t)w * lead + ((int64_t)1 << 23), (int64_t)1 << 24);
-        adv = adv > INT32_MAX ? INT32_MAX : (adv < INT32_MIN ? INT32_MIN : adv);
-        const int64_t turn = ((int64_t)ctrl_cogging_turn(&c, pos) + adv) % 4294967296ll;
-        const uint32_t want_turn = (uint32_t)(turn < 0 ? turn + 4294967296ll : turn);
-        TEST_ASSERT_EQUAL_INT32(ctrl_cogging_ff_turn(&c, want_turn),
-                                ctrl_cogging_ff_ahead(&c, pos, w));
-    }
-    /* no speed: the position's own entry */
-    TEST_ASSERT_EQUAL_INT32(ctrl_cogging_ff(&c, 123u % cpr),
-                            ctrl_cogging_ff_ahead(&c, 123u % cpr, 0));
-}
-
 static void test_ff_exact(void)
 {
     uint32_t seed = 777u;
@@ -102,10 +72,6 @@ static void test_ff_exact(void)
     check_cpr(4000u, 8388608, &seed);
     check_cpr(1000003u, 16777216, &seed);
     check_cpr(0x80000000u, 33554432, &seed); /* the largest cpr, 2 pu rated torque */
-    /* a gimbal's lead (about 6e3) and the largest that fits (saturating) */
-    check_ahead(16384u, 16777216, 6365, &seed);
-    check_ahead(10000u, 22369621, 200000000, &seed);
-    check_ahead(16384u, 16777216, INT32_MAX, &seed);
 }
 
 int main(void)
