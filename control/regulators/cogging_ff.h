@@ -21,11 +21,6 @@
  *             thousandth of a count)
  *   output    Q24 pu torque: linear interpolation between the two entries
  *             around the angle (15-bit fraction), times torque_rated
- *   lead      look-ahead, Q32 turns per pu electrical speed (int32_t, >= 0):
- *             round(tau w_base / (2 pi p) 2^32), tau the drive's delay from
- *             the torque reference to the torque (docs/anticogging.md); the
- *             advance omega_e (Q24 pu) * lead / 2^24 saturates to +-1/2 turn
- *             and is added to the turn modulo one turn (an angle)
  * Per period: one 32x32->64 multiply for the angle, two table reads, two
  * 16x16 multiplies, one 32x32->64 multiply for the scale; no division.
  */
@@ -52,16 +47,12 @@ typedef struct {
     uint32_t cpr;       /* encoder counts per revolution the table was measured with */
     uint64_t pos_q48;   /* round(2^48 / cpr) */
     q24_t torque_rated; /* pu */
-    int32_t lead;       /* Q32 turns per pu electrical speed (0: none) */
 } ctrl_cogging_t;
 
 /* Configuration (once): 0, or -1 when an argument is out of range (table
  * NULL, n_log2 outside [MIN, MAX], cpr outside [2, 2^31], torque_rated <= 0). */
 int ctrl_cogging_init(ctrl_cogging_t *c, const int16_t *table, uint32_t n_log2, uint32_t cpr,
                       q24_t torque_rated);
-
-/* The look-ahead (format above): 0, or -1 when lead < 0 (left unchanged). */
-int ctrl_cogging_set_lead(ctrl_cogging_t *c, int32_t lead);
 
 /* Q32 fraction of a revolution at encoder position pos in [0, cpr). */
 static inline uint32_t ctrl_cogging_turn(const ctrl_cogging_t *c, uint32_t pos)
@@ -76,9 +67,10 @@ static inline uint32_t ctrl_cogging_bin(const ctrl_cogging_t *c, uint32_t turn)
     return turn >> (32u - c->n_log2);
 }
 
-/* The feed-forward torque at the Q32 turn, Q24 pu. */
-static inline q24_t ctrl_cogging_ff_turn(const ctrl_cogging_t *c, uint32_t turn)
+/* The feed-forward torque at encoder position pos in [0, cpr), Q24 pu. */
+static inline q24_t ctrl_cogging_ff(const ctrl_cogging_t *c, uint32_t pos)
 {
+    const uint32_t turn = ctrl_cogging_turn(c, pos);
     const uint32_t i = turn >> (32u - c->n_log2);
     const uint32_t mask = (1u << c->n_log2) - 1u;
     /* the 15 bits below the index: interpolation weight of the next entry */
@@ -88,23 +80,6 @@ static inline q24_t ctrl_cogging_ff_turn(const ctrl_cogging_t *c, uint32_t turn)
     /* |a (2^15 - f) + b f| <= 2^15 * 2^15: Q30 of the rated torque */
     const int32_t v = a * (CTRL_COG_ONE - f) + b * f;
     return fx_round_sat((int64_t)v * c->torque_rated, 30u);
-}
-
-/* The feed-forward torque at encoder position pos in [0, cpr), Q24 pu. */
-static inline q24_t ctrl_cogging_ff(const ctrl_cogging_t *c, uint32_t pos)
-{
-    return ctrl_cogging_ff_turn(c, ctrl_cogging_turn(c, pos));
-}
-
-/* The feed-forward torque at pos advanced by the speed omega_e (Q24 pu
- * electrical) times the drive's delay (lead): the torque made tau later
- * meets the cogging where the rotor will be then. */
-static inline q24_t ctrl_cogging_ff_ahead(const ctrl_cogging_t *c, uint32_t pos, q24_t omega_e)
-{
-    /* |omega_e lead| < 2^62; the advance saturates to +-2^31 (half a turn) */
-    const int32_t adv = fx_round_sat((int64_t)omega_e * c->lead, 24u);
-    /* modulo 2^32 = one turn: an angle's wrap (conversion and sum defined) */
-    return ctrl_cogging_ff_turn(c, ctrl_cogging_turn(c, pos) + (uint32_t)adv);
 }
 
 #endif /* CONTROL_COGGING_FF_H */

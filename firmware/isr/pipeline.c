@@ -678,9 +678,8 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
     fw->refs.torque = fx_add(tref, fw->trim);
 #if CTRL_COGGING
     if (fw->cog_on != 0u && fw->sm.state == FW_STATE_RUNNING) {
-        /* anti-cogging: the table where the rotor will be when the torque
-         * asked now is made (cogging_ff.h's lead), within the limit */
-        const q24_t ff = ctrl_cogging_ff_ahead(&fw->cog.map, fw->enc_pos, est->omega_e);
+        /* anti-cogging: the table at the rotor's position, within the limit */
+        const q24_t ff = ctrl_cogging_ff(&fw->cog.map, fw->enc_pos);
         fw->refs.torque = fx_clamp(fx_add(fw->refs.torque, ff), fx_neg(torque_max), torque_max);
     }
 #endif

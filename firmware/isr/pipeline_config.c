@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "ctrl_cfg_math.h"
-#include "ctrl_foc_config.h"
 #include "ctrl_units.h"
 #include "field_weak_config.h"
 #include "pipeline.h"
@@ -617,41 +616,6 @@ bool fw_commission_poll(fw_t *fw)
 }
 
 /* Initialise desc with cfg into the state block; keep both on success. */
-#if CTRL_COGGING
-/* The anti-cogging look-ahead (cogging_ff.h's lead): tau, the delay from the
- * torque reference to the torque, derived from the drive, not fitted:
- *   1.5 Ts: the reference formed from the position sampled at k acts through
- *           duties applied over [k+1, k+2) (one period of computation, half a
- *           period of the PWM's zero-order hold);
- *   1 / wc: FOC's current loop, Kp = L wc, Ki = R wc (pole cancelled): a
- *           first-order closed loop of time constant 1 / wc (wc from Kp_q / Lq
- *           when Kp_q is set, else the tunable wc, else 2 pi fs / 20, as
- *           ctrl_foc_config.c); a controller of the torque itself (DTC,
- *           MPC) has none.
- * 0, or -1 when the lead does not fit (half a turn per rated speed). */
-static int fw_cogging_lead(fw_t *fw)
-{
-    const double fs = (double)fw->params.fs_hz;
-    double tau = 1.5 / fs;
-    if (fw->ctrl != NULL && strcmp(fw->ctrl->name, "foc") == 0) {
-        const ctrl_foc_cfg_t *c = (const ctrl_foc_cfg_t *)(const void *)fw->ctrl_cfg.bytes;
-        double wc = c->wc > 0.0 ? c->wc : CTRL_TWO_PI * fs / 20.0;
-        if (c->kp_q > 0.0 && fw->machine->lq_h > 0.0) {
-            wc = c->kp_q / fw->machine->lq_h;
-        }
-        tau += 1.0 / wc;
-    }
-    /* Q32 turns per pu electrical speed: tau w_base / (2 pi p) turns */
-    const double lead =
-        tau * fw->bases.w_rad_s / (CTRL_TWO_PI * (double)fw->params.pole_pairs) * 4294967296.0;
-    if (!(lead >= 0.0) || !(lead < 2147483647.0)) {
-        (void)ctrl_cogging_set_lead(&fw->cog.map, 0);
-        return -1;
-    }
-    return ctrl_cogging_set_lead(&fw->cog.map, (int32_t)llround(lead));
-}
-#endif
-
 static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *cfg)
 {
 #if PMSM_LIVE_PARAMS
@@ -681,9 +645,6 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     memcpy(fw->ctrl_state.bytes, st.bytes, sizeof st.bytes);
     memcpy(fw->ctrl_cfg.bytes, cfg, CTRL_CFG_MAX);
     fw->ctrl = d;
-#if CTRL_COGGING
-    (void)fw_cogging_lead(fw); /* fw_cogging_enable refuses a lead that does not fit */
-#endif
     /* Skip the estimates the controller never reads (telemetry takes the
      * rotor-frame values and derives |psi_s| and the sector itself). */
     ctrl_estimator_set_outputs(&fw->est, CTRL_EST_ALL & ~(unsigned)d->est_unused);
@@ -920,9 +881,6 @@ int fw_cogging_enable(fw_t *fw, bool on)
     }
     if (fw->cog.valid == 0u || fw->cog.cal_cpr != fw->enc_cpr) {
         return FW_ENOENT;
-    }
-    if (fw_cogging_lead(fw) != 0) {
-        return FW_ERANGE;
     }
     fw->cog_on = 1u;
     return FW_OK;
