@@ -268,6 +268,21 @@ int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, v
     return FW_OK;
 }
 
+int fw_settings_init(fw_t *fw, hal_t *hal, const settings_t *s, void *cfg_buf, char *why,
+                     size_t cap)
+{
+    ctrl_machine_t m;
+    fw_config_t c;
+    if (fw_settings_config(s, &m, &c, cfg_buf, why, cap) != FW_OK) {
+        return CMD_E_FAILED;
+    }
+    if (fw_init(fw, hal, &c) != FW_OK) {
+        (void)fw_explain(fw, why, cap);
+        return CMD_E_FAILED;
+    }
+    return CMD_OK;
+}
+
 #if CTRL_COGGING
 /* The number x as text (no float conversion in printf). */
 static const char *fw_settings_num(char *buf, size_t cap, double x)

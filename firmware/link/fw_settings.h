@@ -78,6 +78,13 @@ int fw_settings_thr_config(const settings_t *s, thr_config_t *c, char *why, size
 int fw_settings_config(const settings_t *s, ctrl_machine_t *m, fw_config_t *c, void *cfg_buf,
                        char *why, size_t cap);
 
+/* A record's configuration installed on a drive that nothing else holds
+ * (the interactive images, whose commands run between periods): fw_settings_config,
+ * then fw_init. Returns CMD_OK, or CMD_E_FAILED with the reason in why (the
+ * record's refusal, or fw_explain's). */
+int fw_settings_init(fw_t *fw, hal_t *hal, const settings_t *s, void *cfg_buf, char *why,
+                     size_t cap);
+
 /* Start-up: the newest valid record applied through st->apply, else the
  * defaults (st->apply_default when a record was refused). st->msg says which
  * ("settings: record 3 (page 1) applied", "settings: no record in flash,

@@ -72,6 +72,19 @@ static void reset(uint8_t mode)
 /* Runs the sender for ms milliseconds: a pulse is reported at its falling
  * edge with the period since the previous rising edge; thr_update every 1 ms
  * (the main loop). */
+/* The main loop's decoder step at t_us, its arm and disarm events counted. */
+static void update_and_count(void)
+{
+    last = thr_update(&thr, t_us / 1000u);
+    if (last.event == THR_EV_ARM) {
+        n_arm++;
+        t_arm_ms = t_us / 1000u;
+    } else if (last.event == THR_EV_DISARM) {
+        n_disarm++;
+        t_disarm_ms = t_us / 1000u;
+    }
+}
+
 static void run(const sender_t *s, uint32_t ms)
 {
     const uint32_t end = t_us + ms * 1000u;
@@ -88,14 +101,7 @@ static void run(const sender_t *s, uint32_t ms)
         if (s->period_us == 0u) {
             next_us = t_us + 3000u;
         }
-        last = thr_update(&thr, t_us / 1000u);
-        if (last.event == THR_EV_ARM) {
-            n_arm++;
-            t_arm_ms = t_us / 1000u;
-        } else if (last.event == THR_EV_DISARM) {
-            n_disarm++;
-            t_disarm_ms = t_us / 1000u;
-        }
+        update_and_count();
     }
 }
 
@@ -173,14 +179,7 @@ static void run_capture(const sender_t *s, uint32_t spike_at_us, uint32_t ms)
                 thr_pulse(&thr, tim2.ccr2, tim2.ccr1, t_us / 1000u);
             }
         }
-        last = thr_update(&thr, t_us / 1000u);
-        if (last.event == THR_EV_ARM) {
-            n_arm++;
-            t_arm_ms = t_us / 1000u;
-        } else if (last.event == THR_EV_DISARM) {
-            n_disarm++;
-            t_disarm_ms = t_us / 1000u;
-        }
+        update_and_count();
     }
 }
 

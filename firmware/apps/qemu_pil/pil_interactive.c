@@ -55,16 +55,7 @@ static struct {
 static int app_settings_apply(void *ctx, const settings_t *s, char *why, size_t cap)
 {
     (void)ctx;
-    ctrl_machine_t m;
-    fw_config_t c;
-    if (fw_settings_config(s, &m, &c, app.run.ctrl_cfg_buf, why, cap) != FW_OK) {
-        return CMD_E_FAILED;
-    }
-    if (fw_init(&app.run.fw, &app.run.hal, &c) != FW_OK) {
-        (void)fw_explain(&app.run.fw, why, cap);
-        return CMD_E_FAILED;
-    }
-    return CMD_OK;
+    return fw_settings_init(&app.run.fw, &app.run.hal, s, app.run.ctrl_cfg_buf, why, cap);
 }
 
 static int app_settings_default(void *ctx)
