@@ -21,7 +21,23 @@ else()
   message(FATAL_ERROR "f4_image_tests.cmake: no checks for board '${PMSM_BOARD}'")
 endif()
 set(f405_tests ${PMSM_BOARD}_image ${PMSM_BOARD}_image_printf ${PMSM_BOARD}_flash
-    ${PMSM_BOARD}_qemu_boot ${PMSM_BOARD}_qemu_wdg ${PMSM_BOARD}_isr_fpu_free)
+    ${PMSM_BOARD}_qemu_boot ${PMSM_BOARD}_qemu_wdg ${PMSM_BOARD}_isr_fpu_free
+    ${PMSM_BOARD}_stack ${PMSM_BOARD}_stack_limit_fails)
+# The static stack check (tools/stack_check.py), as the B-G431B-ESC1's: every
+# entry point's worst depth from the image's call graph and its
+# -fstack-usage frames, the priority levels nested, within 75 % of the
+# reserved stack; the control interrupt and the medium-rate task free of FPU
+# instructions. And its failure path: a limit below the image's share.
+set(PMSM_F405_STACK_CFG ${PROJECT_SOURCE_DIR}/firmware/apps/f405/stack_check.json)
+set(f405_stack_args --elf ${PMSM_F405_ELF} --config ${PMSM_F405_STACK_CFG}
+    --su-dir ${CMAKE_BINARY_DIR}/firmware/apps/f405 --su-dir ${CMAKE_BINARY_DIR}/hal)
+add_test(NAME ${PMSM_BOARD}_stack
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/stack_check.py ${f405_stack_args}
+                 --verbose)
+add_test(NAME ${PMSM_BOARD}_stack_limit_fails
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/stack_check.py ${f405_stack_args}
+                 --limit 0.30)
+set_tests_properties(${PMSM_BOARD}_stack_limit_fails PROPERTIES WILL_FAIL TRUE)
 # The control interrupt and the medium-rate task without FPU instructions
 # (pmsm_no_fpu): no lazy stacking of the FP context when they preempt.
 add_test(NAME ${PMSM_BOARD}_isr_fpu_free

@@ -16,7 +16,11 @@ Run 1 (the settings sectors erased, as on a new board):
   - start-up lines: reset cause (RCC reads 0: "unknown"), the clock's
     fall-back to HSI naming the HSE, the watchdog's LSI not running, the
     DRV8301 silent ("no answer on SPI"), "gates held off", the settings
-    ("no record");
+    ("no record"), the stack's high-water mark: the start-up code painted
+    the stack, so what the start-up used is found below the whole (an
+    unpainted stack reads as all of it used) and above what its deepest path
+    (the settings' defaults through fw_init) must have used, STACK_MIN_B;
+    "status" gives the mark again, never lower, after every command below;
   - help, status (state, armed=0), config show (no record: refused naming
     why), arm (refused: "err 8 state gates held off: DRV8301 no answer ..."),
     fault (the fault report: none latched), config save (the erase path with
@@ -33,6 +37,7 @@ Each wait is bounded (a hang fails the test by name); exit 0 when all hold.
 """
 import os
 import queue
+import re
 import shutil
 import struct
 import subprocess
@@ -46,6 +51,11 @@ SETTINGS, SETTINGS_SIZE = 0x08004000, 0x8000
 BAD_HANDLER = 0x30000001  # Thumb address of nothing (no memory at 0x3000_0000)
 WAIT_S = 10.0             # one expected line or answer
 RUN_S = 60.0              # one QEMU run, at most
+# Below what the start-up's path to the default configuration (settings with
+# no record -> board_app_reconfigure -> fw_init -> fw_setup_machine) must
+# use: fw_setup_machine's frame alone is 1.7 KiB in these images (its
+# -fstack-usage figure; tools/stack_check.py prints the path).
+STACK_MIN_B = 2048
 
 failures = []
 
@@ -167,7 +177,14 @@ def run_console(elf, tag, serial_index, erased):
           "DRV8301 silent on QEMU's SPI: reported by name, gates held off: " + line)
     line = q.expect(p + "settings: ", "settings") or ""
     check("no record" in line, "settings: erased sectors read as no record: " + line)
-    time.sleep(0.3)  # the console is up once the settings line is out
+    line = q.expect(p + "stack: ", "stack") or ""
+    m = re.search(r"stack: (\d+) of (\d+) B used \(high-water mark\)", line)
+    used, size = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+    check(m is not None and STACK_MIN_B <= used < size,
+          "start-up: the stack's high-water mark from the painting, %d <= used < size "
+          "(an unpainted stack reads as size): %s" % (STACK_MIN_B, line))
+    time.sleep(0.3)  # the console is up once the stack line is out
+    q.stack = (used, size)
 
     a = q.answer("help")
     items = q.items()
@@ -194,8 +211,13 @@ def run_console(elf, tag, serial_index, erased):
           "config save runs the erase path (watchdog's erase window) and names QEMU's "
           "unwritable flash: %s (%.2f s)" % (a, time.monotonic() - t))
     a = q.answer("status")
-    q.items()
+    items = q.items()
     check(a.startswith("ok"), "the console answers after the erase path")
+    st = [re.match(r"stack_used=(\d+) size=(\d+)$", i) for i in items]
+    st = [(int(x.group(1)), int(x.group(2))) for x in st if x]
+    check(len(st) == 1 and st[0][1] == q.stack[1] and q.stack[0] <= st[0][0] < st[0][1],
+          "status: the high-water mark after the commands, not below the start-up's, below "
+          "the size: %s (start-up %d of %d B)" % (st, q.stack[0], q.stack[1]))
     wall = q.close()
     check(wall < RUN_S, "run 1 took %.1f s of wall time" % wall)
     return q.log

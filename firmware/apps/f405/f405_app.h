@@ -90,6 +90,9 @@ void f405_settings_start(f405_t *s);
  * or why there is none. */
 void f405_report_startup(f405_t *s, uint32_t csr);
 void f405_report_line(f405_t *s, const char *a, const char *b, const char *c);
+/* "<tag>stack: <used> of <size> B used (high-water mark)": the main stack's
+ * deepest use since reset (fw_stack.h), after the start-up. */
+void f405_report_stack(f405_t *s, uint32_t used, uint32_t size);
 /* The watchdog's window for a time-out (the values above reach one). */
 void f405_watchdog_set(const f405_t *s, uint32_t ms);
 

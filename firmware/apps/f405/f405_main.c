@@ -18,7 +18,9 @@
  *      (fw_link_set_hold with the reason) while the console stays up;
  *   5. the firmware on the compiled-in machine, the command link, the
  *      throttle capture, the interrupts, the settings record;
- *   6. the watchdog's run window (F405_IWDG_RUN_MS).
+ *   6. the watchdog's run window (F405_IWDG_RUN_MS); the stack's
+ *      high-water mark so far (the start-up's deepest path, the settings
+ *      record's fw_init, is behind it).
  *
  * Interrupts (priority: lower number first):
  *   0 EXTI (nFAULT), TIM1_BRK   gates off first, then the cause latched
@@ -45,6 +47,7 @@
 #include "f4_regs.h"
 #include "f4_startup.h"
 #include "f4_tim.h"
+#include "fw_stack.h"
 #include F405_BOARD_HEADER
 
 _Static_assert(offsetof(f405_t, app) == 0, "the link's context is the f405_t");
@@ -57,6 +60,9 @@ extern const ctrl_machine_t f405_default_machine;
 
 /* Everything lives in one instance; the interrupt handlers take no argument. */
 static f405_t f405;
+
+/* The main stack (stm32f405xg.ld), painted at start-up (fw_stack.h). */
+extern uint32_t __stack_bottom__[], __stack_top__[];
 
 void ADC_IRQHandler(void);
 void PendSV_Handler(void);
@@ -318,6 +324,10 @@ static void f405_slow(f405_t *s)
 
 int main(void)
 {
+    /* The stack below this frame painted: its high-water mark since reset in
+     * "status" and the start-up report (fw_stack.h). 16 words left for the
+     * painting's own call. */
+    fw_stack_paint(__stack_bottom__, f4_sp() - 16u);
     f405_t *s = &f405;
     board_app_t *a = &s->app;
     s->board = &F405_BOARD;
@@ -348,6 +358,7 @@ int main(void)
     }
     /* 5. */
     const int frc = board_app_start(a, &f405_port, &s->hal);
+    fw_link_set_stack(&a->link, __stack_bottom__, __stack_top__);
     f4_iwdg_refresh();
     if (frc != FW_OK) {
         f405_report_line(s, "fw_init failed: ", fw_strerror(frc), "");
@@ -392,6 +403,8 @@ int main(void)
         f405_report_line(s, "watchdog: ", f4_strerror(wrc), "");
         f405_hold(s);
     }
+    f405_report_stack(s, fw_stack_used(__stack_bottom__, __stack_top__),
+                      (uint32_t)((uintptr_t)__stack_top__ - (uintptr_t)__stack_bottom__));
 
     a->last_isr = a->isr_count;
     a->uart.idle = board_app_service;

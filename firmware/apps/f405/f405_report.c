@@ -49,3 +49,11 @@ void f405_report_startup(f405_t *s, uint32_t csr)
         f405_report_line(s, "watchdog: ", line, "");
     }
 }
+
+void f405_report_stack(f405_t *s, uint32_t used, uint32_t size)
+{
+    char line[64];
+    (void)snprintf(line, sizeof line, "%lu of %lu B used (high-water mark)", (unsigned long)used,
+                   (unsigned long)size);
+    f405_report_line(s, "stack: ", line, "");
+}
