@@ -3,6 +3,8 @@
 # simulator reads.
 set(PMSM_ESC1_MACHINE_INI "${PROJECT_SOURCE_DIR}/sim_host/machines/gbm5208_gimbal.ini"
     CACHE FILEPATH "machine file compiled into the B-G431B-ESC1 image as its default motor")
+set(PMSM_F405_MACHINE_INI "${PROJECT_SOURCE_DIR}/sim_host/machines/mj5208_drone.ini"
+    CACHE FILEPATH "machine file compiled into the STM32F405 board images as their default motor")
 
 # pmsm_machine_c(<out.c> <machine.ini> <symbol>): a rule that writes
 # "const ctrl_machine_t <symbol> = {...};" to <out.c>.
