@@ -21,7 +21,7 @@ typedef struct {
 /* Reason word of each error code, in the "err <code> <reason>" line. */
 static const char *const cmd_reasons[CMD_E_COUNT] = {
     "ok",   "unknown", "args",  "number", "range",    "name",        "long",
-    "char", "state",   "fault", "failed", "readonly", "unsupported",
+    "char", "state",   "fault", "failed", "readonly", "unsupported", "lost",
 };
 
 /* ---- output: one line at a time, printable only, truncated to CMD_OUT_MAX ---- */
@@ -1181,11 +1181,13 @@ bool cmd_feed_byte(cmd_t *c, uint8_t byte)
         return false;
     }
     if (byte == '\r' || byte == '\n') {
-        const bool had = (c->len != 0u || c->overflow || c->bad_char);
+        const bool had = (c->len != 0u || c->overflow || c->bad_char || c->lost != NULL);
         if (had) {
             cmd_echo_out(c, "\r\n", 2);
         }
-        if (c->overflow) {
+        if (c->lost != NULL) {
+            cmd_err(c, CMD_E_LOST, c->lost);
+        } else if (c->overflow) {
             cmd_err(c, CMD_E_LONG, NULL);
         } else if (c->bad_char) {
             cmd_err(c, CMD_E_CHAR, NULL);
@@ -1195,8 +1197,12 @@ bool cmd_feed_byte(cmd_t *c, uint8_t byte)
         c->len = 0;
         c->overflow = false;
         c->bad_char = false;
+        c->lost = NULL;
         c->line[0] = '\0';
         return had;
+    }
+    if (c->lost != NULL) {
+        return false; /* a line with a hole: nothing of it counts */
     }
     if (byte == 0x08u || byte == 0x7Fu) {
         /* erase one character; a discarded line stays discarded */
@@ -1223,4 +1229,11 @@ bool cmd_feed_byte(cmd_t *c, uint8_t byte)
     const char ch = (byte == '\t') ? ' ' : (char)byte; /* echo printable only */
     cmd_echo_out(c, &ch, 1);
     return false;
+}
+
+void cmd_line_lost(cmd_t *c, const char *why)
+{
+    if (c != NULL && c->lost == NULL) {
+        c->lost = why != NULL ? why : "on reception";
+    }
 }

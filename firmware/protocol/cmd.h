@@ -6,10 +6,11 @@
  * is ignored. Backspace (0x08) and DEL (0x7F) erase the last character. A line
  * longer than CMD_LINE_MAX characters, or containing a byte outside
  * 0x20..0x7E (TAB counts as a space), is discarded entirely and answered with
- * an error. Every response to a line starts with "ok" or "err <code> <reason>";
- * list responses are "ok <n>" followed by exactly n lines starting with two
- * spaces. Lines end with "\r\n" and never exceed CMD_OUT_MAX bytes; no
- * response byte is ever 0x00 (the telemetry frame delimiter).
+ * an error; so is a line some of whose bytes the receiver lost (cmd_line_lost:
+ * an overrun, a framing error), answered at its end of line. Every response to a line starts with
+ * "ok" or "err <code> <reason>"; list responses are "ok <n>" followed by exactly n lines starting
+ * with two spaces. Lines end with "\r\n" and never exceed CMD_OUT_MAX bytes; no response byte is
+ * ever 0x00 (the telemetry frame delimiter).
  *
  * The interpreter reaches the firmware only through cmd_ops_t (implemented by
  * the firmware pipeline, a mock in the tests). A command is validated
@@ -45,6 +46,7 @@ typedef enum {
     CMD_E_FAILED = 10,      /* the firmware refused or failed */
     CMD_E_READONLY = 11,    /* parameter is read-only */
     CMD_E_UNSUPPORTED = 12, /* the firmware does not implement this op */
+    CMD_E_LOST = 13,        /* bytes of the line were lost on reception */
     CMD_E_COUNT
 } cmd_err_t;
 
@@ -190,6 +192,7 @@ typedef struct {
     size_t len;
     bool overflow;             /* the current line exceeded CMD_LINE_MAX */
     bool bad_char;             /* the current line contained a rejected byte */
+    const char *lost;          /* why bytes of the current line were lost (NULL: none) */
     bool echo;                 /* echo input (for terminals without local echo) */
     uint8_t cm_kind;           /* CMD_CM_IDENT or _BRINGUP: what the last start began (0: none
                                   since reset); the other's status answers idle */
@@ -203,6 +206,12 @@ void cmd_init(cmd_t *c, const cmd_ops_t *ops, void *ctx);
  * true when the byte ended a line that was answered (executed or refused):
  * the main loop serves its watchdogs then, before the next line. */
 bool cmd_feed_byte(cmd_t *c, uint8_t byte);
+
+/* The receiver lost bytes before the next one fed (an overrun while the
+ * core stalled, a framing error): the line being assembled is discarded up
+ * to its end of line, which is answered "err 13 lost <why>" (why: a
+ * sentence that outlives the line; the first loss of a line is named). */
+void cmd_line_lost(cmd_t *c, const char *why);
 
 /* Execute one line (without terminator; len <= CMD_LINE_MAX, printable
  * characters only). Used by cmd_feed_byte; exposed for scripted use. */

@@ -48,8 +48,14 @@ void g4_usart2_init(uint32_t brr)
     g4_mod(G4_RCC + G4_RCC_CCIPR, G4_RCC_CCIPR_USART2SEL_MASK, 0u); /* PCLK1 */
     g4_wr(G4_USART2 + G4_USART_CR1, 0u);
     g4_wr(G4_USART2 + G4_USART_BRR, brr);
-    g4_wr(G4_USART2 + G4_USART_CR1,
-          G4_USART_CR1_UE | G4_USART_CR1_RE | G4_USART_CR1_TE | G4_USART_CR1_RXNEIE);
+    /* FIFO mode, programmed while UE = 0 (RM0440 USART_CR1.FIFOEN): the
+     * RXFIFO keeps 8 characters while the core stalls on a flash page
+     * erase, where RDR alone keeps 1 (RXNEIE is then RXFNEIE: an interrupt
+     * while the RXFIFO is not empty). */
+    const uint32_t cr1 =
+        G4_USART_CR1_FIFOEN | G4_USART_CR1_RE | G4_USART_CR1_TE | G4_USART_CR1_RXNEIE;
+    g4_wr(G4_USART2 + G4_USART_CR1, cr1);
+    g4_wr(G4_USART2 + G4_USART_CR1, cr1 | G4_USART_CR1_UE);
 }
 
 int g4_iwdg_start(uint32_t pr, uint32_t rlr, uint32_t f_cpu_hz)

@@ -388,16 +388,22 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_USART_CR1_UE G4_BIT(0)
 #define G4_USART_CR1_RE G4_BIT(2)
 #define G4_USART_CR1_TE G4_BIT(3)
-#define G4_USART_CR1_RXNEIE G4_BIT(5)
-#define G4_USART_CR1_TXEIE G4_BIT(7)
+#define G4_USART_CR1_RXNEIE G4_BIT(5) /* RXFNEIE in FIFO mode */
+#define G4_USART_CR1_TXEIE G4_BIT(7)  /* TXFNFIE in FIFO mode */
+/* FIFO mode: an RXFIFO and a TXFIFO of 8 characters each (RM0440 USART,
+ * "USART FIFOs and thresholds"; ST's stm32g4xx_hal_uart_ex.c RX_FIFO_DEPTH);
+ * FIFOEN is written only with UE = 0 (RM0440 USART_CR1). */
+#define G4_USART_CR1_FIFOEN G4_BIT(29)
+#define G4_USART_FIFO_DEPTH 8u
 #define G4_USART_BRR 0x0Cu
 #define G4_USART_ISR 0x1Cu
 #define G4_USART_ISR_FE G4_BIT(1)
 #define G4_USART_ISR_NE G4_BIT(2)
 #define G4_USART_ISR_ORE G4_BIT(3)
-#define G4_USART_ISR_RXNE G4_BIT(5)
+#define G4_USART_ISR_RXNE G4_BIT(5) /* RXFNE in FIFO mode: RDR holds the RXFIFO's oldest */
 #define G4_USART_ISR_TC G4_BIT(6)
-#define G4_USART_ISR_TXE G4_BIT(7)
+#define G4_USART_ISR_TXE G4_BIT(7) /* TXFNF in FIFO mode */
+#define G4_USART_ISR_RXFF G4_BIT(24)
 #define G4_USART_ICR 0x20u
 #define G4_USART_ICR_FECF G4_BIT(1)
 #define G4_USART_ICR_NECF G4_BIT(2)

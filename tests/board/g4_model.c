@@ -141,6 +141,41 @@ int g4_model_find_last(uintptr_t reg, uint32_t mask, uint32_t want)
     return -1;
 }
 
+/* USART2's receive flags from the model's RDR / RXFIFO: RXNE (RXFNE) while
+ * a character waits, RXFF with the RXFIFO full, FE raised when a character
+ * with a framing error is the one in RDR (cleared only by ICR.FECF). */
+static void g4_model_usart_flags(void)
+{
+    const uint32_t cr1 = g4_mem_usart2[G4_USART_CR1 / 4u];
+    uint32_t isr = g4_mem_usart2[G4_USART_ISR / 4u] & ~(G4_USART_ISR_RXNE | G4_USART_ISR_RXFF);
+    if (g4_model.usart_n > 0u) {
+        isr |= G4_USART_ISR_RXNE;
+        if ((g4_model.usart_fifo[0] & 0x100u) != 0u) {
+            isr |= G4_USART_ISR_FE;
+        }
+    }
+    if ((cr1 & G4_USART_CR1_FIFOEN) != 0u && g4_model.usart_n == G4_USART_FIFO_DEPTH) {
+        isr |= G4_USART_ISR_RXFF;
+    }
+    g4_mem_usart2[G4_USART_ISR / 4u] = isr;
+}
+
+void g4_model_usart_rx(uint8_t c, bool framing_error)
+{
+    const uint32_t cr1 = g4_mem_usart2[G4_USART_CR1 / 4u];
+    if ((cr1 & (G4_USART_CR1_UE | G4_USART_CR1_RE)) != (G4_USART_CR1_UE | G4_USART_CR1_RE)) {
+        return;
+    }
+    const uint32_t depth = (cr1 & G4_USART_CR1_FIFOEN) != 0u ? G4_USART_FIFO_DEPTH : 1u;
+    if (g4_model.usart_n >= depth) {
+        g4_mem_usart2[G4_USART_ISR / 4u] |= G4_USART_ISR_ORE;
+        g4_model.usart_lost++;
+        return;
+    }
+    g4_model.usart_fifo[g4_model.usart_n++] = (uint16_t)(c | (framing_error ? 0x100u : 0u));
+    g4_model_usart_flags();
+}
+
 uint32_t g4_trace_read(uintptr_t reg)
 {
     uint32_t *c = g4_model_cell(reg);
@@ -178,6 +213,13 @@ uint32_t g4_trace_read(uintptr_t reg)
     }
     if (reg == G4_TIM1 + G4_TIM_SR && (g4_mem_tim1[G4_TIM_CR1 / 4u] & G4_TIM_CR1_CEN) != 0u) {
         *c |= G4_TIM_SR_UIF; /* the counter runs: updates come */
+    }
+    if (reg == G4_USART2 + G4_USART_RDR && g4_model.usart_n > 0u) {
+        *c = g4_model.usart_fifo[0] & 0xFFu; /* the oldest leaves */
+        g4_model.usart_n--;
+        memmove(&g4_model.usart_fifo[0], &g4_model.usart_fifo[1],
+                g4_model.usart_n * sizeof g4_model.usart_fifo[0]);
+        g4_model_usart_flags();
     }
     if (reg >= G4_COMP && reg < G4_COMP + 0x10u) {
         *c = (*c & ~G4_COMP_CSR_VALUE) | (g4_model.comp_high ? G4_COMP_CSR_VALUE : 0u);

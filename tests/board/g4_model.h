@@ -45,6 +45,12 @@ typedef struct {
     void (*irq_pending)(void); /* taken when PRIMASK clears */
     /* Called after every register write (NULL: none): a test's probe. */
     void (*on_write)(uintptr_t reg, uint32_t value);
+    /* USART2's receiver (g4_model_usart_rx): RDR, or with CR1.FIFOEN the
+     * RXFIFO, oldest first; each entry a character, | 0x100 for a framing
+     * error. */
+    uint16_t usart_fifo[G4_USART_FIFO_DEPTH];
+    uint32_t usart_n;
+    uint32_t usart_lost; /* characters an overrun lost */
     /* state the model keeps */
     bool rcr_before_cen;
     bool rcr_written;
@@ -66,6 +72,12 @@ const char *g4_model_name(uintptr_t reg);
 int g4_model_find(uintptr_t reg, uint32_t mask, uint32_t want, int from);
 /* The same, last such write. */
 int g4_model_find_last(uintptr_t reg, uint32_t mask, uint32_t want);
+/* A character arrives on USART2's RX pin (received only with CR1.UE and
+ * RE): into RDR, with CR1.FIFOEN into the 8-character RXFIFO; with no room
+ * it is lost and ORE set (RM0440 USART_ISR.ORE; RDR's, the RXFIFO's
+ * content is kept). framing_error: FE with the character when it reaches
+ * RDR. ISR.RXNE (RXFNE), RXFF and FE follow; a read of RDR pops it. */
+void g4_model_usart_rx(uint8_t c, bool framing_error);
 /* Current register content. */
 uint32_t g4_model_get(uintptr_t reg);
 void g4_model_put(uintptr_t reg, uint32_t value);

@@ -608,6 +608,116 @@ static void test_main_loop_serves_the_watchdog_between_commands(void)
     TEST_ASSERT_EQUAL_STRING("ok 10", reply[12]);
 }
 
+/* ---- USART2's receiver on the register model (g4_model_usart_rx) ---- */
+
+/* The board's serial link as esc1_main.c starts it, on a calibrated drive;
+ * the main loop's clocks as the test above sets them. */
+static void serial_on(void)
+{
+    calibrate_at(2553u);
+    esc.ms_cycles = 170000u;
+    esc.temp_period = 0xFFFFFFFFu;
+    esc.t_temp = g4_cycles();
+    TEST_ASSERT_EQUAL_INT(G4_OK,
+                          esc1_uart_init(&esc.uart, g4_board_esc1.sysclk_hz, g4_board_esc1.baud));
+}
+
+/* Characters on the wire; serviced: the USART interrupt runs after each (a
+ * core that does not stall), else they wait in the receiver (a core stalled
+ * on a flash page erase: 2 x 24.5 ms is over 500 characters at 115 200 Bd). */
+static void wire(const char *text, bool serviced)
+{
+    for (const char *c = text; *c != '\0'; c++) {
+        g4_model_usart_rx((uint8_t)*c, false);
+        if (serviced) {
+            esc1_uart_irq(&esc.uart);
+        }
+    }
+}
+
+/* The main loop until the receive ring is empty (one line per pass). */
+static void main_loop_drains(void)
+{
+    esc1_uart_irq(&esc.uart);
+    for (unsigned pass = 0; pass < 8u && esc.uart.rx_head != esc.uart.rx_tail; pass++) {
+        esc.isr_count++;
+        esc1_loop_once(&esc);
+    }
+    TEST_ASSERT_EQUAL_UINT32(esc.uart.rx_head, esc.uart.rx_tail);
+}
+
+static char fault_alone[160];
+static char rs_before[160];
+
+static void serial_references(void)
+{
+    strcpy(fault_alone, command("fault"));
+    strcpy(rs_before, command("param get m.rs_ohm"));
+}
+
+/* Bytes an overrun lost in the middle of a line (the core stalled while
+ * "rs_ohm 15.0" arrived: the RXFIFO kept 8 characters, ORE lost 3): the line
+ * is discarded up to its end of line and answered "err 13 lost" naming the
+ * overrun (what is left of it, "param set m.rs_ohm 19", is not run), and the
+ * next command is answered alone, as it is without the loss. */
+static void test_overrun_discards_its_line(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("param set m.", true);
+    wire("rs_ohm 15.0", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(3u, g4_model.usart_lost);
+    wire("9\r", true);
+    wire("fault\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(2u, answers(), "one answer per end of line");
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[1]);
+    TEST_ASSERT_EQUAL_STRING(rs_before, command("param get m.rs_ohm"));
+    TEST_ASSERT_EQUAL_UINT32(1u, esc.uart.rx_errors);
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model_get(G4_USART2 + G4_USART_ISR) & G4_USART_ISR_ORE);
+}
+
+/* A short line sent while the core stalls (a script that does not wait for
+ * "config erase"'s answer) survives in the 8-character RXFIFO, and so does
+ * the next command: nothing of one prefixes the other. */
+static void test_rx_fifo_keeps_a_short_line_through_a_stall(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("fault\r", false); /* stalled */
+    wire("fault\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[0]);
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[1]);
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model.usart_lost);
+    TEST_ASSERT_EQUAL_UINT32(0u, esc.uart.rx_errors);
+}
+
+/* A character received with a framing error (FE: RM0440 USART_ISR, the
+ * character in RDR) is a lost one: its line is answered "err 13 lost"
+ * naming it, the next line alone; the byte itself is not taken. */
+static void test_framing_error_discards_its_line(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("param set m.rs_ohm 1", true);
+    g4_model_usart_rx('7', true);
+    esc1_uart_irq(&esc.uart);
+    wire("5.09\r", true);
+    wire("fault\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost framing (FE)", reply[0]);
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[1]);
+    TEST_ASSERT_EQUAL_STRING(rs_before, command("param get m.rs_ohm"));
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model_get(G4_USART2 + G4_USART_ISR) & G4_USART_ISR_FE);
+}
+
 /* "status" gives the main stack's high-water mark once the application has
  * told the link where its painted stack lies. */
 static void test_status_gives_the_stack_high_water_mark(void)
@@ -781,6 +891,9 @@ int main(void)
     RUN_TEST(test_throttle_survives_a_power_cycle);
     RUN_TEST(test_main_loop_serves_the_watchdog_between_commands);
     RUN_TEST(test_status_gives_the_stack_high_water_mark);
+    RUN_TEST(test_overrun_discards_its_line);
+    RUN_TEST(test_rx_fifo_keeps_a_short_line_through_a_stall);
+    RUN_TEST(test_framing_error_discards_its_line);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
     RUN_TEST(test_speed_reference_limit_is_the_drives);

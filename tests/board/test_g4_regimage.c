@@ -779,16 +779,21 @@ static void test_iwdg_sequence(void)
     assert_before(rlr, refresh, "reload before the first refresh");
 }
 
-/* USART2 at 115200 Bd from 170 MHz: BRR 1476 (test_g4_calc), CR1 = UE | RE
- * | TE | RXNEIE = 0x2D, written after BRR (BRR is writable only while UE = 0). */
+/* USART2 at 115200 Bd from 170 MHz: BRR 1476 (test_g4_calc), CR1 = FIFOEN |
+ * RE | TE | RXNEIE (RXFNEIE) | UE = 0x2000_002D (bit positions: ST's
+ * stm32g431xx.h USART_CR1_FIFOEN_Pos 29, RXNEIE_RXFNEIE 5, TE 3, RE 2, UE 0),
+ * BRR and FIFOEN written while UE = 0 (RM0440 USART_BRR, USART_CR1). */
 static void test_usart_image(void)
 {
     g4_usart2_init(1476u);
     TEST_ASSERT_EQUAL_UINT32(1476u, reg(G4_USART2 + G4_USART_BRR));
-    TEST_ASSERT_EQUAL_HEX32(0x2Du, reg(G4_USART2 + G4_USART_CR1));
-    assert_before(g4_model_find(G4_USART2 + G4_USART_BRR, 0u, 0u, 0),
-                  g4_model_find(G4_USART2 + G4_USART_CR1, G4_USART_CR1_UE, G4_USART_CR1_UE, 0),
+    TEST_ASSERT_EQUAL_HEX32(0x2000002Du, reg(G4_USART2 + G4_USART_CR1));
+    const int enable = g4_model_find(G4_USART2 + G4_USART_CR1, G4_USART_CR1_UE, G4_USART_CR1_UE, 0);
+    assert_before(g4_model_find(G4_USART2 + G4_USART_BRR, 0u, 0u, 0), enable,
                   "baud rate set while the USART is disabled");
+    assert_before(g4_model_find(G4_USART2 + G4_USART_CR1, G4_USART_CR1_FIFOEN | G4_USART_CR1_UE,
+                                G4_USART_CR1_FIFOEN, 0),
+                  enable, "FIFO mode set while the USART is disabled");
 }
 
 /* TIM2 as the throttle's capture, the PWM input mode of RM0440's TIM2/3/4/5

@@ -313,6 +313,34 @@ static void test_overlong_and_bad_bytes(void)
     TEST_ASSERT_EQUAL_STRING("err 6 long\r\n", m.out);
 }
 
+/* Bytes the receiver lost (cmd_line_lost before the next byte): the whole
+ * line up to its end of line is void, whatever is left of it ("arm" after
+ * "dis" was lost), backspace does not revive it, the answer names the loss;
+ * the next line is parsed alone. */
+static void test_lost_bytes_void_their_line(void)
+{
+    const mock_state_t before = m.st;
+    mock_clear_out(&m);
+    mock_feed(&c, "ref torque 0.");
+    cmd_line_lost(&c, "overrun (ORE)");
+    cmd_line_lost(&c, "framing (FE)"); /* the first loss is named */
+    mock_feed(&c, "5\b\b\r");
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)\r\n", m.out);
+    mock_clear_out(&m);
+    cmd_line_lost(&c, "overrun (ORE)");
+    mock_feed(&c, "arm\r\nfault\r\n");
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)\r\nok fault 0 none\r\n", m.out);
+    TEST_ASSERT_EQUAL_UINT(0, m.mut_calls);
+    TEST_ASSERT_TRUE(mock_state_equal(&before, &m.st));
+    /* a loss right before the end of line voids the line it ends */
+    mock_clear_out(&m);
+    mock_feed(&c, "arm");
+    cmd_line_lost(&c, NULL);
+    mock_feed(&c, "\n");
+    TEST_ASSERT_EQUAL_STRING("err 13 lost on reception\r\n", m.out);
+    assert_ok("arm", "ok armed");
+}
+
 static void test_echo(void)
 {
     assert_ok("echo on", "ok echo on");
@@ -352,6 +380,7 @@ int main(void)
     RUN_TEST(test_state_preconditions_and_op_failures);
     RUN_TEST(test_line_editing);
     RUN_TEST(test_overlong_and_bad_bytes);
+    RUN_TEST(test_lost_bytes_void_their_line);
     RUN_TEST(test_echo);
     RUN_TEST(test_unsupported_ops);
     return UNITY_END();

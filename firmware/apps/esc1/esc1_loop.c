@@ -55,6 +55,9 @@ void esc1_loop_once(esc1_t *s)
      * one per pass, with the watchdogs served in between. */
     int c;
     while ((c = esc1_uart_getc(&s->uart)) >= 0) {
+        if (c > 0xFF) { /* bytes lost before this one: their line is void */
+            cmd_line_lost(&s->link.cmd, esc1_uart_lost_why(c));
+        }
         if (fw_link_rx(&s->link, (uint8_t)c)) {
             break;
         }

@@ -31,9 +31,9 @@ int esc1_uart_getc(esc1_uart_t *u)
     if (t == u->rx_head) {
         return -1;
     }
-    atomic_signal_fence(memory_order_acquire); /* the byte after its count */
-    const int c = u->rx[t & (ESC1_UART_RX_SIZE - 1u)];
-    atomic_signal_fence(memory_order_release); /* read before its slot is handed back */
+    atomic_signal_fence(memory_order_acquire);         /* the byte after its count */
+    const int c = u->rx[t & (ESC1_UART_RX_SIZE - 1u)]; /* with its losses (bits 8..11) */
+    atomic_signal_fence(memory_order_release);         /* read before its slot is handed back */
     u->rx_tail = t + 1u;
     return c;
 }
@@ -79,23 +79,52 @@ void esc1_uart_puts_polled(esc1_uart_t *u, const char *s)
     }
 }
 
+const char *esc1_uart_lost_why(int c)
+{
+    const uint32_t lost = (uint32_t)c >> 8;
+    return (lost & G4_USART_ISR_ORE) != 0u  ? "overrun (ORE)"
+           : (lost & G4_USART_ISR_FE) != 0u ? "framing (FE)"
+           : (lost & G4_USART_ISR_NE) != 0u ? "noise (NE)"
+                                            : "ring full";
+}
+
 void esc1_uart_irq(esc1_uart_t *u)
 {
-    const uint32_t isr = g4_rd(G4_USART2 + G4_USART_ISR);
-    if ((isr & (G4_USART_ISR_ORE | G4_USART_ISR_FE | G4_USART_ISR_NE)) != 0u) {
-        u->rx_errors++;
-        g4_wr(G4_USART2 + G4_USART_ICR, G4_USART_ICR_ORECF | G4_USART_ICR_FECF | G4_USART_ICR_NECF);
-    }
-    if ((isr & G4_USART_ISR_RXNE) != 0u) {
-        const uint8_t c = (uint8_t)g4_rd(G4_USART2 + G4_USART_RDR); /* clears RXNE */
-        if (u->rx_head - u->rx_tail < ESC1_UART_RX_SIZE) {
+    /* The RXFIFO (RM0440 USART, FIFO mode), oldest first, at most its depth:
+     * an overrun sets ORE only while the RXFIFO is full (RM0440 USART_ISR.ORE)
+     * and only this loop reads it, so the characters an overrun lost came
+     * after every one drained here, and ORE is looked at after them. */
+    for (uint32_t n = 0; n < G4_USART_FIFO_DEPTH; n++) {
+        const uint32_t isr = g4_rd(G4_USART2 + G4_USART_ISR);
+        if ((isr & G4_USART_ISR_RXNE) == 0u) {
+            break;
+        }
+        /* FE and NE are the character's in RDR: cleared before it is read,
+         * as ST's HAL does, so that the next character's stay. */
+        const uint32_t bad = isr & (G4_USART_ISR_FE | G4_USART_ISR_NE);
+        if (bad != 0u) {
+            g4_wr(G4_USART2 + G4_USART_ICR, G4_USART_ICR_FECF | G4_USART_ICR_NECF);
+        }
+        const uint32_t c = g4_rd(G4_USART2 + G4_USART_RDR) & 0xFFu; /* pops the RXFIFO */
+        if (bad != 0u) {
+            u->rx_errors++;
+            u->rx_lost |= bad; /* a damaged character is a lost one */
+        } else if (u->rx_head - u->rx_tail < ESC1_UART_RX_SIZE) {
             atomic_signal_fence(memory_order_acquire);
-            u->rx[u->rx_head & (ESC1_UART_RX_SIZE - 1u)] = c;
+            u->rx[u->rx_head & (ESC1_UART_RX_SIZE - 1u)] = (uint16_t)(c | u->rx_lost << 8);
             atomic_signal_fence(memory_order_release); /* the byte before its count */
             u->rx_head++;
+            u->rx_lost = 0u;
         } else {
             u->rx_dropped++;
+            u->rx_lost |= ESC1_UART_LOST_FULL;
         }
+    }
+    const uint32_t isr = g4_rd(G4_USART2 + G4_USART_ISR);
+    if ((isr & G4_USART_ISR_ORE) != 0u) {
+        g4_wr(G4_USART2 + G4_USART_ICR, G4_USART_ICR_ORECF);
+        u->rx_errors++;
+        u->rx_lost |= G4_USART_ISR_ORE;
     }
     if ((isr & G4_USART_ISR_TXE) != 0u &&
         (g4_rd(G4_USART2 + G4_USART_CR1) & G4_USART_CR1_TXEIE) != 0u) {

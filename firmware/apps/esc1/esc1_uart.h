@@ -16,12 +16,21 @@
 #define ESC1_UART_RX_SIZE 256u /* powers of two */
 #define ESC1_UART_TX_SIZE 1024u
 
+/* What the receiver lost right before a received byte (bits of its ring
+ * entry above the byte): USART_ISR's error flags at their own positions
+ * (RM0440 USART_ISR: FE bit 1, NE bit 2, ORE bit 3), and bit 0 (PE's place:
+ * no parity on this link) for the receive ring found full. */
+#define ESC1_UART_LOST_FULL 0x1u
+#define ESC1_UART_LOST_MASK 0xFu
+
 typedef struct {
-    uint8_t rx[ESC1_UART_RX_SIZE];
+    /* byte | (ESC1_UART_LOST_* of the bytes lost right before it) << 8 */
+    uint16_t rx[ESC1_UART_RX_SIZE];
     uint8_t tx[ESC1_UART_TX_SIZE];
     volatile uint32_t rx_head, rx_tail; /* head: interrupt, tail: main loop */
     volatile uint32_t tx_head, tx_tail; /* head: main loop, tail: interrupt */
     volatile uint32_t rx_dropped, rx_errors;
+    uint32_t rx_lost; /* interrupt only: losses since the last byte stored */
     uint32_t tx_dropped;
     uint32_t tx_wait_cycles; /* longest wait for transmit space before dropping */
     uint32_t byte_cycles;    /* one character on the line, core cycles */
@@ -34,8 +43,11 @@ typedef struct {
 /* Pins, USART2 8N1 at `baud` from PCLK1 = f_pclk_hz. Returns G4_OK or
  * G4_E_CONFIG. */
 int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud);
-/* Next received byte, or -1. */
+/* Next received byte, or -1; bits 8..11 (ESC1_UART_LOST_* << 8) say that
+ * bytes were lost right before it (esc1_uart_lost_why names it). */
 int esc1_uart_getc(esc1_uart_t *u);
+/* What a getc's bits 8..11 say was lost, for "err 13 lost <why>". */
+const char *esc1_uart_lost_why(int c);
 /* Queues bytes; when the ring is full it waits for the interrupt to drain
  * it, up to tx_wait_cycles per byte, calling idle meanwhile, then drops the
  * rest (counted). */
@@ -45,7 +57,9 @@ void esc1_uart_puts(esc1_uart_t *u, const char *s);
  * interrupt is enabled, and the halt loop). Gives up on a character after
  * four character times without TXE (counted in tx_dropped). */
 void esc1_uart_puts_polled(esc1_uart_t *u, const char *s);
-/* USART2 interrupt. */
+/* USART2 interrupt: the RXFIFO drained into the receive ring, each loss
+ * (an overrun, a framing or noise error, the ring full) marked on the next
+ * byte stored; a byte to send when the TXFIFO has room. */
 void esc1_uart_irq(esc1_uart_t *u);
 
 #endif /* FIRMWARE_APPS_ESC1_ESC1_UART_H */
