@@ -124,13 +124,28 @@ void g4_tim2_capture_init(uint32_t psc, uint32_t icf)
 
 bool g4_tim2_capture_read(uint32_t *width, uint32_t *period)
 {
+    /* PWM input mode (RM0440 TIM2/3/4/5): the rising edge that ends a period
+     * captures it in CCR1 and restarts the counter; CCR2 keeps the width of
+     * the period's own pulse until the next pulse's falling edge overwrites
+     * it. Reading CCR1 clears CC1IF, reading CCR2 clears CC2IF (RM0440
+     * TIMx_SR), so no flag of a capture that lands meanwhile is written
+     * away. */
     if ((g4_rd(G4_TIM2 + G4_TIM_SR) & G4_TIM_SR_CC1IF) == 0u) {
         return false;
     }
-    *width = g4_rd(G4_TIM2 + G4_TIM_CCR2);
-    *period = g4_rd(G4_TIM2 + G4_TIM_CCR1);
-    /* Captures overwritten meanwhile (a slow main loop) only lose pulses. */
-    g4_wr(G4_TIM2 + G4_TIM_SR,
-          ~(G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_CC1OF | G4_TIM_SR_CC2OF));
+    const uint32_t c0 = g4_rd(G4_TIM2 + G4_TIM_CNT);
+    const uint32_t p = g4_rd(G4_TIM2 + G4_TIM_CCR1);
+    const uint32_t w = g4_rd(G4_TIM2 + G4_TIM_CCR2);
+    const uint32_t c1 = g4_rd(G4_TIM2 + G4_TIM_CNT); /* microseconds since the period ended */
+    /* A rising edge during the reads restarted the counter (c1 < c0): CCR1
+     * may hold the next period. A width not above the counter may be the
+     * next pulse's, captured since the period ended (the read came later
+     * than the pulse's width). Either way the pair is not one period's: the
+     * period is not reported (the next one is). */
+    if (c1 < c0 || w <= c1) {
+        return false;
+    }
+    *width = w;
+    *period = p;
     return true;
 }

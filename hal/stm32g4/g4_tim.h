@@ -78,8 +78,11 @@ void g4_tim4_encoder_init(uint32_t icf, bool index);
  * resets the counter (slave reset mode on TI1FP1): CCR1 = period, CCR2 =
  * width, in ticks of f_tim / (psc + 1); 32-bit counter; input filter `icf`. */
 void g4_tim2_capture_init(uint32_t psc, uint32_t icf);
-/* A period has ended since the last call (CC1IF): its width (CCR2, read
- * first) and period (CCR1, whose read clears CC1IF), ticks; false if not. */
+/* A period has ended since the last call (CC1IF): its pulse's width (CCR2)
+ * and the period (CCR1), ticks, one period's pair; false if not, and false
+ * when the reads cannot be sure of the pair: a rising edge during them, or
+ * the next pulse's falling edge already captured (a read later than the
+ * pulse's width after the period's end). */
 bool g4_tim2_capture_read(uint32_t *width, uint32_t *period);
 
 /* The 16-bit encoder counter extended to the 32-bit count of hal.h

@@ -214,6 +214,14 @@ uint32_t g4_trace_read(uintptr_t reg)
     if (reg == G4_TIM1 + G4_TIM_SR && (g4_mem_tim1[G4_TIM_CR1 / 4u] & G4_TIM_CR1_CEN) != 0u) {
         *c |= G4_TIM_SR_UIF; /* the counter runs: updates come */
     }
+    /* TIM2's captures (CC1S, CC2S inputs, the throttle): reading CCRx
+     * clears CCxIF (RM0440 TIMx_SR). */
+    if (reg == G4_TIM2 + G4_TIM_CCR1) {
+        g4_mem_tim2[G4_TIM_SR / 4u] &= ~G4_TIM_SR_CC1IF;
+    }
+    if (reg == G4_TIM2 + G4_TIM_CCR2) {
+        g4_mem_tim2[G4_TIM_SR / 4u] &= ~G4_TIM_SR_CC2IF;
+    }
     if (reg == G4_USART2 + G4_USART_RDR && g4_model.usart_n > 0u) {
         *c = g4_model.usart_fifo[0] & 0xFFu; /* the oldest leaves */
         g4_model.usart_n--;

@@ -816,8 +816,9 @@ static void test_usart_image(void)
  *    CEN (else the first period would count at the reset's prescaler 0);
  *  - ARR = 0xFFFFFFFF (TIM2 is 32-bit: no wrap within any period);
  *  - CR1 = CEN last, after the mode is set.
- * Read: CC1IF set -> width = CCR2, period = CCR1, and CC1IF, CC2IF, CC1OF,
- * CC2OF cleared (rc_w0: the other flags are written 1, untouched). */
+ * Read: CC1IF set -> width = CCR2, period = CCR1; the flags cleared by the
+ * reads of CCR1 and CCR2 (RM0440 TIMx_SR), SR never written: a flag set
+ * meanwhile stays. */
 static void test_tim2_capture_image(void)
 {
     TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
@@ -846,12 +847,108 @@ static void test_tim2_capture_image(void)
     TEST_ASSERT_EQUAL_UINT32(7u, w);
     g4_model_put(t + G4_TIM_CCR1, 20000u); /* 50 Hz */
     g4_model_put(t + G4_TIM_CCR2, 1500u);
-    const uint32_t flags = G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_CC1OF | G4_TIM_SR_CC2OF;
-    g4_model_put(t + G4_TIM_SR, flags | G4_TIM_SR_UIF);
+    g4_model_put(t + G4_TIM_CNT, 12u); /* read 12 us after the edge */
+    g4_model_put(t + G4_TIM_SR, G4_TIM_SR_CC1IF | G4_TIM_SR_CC2IF | G4_TIM_SR_UIF);
+    const uint32_t n_log = g4_model.n_log;
     TEST_ASSERT_TRUE(g4_tim2_capture_read(&w, &per));
     TEST_ASSERT_EQUAL_UINT32(1500u, w);
     TEST_ASSERT_EQUAL_UINT32(20000u, per);
     TEST_ASSERT_EQUAL_HEX32(G4_TIM_SR_UIF, reg(t + G4_TIM_SR));
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE(n_log, g4_model.n_log, "no register written by the read");
+}
+
+/* The throttle's pulse train on TIM2 in PWM input mode: pulse k rises at
+ * R_k (the counter restarts; CCR1 = the period that ended), falls at F_k
+ * (CCR2 = its width); period k ends at R_k+1. Edges injected into the
+ * register model as the timer captures them. */
+static void tim2_rise(uint32_t period_us)
+{
+    g4_model_put(G4_TIM2 + G4_TIM_CCR1, period_us);
+    g4_model_put(G4_TIM2 + G4_TIM_CNT, 0u);
+    g4_model_put(G4_TIM2 + G4_TIM_SR, g4_model_get(G4_TIM2 + G4_TIM_SR) | G4_TIM_SR_CC1IF);
+}
+static void tim2_fall(uint32_t width_us)
+{
+    g4_model_put(G4_TIM2 + G4_TIM_CCR2, width_us);
+    g4_model_put(G4_TIM2 + G4_TIM_CNT, width_us);
+    g4_model_put(G4_TIM2 + G4_TIM_SR, g4_model_get(G4_TIM2 + G4_TIM_SR) | G4_TIM_SR_CC2IF);
+}
+/* Pulse k+1 falls 1 700 us after period k ended (pulse k: 1 200 us, 20 ms). */
+static void next_pulse_falls(void)
+{
+    tim2_fall(1700u);
+}
+/* Period k+1 ends (the read came a period late). */
+static void next_period_ends(void)
+{
+    tim2_rise(18000u);
+}
+
+/* A pair read from the capture is one period's: period k (20 000 us) with
+ * pulse k's width (1 200 us), never with pulse k+1's (1 700 us) nor period
+ * k+1 (18 000 us). Captures land inside the read: the next pulse's falling
+ * edge right after the flag is read, or between the reads of CCR1 and
+ * CCR2; the next period's end between those reads; and a read later than
+ * the pulse's width. Each such read reports nothing (the pair is not sure),
+ * never a mixed pair. */
+static void expect_pair_or_nothing(const char *what)
+{
+    uint32_t w = 0u, per = 0u;
+    if (g4_tim2_capture_read(&w, &per)) {
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(1200u, w, what);
+        TEST_ASSERT_EQUAL_UINT32_MESSAGE(20000u, per, what);
+    }
+}
+
+static void period_k_ends(void)
+{
+    g4_model_reset();
+    g4_tim2_capture_init(169u, 15u);
+    g4_model_put(G4_TIM2 + G4_TIM_SR, 0u);
+    tim2_rise(20000u); /* period k-1 ends: the pulse rises */
+    tim2_fall(1200u);
+    g4_model_put(G4_TIM2 + G4_TIM_SR, 0u); /* taken */
+    tim2_rise(20000u);                     /* period k ends */
+    g4_model_put(G4_TIM2 + G4_TIM_CNT, 3u);
+}
+
+static void test_tim2_capture_read_pairs_one_period(void)
+{
+    uint32_t w = 0u, per = 0u;
+    period_k_ends();
+    TEST_ASSERT_TRUE(g4_tim2_capture_read(&w, &per)); /* read 3 us after the edge */
+    TEST_ASSERT_EQUAL_UINT32(1200u, w);
+    TEST_ASSERT_EQUAL_UINT32(20000u, per);
+    TEST_ASSERT_FALSE(g4_tim2_capture_read(&w, &per)); /* taken */
+
+    period_k_ends();
+    g4_model.irq_on_read = G4_TIM2 + G4_TIM_SR; /* lands right after the flag's read */
+    g4_model.irq = next_pulse_falls;
+    expect_pair_or_nothing("falling edge after the flag's read");
+
+    period_k_ends();
+    g4_model.irq_on_read = G4_TIM2 + G4_TIM_CCR1;
+    g4_model.irq = next_pulse_falls;
+    expect_pair_or_nothing("falling edge after CCR1's read");
+    period_k_ends();
+    g4_model.irq_on_read = G4_TIM2 + G4_TIM_CCR2;
+    g4_model.irq = next_pulse_falls;
+    expect_pair_or_nothing("falling edge after CCR2's read");
+
+    period_k_ends();
+    next_pulse_falls(); /* the read comes 1.8 ms late */
+    g4_model_put(G4_TIM2 + G4_TIM_CNT, 1800u);
+    expect_pair_or_nothing("read later than the next pulse's fall");
+    period_k_ends();
+    next_pulse_falls();
+    g4_model.irq_on_read = G4_TIM2 + G4_TIM_CCR1;
+    g4_model.irq = next_period_ends;
+    expect_pair_or_nothing("next period's end after CCR1's read");
+    period_k_ends();
+    next_pulse_falls();
+    g4_model.irq_on_read = G4_TIM2 + G4_TIM_CCR2;
+    g4_model.irq = next_period_ends;
+    expect_pair_or_nothing("next period's end after CCR2's read");
 }
 
 int main(void)
@@ -883,5 +980,6 @@ int main(void)
     RUN_TEST(test_iwdg_sequence);
     RUN_TEST(test_usart_image);
     RUN_TEST(test_tim2_capture_image);
+    RUN_TEST(test_tim2_capture_read_pairs_one_period);
     return UNITY_END();
 }

@@ -35,8 +35,11 @@ typedef struct {
  * rising edge of TI1, CCR1 takes the counter (the period since the last
  * rising edge), CC1IF is set and the counter restarts from 0; on a falling
  * edge CCR2 takes the counter (the high time). The main loop reads CC1IF,
- * CCR2 as the width and CCR1 as the period (g4_tim2_capture_read). 1 us
- * counts; the 32-bit counter never wraps within these runs. */
+ * CCR2 as the width and CCR1 as the period (g4_tim2_capture_read, which
+ * reports nothing when the read comes later than the width after the
+ * period's end: not reached here, reads every 20 us, widths from 30 us;
+ * test_g4_regimage checks it). 1 us counts; the 32-bit counter never wraps
+ * within these runs. */
 static struct {
     uint32_t origin; /* time of the last counter reset, us */
     uint32_t ccr1, ccr2;
@@ -164,8 +167,8 @@ static void capture_edges(const sender_t *s, uint32_t spike_at_us)
  * wide. The main loop reads the capture every CAPTURE_POLL_US, as
  * esc1_throttle_poll does on each pass, and hands it to thr_pulse; it steps
  * the decoder every 1 ms. A spike shorter than the main loop's pass can end
- * before the read, which then pairs the spike's own width with the period:
- * invalid too (not modelled: these spikes outlast the pass). */
+ * before the read, which then reports nothing for that period (not
+ * modelled: these spikes outlast the pass). */
 static void run_capture(const sender_t *s, uint32_t spike_at_us, uint32_t ms)
 {
     const uint32_t end = t_us + ms * 1000u;
