@@ -38,3 +38,10 @@ add_test(NAME fence_check_self_test
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/tools/fence_check.py --self-test
                  ${PROJECT_SOURCE_DIR})
 set_tests_properties(fence_check fence_check_self_test PROPERTIES LABELS "board")
+# The image's sources without the settings store still compile
+# (firmware/apps/esc1/CMakeLists.txt, pmsm_esc1_no_settings).
+if(TARGET pmsm_esc1_no_settings)
+  add_test(NAME esc1_no_settings_compiles
+           COMMAND ${CMAKE_COMMAND} --build ${CMAKE_BINARY_DIR} --target pmsm_esc1_no_settings)
+  set_tests_properties(esc1_no_settings_compiles PROPERTIES LABELS "board")
+endif()
