@@ -3,24 +3,45 @@
 
 #if CTRL_DEAD_COMP
 
-/* s(i) = i / band within [-1, 1], Q24: |i| < 2^31, inv_band < 2^31, the
- * product below 2^62. */
+/* sat(i / w) within [-1, 1], Q24: |i| < 2^31, inv_w < 2^31, the product
+ * below 2^62. */
 static inline q24_t dt_sign(const ctrl_deadtime_t *d, q24_t i)
 {
-    return fx_clamp(fx_round_sat((int64_t)i * d->inv_band, CTRL_DT_BAND_SHIFT), -FX_ONE, FX_ONE);
+    return fx_clamp(fx_round_sat((int64_t)i * d->inv_w, CTRL_DT_BAND_SHIFT), -FX_ONE, FX_ONE);
+}
+
+/* |ripple| of leg x's current at its edges (deadtime.h), Q24 pu: kr the
+ * ripple per unit of the bracket at this period's DC link, dx the leg's duty,
+ * dy and dz the others', each in [0, FX_ONE] (the bracket within [-1/2, 1/2]:
+ * no saturation before kr's). */
+static inline q24_t dt_ripple(q24_t kr, q24_t dx, q24_t dy, q24_t dz)
+{
+    const q24_t ey = dy - dx;
+    const q24_t ez = dz - dx;
+    const q24_t bracket = fx_max(ey, 0) + fx_max(ez, 0) - fx_mul(ey + ez, FX_ONE - dx);
+    return fx_abs(fx_mul(kr, bracket));
+}
+
+/* The leg's sign at full compensation: the mean of its two edges' smoothed
+ * signs, the current at them i -+ r (deadtime.h), Q24 in [-1, 1]. */
+static inline q24_t dt_sign_edges(const ctrl_deadtime_t *d, q24_t i, q24_t r)
+{
+    return fx_rshift32_round(dt_sign(d, fx_sub(i, r)) + dt_sign(d, fx_add(i, r)), 1u);
 }
 
 /* Leg x's written duty for the intended duty (deadtime.h): s the sign of
- * its current, high_prev whether it ended the last period high. */
-static inline q24_t dt_leg(const ctrl_deadtime_t *d, q24_t duty, q24_t s, uint32_t high_prev)
+ * its pulse's edges, s0 that of its current at the period's start (the
+ * ripple's zero), high_prev whether it ended the last period high. */
+static inline q24_t dt_leg(const ctrl_deadtime_t *d, q24_t duty, q24_t s, q24_t s0,
+                           uint32_t high_prev)
 {
     if (duty <= 0) {
         return 0; /* no edge; a pulse of t_d with i > 0 would be lost anyway */
     }
     /* corrections below 1/2 in magnitude (dd < 0.35, dt <= 0.25) */
     q24_t corr = fx_mul(d->dd, s);
-    if (s < 0 && high_prev != 0u) {
-        corr = fx_add(corr, fx_mul(d->dt, s)); /* the late falling edge at the start */
+    if (s0 < 0 && high_prev != 0u) {
+        corr = fx_add(corr, fx_mul(d->dt, s0)); /* the late falling edge at the start */
     }
     return fx_clamp(fx_add(duty, corr), 0, FX_ONE);
 }
@@ -43,26 +64,40 @@ void ctrl_deadtime_apply(ctrl_deadtime_t *d, const ctrl_estimate_t *est, ctrl_le
     const q24_t i_be = fx_round_sat(id * sn + iq * cs, 24u);
     const q24_t half = fx_rshift32_round(i_al, 1u);
     const q24_t root = fx_round_sat((int64_t)i_be * FX_Q30_SQRT3_2, 30u);
+    q24_t i[3];
+    i[0] = i_al;
+    i[1] = fx_sub(root, half);
+    i[2] = fx_neg(fx_add(root, half));
+    /* The ripple at each leg's edges from the three duties at this period's
+     * DC link (Q24 pu per unit of the bracket). */
+    q24_t du[3];
+    for (unsigned x = 0u; x < 3u; x++) {
+        du[x] = fx_clamp(legs->duty[x], 0, FX_ONE);
+    }
+    const q24_t kr = fx_mul(d->k_rip, est->vdc);
     q24_t s[3];
-    s[0] = dt_sign(d, i_al);
-    s[1] = dt_sign(d, fx_sub(root, half));
-    s[2] = dt_sign(d, fx_neg(fx_add(root, half)));
+    s[0] = dt_sign_edges(d, i[0], dt_ripple(kr, du[0], du[1], du[2]));
+    s[1] = dt_sign_edges(d, i[1], dt_ripple(kr, du[1], du[2], du[0]));
+    s[2] = dt_sign_edges(d, i[2], dt_ripple(kr, du[2], du[0], du[1]));
     const uint32_t hp = d->high_prev;
     q24_t loss = 0;
     uint32_t pulses = 0u; /* bit x: leg x a pulse as intended */
     for (unsigned x = 0u; x < 3u; x++) {
-        const q24_t du = legs->duty[x];
         const uint32_t high = hp & (1u << x);
-        if (du >= FX_ONE) {
+        if (du[x] >= FX_ONE) {
             if (high == 0u && s[x] > 0) {
                 /* high all period after a low end: the rising edge at the
-                 * start is late and this leg cannot make up for it */
+                 * start is late and this leg cannot make up for it (a leg
+                 * at 1 has no ripple term: s is its current's at the start) */
                 loss = fx_max(loss, fx_mul(d->dt, s[x]));
             }
-        } else if (du > 0) {
+        } else if (du[x] > 0) {
             pulses |= 1u << x;
         }
-        legs->duty[x] = dt_leg(d, du, s[x], high);
+        /* the start's falling edge (after a high end) sees the current at
+         * the ripple's zero */
+        const q24_t s0 = high != 0u ? dt_sign(d, i[x]) : 0;
+        legs->duty[x] = dt_leg(d, du[x], s[x], s0, high);
     }
     if (loss > 0) {
         /* ... the others' pulses by as much less: the line voltages are kept */

@@ -23,12 +23,29 @@
  *    technique for open-loop PWM-VSI drives", IEEE Trans. Power Electronics,
  *    1999, argue for: no chattering on noisy zero crossings);
  *  - near zero current the PWM ripple carries the current through zero
- *    inside the period, the edges see both signs and the error fades out:
- *    s(i) = i / band clamped to [-1, 1] (a linear transition instead of a
- *    step, cf. the zero-current clamping analysis of J.-W. Choi and S.-K.
- *    Sul, "Inverter output voltage synthesis using novel dead time
- *    compensation", IEEE Trans. Power Electronics, 1996), band = half the
- *    peak-to-peak ripple by default (deadtime_config.c).
+ *    inside the period and the pulse's two edges see different signs: the
+ *    current at an edge is the period's mean i plus the ripple there, and
+ *    the ripple of a centre-aligned period is zero at its start and middle
+ *    and odd about the middle, so the rising edge sees i - r and the falling
+ *    edge i + r (or the reverse), and the leg's error is t_d fs times the
+ *    mean of the two edges' signs (the zero-current analysis of J.-W. Choi
+ *    and S.-K. Sul, "Inverter output voltage synthesis using novel dead time
+ *    compensation", IEEE Trans. Power Electronics, 1996: the error follows
+ *    the current at the switching instants, not its mean). With the phase
+ *    voltage Vdc (s_x - (s_a + s_b + s_c) / 3) integrated from the period's
+ *    start to leg x's rising edge ((1 - d_x) Ts / 2) against its mean,
+ *        r_x = Vdc Ts / (6 L) [ (d_y - d_x)+ + (d_z - d_x)+
+ *                               - ((d_y - d_x) + (d_z - d_x)) (1 - d_x) ],
+ *    (e)+ = max(e, 0), y and z the other legs; |bracket| <= 1/2, at most
+ *    Vdc / (12 L fs) (a leg at 1/2 against two at 0 or 1), 0 for a leg at 0
+ *    or 1 and for three equal duties: at low speed, where all legs sit near
+ *    1/2, it is small and the compensation acts down to small currents. L
+ *    the mean of the inverse inductances, 2 / (1/Ld + 1/Lq) (the ripple's
+ *    direction against d is any over a turn). Each edge's sign is taken as
+ *    i / w within [-1, 1], w the current's uncertainty at an edge (the
+ *    ripple's change over the t_d / 2 the compensation moves an edge and
+ *    the current's sensing: ctrl_deadtime_band_default):
+ *        s(i) = (sat((i - r) / w) + sat((i + r) / w)) / 2.
  * Legs without an edge in the period (clamped legs of a plan): a leg at 0
  * stays 0; a leg at 1 with i < 0 is written below 1, so that it ends low and
  * the next period starts without a late falling edge; a pulse after a period
@@ -56,14 +73,16 @@
 #include "ctrl_types.h"
 #include "fx.h"
 
-/* Shift of inv_band (Q16): 1 / band up to 2^15 per pu. */
+/* Shift of inv_w (Q16): 1 / w up to 2^15 per pu. */
 #define CTRL_DT_BAND_SHIFT 16u
 
 typedef struct {
-    q24_t dd;         /* duty error per leg at full sign, t_d fs + v_f / Vdc_nom, Q24
-                       * fraction of the period; 0 = no compensation */
-    q24_t dt;         /* its dead-time part, t_d fs, Q24 fraction */
-    int32_t inv_band; /* 1 / band, Q16 per pu (CTRL_DT_BAND_SHIFT) */
+    q24_t dd;      /* duty error per leg at full sign, t_d fs + v_f / Vdc_nom, Q24
+                    * fraction of the period; 0 = no compensation */
+    q24_t dt;      /* its dead-time part, t_d fs, Q24 fraction */
+    int32_t inv_w; /* 1 / w, the edge sign's half-width, Q16 per pu (CTRL_DT_BAND_SHIFT) */
+    q24_t k_rip;   /* Ts V_base / (6 L I_base): the edge ripple r_x per unit of its
+                    * bracket and of DC link (pu), Q24 pu */
     /* ---- state ---- */
     uint32_t high_prev; /* bit x: leg x was high at the end of the last period */
 } ctrl_deadtime_t;
@@ -72,13 +91,16 @@ typedef struct {
 typedef struct {
     double dead_time_s; /* t_d, [0, Ts / 4]; 0 with v_fwd_v 0: off */
     double v_fwd_v;     /* forward drop of the conducting device, [0, 10 % of Vdc] V */
-    double band_a;      /* half-width of the sign's linear transition, A (0 = the
-                         * ripple default of ctrl_deadtime_band_default) */
+    double band_a;      /* w, half-width of each edge's sign transition (the current's
+                         * uncertainty at an edge), A (0 = ctrl_deadtime_band_default) */
 } ctrl_deadtime_config_t;
 
-/* Half the peak-to-peak PWM ripple of a phase current at its zero crossing,
- * A, at least 2 % of rated current (deadtime_config.c). */
-double ctrl_deadtime_band_default(const ctrl_machine_t *m, double fs_hz);
+/* w, A: the ripple's largest change over the t_d / 2 the compensation moves
+ * an edge, (2/3) Vdc (t_d / 2) / L, plus 4 counts of the current's ADC
+ * (i_a_per_count, A per count) for the sensing the prediction starts from
+ * (deadtime_config.c). A drive whose current is noisier sets band_a. */
+double ctrl_deadtime_band_default(const ctrl_machine_t *m, double dead_time_s,
+                                  double i_a_per_count);
 
 /* Fixed-point constants; CTRL_OK, or CTRL_EINVAL naming the quantity in *why. */
 int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, const ctrl_params_t *p,
@@ -86,7 +108,7 @@ int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, cons
 
 /* Add the compensation to legs (the duties that act in [k+1, k+2)), each
  * taken within [0, FX_ONE]; est: the estimate of k (next.i_d, next.i_q,
- * next.theta_e, dtheta). Nothing when d->dd == 0. */
+ * next.theta_e, dtheta, vdc). Nothing when d->dd == 0. */
 void ctrl_deadtime_apply(ctrl_deadtime_t *d, const ctrl_estimate_t *est, ctrl_legs_t *legs);
 
 /* The duties written for [k+1, k+2) (after every limit; zeros with the

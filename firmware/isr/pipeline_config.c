@@ -230,9 +230,9 @@ static int fw_setup_machine(fw_t *fw, const fw_config_t *cfg, const ctrl_desc_t 
         const double vf = comp ? cfg->v_fwd_v : 0.0;
         const ctrl_deadtime_config_t dc = {
             dt, vf,
-            cfg->dead_comp_band_a > 0.0
-                ? cfg->dead_comp_band_a
-                : ctrl_deadtime_band_default(fw->machine, (double)in->pwm_freq_hz)};
+            cfg->dead_comp_band_a > 0.0 ? cfg->dead_comp_band_a
+                                        : ctrl_deadtime_band_default(fw->machine, cfg->dead_time_s,
+                                                                     in->adc_current_a_per_count)};
         if (ctrl_deadtime_init(&fw->deadtime, &dc, &fw->params, &fw->bases, &fw->why) != CTRL_OK) {
             return FW_EINVAL;
         }
