@@ -284,9 +284,10 @@ typedef struct {
     bool psi_adapt;
     double dead_time_s, v_fwd_v;
     /* Dead-time and device-drop compensation of the written duties
-     * (control/modulation/deadtime.h) from dead_time_s and v_fwd_v, the
-     * sign's transition over dead_comp_band_a (0 = the PWM ripple's
-     * default). Default on; with it the estimator and the observers take
+     * (control/modulation/deadtime.h) from dead_time_s and v_fwd_v, each
+     * edge's sign softened over dead_comp_band_a, A (0 = the default of
+     * ctrl_deadtime_band_default: the dead time's share of the ripple and
+     * 4 counts of the current's ADC). Default on; with it the estimator and the observers take
      * the uncompensated duties as the applied voltage, without it the
      * observers remove the error themselves. */
     bool dead_comp;
