@@ -24,6 +24,9 @@ const char *rec_loop_init(rec_loop_t *loop, const ctrl_desc_t *d, const sim_mach
     fc.calib_samples = calib_samples;
     fc.sensorless = sensorless != 0u;
     fc.hfi = sensorless == 2u;
+    /* the plant's inverter, compensated as the simulator's drive does */
+    fc.dead_time_s = sm->dead_time_s;
+    fc.v_fwd_v = sm->v_fwd_v;
     if (fw_init(&loop->fw, &loop->hal, &fc) != FW_OK) {
         return "fw_init failed for ";
     }

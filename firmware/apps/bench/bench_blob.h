@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #define BENCH_MAGIC 0x42534d50u /* "PMSB" */
-#define BENCH_VERSION 1u
+#define BENCH_VERSION 2u
 #ifndef BENCH_BLOB_ADDR             /* the build may place it elsewhere (bench_cm0) */
 #define BENCH_BLOB_ADDR 0x20200000u /* QEMU RAM, 2 MB below the stack top */
 #define BENCH_BLOB_MAX 0x00100000u  /* 1 MB */
@@ -48,6 +48,9 @@ typedef struct {
     double rs_ohm, ld_h, lq_h, psi_pm_wb, vdc_v, inertia_kgm2, torque_rated_nm, speed_rated_rpm,
         current_rated_a, current_max_a, psi_ref_wb;
     char machine_name[32];
+    /* fw_config_t.dead_time_s and v_fwd_v of the recording (the plant's
+     * inverter: the dead-time compensation runs with them) */
+    double dead_time_s, v_fwd_v;
 } bench_hdr_t;
 
 typedef struct {
@@ -60,7 +63,7 @@ typedef struct {
     uint32_t cmp[3]; /* compare values written by the ISR */
 } bench_rec_t;
 
-_Static_assert(sizeof(bench_hdr_t) == 240u, "bench_hdr_t layout");
+_Static_assert(sizeof(bench_hdr_t) == 256u, "bench_hdr_t layout");
 _Static_assert(offsetof(bench_hdr_t, adc_current_a_per_count) == 96u, "bench_hdr_t layout");
 _Static_assert(offsetof(bench_hdr_t, machine_name) == 208u, "bench_hdr_t layout");
 _Static_assert(sizeof(bench_rec_t) == 32u, "bench_rec_t layout");

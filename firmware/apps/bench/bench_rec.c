@@ -142,6 +142,8 @@ static int record_one(const ctrl_desc_t *d, const sim_machine_t *sm, double spee
     h->current_max_a = cm.current_max_a;
     h->psi_ref_wb = cm.psi_ref_wb;
     put_name(h->machine_name, sizeof h->machine_name, cm.name != NULL ? cm.name : "machine");
+    h->dead_time_s = sm->dead_time_s; /* as rec_loop_init configured the drive */
+    h->v_fwd_v = sm->v_fwd_v;
     char path[4096];
     snprintf(path, sizeof path, "%s/%s_%u.bin", outdir, d->name, h->speed_rpm);
     FILE *f = fopen(path, "wb");

@@ -60,6 +60,8 @@ int bench_replay_init(bench_replay_t *r, fw_t *fw, hal_t *hal)
     fc.calib_samples = r->hdr->calib_samples;
     fc.sensorless = r->hdr->sensorless != 0u;
     fc.hfi = r->hdr->sensorless == 2u;
+    fc.dead_time_s = r->hdr->dead_time_s;
+    fc.v_fwd_v = r->hdr->v_fwd_v;
     return fw_init(fw, hal, &fc);
 }
 
