@@ -243,7 +243,9 @@ static inline void g4_clr(uintptr_t reg, uint32_t bits)
 #define G4_TIM_CR1_CKD_MASK G4_FIELD(3u, 8)
 #define G4_TIM_CR2 0x04u
 #define G4_TIM_CR2_CCPC G4_BIT(0)
-#define G4_TIM_CR2_MMS_MASK G4_FIELD(7u, 4)
+/* MMS[2:0] at bits 6:4 and MMS[3] at bit 25 (RM0440 TIMx_CR2; ST's
+ * stm32g431xx.h TIM_CR2_MMS_Msk 0x02000070) */
+#define G4_TIM_CR2_MMS_MASK (G4_FIELD(7u, 4) | G4_BIT(25))
 #define G4_TIM_CR2_OIS_MASK G4_FIELD(0x3Fu, 8) /* OIS1, OIS1N .. OIS3, OIS3N */
 #define G4_TIM_CR2_MMS2_MASK G4_FIELD(0xFu, 20)
 #define G4_TIM_CR2_MMS2_UPDATE G4_FIELD(2u, 20)

@@ -128,6 +128,16 @@ static void test_clock_switch_failure_back_to_hsi(void)
     TEST_ASSERT_EQUAL_HEX32(G4_RCC_CFGR_HPRE_DIV1, cfgr & G4_RCC_CFGR_HPRE_MASK);
 }
 
+/* TIMx_CR2's master mode fields (RM0440 TIMx_CR2: MMS[2:0] bits 6:4 with
+ * MMS[3] at bit 25, MMS2[3:0] bits 23:20), as ST's stm32g431xx.h masks them:
+ * TIM_CR2_MMS_Msk 0x02000070, TIM_CR2_MMS2_Msk 0x00F00000. A mask without
+ * MMS[3] would leave a 4-bit mode half-cleared. */
+static void test_tim_cr2_mms_masks(void)
+{
+    TEST_ASSERT_EQUAL_HEX32(0x02000070u, G4_TIM_CR2_MMS_MASK);
+    TEST_ASSERT_EQUAL_HEX32(0x00F00000u, G4_TIM_CR2_MMS2_MASK);
+}
+
 /* ---- board init: end values ---- */
 
 /* TIM1 (RM0440 chapter 29): CR1 = CMS 01 (0x20) | ARPE (0x80) | CEN = 0xA1;
@@ -957,6 +967,7 @@ int main(void)
     RUN_TEST(test_clock_register_image_and_order);
     RUN_TEST(test_clock_hse_failure);
     RUN_TEST(test_clock_switch_failure_back_to_hsi);
+    RUN_TEST(test_tim_cr2_mms_masks);
     RUN_TEST(test_init_tim1_image);
     RUN_TEST(test_init_analog_image);
     RUN_TEST(test_init_pins_and_info);
