@@ -12,6 +12,9 @@
 #include <stdbool.h>
 #include <string.h>
 
+#include "g4_model.h"
+#include "g4_regs.h"
+#include "g4_tim.h"
 #include "throttle.h"
 #include "unity.h"
 
@@ -31,20 +34,17 @@ typedef struct {
 } sender_t;
 
 /* The board's capture (TIM2 in PWM input mode, g4_tim2_capture_init; RM0440
- * TIM2/3/4/5 "PWM input mode", slave mode controller in reset mode): on a
- * rising edge of TI1, CCR1 takes the counter (the period since the last
- * rising edge), CC1IF is set and the counter restarts from 0; on a falling
- * edge CCR2 takes the counter (the high time). The main loop reads CC1IF,
- * CCR2 as the width and CCR1 as the period (g4_tim2_capture_read, which
- * reports nothing when the read comes later than the width after the
- * period's end: not reached here, reads every 20 us, widths from 30 us;
- * test_g4_regimage checks it). 1 us counts; the 32-bit counter never wraps
- * within these runs. */
-static struct {
-    uint32_t origin; /* time of the last counter reset, us */
-    uint32_t ccr1, ccr2;
-    bool cc1if;
-} tim2;
+ * TIM2/3/4/5 "PWM input mode", slave mode controller in reset mode), on the
+ * register model (g4_model.c): on a rising edge of TI1, CCR1 takes the
+ * counter (the period since the last rising edge), CC1IF is set and the
+ * counter restarts from 0; on a falling edge CCR2 takes the counter (the
+ * high time), CC2IF set. The main loop's read is the driver's own,
+ * g4_tim2_capture_read (CC1IF, then CNT, CCR1, CCR2, CNT; it reports nothing
+ * when the read comes later than the width after the period's end: not
+ * reached here, reads every 20 us, widths from 30 us; test_g4_regimage
+ * checks that case). 1 us counts; the 32-bit counter never wraps within
+ * these runs. */
+static uint32_t tim2_origin; /* time of the last counter reset, us */
 /* The edges of the sender's period in progress: edge_at[edge_i..edge_n)
  * still to come (rising or falling: edge_rise). */
 static uint32_t edge_at[4];
@@ -67,7 +67,8 @@ static void reset(uint8_t mode)
     next_us = 3000u;
     seed = 12345u;
     n_arm = n_disarm = 0u;
-    memset(&tim2, 0, sizeof tim2);
+    g4_model_reset();
+    tim2_origin = 0u;
     edge_n = edge_i = 0u;
     thr_init(&thr, &c, 0u);
 }
@@ -110,13 +111,15 @@ static void run(const sender_t *s, uint32_t ms)
 
 static void tim2_edge(uint32_t at_us, bool rising)
 {
-    const uint32_t cnt = at_us - tim2.origin;
+    const uint32_t cnt = at_us - tim2_origin;
+    const uint32_t sr = g4_model_get(G4_TIM2 + G4_TIM_SR);
     if (rising) {
-        tim2.ccr1 = cnt;
-        tim2.cc1if = true;
-        tim2.origin = at_us; /* reset mode: the trigger TI1FP1 clears the counter */
+        g4_model_put(G4_TIM2 + G4_TIM_CCR1, cnt);
+        g4_model_put(G4_TIM2 + G4_TIM_SR, sr | G4_TIM_SR_CC1IF);
+        tim2_origin = at_us; /* reset mode: the trigger TI1FP1 clears the counter */
     } else {
-        tim2.ccr2 = cnt;
+        g4_model_put(G4_TIM2 + G4_TIM_CCR2, cnt);
+        g4_model_put(G4_TIM2 + G4_TIM_SR, sr | G4_TIM_SR_CC2IF);
     }
 }
 
@@ -177,9 +180,10 @@ static void run_capture(const sender_t *s, uint32_t spike_at_us, uint32_t ms)
         while (t_us < step_end) {
             t_us += CAPTURE_POLL_US;
             capture_edges(s, spike_at_us);
-            if (tim2.cc1if) {
-                tim2.cc1if = false;
-                thr_pulse(&thr, tim2.ccr2, tim2.ccr1, t_us / 1000u);
+            g4_model_put(G4_TIM2 + G4_TIM_CNT, t_us - tim2_origin);
+            uint32_t w = 0u, per = 0u;
+            if (g4_tim2_capture_read(&w, &per)) {
+                thr_pulse(&thr, w, per, t_us / 1000u);
             }
         }
         update_and_count();
