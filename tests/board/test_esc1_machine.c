@@ -220,6 +220,11 @@ static void test_reconfiguration_time_is_kept(void)
     TEST_ASSERT_EQUAL_UINT32(0xFFFFFFF0u, esc.init_cycles);
 }
 
+static void expect_prefix(const char *want, const char *got)
+{
+    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(want, got, strlen(want)), got);
+}
+
 /* Neighbours of the compiled-in gimbal motor the core cannot represent at
  * 20 kHz (docs/fixed-point.md, "The range the core takes"): each answer names
  * the quantity, its value and the range; the motor's data stay. */
@@ -227,6 +232,13 @@ static void test_link_refusal_names_quantity_value_range(void)
 {
     esc1_start();
     char want[160];
+    /* What is in force before the refusals and must stay after them: a
+     * controller tunable and a drive setting changed over the link (a
+     * refusal used to put back the defaults: wc 0, psi_adapt 1). */
+    TEST_ASSERT_EQUAL_STRING("ok wc 3000", command("param set wc 3000"));
+    expect_prefix("ok est.psi_adapt 0", command("param set est.psi_adapt 0"));
+    TEST_ASSERT_EQUAL_STRING("ok wc 3000 rad/s", command("param get wc"));
+    const char *name = esc.machine.name; /* a setting's apply names the record's */
     /* 15 r/min (inside the link's [10, 100000]): 11 x 15 x 2 pi / 60 x 50 us =
      * 8.64e-4 rad per period < 0.001 */
     TEST_ASSERT_EQUAL_STRING("err 10 failed rated electrical speed x Ts = 0.0008639 rad per period "
@@ -239,12 +251,15 @@ static void test_link_refusal_names_quantity_value_range(void)
     /* the previous data are in force */
     snprintf(want, sizeof want, "ok m.n_rated_rpm %g r/min", esc1_default_machine.speed_rated_rpm);
     TEST_ASSERT_EQUAL_STRING(want, command("param get m.n_rated_rpm"));
-    TEST_ASSERT_EQUAL_STRING("gbm5208_gimbal", esc.machine.name);
+    TEST_ASSERT_EQUAL_STRING(name, esc.machine.name);
     /* and the firmware runs with them and its controller (the restore used to
      * lose the controller: fw_init had cleared fw_t before it was read) */
     TEST_ASSERT_TRUE(esc.fw.ctrl != NULL);
     TEST_ASSERT_EQUAL_STRING(ESC1_CTRL, esc.fw.ctrl->name);
     TEST_ASSERT_EQUAL_INT(FW_STATE_BOOT, fw_state(&esc.fw));
+    /* with its tunables and the drive's settings as they were */
+    TEST_ASSERT_EQUAL_STRING("ok wc 3000 rad/s", command("param get wc"));
+    expect_prefix("ok est.psi_adapt 0", command("param get est.psi_adapt"));
     /* a value the core takes is taken, and a refusal after it has no stale reason */
     TEST_ASSERT_EQUAL_STRING("ok m.n_rated_rpm 150", command("param set m.n_rated_rpm 150"));
     TEST_ASSERT_EQUAL_STRING("err 4 range [10, 100000]", command("param set m.n_rated_rpm 1"));
@@ -321,11 +336,6 @@ static void test_calibration_takes_the_board_zero(void)
     esc.fw.off_q8[2] = 0;
     TEST_ASSERT_TRUE(fw_link_offsets_text(&esc.fw, line, sizeof line) > 0);
     TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp("current offsets 1542 1543 0 counts", line, 34), line);
-}
-
-static void expect_prefix(const char *want, const char *got)
-{
-    TEST_ASSERT_EQUAL_INT_MESSAGE(0, strncmp(want, got, strlen(want)), got);
 }
 
 /* Machine data, the controller, its tunables that are not live (FOC's mtpa;

@@ -342,6 +342,19 @@ static void esc1_config_kept(esc1_t *s, const ctrl_desc_t *ctrl, fx_angle_t off,
     s->fc.enc_direction = dir;
 }
 
+/* The configuration in force before a reconfiguration, what a refusal puts
+ * back ("the previous data stay"): the drive's settings (fw_t.cfg) and the
+ * controller's tunables (a "param set wc" before it), not the defaults.
+ * Main loop only; static so that the deepest command path's stack (config
+ * default -> fw_init) does not grow by it. */
+static struct {
+    fw_config_t cfg;
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } ctrl_cfg;
+} esc1_in_force;
+
 int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
                          const fw_config_t *cfg)
 {
@@ -361,6 +374,8 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     /* fw_init clears fw_t, so the controller in use is kept here for the
      * restore (else a refused machine left the firmware without one). */
     const ctrl_desc_t *ctrl = s->fw.ctrl;
+    esc1_in_force.cfg = s->fw.cfg;
+    memcpy(esc1_in_force.ctrl_cfg.bytes, s->fw.ctrl_cfg.bytes, CTRL_CFG_MAX);
     const uint32_t t0 = g4_cycles(); /* the hold's length: the start-up report */
     hal_ctrl_hold(&s->hal, true);
     s->machine = *m;
@@ -383,7 +398,16 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->machine = old;
         s->encoder_cpr = old_cpr;
         s->hal.info.encoder_counts_per_rev = old_cpr;
-        esc1_config_kept(s, ctrl, off, dir);
+        if (ctrl != NULL) { /* as it was, tunables included */
+            s->fc = esc1_in_force.cfg;
+            s->fc.machine = &s->machine;
+            s->fc.ctrl = ctrl;
+            s->fc.ctrl_cfg = esc1_in_force.ctrl_cfg.bytes;
+            s->fc.enc_offset = off;
+            s->fc.enc_direction = dir;
+        } else { /* nothing installed before: the defaults */
+            esc1_config_kept(s, ctrl, off, dir);
+        }
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
     }
