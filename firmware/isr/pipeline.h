@@ -616,8 +616,9 @@ static inline bool fw_tunable_is_live(const fw_t *fw, size_t index)
  *   fit this machine, fw->cm_what names the quantity); a failed step latches
  *   FW_FAULT_COMMISSION
  *   (gates off) with the reason in fw->cm.err; stop (fw_cmd_disarm) ends it.
- * fw_commission_apply: the identified Rs, Ld, Lq, psi_pm, inertia and the
- *   encoder offset/direction replace the configured ones (controller and
+ * fw_commission_apply: the identified Rs, Ld, Lq, psi_pm, inertia, the
+ *   encoder offset/direction and (CM_MECH) the Coulomb and viscous friction
+ *   replace the configured ones (controller and
  *   estimator re-initialised from the new machine; tunables back to their
  *   defaults). State ready only (FW_EBUSY), FW_ERANGE if they do not fit.
  * fw_commission_poll: applies a completed identification (ident run) once.
@@ -627,6 +628,24 @@ int fw_commission_apply(fw_t *fw);
 bool fw_commission_poll(fw_t *fw);
 /* Results in SI (direction absolute). */
 void fw_commission_results(const fw_t *fw, cm_si_t *out);
+
+/* What the drive holds beyond its machine data (fw_t.machine_own) that
+ * fw_commission_apply adopts, or a configuration gave: the encoder's offset
+ * and direction and, with the mechanics' identification, the friction. An
+ * application that re-initialises the firmware with new machine data but no
+ * configuration of its own (a board's "param set m.*") reads them before
+ * fw_init (fw_kept_read: fw_init clears fw_t) and puts them into the new
+ * configuration (fw_kept_config), so that an identified motor is not
+ * undone by a change of one of its parameters. */
+typedef struct {
+    fx_angle_t enc_offset;
+    int8_t enc_direction;
+#if CM_MECH
+    double coulomb_nm, viscous_nms;
+#endif
+} fw_kept_t;
+void fw_kept_read(const fw_t *fw, fw_kept_t *k);
+void fw_kept_config(const fw_kept_t *k, fw_config_t *c);
 
 /*
  * Anti-cogging feed-forward (main loop; docs/anticogging.md). The table of

@@ -606,6 +606,27 @@ int fw_commission_apply(fw_t *fw)
     return rc;
 }
 
+void fw_kept_read(const fw_t *fw, fw_kept_t *k)
+{
+    /* every field fw_commission_adopt writes beyond fw->machine_own */
+    k->enc_offset = fw->enc_offset;
+    k->enc_direction = fw->enc_neg != 0u ? -1 : 1;
+#if CM_MECH
+    k->coulomb_nm = fw->cfg.coulomb_nm;
+    k->viscous_nms = fw->cfg.viscous_nms;
+#endif
+}
+
+void fw_kept_config(const fw_kept_t *k, fw_config_t *c)
+{
+    c->enc_offset = k->enc_offset;
+    c->enc_direction = k->enc_direction;
+#if CM_MECH
+    c->coulomb_nm = k->coulomb_nm;
+    c->viscous_nms = k->viscous_nms;
+#endif
+}
+
 bool fw_commission_poll(fw_t *fw)
 {
     if (fw == NULL || fw->cm.apply == 0u || fw_state(fw) != FW_STATE_READY) {

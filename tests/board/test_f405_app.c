@@ -12,8 +12,8 @@
  * drive's, and stays the drive's through a later "param set" of an unrelated
  * m.* or enc.cpr (a reconfiguration), a "config save" and a power cycle:
  * Rs, Ld, Lq, psi_pm, the encoder's offset and direction, and on an image
- * with the mechanics' identification (CM_MECH) the Coulomb and viscous
- * friction beside the inertia.
+ * with the mechanics' identification (CM_MECH, as the F405 images have it)
+ * the Coulomb and viscous friction beside the inertia.
  */
 #include <math.h>
 #include <stdio.h>
@@ -219,6 +219,49 @@ static void expect_machine(const ctrl_machine_t *want, double j, uint32_t off, u
     }
 }
 
+#if CM_MECH
+/* The identified friction in force (fw_config_t, what "ident apply"
+ * adopted and the settings record keeps). */
+static void expect_friction(double coulomb_nm, double viscous_nms)
+{
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * coulomb_nm, coulomb_nm, f405.app.fw.cfg.coulomb_nm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * viscous_nms, viscous_nms, f405.app.fw.cfg.viscous_nms);
+}
+
+/* The mechanics step's records (cm_results_t, pu of r->bases) for a shaft
+ * with Coulomb friction fc (N*m), viscous friction bv (N*m*s) and inertia j
+ * (kg*m^2), as cm_results_si reads them: the four speed windows steady
+ * (no speed change) at 100 and 200 rad/s mechanical with the q current
+ * that holds the friction there (+i_d and -i_d alike, so no reluctance
+ * torque), the two transitions' current sums giving j over the speed step. */
+static void identified_mechanics(cm_results_t *r, double fc, double bv, double j)
+{
+    const fw_t *fw = &f405.app.fw;
+    const double pp = (double)fw->params.pole_pairs;
+    const double ts = 1.0 / (double)fw->info.pwm_freq_hz;
+    const double kt = (double)r->psi / 16777216.0 * r->bases.torque_nm; /* N*m per pu current */
+    const double w[4] = {100.0, 200.0, 200.0, 100.0};                   /* rad/s mechanical */
+    for (int k = 0; k < 4; k++) {
+        r->fw_w[k] = ctrl_q24_from_double(w[k] * pp / r->bases.w_rad_s);
+        r->fw_iq[k] = ctrl_q24_from_double((fc + bv * w[k]) / kt);
+        r->fw_dw[k] = 0;
+        r->fw_n[k] = 1000u;
+        r->fw_len[k] = 1000u;
+    }
+    r->i_fd = 0;
+    const uint32_t n = 2000u; /* each transition's periods */
+    for (int k = 0; k < 2; k++) {
+        /* the torque's integral over it: friction plus j x the speed's change */
+        const double dw = k == 0 ? 100.0 : -100.0;
+        const double tdt = fc * n * ts + j * dw;
+        r->jx_iq[k] = (int64_t)llround(tdt / (kt * ts) * 16777216.0);
+        r->jx_th[k] = 0;
+        r->jx_n[k] = n;
+    }
+    r->have |= CM_HAVE_MECH;
+}
+#endif
+
 /* Identified: twice the file's Rs, 1.5 x its inductances, 1.1 x its flux
  * (pu of the bases they were taken in), the encoder a quarter turn off and
  * counting backwards; adopted by "ident apply". Then param set of the
@@ -227,7 +270,9 @@ static void expect_machine(const ctrl_machine_t *want, double j, uint32_t off, u
  * again: the identified machine and calibration stay in force throughout.
  * Before the board application edited the drive's machine (a3acd36) it
  * answered and rebuilt the compiled-in motor's data (Rs 0.047 ohm for the
- * identified 0.094) with offset 0 and direction +1. */
+ * identified 0.094) with offset 0 and direction +1; before the
+ * reconfiguration kept the drive's friction (fw_kept_t) it fell back to none
+ * at the first param set after ident apply or after a record's. */
 static void test_identified_machine_survives_a_parameter_change(void)
 {
     memset(f4_mem_flash_settings, 0xFF, 2u * F4_FLASH_SECTOR_SIZE); /* a new board */
@@ -245,20 +290,38 @@ static void test_identified_machine_survives_a_parameter_change(void)
     r->psi = ctrl_q24_from_double(1.1 * d->psi_pm_wb / r->bases.psi_wb);
     r->enc_dir = -1;
     r->enc_off = 0x40000000u;
+#if CM_MECH
+    /* and the mechanics: 1.2 x the file's inertia, friction the file has
+     * not (5.6 % and 3.6 % of the rated 0.354 N*m at rated speed) */
+    const double fc = 0.02, bv = 2e-5;
+    identified_mechanics(r, fc, bv, 1.2 * d->inertia_kgm2);
+#endif
     expect_prefix("ok ident applied", command("ident apply"));
     const ctrl_machine_t id = f405.app.fw.machine_own;
+#if CM_MECH
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->inertia_kgm2, 1.2 * d->inertia_kgm2, id.inertia_kgm2);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * fc, fc, f405.app.fw.cfg.coulomb_nm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * bv, bv, f405.app.fw.cfg.viscous_nms);
+    const double fc_id = f405.app.fw.cfg.coulomb_nm, bv_id = f405.app.fw.cfg.viscous_nms;
+#define EXPECT_FRICTION() expect_friction(fc_id, bv_id)
+#else
+#define EXPECT_FRICTION() ((void)0)
+#endif
     TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->rs_ohm, 2.0 * d->rs_ohm, id.rs_ohm);
     TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->ld_h, 1.5 * d->ld_h, id.ld_h);
     TEST_ASSERT_DOUBLE_WITHIN(1e-3 * d->psi_pm_wb, 1.1 * d->psi_pm_wb, id.psi_pm_wb);
-    expect_machine(&id, d->inertia_kgm2, 0x40000000u, 0xFFFFFFFFu);
+    expect_machine(&id, id.inertia_kgm2, 0x40000000u, 0xFFFFFFFFu);
+    EXPECT_FRICTION();
 
     const double j1 = 1.5 * d->inertia_kgm2, j2 = 2.0 * d->inertia_kgm2;
     char set[64];
     (void)snprintf(set, sizeof set, "param set m.j_kgm2 %.9g", j1);
     expect_prefix("ok m.j_kgm2", command(set));
     expect_machine(&id, j1, 0x40000000u, 0xFFFFFFFFu);
+    EXPECT_FRICTION();
     TEST_ASSERT_EQUAL_STRING("ok enc.cpr 8192", command("param set enc.cpr 8192"));
     expect_machine(&id, j1, 0x40000000u, 0xFFFFFFFFu);
+    EXPECT_FRICTION();
 
     /* saved, the board powered off and on: the record's data in force, and
      * kept by a change after it */
@@ -266,10 +329,12 @@ static void test_identified_machine_survives_a_parameter_change(void)
     f405_power_on();
     TEST_ASSERT_EQUAL_STRING("settings: record 1 (page 0) applied", f405.app.settings.msg);
     expect_machine(&id, j1, 0x40000000u, 0xFFFFFFFFu);
+    EXPECT_FRICTION();
     f405_calibrate();
     (void)snprintf(set, sizeof set, "param set m.j_kgm2 %.9g", j2);
     expect_prefix("ok m.j_kgm2", command(set));
     expect_machine(&id, j2, 0x40000000u, 0xFFFFFFFFu);
+    EXPECT_FRICTION();
     expect_prefix("ok enc.cpr 8192", command("param get enc.cpr"));
 }
 

@@ -41,16 +41,15 @@ int board_app_start(board_app_t *a, const board_app_port_t *port, hal_t *hal)
     return rc;
 }
 
-/* The default configuration for the machine staged in a->machine, with the
- * encoder's calibration in force (identified, or a settings record's: the
- * drive's enc_offset and direction), so that a machine parameter changed
- * after it does not put back the uncalibrated 0 / +1. */
-static void board_app_config_kept(board_app_t *a, const ctrl_desc_t *ctrl, fx_angle_t off,
-                                  int8_t dir)
+/* The default configuration for the machine staged in a->machine, with what
+ * the drive held beyond its machine data (identified, or a settings
+ * record's: the encoder's offset and direction, the friction; fw_kept_t),
+ * so that a machine parameter changed after it does not put back the
+ * uncalibrated encoder (0, +1) or no friction. */
+static void board_app_config_kept(board_app_t *a, const ctrl_desc_t *ctrl, const fw_kept_t *kept)
 {
     board_app_config_default(a, &a->fc, &a->machine, ctrl);
-    a->fc.enc_offset = off;
-    a->fc.enc_direction = dir;
+    fw_kept_config(kept, &a->fc);
 }
 
 int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t encoder_cpr,
@@ -66,8 +65,8 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
     }
     const ctrl_machine_t old = a->fw.machine_own; /* in force ("ident apply" rewrites it) */
     const uint32_t old_cpr = a->encoder_cpr;
-    const fx_angle_t off = a->fw.enc_offset; /* fw_init clears fw_t: kept here */
-    const int8_t dir = a->fw.enc_neg != 0u ? -1 : 1;
+    fw_kept_t kept; /* fw_init clears fw_t: read here */
+    fw_kept_read(&a->fw, &kept);
     /* fw_init clears fw_t: the controller in use kept for the restore */
     const ctrl_desc_t *ctrl = a->fw.ctrl;
     a->port->control_irq(false);
@@ -85,7 +84,7 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
         a->fc = *cfg;
         a->fc.machine = &a->machine;
     } else {
-        board_app_config_kept(a, ctrl, off, dir);
+        board_app_config_kept(a, ctrl, &kept);
     }
     int rc = fw_init(&a->fw, a->hal, &a->fc);
     if (rc == FW_OK && a->port->set_trip != NULL && a->port->set_trip(a, &a->machine) != 0) {
@@ -97,7 +96,7 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
         a->machine = old;
         a->encoder_cpr = old_cpr;
         a->hal->info.encoder_counts_per_rev = old_cpr;
-        board_app_config_kept(a, ctrl, off, dir);
+        board_app_config_kept(a, ctrl, &kept);
         (void)fw_init(&a->fw, a->hal, &a->fc);
         if (a->port->set_trip != NULL) {
             (void)a->port->set_trip(a, &a->machine);
