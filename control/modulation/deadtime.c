@@ -22,24 +22,32 @@ static inline q24_t dt_ripple(q24_t kr, q24_t dx, q24_t dy, q24_t dz)
     return fx_abs(fx_mul(kr, bracket));
 }
 
-/* The leg's sign at full compensation: the mean of its two edges' smoothed
- * signs, the current at them i -+ r (deadtime.h), Q24 in [-1, 1]. */
-static inline q24_t dt_sign_edges(const ctrl_deadtime_t *d, q24_t i, q24_t r)
+/* The leg's sign at full compensation times 2: the sum of its two edges'
+ * smoothed signs, the current at them i -+ r (deadtime.h), Q24 in [-2, 2]
+ * (halved where it multiplies: one rounding). */
+static inline q24_t dt_sign2_edges(const ctrl_deadtime_t *d, q24_t i, q24_t r)
 {
-    return fx_rshift32_round(dt_sign(d, fx_sub(i, r)) + dt_sign(d, fx_add(i, r)), 1u);
+    return dt_sign(d, fx_sub(i, r)) + dt_sign(d, fx_add(i, r));
 }
 
-/* Leg x's written duty for the intended duty (deadtime.h): s the sign of
- * its pulse's edges, s0 that of its current at the period's start (the
- * ripple's zero), high_prev whether it ended the last period high. */
-static inline q24_t dt_leg(const ctrl_deadtime_t *d, q24_t duty, q24_t s, q24_t s0,
+/* x s2 / 2, Q24: x a correction below 1/2 (dd < 0.35, dt <= 0.25), |s2| <= 2:
+ * the product below 2^50. */
+static inline q24_t dt_half_mul(q24_t x, q24_t s2)
+{
+    return fx_round_sat((int64_t)x * s2, FX_QBITS + 1u);
+}
+
+/* Leg x's written duty for the intended duty (deadtime.h): s2 twice the sign
+ * of its pulse's edges, s0 the sign of its current at the period's start
+ * (the ripple's zero), high_prev whether it ended the last period high. */
+static inline q24_t dt_leg(const ctrl_deadtime_t *d, q24_t duty, q24_t s2, q24_t s0,
                            uint32_t high_prev)
 {
     if (duty <= 0) {
         return 0; /* no edge; a pulse of t_d with i > 0 would be lost anyway */
     }
     /* corrections below 1/2 in magnitude (dd < 0.35, dt <= 0.25) */
-    q24_t corr = fx_mul(d->dd, s);
+    q24_t corr = dt_half_mul(d->dd, s2);
     if (s0 < 0 && high_prev != 0u) {
         corr = fx_add(corr, fx_mul(d->dt, s0)); /* the late falling edge at the start */
     }
@@ -75,21 +83,22 @@ void ctrl_deadtime_apply(ctrl_deadtime_t *d, const ctrl_estimate_t *est, ctrl_le
         du[x] = fx_clamp(legs->duty[x], 0, FX_ONE);
     }
     const q24_t kr = fx_mul(d->k_rip, est->vdc);
-    q24_t s[3];
-    s[0] = dt_sign_edges(d, i[0], dt_ripple(kr, du[0], du[1], du[2]));
-    s[1] = dt_sign_edges(d, i[1], dt_ripple(kr, du[1], du[2], du[0]));
-    s[2] = dt_sign_edges(d, i[2], dt_ripple(kr, du[2], du[0], du[1]));
+    q24_t s2[3];
+    s2[0] = dt_sign2_edges(d, i[0], dt_ripple(kr, du[0], du[1], du[2]));
+    s2[1] = dt_sign2_edges(d, i[1], dt_ripple(kr, du[1], du[2], du[0]));
+    s2[2] = dt_sign2_edges(d, i[2], dt_ripple(kr, du[2], du[0], du[1]));
     const uint32_t hp = d->high_prev;
     q24_t loss = 0;
     uint32_t pulses = 0u; /* bit x: leg x a pulse as intended */
     for (unsigned x = 0u; x < 3u; x++) {
         const uint32_t high = hp & (1u << x);
         if (du[x] >= FX_ONE) {
-            if (high == 0u && s[x] > 0) {
+            if (high == 0u && s2[x] > 0) {
                 /* high all period after a low end: the rising edge at the
                  * start is late and this leg cannot make up for it (a leg
-                 * at 1 has no ripple term: s is its current's at the start) */
-                loss = fx_max(loss, fx_mul(d->dt, s[x]));
+                 * at 1 has no ripple term: s2 is twice its current's sign at
+                 * the start) */
+                loss = fx_max(loss, dt_half_mul(d->dt, s2[x]));
             }
         } else if (du[x] > 0) {
             pulses |= 1u << x;
@@ -97,7 +106,7 @@ void ctrl_deadtime_apply(ctrl_deadtime_t *d, const ctrl_estimate_t *est, ctrl_le
         /* the start's falling edge (after a high end) sees the current at
          * the ripple's zero */
         const q24_t s0 = high != 0u ? dt_sign(d, i[x]) : 0;
-        legs->duty[x] = dt_leg(d, du[x], s[x], s0, high);
+        legs->duty[x] = dt_leg(d, du[x], s2[x], s0, high);
     }
     if (loss > 0) {
         /* ... the others' pulses by as much less: the line voltages are kept */
