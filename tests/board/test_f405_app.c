@@ -338,9 +338,32 @@ static void test_identified_machine_survives_a_parameter_change(void)
     expect_prefix("ok enc.cpr 8192", command("param get enc.cpr"));
 }
 
+/* A machine parameter the core refuses leaves everything in force as it
+ * was: the machine, the controller, its tunables and the drive's settings
+ * changed over the link. Before, the restore put back the defaults (wc 0,
+ * est.psi_adapt 1). */
+static void test_refused_machine_keeps_what_is_in_force(void)
+{
+    memset(f4_mem_flash_settings, 0xFF, 2u * F4_FLASH_SECTOR_SIZE);
+    f405_power_on();
+    f405_calibrate();
+    TEST_ASSERT_EQUAL_STRING("ok wc 3000", command("param set wc 3000"));
+    expect_prefix("ok est.psi_adapt 0", command("param set est.psi_adapt 0"));
+    const ctrl_machine_t before = f405.app.fw.machine_own;
+    /* 1 uH: Ts Rs / Ld = 50 us x 0.047 ohm / 1 uH = 2.35 > 1 */
+    expect_prefix("err 10 failed Ts Rs / Ld = 2.35 outside [0, 1]",
+                  command("param set m.ld_h 1e-6"));
+    TEST_ASSERT_EQUAL_MEMORY(&before.ld_h, &f405.app.fw.machine_own.ld_h, sizeof before.ld_h);
+    TEST_ASSERT_NOT_NULL(f405.app.fw.ctrl);
+    TEST_ASSERT_EQUAL_STRING(F405_CTRL, f405.app.fw.ctrl->name);
+    TEST_ASSERT_EQUAL_STRING("ok wc 3000 rad/s", command("param get wc"));
+    expect_prefix("ok est.psi_adapt 0", command("param get est.psi_adapt"));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
+    RUN_TEST(test_refused_machine_keeps_what_is_in_force);
     return UNITY_END();
 }

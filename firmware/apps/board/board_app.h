@@ -113,8 +113,12 @@ int board_app_start(board_app_t *a, const board_app_port_t *port, hal_t *hal);
 /* Re-initialises the firmware with new machine data, encoder resolution
  * and configuration (NULL: the defaults for m and the controller in use)
  * while the gates are off: control interrupt masked meanwhile, the hardware
- * threshold moved (port->set_trip). On a refusal the previous data are
- * restored and the core's reason kept for "err 10 failed". CMD_OK,
+ * threshold moved (port->set_trip). Without a configuration (cfg NULL) the
+ * defaults for m, with what the drive held beyond its machine data
+ * (fw_kept_t: encoder offset and direction, friction). On a refusal the
+ * previous data are restored - the machine, the configuration in force and
+ * the controller's tunables - and the core's reason kept for "err 10
+ * failed". CMD_OK,
  * CMD_E_STATE (gates on or about to be), CMD_E_RANGE (encoder counts) or
  * CMD_E_FAILED. */
 int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t encoder_cpr,
