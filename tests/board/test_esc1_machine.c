@@ -728,6 +728,72 @@ static void test_framing_error_discards_its_line(void)
     TEST_ASSERT_EQUAL_UINT32(0u, g4_model_get(G4_USART2 + G4_USART_ISR) & G4_USART_ISR_FE);
 }
 
+/* One pass of the main loop `after` core cycles after the USART interrupt
+ * noted the loss (the model's cycle counter set there). */
+static void loop_after_loss(uint32_t after)
+{
+    g4_model_put(G4_DWT + G4_DWT_CYCCNT, esc.uart.rx_lost_at + after);
+    esc.isr_count++;
+    esc1_loop_once(&esc);
+}
+
+/* A line whose end an overrun lost (all of "param set m.rs_ohm 19\r" sent
+ * while the core stalls: the RXFIFO keeps "param se", the other 14
+ * characters, its end of line among them, are lost). Nothing is answered
+ * while the line may still go on; idle for ESC1_UART_LOST_IDLE_MS (20 ms at
+ * 170 MHz) after the core ran again, it is answered "err 13 lost overrun
+ * (ORE)" and not run, and the next line is read alone (before, it was
+ * joined to the damaged one and voided with it, the damaged one unanswered
+ * until then). */
+static void test_overrun_losing_the_end_of_line(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("param set m.rs_ohm 19\r", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(14u, g4_model.usart_lost);
+    main_loop_drains(); /* the core runs again: "param se" read, the loss noted */
+    const uint32_t idle = esc.uart.lost_idle_cycles;
+    TEST_ASSERT_EQUAL_UINT32(170000u * 20u, idle);
+    loop_after_loss(idle / 2u);
+    loop_after_loss(idle - 64u);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(0u, answers(), "no answer while the line may go on");
+    loop_after_loss(idle);
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    loop_after_loss(2u * idle);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, answers(), "one answer per loss");
+    wire("fault\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[1]);
+    TEST_ASSERT_EQUAL_STRING(rs_before, command("param get m.rs_ohm"));
+}
+
+/* A fragment is never run: "  disarm" streamed during a stall loses "dis"
+ * (the RXFIFO full of "fault\r  "), and the main loop passes while the
+ * sender's line goes on; "arm\r" coming just inside the idle bound belongs
+ * to the damaged line, which is answered "err 13 lost" and does not arm
+ * (a line ended at the loss itself would have run "arm"). */
+static void test_overrun_fragment_is_not_run(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("fault\r  dis", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(3u, g4_model.usart_lost);
+    main_loop_drains();
+    loop_after_loss(esc.uart.lost_idle_cycles / 4u);
+    loop_after_loss(esc.uart.lost_idle_cycles - 64u);
+    wire("arm\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[0]);
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[1]);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_FALSE(fw_gates_on_or_pending(&esc.fw));
+}
+
 /* "status" gives the main stack's high-water mark once the application has
  * told the link where its painted stack lies. */
 static void test_status_gives_the_stack_high_water_mark(void)
@@ -904,6 +970,8 @@ int main(void)
     RUN_TEST(test_overrun_discards_its_line);
     RUN_TEST(test_rx_fifo_keeps_a_short_line_through_a_stall);
     RUN_TEST(test_framing_error_discards_its_line);
+    RUN_TEST(test_overrun_losing_the_end_of_line);
+    RUN_TEST(test_overrun_fragment_is_not_run);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
     RUN_TEST(test_speed_reference_limit_is_the_drives);

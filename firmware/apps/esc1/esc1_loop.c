@@ -53,8 +53,14 @@ void esc1_loop_once(esc1_t *s)
     /* The received bytes up to the end of one command line: a queue of
      * lines (each up to a flash erase long: config erase 2 x 24.5 ms) runs
      * one per pass, with the watchdogs served in between. */
-    int c;
-    while ((c = esc1_uart_getc(&s->uart)) >= 0) {
+    for (;;) {
+        int c = esc1_uart_getc(&s->uart);
+        if (c < 0) { /* all read: a line that ended inside a loss ends now */
+            c = esc1_uart_lost_idle(&s->uart);
+            if (c < 0) {
+                break;
+            }
+        }
         if (c > 0xFF) { /* bytes lost before this one: their line is void */
             cmd_line_lost(&s->link.cmd, esc1_uart_lost_why(c));
         }

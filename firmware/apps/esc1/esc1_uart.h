@@ -22,6 +22,12 @@
  * no parity on this link) for the receive ring found full. */
 #define ESC1_UART_LOST_FULL 0x1u
 #define ESC1_UART_LOST_MASK 0xFu
+/* A line whose end an overrun (or the ring full) may have lost: idle this
+ * long after the loss with nothing received, it is taken as ended inside
+ * the loss (esc1_uart_lost_idle). 20 ms: 230 character times at 115 200
+ * baud, far beyond any gap inside a line a program sends in one write, and
+ * well inside a console's wait for the answer. */
+#define ESC1_UART_LOST_IDLE_MS 20u
 
 typedef struct {
     /* byte | (ESC1_UART_LOST_* of the bytes lost right before it) << 8 */
@@ -30,7 +36,11 @@ typedef struct {
     volatile uint32_t rx_head, rx_tail; /* head: interrupt, tail: main loop */
     volatile uint32_t tx_head, tx_tail; /* head: main loop, tail: interrupt */
     volatile uint32_t rx_dropped, rx_errors;
-    uint32_t rx_lost; /* interrupt only: losses since the last byte stored */
+    /* Losses since the last byte stored (the interrupt's; the main loop
+     * takes them under g4_irq_lock: esc1_uart_lost_idle) and when the last
+     * was noted (core cycles). */
+    volatile uint32_t rx_lost, rx_lost_at;
+    uint32_t lost_idle_cycles; /* ESC1_UART_LOST_IDLE_MS in core cycles */
     uint32_t tx_dropped;
     uint32_t tx_wait_cycles; /* longest wait for transmit space before dropping */
     uint32_t byte_cycles;    /* one character on the line, core cycles */
@@ -46,6 +56,12 @@ int esc1_uart_init(esc1_uart_t *u, uint32_t f_pclk_hz, uint32_t baud);
 /* Next received byte, or -1; bits 8..11 (ESC1_UART_LOST_* << 8) say that
  * bytes were lost right before it (esc1_uart_lost_why names it). */
 int esc1_uart_getc(esc1_uart_t *u);
+/* A line that ended inside a loss: an overrun or the ring full not yet
+ * marked on a byte, the ring and the RXFIFO empty, ESC1_UART_LOST_IDLE_MS
+ * since the loss. Returns an end of line carrying the losses as getc's
+ * bits 8..11 (forgotten here, so the next byte starts a line of its own),
+ * else -1. Main loop. */
+int esc1_uart_lost_idle(esc1_uart_t *u);
 /* What a getc's bits 8..11 say was lost, for "err 13 lost <why>". */
 const char *esc1_uart_lost_why(int c);
 /* Queues bytes; when the ring is full it waits for the interrupt to drain
