@@ -81,8 +81,11 @@ typedef struct {
                     * fraction of the period; 0 = no compensation */
     q24_t dt;      /* its dead-time part, t_d fs, Q24 fraction */
     int32_t inv_w; /* 1 / w, the edge sign's half-width, Q16 per pu (CTRL_DT_BAND_SHIFT) */
-    q24_t k_rip;   /* Ts V_base / (6 L I_base): the edge ripple r_x per unit of its
-                    * bracket and of DC link (pu), Q24 pu */
+#if CTRL_DEAD_COMP
+    q24_t k_rip; /* Ts V_base / (6 L I_base): the edge ripple r_x per unit of its
+                  * bracket and of DC link (pu), Q24 pu (only where built: the
+                  * images without it keep their layout) */
+#endif
     /* ---- state ---- */
     uint32_t high_prev; /* bit x: leg x was high at the end of the last period */
 } ctrl_deadtime_t;

@@ -81,7 +81,6 @@ int ctrl_deadtime_init(ctrl_deadtime_t *d, const ctrl_deadtime_config_t *c, cons
     d->dd = 0;
     d->dt = 0;
     d->inv_w = 0;
-    d->k_rip = 0;
     d->high_prev = 0u;
     return CTRL_OK;
 }
