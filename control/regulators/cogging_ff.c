@@ -16,5 +16,19 @@ int ctrl_cogging_init(ctrl_cogging_t *c, const int16_t *table, uint32_t n_log2, 
     /* round(2^48 / cpr) */
     c->pos_q48 = (((uint64_t)1 << 48) + cpr / 2u) / cpr;
     c->torque_rated = torque_rated;
+    c->lead = 0;
+    c->w_k = FX_ONE;
+    ctrl_cogging_restart(c);
+    return 0;
+}
+
+int ctrl_cogging_set_lead(ctrl_cogging_t *c, int32_t lead, int32_t w_k)
+{
+    if (c == NULL || lead < 0 || w_k <= 0 || w_k > FX_ONE) {
+        return -1;
+    }
+    c->lead = lead;
+    c->w_k = w_k;
+    ctrl_cogging_restart(c);
     return 0;
 }

@@ -306,6 +306,9 @@ static FW_NOINLINE void fw_apply_commands(fw_t *fw, fw_telemetry_t *tm, uint32_t
             ctrl_psi_track_reset(&fw->psi_track); /* from the current model at the first period */
             fw_mid_restart(fw);
             fw_torque_follow_reset(&fw->tqf);
+#if CTRL_COGGING
+            ctrl_cogging_restart(&fw->cog.map); /* no speed or read of the last run */
+#endif
 #if CTRL_SL_START_CHECK
             fw->sl_forced_n = fw->sl_obs_n = 0u;
 #endif
@@ -678,8 +681,9 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
     fw->refs.torque = fx_add(tref, fw->trim);
 #if CTRL_COGGING
     if (fw->cog_on != 0u && fw->sm.state == FW_STATE_RUNNING) {
-        /* anti-cogging: the table at the rotor's position, within the limit */
-        const q24_t ff = ctrl_cogging_ff(&fw->cog.map, fw->enc_pos);
+        /* anti-cogging: the table where the rotor will be when the torque
+         * asked now is made (cogging_ff.h's lead), within the limit */
+        const q24_t ff = ctrl_cogging_step(&fw->cog.map, fw->enc_pos, est->omega_e);
         fw->refs.torque = fx_clamp(fx_add(fw->refs.torque, ff), fx_neg(torque_max), torque_max);
     }
 #endif

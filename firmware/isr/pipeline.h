@@ -654,7 +654,11 @@ void fw_kept_config(const fw_kept_t *k, fw_config_t *c);
  * encoder, within the period's torque limit.
  * fw_cogging_enable: on (FW_ENOENT without a table measured with this
  *   encoder's counts and direction, FW_EINVAL sensorless: no mechanical
- *   angle) or off; taken at the next period.
+ *   angle, FW_ERANGE a look-ahead that does not fit) or off; taken at the
+ *   next period. The table is read ahead of the position by the speed times
+ *   the controller's delay from torque reference to torque (FOC 1.5 Ts +
+ *   1 / wc, the predictive controllers 2 Ts, the hysteresis ones none;
+ *   docs/anticogging.md), set again with each controller.
  * fw_cogging_load: n entries of Q15 of the rated torque against the encoder
  *   position (cogging_ff.h), measured with the encoder's present counts
  *   (the caller checked), n = CTRL_COG_N (else FW_ERANGE); gates off

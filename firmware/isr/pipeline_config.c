@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "ctrl_cfg_math.h"
+#include "ctrl_foc_config.h"
 #include "ctrl_units.h"
 #include "field_weak_config.h"
 #include "pipeline.h"
@@ -636,6 +637,72 @@ bool fw_commission_poll(fw_t *fw)
     return fw_commission_apply(fw) == FW_OK;
 }
 
+#if CTRL_COGGING
+/* The anti-cogging look-ahead (cogging_ff.h's lead): tau, the delay from the
+ * position sampled at k to the torque that answers the reference formed from
+ * it, derived from what the controller is (docs/anticogging.md has it
+ * measured against each controller in the plant):
+ *   FOC: 1.5 Ts + 1 / wc. The duties computed at k act over [k+1, k+2) (one
+ *        period of computation, half a period of the PWM's zero-order
+ *        hold); the current loop, Kp = L wc, Ki = R wc (pole cancelled), is
+ *        a first-order closed loop of time constant 1 / wc (wc from Kp_q / Lq
+ *        when Kp_q is set, else the tunable wc, else 2 pi fs / 20, as
+ *        ctrl_foc_config.c).
+ *   The predictive controllers of the torque (duty-ratio DTC, MPC,
+ *        SVM-DTC): 2 Ts. From the state predicted for k+1 they choose the
+ *        voltage of [k+1, k+2) that brings the torque to the reference at
+ *        k+2: the torque reaches each reference two periods after the
+ *        position it was formed from, along a ramp (no zero-order hold).
+ *   The hysteresis controllers (the switching tables, HDTC, HP-DTC, FOC with
+ *        hysteresis current control; fw_cog_hysteresis): 0. They switch as
+ *        soon as the error leaves its band, most on the prediction for k+1,
+ *        and keep the torque (current) inside a band around the reference:
+ *        no loop lag to lead.
+ * The speed it multiplies: the encoder's (a count per period at most at low
+ * speed: 0 or 1 count at 30 r/min, 16384 counts, 10 kHz) averaged over
+ * 1 / (2 pi FW_COG_SPEED_HZ) = 8 ms; at constant speed the average's delay
+ * costs nothing, and it is tau (0.5 ms) times the speed's change in 8 ms
+ * when the speed changes.
+ * 0, or -1 when the lead does not fit (half a turn per rated speed). */
+#define FW_COG_SPEED_HZ 20.0
+static bool fw_cog_hysteresis(const char *name)
+{
+    static const char *const hyst[] = {"bst",  "mbst",      "ast",   "zst",     "fst",
+                                       "hdtc", "hdtc_pred", "hpdtc", "foc_hyst"};
+    for (size_t i = 0; i < sizeof hyst / sizeof hyst[0]; i++) {
+        if (strcmp(name, hyst[i]) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static int fw_cogging_lead(fw_t *fw)
+{
+    const double fs = (double)fw->params.fs_hz;
+    double tau = 2.0 / fs;
+    if (fw->ctrl != NULL && fw_cog_hysteresis(fw->ctrl->name)) {
+        tau = 0.0;
+    } else if (fw->ctrl != NULL && strcmp(fw->ctrl->name, "foc") == 0) {
+        const ctrl_foc_cfg_t *c = (const ctrl_foc_cfg_t *)(const void *)fw->ctrl_cfg.bytes;
+        double wc = c->wc > 0.0 ? c->wc : CTRL_TWO_PI * fs / 20.0;
+        if (c->kp_q > 0.0 && fw->machine->lq_h > 0.0) {
+            wc = c->kp_q / fw->machine->lq_h;
+        }
+        tau = 1.5 / fs + 1.0 / wc;
+    }
+    /* Q32 turns per pu electrical speed: tau w_base / (2 pi p) turns */
+    const double lead =
+        tau * fw->bases.w_rad_s / (CTRL_TWO_PI * (double)fw->params.pole_pairs) * 4294967296.0;
+    const q24_t w_k = ctrl_q24_from_double(1.0 - ctrl_cfg_exp(-CTRL_TWO_PI * FW_COG_SPEED_HZ / fs));
+    if (!(lead >= 0.0) || !(lead < 2147483647.0)) {
+        (void)ctrl_cogging_set_lead(&fw->cog.map, 0, w_k);
+        return -1;
+    }
+    return ctrl_cogging_set_lead(&fw->cog.map, (int32_t)llround(lead), w_k);
+}
+#endif
+
 /* Initialise desc with cfg into the state block; keep both on success. */
 static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *cfg)
 {
@@ -666,6 +733,9 @@ static int fw_ctrl_install(fw_t *fw, const ctrl_desc_t *d, const unsigned char *
     memcpy(fw->ctrl_state.bytes, st.bytes, sizeof st.bytes);
     memcpy(fw->ctrl_cfg.bytes, cfg, CTRL_CFG_MAX);
     fw->ctrl = d;
+#if CTRL_COGGING
+    (void)fw_cogging_lead(fw); /* fw_cogging_enable refuses a lead that does not fit */
+#endif
     /* Skip the estimates the controller never reads (telemetry takes the
      * rotor-frame values and derives |psi_s| and the sector itself). */
     ctrl_estimator_set_outputs(&fw->est, CTRL_EST_ALL & ~(unsigned)d->est_unused);
@@ -902,6 +972,9 @@ int fw_cogging_enable(fw_t *fw, bool on)
     }
     if (fw->cog.valid == 0u || fw->cog.cal_cpr != fw->enc_cpr) {
         return FW_ENOENT;
+    }
+    if (fw_cogging_lead(fw) != 0) {
+        return FW_ERANGE;
     }
     fw->cog_on = 1u;
     return FW_OK;

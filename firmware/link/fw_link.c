@@ -586,6 +586,11 @@ static int op_cogging(void *ctx, const char *what, const char **detail)
         *detail = "sensorless: no mechanical angle";
         return CMD_E_STATE;
     }
+    if (rc == FW_ERANGE) {
+        /* the look-ahead tau w_rated / (2 pi p) in [0, 1/2) turn (cogging_ff.h) */
+        *detail = "look-ahead beyond half a turn at the rated speed: rated speed or current loop";
+        return CMD_E_RANGE;
+    }
     return fw_link_err(rc);
 }
 #endif

@@ -29,6 +29,17 @@ void cog_table_truth(const sim_machine_t *m, int16_t *table)
     }
 }
 
+void cog_table_counted(const sim_machine_t *m, int16_t *table)
+{
+    plant_config_t pc;
+    sim_machine_to_plant(m, &pc);
+    const double half = 0.5 / (4.0 * (double)m->encoder_lines); /* turns */
+    for (uint32_t i = 0; i < CTRL_COG_N; i++) {
+        const double th = 2.0 * COG_PI * ((double)i / (double)CTRL_COG_N + half);
+        table[i] = (int16_t)lround(-cog_truth(&pc, th) / m->torque_rated_nm * 32768.0);
+    }
+}
+
 /* RSS of the harmonics' amplitudes from the sums of x cos, x sin over n samples. */
 static double cog_harmonics(const double *fc, const double *fs, int k_n, uint64_t n)
 {
@@ -132,6 +143,50 @@ void cog_ripple(const sim_machine_t *m, const char *ctrl, const int16_t *table, 
     sim_run_free(&r);
     out->torque_sd_nm = sqrt(fmax(s2 / (double)n - (s1 / (double)n) * (s1 / (double)n), 0.0));
     out->torque_cog_nm = cog_harmonics(fc, fs, pc.cog_n, n);
+}
+
+void cog_torque_phasor(const sim_machine_t *m, const char *ctrl, const int16_t *table, double rpm,
+                       double frac, double settle_s, double window_s, double te[2], double cog[2])
+{
+    static sim_run_t r;
+    static sim_run_cfg_t c;
+    const ctrl_desc_t *d = ctrl_find(ctrl);
+    TEST_ASSERT_NOT_NULL(d);
+    plant_config_t pc;
+    sim_machine_to_plant(m, &pc);
+    const double n_cog = (double)pc.cog_per_rev;
+    const double per = 60.0 / rpm / n_cog;
+    sim_run_config_default(&c, m, d);
+    c.fs_hz = d->fs_default_hz;
+    c.hal.pwm_freq_hz = c.fs_hz;
+    c.free_mech = false;
+    c.speed_rpm = rpm;
+    c.torque_ref_nm = frac * m->torque_rated_nm;
+    c.duration_s = settle_s + ceil(window_s / per) * per;
+    c.calib_samples = 64u;
+    cog_start(&r, &c, table);
+    double s[4] = {0.0, 0.0, 0.0, 0.0};
+    uint64_t n = 0;
+    while (!sim_run_done(&r)) {
+        TEST_ASSERT_EQUAL_INT(0, sim_run_period(&r));
+        if (r.armed && sim_run_time(&r) >= settle_s) {
+            const double th = plant_theta_m(&r.plant);
+            const double t = plant_torque(&r.plant), tc = -cog_truth(&pc, th);
+            const double cs = cos(n_cog * th), sn = sin(n_cog * th);
+            s[0] += t * cs;
+            s[1] += t * sn;
+            s[2] += tc * cs;
+            s[3] += tc * sn;
+            n++;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, fw_fault(&r.fw));
+    sim_run_free(&r);
+    /* x e^{-j n th}: re = sum x cos, im = -sum x sin (amplitude 2 |.| / n) */
+    te[0] = 2.0 * s[0] / (double)n;
+    te[1] = -2.0 * s[1] / (double)n;
+    cog[0] = 2.0 * s[2] / (double)n;
+    cog[1] = -2.0 * s[3] / (double)n;
 }
 
 int cog_calibrate(const sim_machine_t *m, double rpm, double bw_hz, int16_t *table,

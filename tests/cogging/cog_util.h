@@ -13,6 +13,19 @@ double cog_truth(const plant_config_t *pc, double th);
 /* The ideal table: -T_cog at each entry's angle (encoder aligned, counting up). */
 void cog_table_truth(const sim_machine_t *m, int16_t *table);
 
+/* The ideal table as the calibration measures it: the encoder's count is the
+ * floor of the angle, so a count's samples average half a count beyond it
+ * (the bins centred on their entries keep that): -T_cog half a count after
+ * each entry's angle. */
+void cog_table_counted(const sim_machine_t *m, int16_t *table);
+
+/* Torque mode at frac of the rated torque on the dynamometer at rpm with
+ * table (NULL: none), window_s (whole cogging periods) after settle_s: the
+ * phasors at the cogging fundamental of the mechanical angle (re, im; N*m) of
+ * the electromagnetic torque te and of -T_cog (what it should be). */
+void cog_torque_phasor(const sim_machine_t *m, const char *ctrl, const int16_t *table, double rpm,
+                       double frac, double settle_s, double window_s, double te[2], double cog[2]);
+
 typedef struct {
     double speed_sd_rpm;  /* speed mode at 30 r/min: sd of the true speed */
     double speed_cog_rpm; /* its amplitude at the cogging harmonics of the angle (RSS) */

@@ -8,7 +8,8 @@
  * period's ISR inputs, the table and a hash of each period's outputs (the
  * ones pil_ident_hash covers, plus the torque reference with the
  * feed-forward in it, the feed-forward itself and the encoder position it was
- * read at) into pil_cog_data.c; pil_cog_replay replays the inputs through
+ * read at, the look-ahead's filtered speed and the feed-forward it holds)
+ * into pil_cog_data.c; pil_cog_replay replays the inputs through
  * fw_isr on the host and in QEMU and compares every period's hash.
  */
 #ifndef TESTS_TARGET_PIL_PIL_COG_H
@@ -44,6 +45,9 @@ static inline uint32_t pil_cog_hash(const hal_pwm_t *pwm, int gates, const fw_t 
     h = pil_ident_mix(h, (uint32_t)fw->torque_ref_now);
     h = pil_ident_mix(h, fw->enc_pos);
     h = pil_ident_mix(h, (uint32_t)ctrl_cogging_ff(&fw->cog.map, fw->enc_pos));
+    /* the look-ahead's state: its filtered speed and the feed-forward held */
+    h = pil_ident_mix(h, (uint32_t)fw->cog.map.w);
+    h = pil_ident_mix(h, (uint32_t)fw->cog.map.ff_held);
     h = pil_ident_mix(h, fw->cog_on);
     return h;
 }
