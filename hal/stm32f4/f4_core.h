@@ -52,17 +52,6 @@ static inline uint32_t f4_cycles(void)
 {
     return f4_rd(F4_DWT + F4_DWT_CYCCNT);
 }
-/* The stack pointer now (the main stack in thread mode). */
-static inline uint32_t *f4_sp(void)
-{
-#if defined(F4_MEM_ARRAYS)
-    return (uint32_t *)0; /* the register model has no stack of its own */
-#else
-    uint32_t *sp;
-    __asm__ volatile("mov %0, sp" : "=r"(sp));
-    return sp;
-#endif
-}
 /* Busy-waits at least n core cycles. */
 void f4_delay_cycles(uint32_t n);
 /* Waits until (*reg & mask) == want; false after timeout_cycles core cycles. */

@@ -35,17 +35,6 @@ static inline uint32_t g4_cycles(void)
 {
     return g4_rd(G4_DWT + G4_DWT_CYCCNT);
 }
-/* The stack pointer now (the main stack in thread mode). */
-static inline uint32_t *g4_sp(void)
-{
-#if defined(G4_MEM_ARRAYS)
-    return (uint32_t *)0; /* the register model has no stack of its own */
-#else
-    uint32_t *sp;
-    __asm__ volatile("mov %0, sp" : "=r"(sp));
-    return sp;
-#endif
-}
 /* Busy-waits at least n core cycles. */
 void g4_delay_cycles(uint32_t n);
 /* Waits until (*reg & mask) == want; false after timeout_cycles core cycles. */

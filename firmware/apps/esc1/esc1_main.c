@@ -41,6 +41,7 @@
 #include "g4_periph.h"
 #include "g4_regs.h"
 #include "g4_startup.h"
+#include "stm32_startup.h"
 
 /* Everything lives in one instance; the interrupt handlers take no argument,
  * so it is reachable at file scope. */
@@ -108,7 +109,7 @@ int main(void)
     /* The stack below this frame painted: its high-water mark since reset in
      * "status" and the start-up report (fw_stack.h). 16 words left for the
      * painting's own call. */
-    fw_stack_paint(__stack_bottom__, g4_sp() - 16u);
+    fw_stack_paint(__stack_bottom__, stm32_sp() - 16u);
     esc1_t *s = &esc1;
     const g4_board_t *b = &g4_board_esc1;
     g4_cycle_counter_init();

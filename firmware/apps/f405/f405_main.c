@@ -48,6 +48,7 @@
 #include "f4_startup.h"
 #include "f4_tim.h"
 #include "fw_stack.h"
+#include "stm32_startup.h"
 #include F405_BOARD_HEADER
 
 _Static_assert(offsetof(f405_t, app) == 0, "the link's context is the f405_t");
@@ -327,7 +328,7 @@ int main(void)
     /* The stack below this frame painted: its high-water mark since reset in
      * "status" and the start-up report (fw_stack.h). 16 words left for the
      * painting's own call. */
-    fw_stack_paint(__stack_bottom__, f4_sp() - 16u);
+    fw_stack_paint(__stack_bottom__, stm32_sp() - 16u);
     f405_t *s = &f405;
     board_app_t *a = &s->app;
     s->board = &F405_BOARD;
