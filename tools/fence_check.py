@@ -10,12 +10,13 @@ behind a release signal fence, read after the other side's count behind an
 acquire fence. A signal fence emits no instruction, so no test of the
 program's behaviour sees one missing; with link-time optimisation a plain
 store may then move past the count. This check reads the functions that
-publish or consume a count and requires, in each, the listed steps in order:
+publish or consume a count (or take a step with the interrupts masked,
+g4_irq_lock) and requires, in each, the listed steps in order:
 a step is a regular expression over the function's text with comments
 removed, and the next step is searched after the previous one's match. It
 fails (exit 1) naming the function and the step not found in order.
 
---self-test removes each rule's fences from its function in turn and fails
+--self-test removes each rule's fences (and locks) from its function in turn and fails
 unless the rule then fails (the check's own failure path).
 
 It catches a fence removed, or a store moved above its fence; not a field
@@ -27,6 +28,7 @@ import sys
 
 REL = r"(atomic_signal_fence\(memory_order_release\)|FW_RELEASE\(\))"
 ACQ = r"atomic_signal_fence\(memory_order_acquire\)"
+LOCK = r"g4_irq_lock\(\)"  # the interrupts masked (PRIMASK) for the steps after it
 
 # (file, function, [steps in order], what it publishes)
 RULES = [
@@ -68,6 +70,13 @@ RULES = [
     ("firmware/apps/esc1/esc1_uart.c", "esc1_uart_irq",
      [r"rx_tail", ACQ, r"u->rx\[", REL, r"rx_head\+\+", r"tx_head", ACQ, r"u->tx\[", REL, r"tx_tail\+\+"],
      "the interrupt's side of both rings"),
+    ("firmware/apps/esc1/esc1_uart.c", "esc1_uart_lost_idle",
+     [LOCK, r"u->rx_lost;", r"u->rx_lost = 0u", r"g4_irq_unlock"],
+     "a pending loss read and cleared with the interrupt masked (none noted meanwhile is lost)"),
+    # TIM1 BDTR.MOE (B-G431B-ESC1): set only with the trip checked, the interrupts masked
+    ("hal/stm32g4/g4_hal.c", "hal_gate_enable",
+     [LOCK, r"hal_trip_active\(h\)", r"g4_tim1_outputs\(true\)", r"g4_irq_unlock"],
+     "MOE's read-modify-write with the break interrupt held off"),
 ]
 
 
@@ -125,7 +134,7 @@ def main(argv):
             continue
         # self-test: every fence of the rule removed in turn must fail it
         for k, step in enumerate(steps):
-            if step not in (REL, ACQ):
+            if step not in (REL, ACQ, LOCK):
                 continue
             n = len(re.findall(step, body))
             for j in range(n):

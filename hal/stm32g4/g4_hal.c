@@ -145,12 +145,22 @@ void hal_pwm_write(hal_t *h, const hal_pwm_t *pwm)
 
 void hal_gate_enable(hal_t *h, bool enable)
 {
-    if (enable && !hal_trip_active(h)) {
-        g4_tim1_outputs(true);
-        /* A break between the check and the write (its interrupt has
-         * latched it, the hardware had cleared MOE, the write set it again):
-         * off again. A break after this check clears MOE in hardware. */
-        if (!hal_trip_active(h)) {
+    if (enable) {
+        /* The trip's check and MOE's read-modify-write as one step with the
+         * interrupts masked (g4_irq_lock): the break interrupt, which clears
+         * MOE too, cannot run between the read and the write and have its
+         * "gates off" undone by it; pending, it runs after the write, its
+         * clear the last word. A break in hardware meanwhile clears MOE and
+         * holds it clear while its input is active (RM0440 TIM1 break).
+         * Called at an arm or a commissioning step's first period, never
+         * every period: the lock costs nothing per period. */
+        const uint32_t primask = g4_irq_lock();
+        const bool on = !hal_trip_active(h);
+        if (on) {
+            g4_tim1_outputs(true);
+        }
+        g4_irq_unlock(primask);
+        if (on) {
             return;
         }
     }

@@ -476,6 +476,38 @@ static void test_runtime_gates_and_trip(void)
     TEST_ASSERT_FALSE(reg(bdtr) & G4_TIM_BDTR_MOE);
 }
 
+/* The break interrupt taken inside the arm's read-modify-write of BDTR (at
+ * its read, MOE = 0): hal_gate_enable sets MOE with the interrupts masked,
+ * so the break interrupt runs after its write and its MOE clear is the last
+ * word: no write sets MOE after the interrupt has turned the gates off.
+ * Before, the interrupt ran between the read and the write, which set MOE
+ * again until a re-check cleared it. */
+static int break_irq_at;
+static void break_irq_now(void)
+{
+    g4_model_put(G4_TIM1 + G4_TIM_SR, G4_TIM_SR_BIF); /* a comparator trips */
+    g4_hal_break_irq(&hal);
+    break_irq_at = (int)g4_model.n_log;
+}
+
+static void test_runtime_arm_and_break_interrupt(void)
+{
+    TEST_ASSERT_EQUAL_INT(G4_OK, esc1_init());
+    const uintptr_t bdtr = G4_TIM1 + G4_TIM_BDTR;
+    TEST_ASSERT_FALSE(reg(bdtr) & G4_TIM_BDTR_MOE);
+    break_irq_at = -1;
+    g4_model.irq_on_read = bdtr;
+    g4_model.irq = break_irq_now;
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_TRUE_MESSAGE(break_irq_at >= 0, "the break interrupt was taken");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        -1, g4_model_find(bdtr, G4_TIM_BDTR_MOE, G4_TIM_BDTR_MOE, break_irq_at),
+        "MOE set after the break interrupt's clear");
+    TEST_ASSERT_FALSE(reg(bdtr) & G4_TIM_BDTR_MOE);
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    TEST_ASSERT_EQUAL_UINT32(0u, g4_model.primask);
+}
+
 /* A comparator stuck high (RM0440 TIM1 break: BIF cannot be cleared while
  * the break input is active): the handler must not leave the interrupt
  * pending, or it re-enters at priority 0 until the watchdog resets the chip.
@@ -985,6 +1017,7 @@ int main(void)
     RUN_TEST(test_runtime_system_break_cause);
     RUN_TEST(test_runtime_break_during_clear_kept);
     RUN_TEST(test_runtime_break_rearm);
+    RUN_TEST(test_runtime_arm_and_break_interrupt);
     RUN_TEST(test_runtime_break_rearm_under_the_lock);
     RUN_TEST(test_runtime_samples_and_compare);
     RUN_TEST(test_runtime_encoder);
