@@ -52,9 +52,12 @@ add_test(NAME ${PMSM_BOARD}_image_printf
 add_test(NAME ${PMSM_BOARD}_flash
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/test_flash.py ${PROJECT_SOURCE_DIR}
                  ${PMSM_F405_ELF} ${f405_flash_board})
+# The stack's high-water mark after "config default" against the static
+# worst case (tools/stack_check.py run beside QEMU).
 add_test(NAME ${PMSM_BOARD}_qemu_boot
          COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/qemu_f405_boot.py ${PMSM_F405_ELF}
-                 ${PMSM_BOARD} ${f405_qemu_serial} ${f405_console_irq})
+                 ${PMSM_BOARD} ${f405_qemu_serial} ${f405_console_irq}
+                 ${PROJECT_SOURCE_DIR}/tools/stack_check.py ${f405_stack_args})
 # The start-up on the fall-back clock (QEMU's path) within the watchdog's
 # boot window: its instructions counted with the bench's QEMU plugin.
 add_test(NAME ${PMSM_BOARD}_qemu_wdg

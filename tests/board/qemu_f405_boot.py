@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Boots a real STM32F405 board image in QEMU's emulated STM32F405.
 
-    qemu_f405_boot.py IMAGE.elf TAG SERIAL_INDEX CONSOLE_IRQ
+    qemu_f405_boot.py IMAGE.elf TAG SERIAL_INDEX CONSOLE_IRQ [STACK_CHECK ARGS...]
 
 QEMU 7.2's netduinoplus2 machine is an STM32F405 whose USARTs, TIM2-5, ADCs,
 SPI, SYSCFG, EXTI and NVIC are modelled; RCC, the flash interface, GPIO,
@@ -21,6 +21,11 @@ Run 1 (the settings sectors erased, as on a new board):
     unpainted stack reads as all of it used) and above what its deepest path
     (the settings' defaults through fw_init) must have used, STACK_MIN_B;
     "status" gives the mark again, never lower, after every command below;
+    after "config default" (the deepest command path: the command
+    interpreter, the settings' defaults, fw_init) the mark must stay within
+    the static worst case of the image that STACK_CHECK (tools/stack_check.py
+    and its arguments, run beside QEMU) computes: what ran is bounded by the
+    analysis, or the analysis misses a frame;
   - help, status (state, armed=0), config show (no record: refused naming
     why), arm (refused: "err 8 state gates held off: DRV8301 no answer ..."),
     fault (the fault report: none latched), config save (the erase path with
@@ -162,6 +167,12 @@ def elf_patch(path, addr, word):
     raise SystemExit("no loadable segment holds 0x%08x" % addr)
 
 
+def stack_items(items):
+    """(used, size) of status's "stack_used=N size=M" item(s)."""
+    st = [re.match(r"stack_used=(\d+) size=(\d+)$", i) for i in items]
+    return [(int(x.group(1)), int(x.group(2))) for x in st if x]
+
+
 def run_console(elf, tag, serial_index, erased):
     q = Qemu(elf, serial_index, [(erased, SETTINGS)])
     p = tag + ": "
@@ -213,14 +224,21 @@ def run_console(elf, tag, serial_index, erased):
     a = q.answer("status")
     items = q.items()
     check(a.startswith("ok"), "the console answers after the erase path")
-    st = [re.match(r"stack_used=(\d+) size=(\d+)$", i) for i in items]
-    st = [(int(x.group(1)), int(x.group(2))) for x in st if x]
+    st = stack_items(items)
     check(len(st) == 1 and st[0][1] == q.stack[1] and q.stack[0] <= st[0][0] < st[0][1],
           "status: the high-water mark after the commands, not below the start-up's, below "
           "the size: %s (start-up %d of %d B)" % (st, q.stack[0], q.stack[1]))
+    a = q.answer("config default")
+    check(a.startswith("ok compiled-in defaults applied"), "config default runs: " + a)
+    a = q.answer("status")
+    st = stack_items(q.items())
+    q.stack_deep = st[0][0] if len(st) == 1 else None
+    check(q.stack_deep is not None and q.stack[0] <= q.stack_deep < q.stack[1],
+          "status after config default: the high-water mark %s B (start-up %d B)" %
+          (q.stack_deep, q.stack[0]))
     wall = q.close()
     check(wall < RUN_S, "run 1 took %.1f s of wall time" % wall)
-    return q.log
+    return q.log, q.stack_deep
 
 
 def run_fault(elf, tag, serial_index, console_irq, erased, tmp):
@@ -244,23 +262,43 @@ def run_fault(elf, tag, serial_index, console_irq, erased, tmp):
 
 
 def main():
-    if len(sys.argv) != 5:
+    if len(sys.argv) < 5:
         raise SystemExit(__doc__)
     elf, tag, serial_index, console_irq = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(
         sys.argv[4])
     if shutil.which("qemu-system-arm") is None:
         raise SystemExit("qemu-system-arm not found (tools/setup installs it)")
+    # the static analysis, beside the emulator
+    static = None
+    if len(sys.argv) > 5:
+        static = subprocess.Popen([sys.executable] + sys.argv[5:], stdout=subprocess.PIPE,
+                                  stderr=subprocess.STDOUT, text=True)
     tmp = tempfile.mkdtemp(prefix="qemu_f405_")
     logs = []
+    deep = None
     try:
         erased = os.path.join(tmp, "erased.bin")
         open(erased, "wb").write(b"\xff" * SETTINGS_SIZE)
         print("== run 1: start-up and console of %s ==" % os.path.basename(elf))
-        logs.append(run_console(elf, tag, serial_index, erased))
+        log, deep = run_console(elf, tag, serial_index, erased)
+        logs.append(log)
         print("== run 2: a fault, the watchdog path, the report after the reset ==")
         logs.append(run_fault(elf, tag, serial_index, console_irq, erased, tmp))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    if static is not None:
+        out = static.communicate(timeout=300)[0]
+        worst = re.search(r"worst case (\d+) B", out)
+        thread = re.search(r"^\s+thread\s+\S+\s+(\d+) B", out, re.M)
+        if check(worst is not None and thread is not None,
+                 "the static stack check ran (%s)" % " ".join(sys.argv[5:7])):
+            w, t = int(worst.group(1)), int(thread.group(1))
+            check(deep is not None and deep <= w,
+                  "measured after config default %s B <= the static worst case %d B (its "
+                  "main-loop path alone %d B: measured %s)" %
+                  (deep, w, t, "%.1f %% of it" % (100.0 * deep / t) if deep else "-"))
+        else:
+            print(out)
     if failures:
         for n, log in enumerate(logs, 1):
             print("---- console, run %d ----\n%s" % (n, "\n".join(log)))
