@@ -73,10 +73,14 @@ static inline void f4_pendsv_pend(void)
 
 /* Every configurable-priority exception held off (PRIMASK, CPSID i: ARMv7-M
  * ARM B1.4.3) for a few instructions; the previous PRIMASK back on unlock.
- * The host register model runs one context: no-ops there. */
+ * The traced register model keeps a PRIMASK of its own and holds its
+ * modelled interrupts off while it is set; the untraced array build (the
+ * instruction-count image) runs one context: no-ops there. */
 static inline uint32_t f4_irq_lock(void)
 {
-#if defined(F4_MEM_ARRAYS)
+#if defined(F4_MEM_ARRAYS) && defined(F4_REG_TRACE)
+    return f4_trace_irq_lock();
+#elif defined(F4_MEM_ARRAYS)
     return 0u;
 #else
     uint32_t primask;
@@ -86,7 +90,9 @@ static inline uint32_t f4_irq_lock(void)
 }
 static inline void f4_irq_unlock(uint32_t primask)
 {
-#if defined(F4_MEM_ARRAYS)
+#if defined(F4_MEM_ARRAYS) && defined(F4_REG_TRACE)
+    f4_trace_irq_unlock(primask);
+#elif defined(F4_MEM_ARRAYS)
     (void)primask;
 #else
     __asm__ volatile("msr primask, %0" ::"r"(primask) : "memory");

@@ -149,11 +149,22 @@ void hal_ctrl_hold(hal_t *h, bool hold)
 
 void hal_gate_enable(hal_t *h, bool enable)
 {
-    if (enable && !hal_trip_active(h)) {
-        f4_tim1_outputs(true);
-        /* A fault between the check and the write (its interrupt has cleared
-         * MOE, the write set it again): off again. */
-        if (!hal_trip_active(h)) {
+    if (enable) {
+        /* The trip's check and MOE's read-modify-write as one step with the
+         * interrupts masked (f4_irq_lock): the nFAULT and break interrupts,
+         * which clear MOE too, cannot run between the read and the write and
+         * have their "gates off" undone by it; pending, they run after the
+         * write, their clear the last word. A break in hardware meanwhile
+         * clears MOE and holds it clear while its input is active (RM0090
+         * sec. 17.3.14). Called at an arm or a commissioning step's first
+         * period, never every period: the lock costs nothing per period. */
+        const uint32_t primask = f4_irq_lock();
+        const bool on = !hal_trip_active(h);
+        if (on) {
+            f4_tim1_outputs(true);
+        }
+        f4_irq_unlock(primask);
+        if (on) {
             return;
         }
     }

@@ -108,6 +108,9 @@ F4_PERIPHS(F4_DECLARE_ARRAY)
 #if defined(F4_REG_TRACE)
 uint32_t f4_trace_read(uintptr_t reg);
 void f4_trace_write(uintptr_t reg, uint32_t value);
+/* The register model's PRIMASK (f4_irq_lock / f4_irq_unlock). */
+uint32_t f4_trace_irq_lock(void);
+void f4_trace_irq_unlock(uint32_t primask);
 static inline uint32_t f4_rd(uintptr_t reg)
 {
     return f4_trace_read(reg);

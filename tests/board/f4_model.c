@@ -256,7 +256,38 @@ uint32_t f4_trace_read(uintptr_t reg)
     if (s >= 0 && reg == spis[s] + F4_SPI_DR) {
         *f4_reg(spis[s], F4_SPI_SR) &= ~F4_SPI_SR_RXNE;
     }
-    return *c;
+    const uint32_t v = *c;
+    if (f4_model.irq_on_read == reg && f4_model.irq != NULL) {
+        /* An interrupt taken right after this load: the caller stores what it
+         * read, modified, after the handler has run; with PRIMASK set, held
+         * pending until it clears. */
+        void (*irq)(void) = f4_model.irq;
+        f4_model.irq = NULL;
+        if (f4_model.primask != 0u) {
+            f4_model.irq_pending = irq;
+        } else {
+            irq();
+        }
+    }
+    return v;
+}
+
+uint32_t f4_trace_irq_lock(void)
+{
+    const uint32_t prev = f4_model.primask;
+    f4_model.primask = 1u;
+    f4_model.n_locks++;
+    return prev;
+}
+
+void f4_trace_irq_unlock(uint32_t primask)
+{
+    f4_model.primask = primask;
+    if (primask == 0u && f4_model.irq_pending != NULL) {
+        void (*irq)(void) = f4_model.irq_pending;
+        f4_model.irq_pending = NULL;
+        irq();
+    }
 }
 
 /* FLASH_CR and the settings sectors: the flash interface's side effects. */

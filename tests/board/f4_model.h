@@ -58,6 +58,16 @@ typedef struct {
      * could reach a peripheral whose clock is not yet on). */
     uintptr_t rcc_enable_pending;
     uint32_t rcc_enable_unsynced;
+    /* The next read of irq_on_read runs irq() right after the load (an
+     * interrupt inside a read-modify-write); one shot. */
+    uintptr_t irq_on_read;
+    void (*irq)(void);
+    /* PRIMASK (f4_irq_lock sets it, f4_irq_unlock puts the previous value
+     * back): while set, the irq above is held pending and taken at the
+     * unlock that clears it, as the core takes a pended interrupt. */
+    uint32_t primask;
+    uint32_t n_locks;          /* f4_irq_lock calls so far */
+    void (*irq_pending)(void); /* taken when PRIMASK clears */
 } f4_model_t;
 
 extern f4_model_t f4_model;

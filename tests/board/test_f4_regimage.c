@@ -182,6 +182,18 @@ static void test_clock_fall_backs(void)
  * then high (the driver's reset, > 20 us) before the first SPI frame; the
  * control registers written before TIM1 is configured; TIM1's BDTR (MOE 0)
  * before the pins become AF; the counter started last. */
+/* The break interrupt as the image has it (TIM1_BRK_TIM9_IRQHandler ->
+ * f4_hal_break_irq), BIF latched by the hardware's break; the log index of
+ * its write that clears MOE. */
+static int break_clear = -1;
+static void break_irq(void)
+{
+    f4_model_put(F4_TIM1 + F4_TIM_SR, f4_model_get(F4_TIM1 + F4_TIM_SR) | F4_TIM_SR_BIF);
+    const int from = (int)f4_model.n_log;
+    f4_hal_break_irq(&hal);
+    break_clear = f4_model_find(F4_TIM1 + F4_TIM_BDTR, F4_TIM_BDTR_MOE, 0u, from);
+}
+
 static void test_vesc6_start_up_image(void)
 {
     const f4_board_t *b = &f4_board_vesc6;
@@ -238,6 +250,33 @@ static void test_vesc6_start_up_image(void)
     assert_before(pins_af, cen, "the counter started last");
     TEST_ASSERT_EQUAL_INT(
         -1, f4_model_find(F4_TIM1 + F4_TIM_BDTR, F4_TIM_BDTR_MOE, F4_TIM_BDTR_MOE, 0));
+}
+
+/* The arm's MOE against the break interrupt (hal_gate_enable): the break
+ * taken right after the arm's read of TIM1_BDTR, inside its read-modify-
+ * write. The trip check and the write are one step with the interrupts
+ * masked, so the interrupt runs after the write and its clear of MOE is the
+ * last word: no write sets MOE after it. Before, the write stored the MOE
+ * read before the break, setting it again until the re-check cleared it. */
+static void test_break_inside_the_arm_keeps_the_gates_off(void)
+{
+    const f4_board_t *b = &f4_board_vesc6;
+    attach_drv(b);
+    TEST_ASSERT_EQUAL_INT(F4_OK, board_init(b));
+    TEST_ASSERT_FALSE(hal_trip_active(&hal));
+    f4_model.irq_on_read = F4_TIM1 + F4_TIM_BDTR;
+    f4_model.irq = break_irq;
+    const uint32_t locks = f4_model.n_locks;
+    hal_gate_enable(&hal, true);
+    TEST_ASSERT_NULL_MESSAGE(f4_model.irq, "the break interrupt was taken");
+    TEST_ASSERT_TRUE_MESSAGE(break_clear >= 0, "the interrupt cleared MOE");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(
+        -1, f4_model_find(F4_TIM1 + F4_TIM_BDTR, F4_TIM_BDTR_MOE, F4_TIM_BDTR_MOE, break_clear),
+        "MOE set again after the break interrupt's clear");
+    TEST_ASSERT_EQUAL_HEX32(0u, reg(F4_TIM1 + F4_TIM_BDTR) & F4_TIM_BDTR_MOE);
+    TEST_ASSERT_TRUE(hal_trip_active(&hal));
+    TEST_ASSERT_TRUE(f4_model.n_locks > locks); /* and the lock let go */
+    TEST_ASSERT_EQUAL_UINT32(0u, f4_model.primask);
 }
 
 /* ODrive v3.6 M0: control 1 = 0x550, control 2 = 0x008 (ODrive's own
@@ -705,6 +744,7 @@ int main(void)
     RUN_TEST(test_adc_read_rebuilds_phase_a);
     RUN_TEST(test_pwm_limit_ack_and_encoder);
     RUN_TEST(test_servo_capture);
+    RUN_TEST(test_break_inside_the_arm_keeps_the_gates_off);
     RUN_TEST(test_gate_pins_safe);
     RUN_TEST(test_gate_pins_clock_level_mode);
     RUN_TEST(test_iwdg_start_and_lsi);
