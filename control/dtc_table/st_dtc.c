@@ -131,8 +131,17 @@ void st_fst_step(void *state, const ctrl_ctx_t *ctx, ctrl_out_t *out)
         s->psi_le_lim = fx_mag_le_lim(s->flux_ref.value);
     }
     const int psi_inc = nx->psi_amp_sq < s->psi_le_lim;
-    /* Step detection on the reference itself, not on T_vref. */
-    const st_fst_mode_t mode = st_fst_logic_step(&s->logic, tref, t_err, ctx->est->omega_e);
+    /* Step detection on the commanded reference, not on T_vref, nor on the
+     * anti-cogging feed-forward (ctrl_refs_t.torque_ff): that is a known
+     * cancellation of the cogging moving at each encoder count, and taken as
+     * a step it kept FST out of its steady-state modes (docs/anticogging.md,
+     * "FST"). */
+#if CTRL_COGGING
+    const q24_t tcmd = fx_sub(tref, ctx->ref->torque_ff);
+#else
+    const q24_t tcmd = tref;
+#endif
+    const st_fst_mode_t mode = st_fst_logic_step(&s->logic, tcmd, t_err, ctx->est->omega_e);
     if (mode != ST_FST_DYNAMIC) {
         /* Integrate in steady state only (a step's error is the dynamics').
          * k_i <= 0.5 (2^23), |error| <= 2^31: |product| <= 2^54, no saturation. */

@@ -81,6 +81,9 @@ void st_fst_logic_reset(st_fst_logic_t *l);
  * changes because the reference moved, not because the torque crossed it.
  * Returns ST_FST_DYNAMIC while the flag is set, else the steady-state column
  * by the rotation direction (forward for omega >= 0).
+ * FST's step passes T_ref without the anti-cogging feed-forward
+ * (ctrl_refs_t.torque_ff): a known cancellation of the cogging that moves at
+ * each encoder count is not a reference step (docs/anticogging.md, "FST").
  */
 st_fst_mode_t st_fst_logic_update(st_fst_logic_t *l, q24_t tref, q24_t terr, q24_t omega);
 

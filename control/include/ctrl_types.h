@@ -57,6 +57,13 @@ typedef struct {
 typedef struct {
     q24_t torque; /* torque reference, pu */
     q24_t psi;    /* stator-flux amplitude reference, pu; 0 = controller's own (MTPA) */
+#if CTRL_COGGING
+    /* The share of torque that is the anti-cogging feed-forward
+     * (cogging_ff.h), pu: a known cancellation of the cogging that moves at
+     * each encoder count, not a command; FST's step detection (st_dtc.h)
+     * leaves it out. 0 with the feed-forward off. */
+    q24_t torque_ff;
+#endif
 } ctrl_refs_t;
 
 /*

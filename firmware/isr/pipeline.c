@@ -684,7 +684,11 @@ static inline bool fw_control_out(fw_t *fw, fw_telemetry_t *tm, ctrl_angle_sl_t 
         /* anti-cogging: the table where the rotor will be when the torque
          * asked now is made (cogging_ff.h's lead), within the limit */
         const q24_t ff = ctrl_cogging_step(&fw->cog.map, fw->enc_pos, est->omega_e);
-        fw->refs.torque = fx_clamp(fx_add(fw->refs.torque, ff), fx_neg(torque_max), torque_max);
+        const q24_t cmd = fw->refs.torque;
+        fw->refs.torque = fx_clamp(fx_add(cmd, ff), fx_neg(torque_max), torque_max);
+        fw->refs.torque_ff = fx_sub(fw->refs.torque, cmd); /* what the limit left of ff */
+    } else {
+        fw->refs.torque_ff = 0;
     }
 #endif
     fw->refs.psi = weak != 0u ? mo->psi_ref : 0;
