@@ -794,6 +794,41 @@ static void test_overrun_fragment_is_not_run(void)
     TEST_ASSERT_FALSE(fw_gates_on_or_pending(&esc.fw));
 }
 
+/* A character damaged (framing, noise) while an overrun's loss is pending
+ * is one more received from a sender still streaming: the idle clock starts
+ * again there. "fault\r  di" streamed during a stall loses "di", the "s" of
+ * "  disarm" comes with a framing error just inside the idle bound, and
+ * "arm\r" after the bound counted from the overrun but inside it counted
+ * from the "s": all one damaged line, answered "err 13 lost" once, and
+ * nothing armed (with the clock left at the overrun the loss was answered
+ * before "arm\r" came, which then ran alone and armed). */
+static void test_framing_error_restarts_the_idle_clock(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("fault\r  di", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(2u, g4_model.usart_lost);
+    main_loop_drains();
+    const uint32_t t_ore = esc.uart.rx_lost_at;
+    const uint32_t idle = esc.uart.lost_idle_cycles;
+    g4_model_put(G4_DWT + G4_DWT_CYCCNT, t_ore + idle - 64u);
+    g4_model_usart_rx('s', true);
+    esc1_uart_irq(&esc.uart);
+    g4_model_put(G4_DWT + G4_DWT_CYCCNT, t_ore + idle + idle / 2u);
+    esc.isr_count++;
+    esc1_loop_once(&esc);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(1u, answers(), "no answer while the line may go on");
+    wire("arm\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[0]);
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[1]);
+    TEST_ASSERT_EQUAL_INT(FW_STATE_READY, fw_state(&esc.fw));
+    TEST_ASSERT_FALSE(fw_gates_on_or_pending(&esc.fw));
+    TEST_ASSERT_EQUAL_UINT32(2u, esc.uart.rx_errors);
+}
+
 /* "status" gives the main stack's high-water mark once the application has
  * told the link where its painted stack lies. */
 static void test_status_gives_the_stack_high_water_mark(void)
@@ -972,6 +1007,7 @@ int main(void)
     RUN_TEST(test_framing_error_discards_its_line);
     RUN_TEST(test_overrun_losing_the_end_of_line);
     RUN_TEST(test_overrun_fragment_is_not_run);
+    RUN_TEST(test_framing_error_restarts_the_idle_clock);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
     RUN_TEST(test_speed_reference_limit_is_the_drives);

@@ -133,6 +133,9 @@ void esc1_uart_irq(esc1_uart_t *u)
         if (bad != 0u) {
             u->rx_errors++;
             u->rx_lost |= bad; /* a damaged character is a lost one */
+            /* and one received: a sender still streaming, so an overrun's
+             * pending loss waits its idle bound from here */
+            u->rx_lost_at = g4_cycles();
         } else if (u->rx_head - u->rx_tail < ESC1_UART_RX_SIZE) {
             atomic_signal_fence(memory_order_acquire);
             u->rx[u->rx_head & (ESC1_UART_RX_SIZE - 1u)] = (uint16_t)(c | u->rx_lost << 8);
