@@ -31,6 +31,7 @@
 
 #include "board_esc1.h"
 #include "controller.h"
+#include "fw_link.h"
 #include "hal_replay.h"
 #include "pipeline.h"
 #include "qemu_mps2.h"
@@ -101,9 +102,83 @@ static void test_fw_init_within_the_watchdog(void)
     TEST_ASSERT_TRUE_MESSAGE(worst <= (uint32_t)limit, "fw_init too long for the watchdog");
 }
 
+/* A command's reply against the throttle's signal-loss time-out. The main
+ * loop reads the throttle's capture once per pass and, while the serial
+ * writer waits for space in its 1 KiB transmit ring, at every turn of the
+ * wait (esc1_service); so the longest stretch without a read is a reply's
+ * formatting until its first 1 KiB is written (the ring empty: none waits
+ * before), or between two writes after that. Counted here for the link's
+ * own commands (the ESC1's board parameters, esc1_params.c, add lines of
+ * the same kind to "param list"), on a configured drive.
+ *
+ * Asserted: the longest stretch, at CPI 3 and with the main loop left 6 %
+ * of the core (the control interrupt's worst, sensorless at 40 kHz: 94 %,
+ * docs/board-b-g431b-esc1.md), is shorter than the 100 ms time-out less
+ * one period at the lowest rate (22 ms): no single command's reply makes a
+ * "no pulse" disarm; 265 200 instructions. Measured: "param list" about
+ * 60 000 (17.7 ms under those assumptions, 0.5 ms of core time at CPI 1.5:
+ * longer than a pulse's width, so it can skip periods; docs/bringup.md
+ * step 9). */
+#define THR_SHARE_MIN 0.06
+#define THR_GAP_S (0.100 - 0.022)
+
+static fw_link_t link;
+static uint32_t written, t_first, t_last, gap_after;
+
+static void count_write(void *ctx, const uint8_t *bytes, size_t len)
+{
+    (void)ctx;
+    (void)bytes;
+    const uint32_t t = timer1_read();
+    if (written >= 1024u && t - t_last > gap_after) {
+        gap_after = t - t_last;
+    }
+    written += (uint32_t)len;
+    if (written >= 1024u && t_first == 0u) {
+        t_first = t; /* the ring full: the writer waits from here on */
+    }
+    t_last = t;
+}
+
+static void test_reply_reads_the_throttle_in_time(void)
+{
+    const uint32_t kinstr = timer1_ticks_per_kinstr();
+    const double limit = THR_GAP_S * F_CPU_HZ * THR_SHARE_MIN / CPI;
+    hal_info_t info;
+    esc1_info(&info);
+    fw_config_t fc;
+    fw_config_default(&fc, &esc1_default_machine, ctrl_find("foc"));
+    hal_replay_init(&hal, &info);
+    TEST_ASSERT_EQUAL_INT(FW_OK, fw_init(&fw, &hal, &fc));
+    fw_link_init(&link, &fw, count_write, NULL);
+    const char *cmds[] = {"param list", "tel list", "help", "status", "param get m.rs_ohm"};
+    uint32_t worst = 0u;
+    for (size_t k = 0; k < sizeof cmds / sizeof cmds[0]; k++) {
+        written = t_first = gap_after = 0u;
+        const uint32_t t0 = timer1_read();
+        for (const char *c = cmds[k]; *c != '\0'; c++) {
+            (void)fw_link_rx(&link, (uint8_t)*c);
+        }
+        (void)fw_link_rx(&link, '\r');
+        const uint32_t t1 = timer1_read();
+        const uint32_t first = (t_first != 0u ? t_first : t1) - t0;
+        const uint32_t ticks = first > gap_after ? first : gap_after;
+        const uint32_t n = (uint32_t)(((uint64_t)ticks * 1000u + kinstr / 2u) / kinstr);
+        printf("reply %-18s %5u B: %6u instructions without a throttle read, %.1f ms with %.0f %% "
+               "of the core at CPI %.0f\n",
+               cmds[k], (unsigned)written, (unsigned)n, n * CPI / F_CPU_HZ / THR_SHARE_MIN * 1e3,
+               THR_SHARE_MIN * 100.0, CPI);
+        TEST_ASSERT_TRUE_MESSAGE(written > 0u, cmds[k]);
+        worst = n > worst ? n : worst;
+    }
+    printf("reply worst %u instructions; limit %.0f\n", (unsigned)worst, limit);
+    TEST_ASSERT_TRUE_MESSAGE(worst <= (uint32_t)limit, "a reply too long for the throttle");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_fw_init_within_the_watchdog);
+    RUN_TEST(test_reply_reads_the_throttle_in_time);
     return UNITY_END();
 }

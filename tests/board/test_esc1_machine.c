@@ -794,6 +794,27 @@ static void test_overrun_fragment_is_not_run(void)
     TEST_ASSERT_FALSE(fw_gates_on_or_pending(&esc.fw));
 }
 
+/* An overrun that loses only the LF of a CRLF ("\r\nfault\r\n" during a
+ * stall: the RXFIFO keeps "\r\nfault\r"), as PROTOCOL.md and the board page
+ * say: "fault" answered, then, idle 20 ms after the loss, an "err 13 lost"
+ * that answers no line; a line within those 20 ms is voided with it. */
+static void test_overrun_losing_only_the_lf(void)
+{
+    serial_on();
+    serial_references();
+    n_reply = 0;
+    wire("\r\nfault\r\n", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(1u, g4_model.usart_lost);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[0]);
+    loop_after_loss(esc.uart.lost_idle_cycles / 2u);
+    wire("fault\r", true);
+    main_loop_drains();
+    TEST_ASSERT_EQUAL_UINT(2u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[1]);
+}
+
 /* A character damaged (framing, noise) while an overrun's loss is pending
  * is one more received from a sender still streaming: the idle clock starts
  * again there. "fault\r  di" streamed during a stall loses "di", the "s" of
@@ -1008,6 +1029,7 @@ int main(void)
     RUN_TEST(test_overrun_losing_the_end_of_line);
     RUN_TEST(test_overrun_fragment_is_not_run);
     RUN_TEST(test_framing_error_restarts_the_idle_clock);
+    RUN_TEST(test_overrun_losing_only_the_lf);
     RUN_TEST(test_ident_apply_holds_the_control_interrupt);
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
     RUN_TEST(test_speed_reference_limit_is_the_drives);
