@@ -61,12 +61,15 @@ the anti-cogging sweep's 40 s of motor time), clicked through as a user:
     "feed-forward on" makes it read on;
   - speed mode at 30 r/min, armed: the page's speed ripple measurement (the
     plotted speed's standard deviation over 2 s) with the feed-forward off,
-    then on: at most 0.6 of it with the table. The speed the page plots is
-    the firmware's estimate, whose quantisation alone makes about 6.7 r/min
-    on this machine (measured with its cogging set to 0), so the total falls
-    by about half while the cogging's own share falls by about 90 %; the
-    ctest `cogging` checks the 80 % on the true speed. With the
-    feed-forward's sign reversed the ripple grows and this fails.
+    then on: at most 0.65 of it with the table. The speed the page plots is
+    the firmware's estimate; on this machine with its cogging set to 0 the
+    page measures 9.7-10.4 r/min (FST's own ripple and the estimate's
+    quantisation), with the cogging about 17-18. Independent causes add in
+    variance: a table that removes 80 % of the cogging's share leaves
+    sqrt(10.4^2 + 0.2^2 (17.4^2 - 10.4^2)) = 10.8 r/min, 0.62 of it; 0.65
+    allows the 2 s window's scatter. The ctest `cogging` checks the 80 % on
+    the true speed. With the feed-forward's sign reversed the ripple grows
+    and this fails.
 """
 import argparse
 import asyncio
@@ -480,7 +483,7 @@ IDENT_BOUNDS = {"rs_ohm": 0.02, "ld_mh": 0.05, "lq_mh": 0.05, "psi_pm_wb": 0.02,
 OFFSET_BOUND_DEG = 2.0
 CPR_CHECK = 0.03       # the firmware's own counts check (enc_cpr: 3 %)
 RIPPLE_RPM = 30.0      # the speed of the ripple measurement (docs/anticogging.md)
-RIPPLE_RATIO = 0.6     # the ripple with the table at most this share of the one without
+RIPPLE_RATIO = 0.65    # the ripple with the table at most this share of the one without
 
 
 def machine_truth(path):
