@@ -28,7 +28,7 @@ import sys
 
 REL = r"(atomic_signal_fence\(memory_order_release\)|FW_RELEASE\(\))"
 ACQ = r"atomic_signal_fence\(memory_order_acquire\)"
-LOCK = r"g4_irq_lock\(\)"  # the interrupts masked (PRIMASK) for the steps after it
+LOCK = r"[gf]4_irq_lock\(\)"  # the interrupts masked (PRIMASK) for the steps after it
 
 # (file, function, [steps in order], what it publishes)
 RULES = [
@@ -73,6 +73,10 @@ RULES = [
     ("firmware/apps/esc1/esc1_uart.c", "esc1_uart_lost_idle",
      [LOCK, r"u->rx_lost;", r"u->rx_lost = 0u", r"g4_irq_unlock"],
      "a pending loss read and cleared with the interrupt masked (none noted meanwhile is lost)"),
+    # the console's pending loss (STM32F405 boards: board_uart.c under f405_uart.c's lock)
+    ("firmware/apps/f405/f405_uart.c", "f405_uart_next",
+     [LOCK, r"F4_USART_SR", r"board_uart_lost_idle\(", r"f4_irq_unlock"],
+     "a pending loss read and cleared with the USART interrupt masked (none noted meanwhile is lost)"),
     # TIM1 BDTR.MOE (B-G431B-ESC1): set only with the trip checked, the interrupts masked
     ("hal/stm32g4/g4_hal.c", "hal_gate_enable",
      [LOCK, r"hal_trip_active\(h\)", r"g4_tim1_outputs\(true\)", r"g4_irq_unlock"],

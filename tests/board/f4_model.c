@@ -187,6 +187,23 @@ static void f4_model_rcc_sync(uintptr_t reg, bool read)
     }
 }
 
+void f4_model_usart_rx(uintptr_t base, uint8_t c, uint32_t errors)
+{
+    const uint32_t on = F4_USART_CR1_UE | F4_USART_CR1_RE;
+    if ((*f4_reg(base, F4_USART_CR1) & on) != on) {
+        return;
+    }
+    f4_model.usart_rx_base = base;
+    uint32_t *sr = f4_reg(base, F4_USART_SR);
+    if ((*sr & F4_USART_SR_RXNE) != 0u) {
+        *sr |= F4_USART_SR_ORE;
+        f4_model.usart_lost++;
+        return;
+    }
+    f4_model.usart_rdr = c;
+    *sr |= F4_USART_SR_RXNE | (errors & (F4_USART_SR_FE | F4_USART_SR_NF));
+}
+
 uint32_t f4_trace_read(uintptr_t reg)
 {
     uint32_t *c = f4_model_cell(reg);
@@ -255,6 +272,18 @@ uint32_t f4_trace_read(uintptr_t reg)
     const int s = f4_model_index(reg, spis, 3u, 0x24u);
     if (s >= 0 && reg == spis[s] + F4_SPI_DR) {
         *f4_reg(spis[s], F4_SPI_SR) &= ~F4_SPI_SR_RXNE;
+    }
+    const uintptr_t ub = f4_model.usart_rx_base;
+    if (ub != 0u && reg == ub + F4_USART_SR) {
+        f4_model.usart_sr_read = true;
+    }
+    if (ub != 0u && reg == ub + F4_USART_DR) {
+        /* the received character; RXNE cleared, the errors by the sequence
+         * SR read then DR read (RM0090 sec. 30.6.1) */
+        *c = f4_model.usart_rdr;
+        const uint32_t errs = F4_USART_SR_ORE | F4_USART_SR_FE | F4_USART_SR_NF;
+        *f4_reg(ub, F4_USART_SR) &= ~(F4_USART_SR_RXNE | (f4_model.usart_sr_read ? errs : 0u));
+        f4_model.usart_sr_read = false;
     }
     const uint32_t v = *c;
     if (f4_model.irq_on_read == reg && f4_model.irq != NULL) {

@@ -68,6 +68,13 @@ typedef struct {
     uint32_t primask;
     uint32_t n_locks;          /* f4_irq_lock calls so far */
     void (*irq_pending)(void); /* taken when PRIMASK clears */
+    /* A USART's receiver (f4_model_usart_rx): the character in DR, whether
+     * SR was read since the last read of DR (the clearing sequence), the
+     * characters an overrun lost. */
+    uintptr_t usart_rx_base;
+    uint8_t usart_rdr;
+    bool usart_sr_read;
+    uint32_t usart_lost;
 } f4_model_t;
 
 extern f4_model_t f4_model;
@@ -82,6 +89,12 @@ const char *f4_model_name(uintptr_t reg);
  * or after `from`; -1 if none. */
 int f4_model_find(uintptr_t reg, uint32_t mask, uint32_t want, int from);
 int f4_model_find_last(uintptr_t reg, uint32_t mask, uint32_t want);
+/* A character arrives on the RX pin of the USART at base (received only
+ * with CR1.UE and RE): into DR with SR.RXNE, and SR's FE / NF from errors
+ * for it; with RXNE still set it is lost and ORE set, DR keeping its
+ * character (RM0090 sec. 30.6.1 USART_SR.ORE). A read of DR clears RXNE,
+ * and ORE, FE, NF when SR was read before it. */
+void f4_model_usart_rx(uintptr_t base, uint8_t c, uint32_t errors);
 /* Current register content. */
 uint32_t f4_model_get(uintptr_t reg);
 void f4_model_put(uintptr_t reg, uint32_t value);

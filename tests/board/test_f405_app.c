@@ -22,6 +22,7 @@
 #include "board_app.h"
 #include "drv8301_model.h"
 #include "f405_app.h"
+#include "f405_uart.h"
 #include "f4_clock.h"
 #include "f4_core.h"
 #include "f4_flash.h"
@@ -68,11 +69,12 @@ static void console_nothing(void)
 {
 }
 
-/* A clock that moves with every read: no wait in the application hangs. */
+/* A clock that moves with every read: no wait in the application hangs;
+ * a test moves it on (test_now += ...) for the time between characters. */
+static uint32_t test_now;
 static uint32_t test_ticks(void)
 {
-    static uint32_t t;
-    return t += 10u;
+    return test_now += 10u;
 }
 
 static const board_uart_port_t console_port = {console_nothing, console_nothing, console_put,
@@ -360,10 +362,154 @@ static void test_refused_machine_keeps_what_is_in_force(void)
     expect_prefix("ok est.psi_adapt 0", command("param get est.psi_adapt"));
 }
 
+/* ---- the console's USART on the register model (f4_model_usart_rx) ---- */
+
+static f4_usart_t usart;
+
+/* The console as f405_main.c starts it (f405_uart_init: the board's USART,
+ * VESC 6's USART3, on the model), its output kept by the test's console;
+ * the drive calibrated. */
+static void serial_on(void)
+{
+    memset(f4_mem_flash_settings, 0xFF, 2u * F4_FLASH_SECTOR_SIZE);
+    f405_power_on();
+    f405_calibrate();
+    TEST_ASSERT_EQUAL_INT(
+        F4_OK, f405_uart_init(&f405.app.uart, &usart, f405.board, &f405.clk, f405.board->baud));
+    f405.app.uart.port = &console_port;
+    f405.app.uart.polled = true;
+    TEST_ASSERT_EQUAL_UINT32(20000u, f405.app.uart.lost_idle_ticks);
+    n_reply = 0;
+}
+
+/* Characters on the wire; serviced: the USART interrupt runs after each (a
+ * core that does not stall), else they wait in the receiver (a core stalled
+ * on a flash sector erase: 250 ms is over 2 800 characters at 115 200 Bd,
+ * and the F4's USART keeps one, in DR). */
+static void wire(const char *text, bool serviced)
+{
+    for (const char *c = text; *c != '\0'; c++) {
+        f4_model_usart_rx(usart.base, (uint8_t)*c, 0u);
+        if (serviced) {
+            f405_uart_irq(&f405.app.uart, &usart);
+        }
+    }
+}
+
+/* The main loop's passes as f405_main.c runs them (one line each). */
+static void main_loop(unsigned passes)
+{
+    for (unsigned pass = 0; pass < passes; pass++) {
+        board_app_console(&f405.app, f405_uart_next);
+        fw_link_poll(&f405.app.link);
+    }
+}
+
+/* The reply lines that answer a line ("ok ...", "err ..."). */
+static unsigned answers(void)
+{
+    unsigned n = 0;
+    for (size_t k = 0; k < n_reply; k++) {
+        n += strncmp(reply[k], "ok", 2) == 0 || strncmp(reply[k], "err", 3) == 0;
+    }
+    return n;
+}
+
+/* Bytes an overrun lost in the middle of a line (the core stalled while
+ * "rs_ohm 15.0" arrived: DR kept the 'r', ORE lost the other 10): the line
+ * is discarded up to its end of line and answered "err 13 lost" naming the
+ * overrun (what is left of it, "param set m.r9", is not run), and the next
+ * command is answered alone. Before: "param set m.r9" ran (err 5 name). */
+static void test_overrun_discards_its_line(void)
+{
+    serial_on();
+    char fault_alone[160], rs_before[160];
+    strcpy(fault_alone, command("fault"));
+    strcpy(rs_before, command("param get m.rs_ohm"));
+    n_reply = 0;
+    wire("param set m.", true);
+    wire("rs_ohm 15.0", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(10u, f4_model.usart_lost);
+    f405_uart_irq(&f405.app.uart, &usart); /* the core runs again: pended */
+    wire("9\r", true);
+    wire("fault\r", true);
+    main_loop(4u);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(2u, answers(), "one answer per end of line");
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[1]);
+    TEST_ASSERT_EQUAL_STRING(rs_before, command("param get m.rs_ohm"));
+    TEST_ASSERT_EQUAL_UINT32(1u, f405.app.uart.rx_errors);
+    TEST_ASSERT_EQUAL_UINT32(0u, f4_model_get(usart.base + F4_USART_SR) &
+                                     (F4_USART_SR_ORE | F4_USART_SR_RXNE));
+}
+
+/* An overrun that lost the end of line ("ohm\r" sent while the core
+ * stalled; DR kept the 'o'): nothing comes after it, so the line is taken
+ * as ended once idle BOARD_UART_LOST_IDLE_MS after the loss, answered
+ * "err 13 lost" then and not before, and the next line read alone. Before:
+ * no answer, and the next line ran as "param get m.rs_ofault". */
+static void test_lost_end_of_line_answered_after_the_idle_time(void)
+{
+    serial_on();
+    char fault_alone[160];
+    strcpy(fault_alone, command("fault"));
+    n_reply = 0;
+    wire("param get m.rs_", true);
+    wire("ohm\r", false); /* stalled */
+    TEST_ASSERT_EQUAL_UINT32(3u, f4_model.usart_lost);
+    f405_uart_irq(&f405.app.uart, &usart);
+    main_loop(2u);
+    test_now += 19000u; /* 19 ms on: the line may still go on */
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(0u, answers(), "not before the idle time");
+    test_now += 1000u;
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    n_reply = 0;
+    wire("fault\r", true);
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING(fault_alone, reply[0]);
+}
+
+/* "  disarm" whose "dis" an overrun lost (DR held the second space when
+ * the core stalled): what arrives within the idle
+ * time after the loss ("arm") still belongs to the damaged line, which is
+ * discarded: never run as "arm". Before: "  arm" ran. With the idle bound
+ * 0 the main loop's pass between ends the line and "arm" runs alone. */
+static void test_fragment_of_a_damaged_line_never_runs(void)
+{
+    serial_on();
+    /* "arm" alone is taken: answered, the arm requested of the interrupt */
+    const volatile uint32_t *arms = &f405.app.fw.ml.req[FW_REQ_ARM];
+    const uint32_t arms0 = *arms;
+    wire("arm\r", true);
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_STRING("ok armed", reply[0]);
+    TEST_ASSERT_EQUAL_UINT32(arms0 + 1u, *arms);
+
+    n_reply = 0;
+    wire(" ", true);
+    wire(" dis", false); /* stalled: DR keeps the second space */
+    TEST_ASSERT_EQUAL_UINT32(3u, f4_model.usart_lost);
+    f405_uart_irq(&f405.app.uart, &usart);
+    main_loop(1u); /* a pass between: the line goes on within a character */
+    test_now += 100u;
+    wire("arm\r", true);
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    TEST_ASSERT_EQUAL_UINT32_MESSAGE(arms0 + 1u, *arms, "the fragment 'arm' ran");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_identified_machine_survives_a_parameter_change);
     RUN_TEST(test_refused_machine_keeps_what_is_in_force);
+    RUN_TEST(test_overrun_discards_its_line);
+    RUN_TEST(test_lost_end_of_line_answered_after_the_idle_time);
+    RUN_TEST(test_fragment_of_a_damaged_line_never_runs);
     return UNITY_END();
 }

@@ -215,6 +215,19 @@ bool board_app_temperature(board_app_t *a, double temp_c, double trip_c)
     return a->temp_trip;
 }
 
+void board_app_console(board_app_t *a, int (*next)(board_uart_t *u))
+{
+    int c;
+    while ((c = next(&a->uart)) >= 0) {
+        if (c > 0xFF) { /* bytes lost before this one: their line is void */
+            cmd_line_lost(&a->link.cmd, board_uart_lost_why(c));
+        }
+        if (fw_link_rx(&a->link, (uint8_t)c)) {
+            break; /* one command line per pass: the watchdogs after each */
+        }
+    }
+}
+
 void board_app_messages(board_app_t *a)
 {
     if (a->thr_losses != a->thr_losses_told) {

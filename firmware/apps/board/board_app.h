@@ -141,6 +141,13 @@ void board_app_throttle_poll(board_app_t *a);
  * (temp_check off: released). Returns whether the trip is latched. */
 bool board_app_temperature(board_app_t *a, double temp_c, double trip_c);
 
+/* Main loop: the console's received bytes fed to the command link up to the
+ * end of one command line (the watchdogs are served between lines). next:
+ * the chip's reader (board_uart_getc's values: bits 8..11 say bytes were
+ * lost before this one, whose line is then discarded and answered err 13;
+ * -1: nothing more). */
+void board_app_console(board_app_t *a, int (*next)(board_uart_t *u));
+
 /* Main loop: the lines it owes (a throttle loss, the measured current
  * offsets once their calibration has ended). */
 void board_app_messages(board_app_t *a);

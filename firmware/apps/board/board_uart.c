@@ -12,6 +12,7 @@ void board_uart_init(board_uart_t *u, const board_uart_port_t *port, uint32_t ti
     u->tx_wait_ticks = (uint32_t)((uint64_t)ticks_hz * 10u * BOARD_UART_TX_SIZE / baud);
     u->byte_ticks = (uint32_t)((uint64_t)ticks_hz * 10u / baud) + 1u;
     u->poll_cycles = (uint32_t)((uint64_t)f_cpu_hz * 10u / baud);
+    u->lost_idle_ticks = ticks_hz / 1000u * BOARD_UART_LOST_IDLE_MS;
 }
 
 int board_uart_getc(board_uart_t *u)
@@ -20,9 +21,37 @@ int board_uart_getc(board_uart_t *u)
     if (t == u->rx_head) {
         return -1;
     }
-    const int c = u->rx[t & (BOARD_UART_RX_SIZE - 1u)];
+    const int c = u->rx[t & (BOARD_UART_RX_SIZE - 1u)]; /* with its losses (bits 8..11) */
     u->rx_tail = t + 1u;
     return c;
+}
+
+int board_uart_lost_idle(board_uart_t *u, bool rx_waiting)
+{
+    /* Why only these: an overrun (or the ring full) loses bytes only of a
+     * sender that streams them (2 characters within a flash sector erase,
+     * 256 behind a busy main loop), and such a sender's line goes on within
+     * a character time of the core running again; a line idle for
+     * lost_idle_ticks after the loss ended inside it. A framing or noise
+     * error hits one character of any sender, a typist's too, whose pauses
+     * say nothing: its line ends at the next end of line received. */
+    const uint32_t pending = u->rx_lost;
+    if ((pending & (BOARD_UART_LOST_OVERRUN | BOARD_UART_LOST_FULL)) == 0u ||
+        u->rx_head != u->rx_tail || rx_waiting ||
+        u->port->ticks() - u->rx_lost_at < u->lost_idle_ticks) {
+        return -1;
+    }
+    u->rx_lost = 0u; /* the next byte starts a line of its own */
+    return (int)(pending << 8 | '\r');
+}
+
+const char *board_uart_lost_why(int c)
+{
+    const uint32_t lost = (uint32_t)c >> 8;
+    return (lost & BOARD_UART_LOST_OVERRUN) != 0u   ? "overrun (ORE)"
+           : (lost & BOARD_UART_LOST_FRAMING) != 0u ? "framing (FE)"
+           : (lost & BOARD_UART_LOST_NOISE) != 0u   ? "noise (NF)"
+                                                    : "ring full";
 }
 
 /* A byte by polling, calling idle between the characters (the writer's
@@ -101,10 +130,22 @@ void board_uart_puts_polled(board_uart_t *u, const char *s)
 void board_uart_rx(board_uart_t *u, uint8_t c)
 {
     if (u->rx_head - u->rx_tail < BOARD_UART_RX_SIZE) {
-        u->rx[u->rx_head & (BOARD_UART_RX_SIZE - 1u)] = c;
+        u->rx[u->rx_head & (BOARD_UART_RX_SIZE - 1u)] = (uint16_t)(c | u->rx_lost << 8);
         u->rx_head++;
+        u->rx_lost = 0u;
     } else {
         u->rx_dropped++;
+        u->rx_lost |= BOARD_UART_LOST_FULL;
+        u->rx_lost_at = u->port->ticks();
+    }
+}
+
+void board_uart_rx_lost(board_uart_t *u, uint32_t lost)
+{
+    u->rx_errors++;
+    u->rx_lost |= lost;
+    if ((lost & BOARD_UART_LOST_OVERRUN) != 0u) {
+        u->rx_lost_at = u->port->ticks(); /* the core runs again: the loss ends here */
     }
 }
 

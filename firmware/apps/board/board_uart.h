@@ -16,6 +16,22 @@
 #define BOARD_UART_RX_SIZE 256u /* powers of two */
 #define BOARD_UART_TX_SIZE 1024u
 
+/* What the receiver lost right before a received byte (bits of its ring
+ * entry above the byte): at the F4 USART_SR's error flags' positions
+ * (RM0090 sec. 30.6.1: FE bit 1, NF bit 2, ORE bit 3; ST's stm32f405xx.h
+ * USART_SR_FE/NE/ORE), and bit 0 (PE's place: no parity on this link) for
+ * the receive ring found full. */
+#define BOARD_UART_LOST_FULL 0x1u
+#define BOARD_UART_LOST_FRAMING 0x2u
+#define BOARD_UART_LOST_NOISE 0x4u
+#define BOARD_UART_LOST_OVERRUN 0x8u
+/* A line whose end an overrun (or the ring full) may have lost: idle this
+ * long after the loss with nothing received, it is taken as ended inside
+ * the loss (board_uart_lost_idle). 20 ms: 230 character times at 115 200
+ * baud, far beyond any gap inside a line a program sends in one write, and
+ * well inside a console's wait for the answer (the B-G431B-ESC1's bound). */
+#define BOARD_UART_LOST_IDLE_MS 20u
+
 typedef struct {
     /* the transmit interrupt on (it sends while bytes are queued), off */
     void (*tx_irq_on)(void);
@@ -26,11 +42,17 @@ typedef struct {
 } board_uart_port_t;
 
 typedef struct {
-    uint8_t rx[BOARD_UART_RX_SIZE];
+    /* byte | (BOARD_UART_LOST_* of the bytes lost right before it) << 8 */
+    uint16_t rx[BOARD_UART_RX_SIZE];
     uint8_t tx[BOARD_UART_TX_SIZE];
     volatile uint32_t rx_head, rx_tail; /* head: interrupt, tail: main loop */
     volatile uint32_t tx_head, tx_tail; /* head: main loop, tail: interrupt */
     volatile uint32_t rx_dropped, rx_errors;
+    /* Losses since the last byte stored (the interrupt's; the main loop
+     * takes them with the USART's interrupt masked: board_uart_lost_idle)
+     * and when the last overrun or full ring was noted (port ticks). */
+    volatile uint32_t rx_lost, rx_lost_at;
+    uint32_t lost_idle_ticks; /* BOARD_UART_LOST_IDLE_MS in port ticks */
     uint32_t tx_dropped;
     uint32_t tx_wait_ticks; /* longest wait for transmit space before dropping */
     uint32_t byte_ticks;    /* one character on the line */
@@ -56,8 +78,18 @@ void board_uart_init(board_uart_t *u, const board_uart_port_t *port, uint32_t ti
  * interrupt), every later byte is sent by polling (u->polled) and the
  * probe's bytes too. Returns true when the interrupt works. */
 bool board_uart_check_tx(board_uart_t *u, const uint8_t *probe, size_t n);
-/* Next received byte, or -1. */
+/* Next received byte, or -1; bits 8..11 (BOARD_UART_LOST_* << 8) say that
+ * bytes were lost right before it (board_uart_lost_why names it). */
 int board_uart_getc(board_uart_t *u);
+/* A line that ended inside a loss: an overrun or the ring full not yet
+ * marked on a byte, the ring empty and rx_waiting false (no character in
+ * the USART), BOARD_UART_LOST_IDLE_MS since the loss. Returns an end of
+ * line carrying the losses as getc's bits 8..11 (forgotten here, so the
+ * next byte starts a line of its own), else -1. Main loop, with the USART's
+ * interrupt masked. */
+int board_uart_lost_idle(board_uart_t *u, bool rx_waiting);
+/* What a getc's bits 8..11 say was lost, for "err 13 lost <why>". */
+const char *board_uart_lost_why(int c);
 /* Queues bytes; when the ring is full it waits for the interrupt to drain
  * it, up to tx_wait_ticks per byte, calling idle meanwhile, then drops the
  * rest (counted). */
@@ -68,10 +100,14 @@ void board_uart_puts(board_uart_t *u, const char *s);
  * character times (counted in tx_dropped). */
 void board_uart_puts_polled(board_uart_t *u, const char *s);
 
-/* From the chip's USART interrupt: a received byte (dropped and counted when
- * the ring is full); the next byte to send, false when the ring is empty
- * (the handler then switches the transmit interrupt off). */
+/* From the chip's USART interrupt: a received byte, marked with the losses
+ * since the last one stored (dropped, counted and itself a loss when the
+ * ring is full); bytes the USART lost (BOARD_UART_LOST_*: counted in
+ * rx_errors, marked on the next byte stored); the next byte to send, false
+ * when the ring is empty (the handler then switches the transmit interrupt
+ * off). */
 void board_uart_rx(board_uart_t *u, uint8_t c);
+void board_uart_rx_lost(board_uart_t *u, uint32_t lost);
 bool board_uart_tx_next(board_uart_t *u, uint8_t *c);
 
 #endif /* FIRMWARE_APPS_BOARD_BOARD_UART_H */

@@ -412,12 +412,7 @@ int main(void)
     a->uart.idle_ctx = a;
     uint32_t t_slow = a->now_ms;
     for (;;) {
-        int c;
-        while ((c = board_uart_getc(&a->uart)) >= 0) {
-            if (fw_link_rx(&a->link, (uint8_t)c)) {
-                break; /* one command line per pass: the watchdogs after each */
-            }
-        }
+        board_app_console(a, f405_uart_next);
         fw_link_poll(&a->link);
         board_app_service(a);
         board_app_messages(a);

@@ -1,5 +1,6 @@
 /* The console on the board's USART (f405_uart.h): the F4's USART registers
  * (RM0090 sec. 30.6) under the shared byte rings (board_uart.h). */
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "f405_uart.h"
@@ -8,6 +9,12 @@
 #include "f4_tim.h"
 #include "stm32_calc.h"
 #include F405_BOARD_HEADER
+
+/* The losses board_uart marks are USART_SR's error flags where they stand. */
+_Static_assert(F4_USART_SR_FE == BOARD_UART_LOST_FRAMING &&
+                   F4_USART_SR_NF == BOARD_UART_LOST_NOISE &&
+                   F4_USART_SR_ORE == BOARD_UART_LOST_OVERRUN,
+               "BOARD_UART_LOST_* are RM0090 USART_SR's FE, NF, ORE");
 
 /* The one console of the image (the port's callbacks take no argument). */
 static uintptr_t f405_uart_base;
@@ -63,15 +70,44 @@ int f405_uart_init(board_uart_t *ring, f4_usart_t *usart, const f4_board_t *b,
     return F4_OK;
 }
 
+int f405_uart_next(board_uart_t *ring)
+{
+    const int c = board_uart_getc(ring);
+    if (c >= 0) {
+        return c;
+    }
+    /* all read: a line that ended inside a loss ends now (under the lock:
+     * the interrupt neither notes a loss nor stores a byte meanwhile) */
+    const uint32_t pm = f4_irq_lock();
+    const bool waiting = (f4_rd(f405_uart_base + F4_USART_SR) & F4_USART_SR_RXNE) != 0u;
+    const int lost = board_uart_lost_idle(ring, waiting);
+    f4_irq_unlock(pm);
+    return lost;
+}
+
 void f405_uart_irq(board_uart_t *ring, const f4_usart_t *usart)
 {
     const uintptr_t u = usart->base;
+    /* RM0090 sec. 30.6.1 USART_SR: ORE, FE and NF are cleared by a read of
+     * SR followed by a read of DR, the sequence below. FE and NF belong to
+     * the character in DR: a damaged character is a lost one. An overrun
+     * keeps DR's character (received before the lost ones) and overwrites
+     * the shift register: the loss comes after DR's character, so it is
+     * noted after that character is stored. ORE can be set with RXNE clear
+     * (the character read while the next arrived, or one arriving inside
+     * the sequence): DR is then read only to clear it. */
     const uint32_t sr = f4_rd(u + F4_USART_SR);
-    if ((sr & (F4_USART_SR_ORE | F4_USART_SR_FE | F4_USART_SR_NF)) != 0u) {
-        ring->rx_errors++; /* cleared by this SR read and the DR read below */
-    }
     if ((sr & (F4_USART_SR_RXNE | F4_USART_SR_ORE)) != 0u) {
-        board_uart_rx(ring, (uint8_t)f4_rd(u + F4_USART_DR));
+        const uint8_t c = (uint8_t)f4_rd(u + F4_USART_DR);
+        const uint32_t bad = sr & (F4_USART_SR_FE | F4_USART_SR_NF);
+        if (bad != 0u) {
+            board_uart_rx_lost(ring, bad); /* BOARD_UART_LOST_* at SR's positions */
+        } else if ((sr & F4_USART_SR_RXNE) != 0u) {
+            board_uart_rx(ring, c);
+        }
+        if ((sr & F4_USART_SR_ORE) != 0u) {
+            board_uart_rx_lost(ring, BOARD_UART_LOST_OVERRUN);
+        }
     }
     if ((sr & F4_USART_SR_TXE) != 0u && (f4_rd(u + F4_USART_CR1) & F4_USART_CR1_TXEIE) != 0u) {
         uint8_t c;

@@ -18,7 +18,13 @@
  * clock: the board's tick timer, f4_ticks); F4_OK or F4_E_CONFIG. */
 int f405_uart_init(board_uart_t *ring, f4_usart_t *usart, const f4_board_t *b,
                    const f4_clocks_t *clk, uint32_t baud);
-/* The USART interrupt's body. */
+/* The next received byte as board_uart_getc gives it (bits 8..11: bytes
+ * lost before it), or a line that ended inside a loss taken as ended
+ * (board_uart_lost_idle), or -1. Main loop. */
+int f405_uart_next(board_uart_t *ring);
+/* The USART interrupt's body: the received character into the ring, each
+ * loss (an overrun, a framing error, noise, the ring full) marked on the
+ * next byte stored; a byte to send when TXE and the ring has one. */
 void f405_uart_irq(board_uart_t *ring, const f4_usart_t *usart);
 
 #endif /* FIRMWARE_APPS_F405_F405_UART_H */
