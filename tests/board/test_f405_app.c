@@ -503,6 +503,30 @@ static void test_fragment_of_a_damaged_line_never_runs(void)
     TEST_ASSERT_EQUAL_UINT32_MESSAGE(arms0 + 1u, *arms, "the fragment 'arm' ran");
 }
 
+/* A character with a framing error after an overrun's loss is one received:
+ * the sender is still streaming, so the pending loss waits its idle bound
+ * from that character, not from the overrun. */
+static void test_framing_error_restarts_the_idle_time(void)
+{
+    serial_on();
+    wire("param get m.rs_", true);
+    wire("ohm", false); /* stalled: DR keeps the 'o' */
+    f405_uart_irq(&f405.app.uart, &usart);
+    main_loop(1u);
+    test_now += 15000u;
+    f4_model_usart_rx(usart.base, '\r', F4_USART_SR_FE);
+    f405_uart_irq(&f405.app.uart, &usart);
+    test_now += 15000u; /* 30 ms after the overrun, 15 ms after the FE */
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT_MESSAGE(0u, answers(), "not 20 ms after the overrun");
+    test_now += 5000u;
+    main_loop(2u);
+    TEST_ASSERT_EQUAL_UINT(1u, answers());
+    TEST_ASSERT_EQUAL_STRING("err 13 lost overrun (ORE)", reply[0]);
+    TEST_ASSERT_EQUAL_UINT32(2u, f405.app.uart.rx_errors);
+    TEST_ASSERT_EQUAL_UINT32(0u, f4_model_get(usart.base + F4_USART_SR) & F4_USART_SR_FE);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -511,5 +535,6 @@ int main(void)
     RUN_TEST(test_overrun_discards_its_line);
     RUN_TEST(test_lost_end_of_line_answered_after_the_idle_time);
     RUN_TEST(test_fragment_of_a_damaged_line_never_runs);
+    RUN_TEST(test_framing_error_restarts_the_idle_time);
     return UNITY_END();
 }

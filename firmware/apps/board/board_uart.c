@@ -144,9 +144,10 @@ void board_uart_rx_lost(board_uart_t *u, uint32_t lost)
 {
     u->rx_errors++;
     u->rx_lost |= lost;
-    if ((lost & BOARD_UART_LOST_OVERRUN) != 0u) {
-        u->rx_lost_at = u->port->ticks(); /* the core runs again: the loss ends here */
-    }
+    /* An overrun: the core runs again, the loss ends here. A damaged
+     * character: one received, a sender still streaming, so an overrun's
+     * pending loss waits its idle bound from here. */
+    u->rx_lost_at = u->port->ticks();
 }
 
 bool board_uart_tx_next(board_uart_t *u, uint8_t *c)

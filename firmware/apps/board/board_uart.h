@@ -50,7 +50,7 @@ typedef struct {
     volatile uint32_t rx_dropped, rx_errors;
     /* Losses since the last byte stored (the interrupt's; the main loop
      * takes them with the USART's interrupt masked: board_uart_lost_idle)
-     * and when the last overrun or full ring was noted (port ticks). */
+     * and when the last loss was noted (port ticks). */
     volatile uint32_t rx_lost, rx_lost_at;
     uint32_t lost_idle_ticks; /* BOARD_UART_LOST_IDLE_MS in port ticks */
     uint32_t tx_dropped;
