@@ -73,6 +73,20 @@ RULES = [
     ("firmware/apps/esc1/esc1_uart.c", "esc1_uart_lost_idle",
      [LOCK, r"u->rx_lost;", r"u->rx_lost = 0u", r"g4_irq_unlock"],
      "a pending loss read and cleared with the interrupt masked (none noted meanwhile is lost)"),
+    # the console's byte rings (STM32F405 boards: board_uart.c, filled and
+    # drained by f405_uart.c's interrupt)
+    ("firmware/apps/board/board_uart.c", "board_uart_getc",
+     [r"rx_head", ACQ, r"u->rx\[", REL, r"rx_tail ="],
+     "a received byte read after its count and before its slot is handed back"),
+    ("firmware/apps/board/board_uart.c", "board_uart_write",
+     [r"tx_tail", ACQ, r"u->tx\[", REL, r"tx_head\+\+"],
+     "a byte to send stored in a freed slot and before its count"),
+    ("firmware/apps/board/board_uart.c", "board_uart_rx",
+     [r"rx_tail", ACQ, r"u->rx\[", REL, r"rx_head\+\+"],
+     "a received byte stored in a freed slot and before its count"),
+    ("firmware/apps/board/board_uart.c", "board_uart_tx_next",
+     [r"tx_head", ACQ, r"u->tx\[", REL, r"tx_tail\+\+"],
+     "a byte to send read after its count and before its slot is handed back"),
     # the console's pending loss (STM32F405 boards: board_uart.c under f405_uart.c's lock)
     ("firmware/apps/f405/f405_uart.c", "f405_uart_next",
      [LOCK, r"F4_USART_SR", r"board_uart_lost_idle\(", r"f4_irq_unlock"],

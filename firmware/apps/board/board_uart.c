@@ -1,6 +1,7 @@
 /* Console byte rings (board_uart.h). */
 #include "board_uart.h"
 
+#include <stdatomic.h>
 #include <string.h>
 
 void board_uart_init(board_uart_t *u, const board_uart_port_t *port, uint32_t ticks_hz,
@@ -21,7 +22,9 @@ int board_uart_getc(board_uart_t *u)
     if (t == u->rx_head) {
         return -1;
     }
+    atomic_signal_fence(memory_order_acquire);          /* the byte after its count */
     const int c = u->rx[t & (BOARD_UART_RX_SIZE - 1u)]; /* with its losses (bits 8..11) */
+    atomic_signal_fence(memory_order_release);          /* read before its slot is handed back */
     u->rx_tail = t + 1u;
     return c;
 }
@@ -106,7 +109,9 @@ void board_uart_write(board_uart_t *u, const uint8_t *bytes, size_t len)
                 }
             }
         }
+        atomic_signal_fence(memory_order_acquire); /* the slot freed before it is written */
         u->tx[u->tx_head & (BOARD_UART_TX_SIZE - 1u)] = bytes[i];
+        atomic_signal_fence(memory_order_release); /* the byte before its count */
         u->tx_head++;
         u->port->tx_irq_on();
     }
@@ -130,7 +135,9 @@ void board_uart_puts_polled(board_uart_t *u, const char *s)
 void board_uart_rx(board_uart_t *u, uint8_t c)
 {
     if (u->rx_head - u->rx_tail < BOARD_UART_RX_SIZE) {
+        atomic_signal_fence(memory_order_acquire); /* the slot freed before it is written */
         u->rx[u->rx_head & (BOARD_UART_RX_SIZE - 1u)] = (uint16_t)(c | u->rx_lost << 8);
+        atomic_signal_fence(memory_order_release); /* the byte before its count */
         u->rx_head++;
         u->rx_lost = 0u;
     } else {
@@ -155,7 +162,9 @@ bool board_uart_tx_next(board_uart_t *u, uint8_t *c)
     if (u->tx_tail == u->tx_head) {
         return false;
     }
+    atomic_signal_fence(memory_order_acquire); /* the byte after its count */
     *c = u->tx[u->tx_tail & (BOARD_UART_TX_SIZE - 1u)];
+    atomic_signal_fence(memory_order_release); /* read before its slot is handed back */
     u->tx_tail++;
     return true;
 }
