@@ -647,6 +647,26 @@ typedef struct {
 void fw_kept_read(const fw_t *fw, fw_kept_t *k);
 void fw_kept_config(const fw_kept_t *k, fw_config_t *c);
 
+/* The configuration in force: the drive's settings (fw_t.cfg), the
+ * controller and its tunables (a "param set wc" before it) — what a refused
+ * reconfiguration puts back ("the previous data stay"), not the defaults.
+ * Read before fw_init (fw_in_force_read: fw_init clears fw_t). A board keeps
+ * it static (main loop only), so that the deepest command path's stack
+ * (config default -> fw_init) does not grow by it.
+ * fw_in_force_config: *c as it was, on machine m, with what the drive held
+ * beyond its machine data (kept); false, *c untouched, when no controller
+ * was installed (the caller's defaults then). c->ctrl_cfg points into *f. */
+typedef struct {
+    fw_config_t cfg; /* cfg.ctrl: the controller in use (fw_t.ctrl) */
+    union {
+        max_align_t align;
+        unsigned char bytes[CTRL_CFG_MAX];
+    } ctrl_cfg;
+} fw_in_force_t;
+void fw_in_force_read(const fw_t *fw, fw_in_force_t *f);
+bool fw_in_force_config(const fw_in_force_t *f, const ctrl_machine_t *m, const fw_kept_t *kept,
+                        fw_config_t *c);
+
 /*
  * Anti-cogging feed-forward (main loop; docs/anticogging.md). The table of
  * the step "cogging" (cm_cogging.h) or one loaded (settings, tests) is added

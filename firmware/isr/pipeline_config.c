@@ -628,6 +628,26 @@ void fw_kept_config(const fw_kept_t *k, fw_config_t *c)
 #endif
 }
 
+void fw_in_force_read(const fw_t *fw, fw_in_force_t *f)
+{
+    f->cfg = fw->cfg;
+    f->cfg.ctrl = fw->ctrl;
+    memcpy(f->ctrl_cfg.bytes, fw->ctrl_cfg.bytes, CTRL_CFG_MAX);
+}
+
+bool fw_in_force_config(const fw_in_force_t *f, const ctrl_machine_t *m, const fw_kept_t *kept,
+                        fw_config_t *c)
+{
+    if (f->cfg.ctrl == NULL) {
+        return false;
+    }
+    *c = f->cfg;
+    c->machine = m;
+    c->ctrl_cfg = f->ctrl_cfg.bytes;
+    fw_kept_config(kept, c);
+    return true;
+}
+
 bool fw_commission_poll(fw_t *fw)
 {
     if (fw == NULL || fw->cm.apply == 0u || fw_state(fw) != FW_STATE_READY) {

@@ -52,18 +52,9 @@ static void board_app_config_kept(board_app_t *a, const ctrl_desc_t *ctrl, const
     fw_kept_config(kept, &a->fc);
 }
 
-/* The configuration in force before a reconfiguration, what a refusal puts
- * back ("the previous data stay"): the drive's settings (fw_t.cfg) and the
- * controller's tunables (a "param set wc" before it), not the defaults.
- * Main loop only; static so that the deepest command path's stack (config
- * default -> fw_init) does not grow by it. */
-static struct {
-    fw_config_t cfg;
-    union {
-        max_align_t align;
-        unsigned char bytes[CTRL_CFG_MAX];
-    } ctrl_cfg;
-} board_app_in_force;
+/* What a refusal puts back (fw_in_force_t; static: the stack of the
+ * deepest command path does not grow by it). */
+static fw_in_force_t board_app_in_force;
 
 int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t encoder_cpr,
                           const fw_config_t *cfg)
@@ -80,10 +71,9 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
     const uint32_t old_cpr = a->encoder_cpr;
     fw_kept_t kept; /* fw_init clears fw_t: read here */
     fw_kept_read(&a->fw, &kept);
-    /* fw_init clears fw_t: the controller in use kept for the restore */
+    /* fw_init clears fw_t: the controller in use and its settings kept for the restore */
     const ctrl_desc_t *ctrl = a->fw.ctrl;
-    board_app_in_force.cfg = a->fw.cfg;
-    memcpy(board_app_in_force.ctrl_cfg.bytes, a->fw.ctrl_cfg.bytes, CTRL_CFG_MAX);
+    fw_in_force_read(&a->fw, &board_app_in_force);
     a->port->control_irq(false);
     /* fw_init blocks the main loop for longer than the run window (the
      * board's documentation gives its count), the interrupt masked. */
@@ -111,13 +101,8 @@ int board_app_reconfigure(board_app_t *a, const ctrl_machine_t *m, uint32_t enco
         a->machine = old;
         a->encoder_cpr = old_cpr;
         a->hal->info.encoder_counts_per_rev = old_cpr;
-        if (ctrl != NULL) { /* as it was, tunables included */
-            a->fc = board_app_in_force.cfg;
-            a->fc.machine = &a->machine;
-            a->fc.ctrl = ctrl;
-            a->fc.ctrl_cfg = board_app_in_force.ctrl_cfg.bytes;
-            fw_kept_config(&kept, &a->fc);
-        } else { /* nothing installed before: the defaults */
+        /* as it was, tunables included; nothing installed before: the defaults */
+        if (!fw_in_force_config(&board_app_in_force, &a->machine, &kept, &a->fc)) {
             board_app_config_kept(a, ctrl, &kept);
         }
         (void)fw_init(&a->fw, a->hal, &a->fc);

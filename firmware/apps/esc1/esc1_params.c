@@ -331,29 +331,20 @@ int esc1_reconfigure(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr)
     return esc1_reconfigure_cfg(s, m, encoder_cpr, NULL);
 }
 
-/* The default configuration for the machine staged in s->machine, with the
- * encoder's calibration in force (identified, or a settings record's: the
- * drive's enc_offset and direction), so that a machine parameter changed
- * after it does not put back the uncalibrated 0 / +1. */
-static void esc1_config_kept(esc1_t *s, const ctrl_desc_t *ctrl, fx_angle_t off, int8_t dir)
+/* The default configuration for the machine staged in s->machine, with what
+ * the drive held beyond its machine data (identified, or a settings
+ * record's: the encoder's offset and direction; fw_kept_t), so that a
+ * machine parameter changed after it does not put back the uncalibrated
+ * encoder (0, +1). */
+static void esc1_config_kept(esc1_t *s, const ctrl_desc_t *ctrl, const fw_kept_t *kept)
 {
     esc1_config_default(&s->fc, s->hal.board, &s->machine, ctrl);
-    s->fc.enc_offset = off;
-    s->fc.enc_direction = dir;
+    fw_kept_config(kept, &s->fc);
 }
 
-/* The configuration in force before a reconfiguration, what a refusal puts
- * back ("the previous data stay"): the drive's settings (fw_t.cfg) and the
- * controller's tunables (a "param set wc" before it), not the defaults.
- * Main loop only; static so that the deepest command path's stack (config
- * default -> fw_init) does not grow by it. */
-static struct {
-    fw_config_t cfg;
-    union {
-        max_align_t align;
-        unsigned char bytes[CTRL_CFG_MAX];
-    } ctrl_cfg;
-} esc1_in_force;
+/* What a refusal puts back (fw_in_force_t; static: the stack of the
+ * deepest command path does not grow by it). */
+static fw_in_force_t esc1_in_force;
 
 int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cpr,
                          const fw_config_t *cfg)
@@ -369,13 +360,13 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
     }
     const ctrl_machine_t old = s->fw.machine_own;
     const uint32_t old_cpr = s->encoder_cpr;
-    const fx_angle_t off = s->fw.enc_offset; /* fw_init clears fw_t: kept here */
-    const int8_t dir = s->fw.enc_neg != 0u ? -1 : 1;
-    /* fw_init clears fw_t, so the controller in use is kept here for the
-     * restore (else a refused machine left the firmware without one). */
+    fw_kept_t kept; /* fw_init clears fw_t: read here */
+    fw_kept_read(&s->fw, &kept);
+    /* fw_init clears fw_t, so the controller in use and its settings are
+     * kept here for the restore (else a refused machine left the firmware
+     * without one). */
     const ctrl_desc_t *ctrl = s->fw.ctrl;
-    esc1_in_force.cfg = s->fw.cfg;
-    memcpy(esc1_in_force.ctrl_cfg.bytes, s->fw.ctrl_cfg.bytes, CTRL_CFG_MAX);
+    fw_in_force_read(&s->fw, &esc1_in_force);
     const uint32_t t0 = g4_cycles(); /* the hold's length: the start-up report */
     hal_ctrl_hold(&s->hal, true);
     s->machine = *m;
@@ -385,7 +376,7 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->fc = *cfg;
         s->fc.machine = &s->machine;
     } else {
-        esc1_config_kept(s, ctrl, off, dir);
+        esc1_config_kept(s, ctrl, &kept);
     }
     int rc = fw_init(&s->fw, &s->hal, &s->fc);
     if (rc == FW_OK && g4_hal_set_trip_current(&s->hal, trip) != G4_OK) {
@@ -398,15 +389,9 @@ int esc1_reconfigure_cfg(esc1_t *s, const ctrl_machine_t *m, uint32_t encoder_cp
         s->machine = old;
         s->encoder_cpr = old_cpr;
         s->hal.info.encoder_counts_per_rev = old_cpr;
-        if (ctrl != NULL) { /* as it was, tunables included */
-            s->fc = esc1_in_force.cfg;
-            s->fc.machine = &s->machine;
-            s->fc.ctrl = ctrl;
-            s->fc.ctrl_cfg = esc1_in_force.ctrl_cfg.bytes;
-            s->fc.enc_offset = off;
-            s->fc.enc_direction = dir;
-        } else { /* nothing installed before: the defaults */
-            esc1_config_kept(s, ctrl, off, dir);
+        /* as it was, tunables included; nothing installed before: the defaults */
+        if (!fw_in_force_config(&esc1_in_force, &s->machine, &kept, &s->fc)) {
+            esc1_config_kept(s, ctrl, &kept);
         }
         (void)fw_init(&s->fw, &s->hal, &s->fc);
         (void)g4_hal_set_trip_current(&s->hal, esc1_hw_trip_a(s->hal.board, &old));
